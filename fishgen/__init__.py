@@ -1,0 +1,27 @@
+"""fishgen: procedural fish and cloud assets (VRFish species files, RekAwan cube files).
+
+The public API is imported lazily so that ``import fishgen`` (and the CLI's
+``--help``) does not pay for numpy and trimesh.
+"""
+from __future__ import annotations
+
+import importlib
+
+__version__ = "0.1.0"
+
+_API = {
+    "load_species": "fishgen.species.parser",
+    "Species": "fishgen.species.model",
+    "build_fish": "fishgen.assembly.fish",
+    "FishAsset": "fishgen.assembly.fish",
+    "export": "fishgen.exchange",
+    "FishgenError": "fishgen.errors",
+}
+
+__all__ = sorted(_API)
+
+
+def __getattr__(name: str):
+    if name in _API:
+        return getattr(importlib.import_module(_API[name]), name)
+    raise AttributeError(f"module 'fishgen' has no attribute {name!r}")

@@ -1,0 +1,3 @@
+from fishgen.cli import main
+
+main()

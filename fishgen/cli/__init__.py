@@ -1,0 +1,75 @@
+"""Command-line entry point: a thin, lazily-loaded layer over the library API.
+
+Subcommands live in their own modules and are imported only when invoked, so
+``fishgen --help`` stays instant (no numpy/trimesh import).
+"""
+from __future__ import annotations
+
+import importlib
+import signal
+import sys
+
+import click
+
+# name -> (module, attribute, one-line help shown by `fishgen --help`)
+COMMANDS = {
+    "build": ("fishgen.cli.build", "build", "Build a species file into a textured, fin-animated fish asset."),
+    "clouds": ("fishgen.cli.clouds", "clouds", "Fill cloud cube files (.awn) with particles and export them."),
+    "preview": ("fishgen.cli.preview", "preview", "Render inputs or assets to PNG, contact sheets or swim loops."),
+    "view": ("fishgen.cli.view", "view", "Open an asset in a self-contained three.js viewer page."),
+}
+
+
+class LazyGroup(click.Group):
+    def list_commands(self, ctx):
+        return sorted(COMMANDS)
+
+    def get_command(self, ctx, name):
+        if name not in COMMANDS:
+            return None
+        module, attr, _ = COMMANDS[name]
+        try:
+            return getattr(importlib.import_module(module), attr)
+        except ModuleNotFoundError as err:
+            if err.name == module:
+                return None
+            raise
+
+    def format_commands(self, ctx, formatter):
+        rows = [(name, COMMANDS[name][2]) for name in self.list_commands(ctx)]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="fishgen")
+def cli() -> None:
+    """fishgen: procedural fish and cloud assets for games and pipelines.
+
+    Run `fishgen COMMAND --help` for the options of each command.
+    """
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console-script entry: bad input becomes a one-line error, never a traceback."""
+    from fishgen.errors import FishgenError
+
+    # SIGTERM unwinds like Ctrl-C so atomic writers can remove their temp files.
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    try:
+        cli.main(args=argv, prog_name="fishgen", standalone_mode=False)
+    except FishgenError as err:
+        click.echo(f"fishgen: {err}" if err.file is None else str(err), err=True)
+        sys.exit(2)
+    except click.exceptions.Abort:
+        click.echo("fishgen: interrupted", err=True)
+        sys.exit(130)
+    except click.ClickException as err:
+        err.show()
+        sys.exit(err.exit_code)
+    except KeyboardInterrupt:
+        click.echo("fishgen: interrupted", err=True)
+        sys.exit(130)
+    except OSError as err:
+        click.echo(f"fishgen: {err.filename or ''}: {err.strerror or err}", err=True)
+        sys.exit(1)
