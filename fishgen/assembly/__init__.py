@@ -1,0 +1,1 @@
+"""Assembly: species + geometry -> a scene of parts, materials, textures and animation."""

@@ -1,0 +1,140 @@
+"""Build a game-ready fish from a species: parts in glTF axes and metres, materials,
+textures and the looping ``swim`` clip.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fishgen.assembly.animation import MAX_CLIP_FRAMES, FinMotion, clip_frames
+from fishgen.assembly.materials import (FIN_MODES, Material, default_fin_mode, load_textures,
+                                        make_materials)
+from fishgen.errors import FishgenError
+from fishgen.geometry.body import build_body
+from fishgen.geometry.fins import Fin, caudal_fin, mirrored, pectoral_fin, pelvic_fin, vertical_fin
+from fishgen.geometry.mesh import Mesh
+from fishgen.geometry.shapes import profile_for
+from fishgen.species.model import Species
+
+#: One VRFish world unit in metres (docs/decisions.md): BonyBream's world scale
+#: 25.5 x scaleX 0.26 then gives a 0.33 m body, a typical adult bony bream.
+METRES_PER_WORLD_UNIT = 0.05
+
+#: Thesis axes (x nose->tail, y up, z left) to glTF (+Y up, head towards +Z, left = +X).
+THESIS_TO_GLTF = np.array([[0.0, 0.0, 1.0],
+                           [0.0, 1.0, 0.0],
+                           [-1.0, 0.0, 0.0]])
+
+
+@dataclass(frozen=True)
+class Part:
+    """One node of the fish: a mesh placed at ``translation`` (the pivot for moving fins)."""
+    name: str
+    mesh: Mesh
+    material: str
+    translation: np.ndarray
+    motion: FinMotion | None = None
+
+
+@dataclass(frozen=True)
+class FishAsset:
+    name: str
+    parts: tuple[Part, ...]
+    materials: dict[str, Material]
+    images: dict[str, bytes]
+    fps: float
+    clip_frames: int
+    fin_mode: str
+    species: Species | None = field(default=None, compare=False)
+
+    @property
+    def clip_seconds(self) -> float:
+        return self.clip_frames / self.fps if self.clip_frames else 0.0
+
+    def rest_meshes(self) -> list[tuple[Part, Mesh]]:
+        """Every part's mesh in asset space (rest pose)."""
+        return [(p, Mesh(p.mesh.positions + p.translation, p.mesh.faces, p.mesh.uvs)) for p in self.parts]
+
+    def bounds(self) -> np.ndarray:
+        pts = np.concatenate([m.positions for _, m in self.rest_meshes()])
+        return np.stack([pts.min(axis=0), pts.max(axis=0)])
+
+
+def build_fins(species: Species, rings: np.ndarray) -> list[Fin]:
+    """All fins in scaled thesis space; right-hand paired fins mirror the left ones."""
+    s = np.asarray(species.scale, dtype=np.float64)
+    tp = species.texture_points
+    uv = (lambda name: getattr(tp, name)) if tp is not None else (lambda name: None)
+    fins = [caudal_fin(species.caudal, s, uv("caudal"))]
+    for name, fin, side in (("dorsal", species.dorsal, 1.0), ("adipose", species.adipose, 1.0),
+                            ("anal", species.anal, -1.0)):
+        if fin.present:
+            fins.append(vertical_fin(f"{name}_fin", fin, rings, s, side, uv(name)))
+    for left in (pectoral_fin(species.pectoral, rings, s, uv("pectoral")),
+                 pelvic_fin(species.pelvic, rings, s, uv("pelvic"))):
+        fins += [left, mirrored(left)]
+    return [f for f in fins if len(f.mesh.faces)]
+
+
+def build_fish(species: Species, *, fins: str | None = None, length: float | None = None,
+               fps: float = 30.0) -> FishAsset:
+    """Build the fish of ``species``.
+
+    ``fins``: ``blend``, ``mask`` or ``opaque`` (default: ``mask`` when the file
+    says masked and the fish is textured, else ``blend``). ``length``: nose-to-tail
+    length in metres (default: world scale x scaleX x 0.05 m per world unit for the
+    body). ``fps``: frame rate the fins' step sizes are counted in.
+    """
+    mode = fins or default_fin_mode(species)
+    if mode not in FIN_MODES:
+        raise FishgenError(f"expected a fin mode ({', '.join(FIN_MODES)}), found {mode!r}")
+    if mode == "mask" and not species.textured:
+        raise FishgenError("expected a textured species for --fins mask (the mask is a texture), "
+                           "found textured false", species.source)
+    if not fps > 0 or fps > 1000:
+        raise FishgenError(f"expected --fps in (0, 1000], found {fps}")
+    if length is not None and not (0 < length < 1e4):
+        raise FishgenError(f"expected --length in metres (0 < L < 10000), found {length}")
+
+    tp = species.texture_points
+    body_uv = None
+    if tp is not None:
+        body_uv = np.asarray(tp.body, dtype=np.float64).reshape(
+            species.body_sections, species.circle_sections, 2)
+    body = build_body(profile_for(species.shape_class, species.shape_params), species.body_sections,
+                      species.circle_sections, species.scale, body_uv)
+    fin_list = build_fins(species, body.rings)
+
+    # Scaled thesis space -> glTF axes in metres, centred on the body's middle.
+    nose_to_tail = max(float(body.mesh.positions[:, 0].max()),
+                       *(float(f.mesh.positions[:, 0].max()) for f in fin_list))
+    metres = (length / nose_to_tail) if length is not None else (
+        species.world_scale * METRES_PER_WORLD_UNIT)
+    centre = np.array([0.5 * species.scale[0], 0.0, 0.0])
+
+    def place(points: np.ndarray) -> np.ndarray:
+        return (points - centre) @ THESIS_TO_GLTF.T * metres
+
+    parts = [Part("body", Mesh(place(body.mesh.positions), body.mesh.faces, body.mesh.uvs), "body",
+                  np.zeros(3))]
+    motions = []
+    for fin in fin_list:
+        motion = FinMotion.from_fin(fin.movement_angle, fin.step_size,
+                                    -1.0 if fin.mirror_of else 1.0) if fin.pivot is not None else None
+        if motion is not None:
+            pivot = place(fin.pivot[None, :])[0]
+            motions.append(motion)
+        else:
+            pivot = np.zeros(3)
+        mesh = Mesh(place(fin.mesh.positions) - pivot, fin.mesh.faces, fin.mesh.uvs)
+        parts.append(Part(fin.name, mesh, "fins", pivot, motion))
+
+    frames = clip_frames(motions)
+    if frames > MAX_CLIP_FRAMES:
+        raise FishgenError(f"expected fin cycles that loop within {MAX_CLIP_FRAMES} frames, found "
+                           f"{frames} (periods {sorted({m.period_frames for m in motions})}); "
+                           "choose movement angles and step sizes with a small common multiple",
+                           species.source)
+    return FishAsset(species.name, tuple(parts), make_materials(species, mode),
+                     load_textures(species, mode), float(fps), frames, mode, species)

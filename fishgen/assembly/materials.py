@@ -1,0 +1,81 @@
+"""Materials and textures for the three fin techniques of thesis chapter 5.
+
+``blend``  semi-translucent fins (alphaMode BLEND) with alpha from the file's
+           transparency, 0.5 where it is 1.0 as the thesis' blending did.
+``mask``   the black/white mask cuts the fin shape out of the fin triangles:
+           colour and mask become one RGBA texture, alphaMode MASK -- what the
+           thesis' stencil + alpha test achieved, in one pass.
+``opaque`` plain textured fins.
+"""
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+
+from fishgen.species.model import Species
+
+FIN_MODES = ("blend", "mask", "opaque")
+MASK_CUTOFF = 0.5
+MAX_TEXTURE_SIDE = 8192
+
+
+@dataclass(frozen=True)
+class Material:
+    name: str
+    base_color: tuple[float, float, float, float]
+    texture: str | None = None          # key into FishAsset.images
+    alpha_mode: str = "OPAQUE"
+    alpha_cutoff: float | None = None
+    double_sided: bool = False
+
+
+def fin_alpha(transparency: float) -> float:
+    return 0.5 if transparency >= 1.0 else transparency
+
+
+def default_fin_mode(species: Species) -> str:
+    return "mask" if species.masked and species.textured else "blend"
+
+
+def load_textures(species: Species, mode: str) -> dict[str, bytes]:
+    """PNG bytes of the textures a build needs, turned upright for glTF.
+
+    VRFish stores its textures upside down for OpenGL (thesis chapter 6) while
+    the texture points are measured from the top of the upright picture, so
+    flipping the image back lets the file's (u, v) be used as glTF UVs as they are.
+    """
+    from PIL import Image, ImageOps
+
+    if not species.textured or species.colour_texture is None:
+        return {}
+    with Image.open(species.colour_texture) as img:
+        colour = ImageOps.flip(img.convert("RGB"))
+    if mode == "mask":
+        with Image.open(species.mask_texture) as img:
+            mask = ImageOps.flip(img.convert("L"))
+        if mask.size != colour.size:
+            mask = mask.resize(colour.size, Image.Resampling.NEAREST)
+        colour = colour.convert("RGBA")
+        colour.putalpha(mask)
+    return {"skin": _png(colour)}
+
+
+def _png(image) -> bytes:
+    out = io.BytesIO()
+    image.save(out, format="PNG", optimize=False, compress_level=6)
+    return out.getvalue()
+
+
+def make_materials(species: Species, mode: str) -> dict[str, Material]:
+    textured = species.textured and species.colour_texture is not None
+    colour = (*species.colour, 1.0)
+    tex = "skin" if textured else None
+    body = Material("body", (1.0, 1.0, 1.0, 1.0) if textured else colour, tex)
+    fin_rgb = (1.0, 1.0, 1.0) if textured else species.colour
+    if mode == "blend":
+        fins = Material("fins", (*fin_rgb, fin_alpha(species.transparency)), tex, "BLEND", None, True)
+    elif mode == "mask" and textured:
+        fins = Material("fins", (*fin_rgb, 1.0), tex, "MASK", MASK_CUTOFF, True)
+    else:
+        fins = Material("fins", (*fin_rgb, 1.0), tex, "OPAQUE", None, True)
+    return {"body": body, "fins": fins}

@@ -1,0 +1,1 @@
+"""Pure geometry: body and fin construction over numpy arrays (thesis units)."""

@@ -1,0 +1,102 @@
+"""The body: a profile rotated about the x-axis (thesis 4.1), closed at both ends.
+
+Thesis axes: x from the nose (0) to the tail (1), y up, z to the fish's left.
+Positions are returned already scaled by the species' scaleX/Y/Z.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fishgen.geometry.mesh import Mesh
+from fishgen.geometry.shapes import Profile
+
+CLOSED_EPS = 1e-9
+
+
+@dataclass(frozen=True)
+class Body:
+    rings: np.ndarray        # (BodySections, CircleSections, 3) scaled positions
+    radii: np.ndarray        # (BodySections,) unscaled profile radius
+    mesh: Mesh
+    ring_index: np.ndarray   # (BodySections, CircleSections) vertex index of each ring point
+
+
+def ring_positions(profile: Profile, bodies: int, circles: int, scale) -> tuple[np.ndarray, np.ndarray]:
+    """Ring points: x_j = j/(B-1), r_j = profile(x_j), angle_i = 2 pi i / C."""
+    x = np.arange(bodies, dtype=np.float64) / (bodies - 1)
+    r = np.maximum(profile(x), 0.0)
+    theta = 2.0 * np.pi * np.arange(circles, dtype=np.float64) / circles
+    rings = np.empty((bodies, circles, 3))
+    rings[:, :, 0] = x[:, None]
+    rings[:, :, 1] = r[:, None] * np.sin(theta)[None, :]
+    rings[:, :, 2] = r[:, None] * np.cos(theta)[None, :]
+    return rings * np.asarray(scale, dtype=np.float64), r
+
+
+def build_body(profile: Profile, bodies: int, circles: int, scale,
+               uv: np.ndarray | None = None) -> Body:
+    """Closed, watertight body mesh. ``uv`` is (B, C, 2) texture points or None.
+
+    An end ring of zero radius collapses to one apex vertex; an end ring with a
+    radius gets a flat cap around a centre vertex. Either way the surface closes.
+    """
+    rings, radii = ring_positions(profile, bodies, circles, scale)
+    if uv is None:
+        uv = np.zeros((bodies, circles, 2))
+    open_rings = np.flatnonzero(radii > CLOSED_EPS)
+    if open_rings.size == 0:
+        raise ValueError("the body profile is zero everywhere")
+    first, last = open_rings[0], open_rings[-1]
+    kept = np.arange(first, last + 1)
+    n_ring = kept.size * circles
+
+    ring_index = np.full((bodies, circles), -1, dtype=np.int64)
+    ring_index[kept] = np.arange(n_ring).reshape(kept.size, circles)
+    nose, tail = n_ring, n_ring + 1
+    nose_ring, tail_ring = max(first - 1, 0), min(last + 1, bodies - 1)
+    # A collapsed end ring's points all map to the apex.
+    if first > 0:
+        ring_index[:first] = nose
+    if last < bodies - 1:
+        ring_index[last + 1:] = tail
+
+    positions = np.concatenate([
+        rings[kept].reshape(-1, 3),
+        [[rings[nose_ring, 0, 0], 0.0, 0.0], [rings[tail_ring, 0, 0], 0.0, 0.0]],
+    ])
+    uvs = np.concatenate([uv[kept].reshape(-1, 2), [uv[nose_ring].mean(axis=0)],
+                          [uv[tail_ring].mean(axis=0)]])
+
+    i = np.arange(circles)
+    p = (i + 1) % circles
+    grid = np.arange(n_ring).reshape(kept.size, circles)
+    a, b = grid[:-1][:, i], grid[:-1][:, p]          # ring j: points i and i+1
+    c, d = grid[1:][:, i], grid[1:][:, p]            # ring j+1
+    side = np.concatenate([np.stack([a, d, b], -1).reshape(-1, 3),
+                           np.stack([a, c, d], -1).reshape(-1, 3)])
+    front, back = grid[0], grid[-1]
+    nose_fan = np.stack([np.full(circles, nose), front[i], front[p]], axis=1)
+    tail_fan = np.stack([np.full(circles, tail), back[p], back[i]], axis=1)
+    faces = np.concatenate([side, nose_fan, tail_fan]).astype(np.int64)
+    return Body(rings, radii, Mesh(positions, faces, uvs), ring_index)
+
+
+def midline_point(rings: np.ndarray, section: int, side: float) -> np.ndarray:
+    """Point of the faceted ring ``section`` straight above (side=+1) or below (-1) the axis.
+
+    Fins sit here, on the mesh's own surface rather than on the true curve, so
+    there is no gap between fin and body at any level of detail (thesis 8.2.1).
+    """
+    ring = rings[section]
+    z, y = ring[:, 2], ring[:, 1]
+    z_next, y_next = np.roll(z, -1), np.roll(y, -1)
+    crossing = (z >= 0) & (z_next <= 0) if side > 0 else (z <= 0) & (z_next >= 0)
+    for k in np.flatnonzero(crossing):
+        dz = z[k] - z_next[k]
+        t = 0.0 if dz == 0 else z[k] / dz
+        yk = y[k] + t * (y_next[k] - y[k])
+        if yk * side >= 0:
+            return np.array([ring[0, 0], yk, 0.0])
+    return np.array([ring[0, 0], 0.0, 0.0])

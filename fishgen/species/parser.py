@@ -1,0 +1,395 @@
+"""Parser for VRFish species parameter files (thesis Appendix A).
+
+Lines starting with ``//`` are whole-line comments; records come in a fixed
+order, one record per line. Every fault is a :class:`FishgenError` reading
+``FILE:LINE: expected ..., found ...``.
+"""
+from __future__ import annotations
+
+import math
+import os
+import unicodedata
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterator, Sequence
+
+from fishgen.errors import FishgenError
+from fishgen.species.model import (Behaviour, CaudalFin, PectoralFin, PelvicFin, Species,
+                                   TexturePoints, VerticalFin)
+
+#: Largest level of detail accepted; refused before anything is allocated.
+MAX_SECTIONS = 1024
+MAX_SPECIES_FILE_BYTES = 16 * 1024 * 1024
+
+
+@dataclass(frozen=True)
+class _Line:
+    number: int
+    text: str
+
+    @property
+    def tokens(self) -> list[str]:
+        return self.text.split()
+
+
+class _Reader:
+    """Walks the meaningful (non-comment, non-blank) lines of a species file."""
+
+    def __init__(self, text: str, file: str):
+        self.file = file
+        self.lines = [_Line(n, raw.strip()) for n, raw in enumerate(text.splitlines(), 1)
+                      if raw.strip() and not raw.lstrip().startswith("//")]
+        self.pos = 0
+        self.last_line = text.count("\n") + 1
+
+    def peek(self) -> _Line | None:
+        return self.lines[self.pos] if self.pos < len(self.lines) else None
+
+    def error(self, line: _Line | None, what: str, found: str) -> FishgenError:
+        number = line.number if line else self.last_line
+        return FishgenError(f"expected {what}, found {found}", self.file, number)
+
+    def record(self, what: str, count: int | None = None, at_least: int | None = None) -> _Line:
+        line = self.peek()
+        if line is None:
+            raise self.error(None, what, "end of file (the file is truncated)")
+        self.pos += 1
+        n = len(line.tokens)
+        if (count is not None and n != count) or (at_least is not None and n < at_least):
+            wanted = f"{count}" if count is not None else f"at least {at_least}"
+            raise self.error(line, f"{what} ({wanted} values)", _found_values(line))
+        return line
+
+
+def _hint(token: str) -> str:
+    odd = [c for c in token if ord(c) > 127 or not c.isprintable()]
+    if odd:
+        c = odd[0]
+        name = unicodedata.name(c, "unnamed character")
+        return f" (U+{ord(c):04X} {name}: a misprinted digit?)"
+    if token[:1].isalpha() and len(token) > 1:
+        return " (a wrapped comment line? every comment line must start with //)"
+    return ""
+
+
+def _found_values(line: _Line) -> str:
+    tokens = line.tokens
+    shown = " ".join(tokens)
+    if len(shown) > 48:
+        shown = shown[:47] + "…"
+    non_numeric = next((t for t in tokens if not _is_number(t)), None)
+    hint = _hint(non_numeric) if non_numeric is not None else ""
+    return f"{len(tokens)} value{'s' if len(tokens) != 1 else ''} {shown!r}{hint}"
+
+
+def _is_number(token: str) -> bool:
+    try:
+        return math.isfinite(float(token))
+    except ValueError:
+        return False
+
+
+class _Fields:
+    """Typed access to the tokens of one record, with errors pointing at the line."""
+
+    def __init__(self, reader: _Reader, line: _Line, names: Sequence[str]):
+        self.reader, self.line, self.names = reader, line, names
+        self.tokens = line.tokens
+
+    def _fail(self, i: int, what: str) -> FishgenError:
+        token = self.tokens[i]
+        return self.reader.error(self.line, f"{self.names[i]} as {what}", f"{token!r}{_hint(token)}")
+
+    def number(self, i: int, low: float | None = None, high: float | None = None,
+               open_low: bool = False) -> float:
+        try:
+            value = float(self.tokens[i])
+        except ValueError:
+            raise self._fail(i, "a number") from None
+        if not math.isfinite(value):
+            raise self._fail(i, "a finite number")
+        if (low is not None and (value < low or (open_low and value == low))) or \
+                (high is not None and value > high):
+            lo = "" if low is None else (f"> {low:g}" if open_low else f">= {low:g}")
+            hi = "" if high is None else f"<= {high:g}"
+            raise self._fail(i, "a number " + " and ".join(x for x in (lo, hi) if x))
+        return value
+
+    def whole(self, i: int, low: int = 0, high: int | None = None, what: str = "a whole number") -> int:
+        try:
+            value = float(self.tokens[i])
+        except ValueError:
+            raise self._fail(i, what) from None
+        if not math.isfinite(value) or value != int(value):
+            raise self._fail(i, what)
+        value = int(value)
+        if value < low or (high is not None and value > high):
+            rng = f"{low}..{high}" if high is not None else f">= {low}"
+            raise self._fail(i, f"{what} in {rng}")
+        return value
+
+    def flag(self, i: int) -> bool:
+        token = self.tokens[i].lower()
+        if token not in ("true", "false"):
+            raise self._fail(i, "true or false")
+        return token == "true"
+
+    def vec(self, i: int, n: int) -> tuple[float, ...]:
+        return tuple(self.number(i + k) for k in range(n))
+
+
+# Record names as the thesis' comments give them.
+HEADER = ("name", "world_scale", "urgeFactor", "start x", "start y", "start z", "cube_size")
+SHAPE = ("fishshape_subclass", "BodySections", "CircleSections", "textured", "masked",
+         "turn_T", "catchfish_T")
+CAUDAL = ("top_line", "middle_line", "top_angle", "no_of_top_triangles", "connection x",
+          "connection y", "connection z", "rotation_angle", "bottom_line", "bottom_angle",
+          "no_of_bottom_triangles", "movement_angle", "step_size")
+VERTICAL = ("startBodySection", "endBodySection", "startLength", "endLength",
+            "startangle_in_degrees", "proportion")
+PELVIC = ("startCircleSection", "startBodySection", "endBodySection", "start_length",
+          "end_length", "end_angle", "movement_angle", "step_size")
+PECTORAL = ("startBodySection", "startCircleSection", "no_of_triangles", "startLength",
+            "startAngle", "proportion", "version_t", "movement_angle", "step_size")
+URGES = ("random", "center", "keepaway", "repelDistance", "speed", "changeRate", "direction")
+
+
+def _shape_classes() -> set[str]:
+    from fishgen.geometry.shapes import SHAPES
+    return set(SHAPES)
+
+
+def _vertical(reader: _Reader, label: str, bodies: int) -> VerticalFin:
+    line = reader.record(f"the {label} record `{' '.join(VERTICAL)}`", 6)
+    f = _Fields(reader, line, [f"{label} {n}" for n in VERTICAL])
+    start = f.whole(0, 0, bodies - 1, "a BodySection number")
+    end = f.whole(1, start, bodies - 1, f"a BodySection number (from startBodySection {start})")
+    return VerticalFin(start, end, f.number(2, 0), f.number(3, 0), f.number(4, -180, 180),
+                       f.number(5, 0, 1))
+
+
+def _points(reader: _Reader, label: str, expected: int, why: str) -> tuple[tuple[float, float], ...]:
+    line = reader.record(f"the number of {label} texture points", 1)
+    f = _Fields(reader, line, [f"number of {label} texture points"])
+    count = f.whole(0, 0, None, "a whole number")
+    if count != expected:
+        raise reader.error(line, f"{expected} {label} texture points ({why})", f"{count}")
+    points = []
+    for _ in range(count):
+        pl = reader.record(f"a {label} texture point `u v`", 2)
+        pf = _Fields(reader, pl, ("u", "v"))
+        points.append((pf.number(0), pf.number(1)))
+    return tuple(points)
+
+
+def _body_points(reader: _Reader, bodies: int, circles: int) -> tuple[tuple[float, float], ...]:
+    line = reader.record("the number of body texture points", 1)
+    f = _Fields(reader, line, ["number_of_points_body_points"])
+    count = f.whole(0, 0, None, "a whole number")
+    if count != bodies * circles:
+        raise reader.error(line, f"{bodies * circles} body texture points "
+                           f"(BodySections {bodies} x CircleSections {circles})", f"{count}")
+    points = []
+    for j in range(bodies):
+        for i in range(circles):
+            pl = reader.record(f"body texture point `{j} {i} u v`", 4)
+            pf = _Fields(reader, pl, ("bodySection_no", "circleSection_no", "u", "v"))
+            if pf.whole(0) != j or pf.whole(1) != i:
+                raise reader.error(pl, f"body texture point for section {j}, circle {i}",
+                                   f"section {pl.tokens[0]}, circle {pl.tokens[1]}")
+            points.append((pf.number(2), pf.number(3)))
+    return tuple(points)
+
+
+def parse_species(text: str, file: str | os.PathLike = "<species>",
+                  textures: Callable[[str, _Line], Path] | None = None) -> Species:
+    """Parse species-file text. ``textures`` resolves a texture name (see :func:`load_species`)."""
+    file = os.fspath(file)
+    reader = _Reader(text, file)
+    if reader.peek() is None:
+        raise FishgenError("expected a VRFish species file, found "
+                           + ("an empty file" if not text.strip() else "only comments"), file, 1)
+
+    line = reader.record(f"the header record `{' '.join(HEADER)}`", 7)
+    f = _Fields(reader, line, HEADER)
+    name = line.tokens[0]
+    world_scale = f.number(1, 0, open_low=True)
+    urge = f.number(2)
+    start = f.vec(3, 3)
+    cube = f.number(6)
+
+    line = reader.record("the fish colour record `R G B`", 3)
+    f = _Fields(reader, line, ("red", "green", "blue"))
+    colour = (f.number(0, 0, 1), f.number(1, 0, 1), f.number(2, 0, 1))
+
+    line = reader.record(f"the shape record `{' '.join(SHAPE)}`", at_least=7)
+    f = _Fields(reader, line, SHAPE + tuple(f"shape parameter {k + 1}" for k in range(len(line.tokens))))
+    shape_class = line.tokens[0]
+    known = _shape_classes()
+    if shape_class not in known:
+        raise reader.error(line, "a shape class (one of " + ", ".join(sorted(known)) + ")",
+                           f"{shape_class!r}")
+    bodies = f.whole(1, 3, MAX_SECTIONS, "BodySections")
+    circles = f.whole(2, 3, MAX_SECTIONS, "CircleSections")
+    textured, masked, turn, catch = (f.flag(k) for k in range(3, 7))
+    shape_params = tuple(f.number(k) for k in range(7, len(line.tokens)))
+    from fishgen.geometry.shapes import check_shape_params
+    problem = check_shape_params(shape_class, shape_params)
+    if problem:
+        raise reader.error(line, problem, f"{len(shape_params)} extra values")
+
+    line = reader.record("the body scale record `scaleX scaleY scaleZ`", 3)
+    f = _Fields(reader, line, ("scaleX", "scaleY", "scaleZ"))
+    scale = tuple(f.number(k, 0, open_low=True) for k in range(3))
+
+    line = reader.record("the caudal fin record (13 values)", 13)
+    f = _Fields(reader, line, [f"caudal {n}" for n in CAUDAL])
+    caudal = CaudalFin(
+        top_line=f.number(0, 0), middle_line=f.number(1, 0), top_angle=f.number(2, -180, 180),
+        top_triangles=f.whole(3, 1, 256, "a number of triangles"),
+        connection=(f.number(4, 0, 1), f.number(5), f.number(6)), rotation_angle=f.number(7, -180, 180),
+        bottom_line=f.number(8, 0), bottom_angle=f.number(9, -180, 180),
+        bottom_triangles=f.whole(10, 1, 256, "a number of triangles"),
+        movement_angle=f.number(11, 0, 90), step_size=f.number(12, 0))
+    _check_motion(reader, line, f, 11, 12)
+
+    adipose = _vertical(reader, "adipose fin", bodies)
+    dorsal = _vertical(reader, "dorsal fin", bodies)
+
+    line = reader.record(f"the pelvic fin record `{' '.join(PELVIC)}`", 8)
+    f = _Fields(reader, line, [f"pelvic {n}" for n in PELVIC])
+    p_circle = f.whole(0, 0, circles - 1, "a CircleSection number")
+    p_start = f.whole(1, 0, bodies - 1, "a BodySection number")
+    p_end = f.whole(2, p_start, bodies - 1, f"a BodySection number (from startBodySection {p_start})")
+    pelvic = PelvicFin(p_circle, p_start, p_end, f.number(3, 0), f.number(4, 0), f.number(5, -180, 180),
+                       f.number(6, 0, 90), f.number(7, 0))
+    _check_motion(reader, line, f, 6, 7)
+
+    anal = _vertical(reader, "anal fin", bodies)
+
+    line = reader.record(f"the pectoral fin record `{' '.join(PECTORAL)}`", 9)
+    f = _Fields(reader, line, [f"pectoral {n}" for n in PECTORAL])
+    pectoral = PectoralFin(
+        start_section=f.whole(0, 0, bodies - 1, "a BodySection number"),
+        start_circle=f.whole(1, 0, circles - 1, "a CircleSection number"),
+        triangles=f.whole(2, 1, circles - 1, "a number of triangles (each spans one CircleSection)"),
+        start_length=f.number(3, 0), start_angle=f.number(4, -180, 180), proportion=f.number(5, 0, 1),
+        version=f.number(6), movement_angle=f.number(7, 0, 90), step_size=f.number(8, 0))
+    _check_motion(reader, line, f, 7, 8)
+
+    colour_tex = mask_tex = None
+    points = None
+    transparency = 1.0
+    nxt = reader.peek()
+    has_texture_block = textured or (nxt is not None and len(nxt.tokens) == 2 and not _is_number(nxt.tokens[0]))
+    if has_texture_block:
+        line = reader.record("the texture record `texture_file black_and_white_file`", 2)
+        if textured and textures is not None:
+            colour_tex = textures(line.tokens[0], line)
+            mask_tex = textures(line.tokens[1], line)
+        body = _body_points(reader, bodies, circles)
+        caudal_pts = _points(reader, "caudal fin", caudal.texture_point_count,
+                             f"1 + (top triangles {caudal.top_triangles} + 1) + "
+                             f"(bottom triangles {caudal.bottom_triangles} + 1)")
+        line = reader.record("the fin transparency", 1)
+        transparency = _Fields(reader, line, ("transparency_t",)).number(0, 0, 1)
+        span = "2 x (endBodySection {e} - startBodySection {s} + 1)"
+        dorsal_pts = _points(reader, "dorsal fin", dorsal.texture_point_count,
+                             span.format(e=dorsal.end_section, s=dorsal.start_section))
+        adipose_pts = _points(reader, "adipose fin", adipose.texture_point_count,
+                              span.format(e=adipose.end_section, s=adipose.start_section))
+        anal_pts = _points(reader, "anal fin", anal.texture_point_count,
+                           span.format(e=anal.end_section, s=anal.start_section))
+        pectoral_pts = _points(reader, "pectoral fin", pectoral.texture_point_count,
+                               f"2 x triangles {pectoral.triangles} + 1")
+        pelvic_pts = _points(reader, "pelvic fin", pelvic.texture_point_count,
+                             span.format(e=pelvic.end_section, s=pelvic.start_section))
+        points = TexturePoints(body, caudal_pts, dorsal_pts, adipose_pts, anal_pts, pectoral_pts,
+                               pelvic_pts)
+        if not textured:
+            points = None
+
+    line = reader.record("the initial velocity record `vx vy vz`", 3)
+    velocity = _Fields(reader, line, ("vx", "vy", "vz")).vec(0, 3)
+    line = reader.record(f"the urge weightings record `{' '.join(URGES)}`", 7)
+    urges = _Fields(reader, line, URGES).vec(0, 7)
+    line = reader.record("the flee record (2 values)", 2)
+    flee = _Fields(reader, line, ("flee 1", "flee 2")).vec(0, 2)
+    extra = reader.peek()
+    if extra is not None:
+        raise reader.error(extra, "end of file after the flee record", _found_values(extra))
+
+    return Species(
+        name=name, world_scale=world_scale, urge_factor=urge, start_position=start, cube_size=cube,
+        colour=colour, shape_class=shape_class, shape_params=shape_params, body_sections=bodies,
+        circle_sections=circles, textured=textured, masked=masked, turn_test=turn,
+        catchfish_test=catch, scale=scale, caudal=caudal, adipose=adipose, dorsal=dorsal,
+        pelvic=pelvic, anal=anal, pectoral=pectoral, transparency=transparency,
+        colour_texture=colour_tex, mask_texture=mask_tex, texture_points=points,
+        behaviour=Behaviour(velocity, *urges, flee=flee), source=Path(file))
+
+
+def _check_motion(reader: _Reader, line: _Line, f: _Fields, angle: int, step: int) -> None:
+    if float(f.tokens[angle]) > 0 and float(f.tokens[step]) <= 0:
+        raise f._fail(step, "a step size > 0 (the fin has a movement angle)")
+
+
+def texture_roots(species_path: Path, textures_dir: str | os.PathLike | None) -> list[Path]:
+    """Folders a species file may read textures from: ``--textures DIR``, or else the
+    species file's folder and the ``textures/`` folder beside it."""
+    if textures_dir is not None:
+        return [Path(textures_dir).resolve()]
+    here = species_path.resolve().parent
+    return [here, (here.parent / "textures").resolve()]
+
+
+def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> Path:
+    """Resolve a texture name inside one of ``roots``; never outside them."""
+    shown = " or ".join(str(r) for r in roots)
+    escaped = False
+    for root in roots:
+        candidate = (root / name).resolve()
+        if not candidate.is_relative_to(root):
+            escaped = True
+            continue
+        if candidate.is_file():
+            return candidate
+    if escaped or os.path.isabs(name):
+        raise FishgenError(f"expected a texture path inside {shown}, found {name!r} "
+                           "(texture paths may not leave the texture folder; use --textures DIR)",
+                           file, line)
+    raise FishgenError(f"expected an existing texture file, found {name!r} missing from {shown}",
+                       file, line)
+
+
+def load_species(path: str | os.PathLike, textures_dir: str | os.PathLike | None = None) -> Species:
+    """Read and check a species file; texture files are resolved and must exist."""
+    path = Path(path)
+    file = os.fspath(path)
+    try:
+        size = path.stat().st_size
+        if size > MAX_SPECIES_FILE_BYTES:
+            raise FishgenError(f"expected a species file of at most {MAX_SPECIES_FILE_BYTES} bytes, "
+                               f"found {size} bytes", file, 1)
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise FishgenError("expected a species file, found no such file", file) from None
+    except IsADirectoryError:
+        raise FishgenError("expected a species file, found a directory", file) from None
+    if b"\0" in data:
+        raise FishgenError("expected a text species file, found binary data", file,
+                           data[: data.index(b"\0")].count(b"\n") + 1)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise FishgenError("expected a UTF-8 text species file, found binary data", file,
+                           data[: err.start].count(b"\n") + 1) from None
+    roots = texture_roots(path, textures_dir)
+    return parse_species(text, file,
+                         lambda name, line: resolve_texture(name, roots, file, line.number))
+
+
+def iter_records(text: str) -> Iterator[tuple[int, str]]:
+    """(line number, text) of every meaningful line: a helper for tools and tests."""
+    for line in _Reader(text, "<text>").lines:
+        yield line.number, line.text
