@@ -23,6 +23,9 @@ _INTEGER = re.compile(r"[+-]?[0-9]+")
 _REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _CONTROL = re.compile(rb"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
 
+_FLOAT32_MAX = 3.4028234663852886e38
+_FLOAT32_TINY = 1.1754943508222875e-38
+
 CUBE_FIELDS = ("particle count", "x size", "y size", "z size",
                "centre x", "centre y", "centre z", "maximum radius")
 
@@ -136,6 +139,10 @@ def _real(token: str, what: str, name: str, number: int, positive: bool) -> floa
         raise expected(f"a finite number for the {what}", describe(token), name, number)
     if positive and value <= 0:
         raise expected(f"a {what} greater than 0", describe(token), name, number)
+    # Particles are stored as float32: values it cannot hold would turn into 0 or infinity.
+    if abs(value) > _FLOAT32_MAX or (positive and value < _FLOAT32_TINY):
+        raise expected(f"a {what} within float32 range ({_FLOAT32_TINY:.3g} to {_FLOAT32_MAX:.3g})",
+                       describe(token), name, number)
     return value
 
 
