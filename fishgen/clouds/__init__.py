@@ -6,10 +6,10 @@
 
 Several files make one scene with ``merge_clouds([fill_cloud(a, offset=...), ...])``.
 """
-from fishgen.clouds.export import FORMATS, export_cloud
+from fishgen.clouds.export import FORMATS, check_output, export_cloud
 from fishgen.clouds.fill import METHODS, fill_cloud, merge_clouds
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, Cloud, Cube, CubeFile
 from fishgen.clouds.parser import CubeFileWarning, load_cubes, parse_cubes
 
 __all__ = ["Cloud", "Cube", "CubeFile", "CubeFileWarning", "DEFAULT_MAX_PARTICLES", "FORMATS",
-           "METHODS", "export_cloud", "fill_cloud", "load_cubes", "merge_clouds", "parse_cubes"]
+           "METHODS", "check_output", "export_cloud", "fill_cloud", "load_cubes", "merge_clouds", "parse_cubes"]

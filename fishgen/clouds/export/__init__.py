@@ -10,8 +10,8 @@ from fishgen.errors import FishgenError
 FORMATS = (".ply", ".glb", ".gltf", ".csv", ".npy")
 
 
-def export_cloud(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = False) -> None:
-    """Write ``cloud`` to ``path`` (.ply, .glb, .gltf, .csv or .npy), atomically."""
+def check_output(path: str | os.PathLike, billboards: bool = False) -> str:
+    """Return the output's format suffix, or raise FishgenError before any work is done."""
     suffix = Path(path).suffix.lower()
     if suffix not in FORMATS:
         raise FishgenError(f"expected an output ending in {', '.join(FORMATS)}, "
@@ -19,6 +19,12 @@ def export_cloud(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = Fa
     if billboards and suffix not in (".glb", ".gltf"):
         raise FishgenError(f"expected a .glb or .gltf output with --billboards, found {suffix!r}",
                            path)
+    return suffix
+
+
+def export_cloud(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = False) -> None:
+    """Write ``cloud`` to ``path`` (.ply, .glb, .gltf, .csv or .npy), atomically."""
+    suffix = check_output(path, billboards)
     if suffix == ".ply":
         from fishgen.clouds.export.ply import write_ply
         write_ply(cloud, path)
