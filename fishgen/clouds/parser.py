@@ -97,13 +97,15 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
 
 
 def _decode(data: bytes, name: str) -> str:
+    """Text as UTF-8 (ASCII in practice); any control byte or invalid sequence means binary."""
     bad = _CONTROL.search(data)
-    position = bad.start() if bad else None
+    try:
+        text = data.decode("utf-8-sig")
+        position = bad.start() if bad else None
+    except UnicodeDecodeError as err:
+        position = min(err.start, bad.start()) if bad else err.start
     if position is None:
-        try:
-            return data.decode("utf-8-sig")
-        except UnicodeDecodeError as err:
-            position = err.start
+        return text
     line = data[:position].count(b"\n") + 1
     raise expected("a text cube file", "binary data", name, line)
 

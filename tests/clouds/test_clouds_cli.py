@@ -1,0 +1,135 @@
+"""`fishgen clouds` as a user runs it: real subprocesses, exit codes, stderr, files."""
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import trimesh
+
+from cloud_tables import TABLES, TOTALS
+
+
+def assert_one_line_error(result, startswith):
+    assert result.returncode != 0
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(startswith), result.stderr
+
+
+def test_the_three_tables_to_ply_and_glb(cli, tmp_path, gltf_validator):
+    for table, total in TOTALS.items():
+        ply, glb = tmp_path / f"{table}.ply", tmp_path / f"{table}.glb"
+        result = cli("clouds", TABLES[table], "-o", ply)
+        assert result.returncode == 0 and result.stderr == "", result.stderr
+        assert f"{total:,} particles" in result.stdout
+        assert len(trimesh.load(ply).vertices) == total
+        assert cli("clouds", TABLES[table], "-o", glb, "--billboards").returncode == 0
+        gltf_validator(glb)
+
+
+def test_scene_of_several_files_with_offsets(cli, tmp_path):
+    out = tmp_path / "sky.npy"
+    result = cli("clouds", TABLES["4.3"], TABLES["4.4"], "--offset", "0,0,0",
+                 "--offset", "-30, 4.5, 1e1", "-o", out, "--seed", "3", "--method", "uniform")
+    assert result.returncode == 0, result.stderr
+    data = np.load(out)
+    assert len(data) == 554 + 615 and data["cube"].max() == 17 + 23 - 1
+    second = data[data["cube"] >= 17]
+    assert second["x"].max() < -20 and second["z"].min() > 5  # moved by the offset
+
+
+def test_same_seed_same_bytes_through_the_cli(cli, tmp_path):
+    for name, seed in (("a.ply", "5"), ("b.ply", "5"), ("c.ply", "6")):
+        assert cli("clouds", TABLES["4.4"], "-o", tmp_path / name, "--seed", seed).returncode == 0
+    a, b, c = ((tmp_path / n).read_bytes() for n in ("a.ply", "b.ply", "c.ply"))
+    assert a == b != c
+
+
+BAD = {
+    "cube count": ("3\n2\n1, 1, 1, 1, 0, 0, 0, 1\n", 4),
+    "fields": ("1\n1\n1, 1, 1, 1, 0, 0, 1\n", 3),
+    "non-number": ("1\n1\n1, 1, 1, x, 0, 0, 0, 1\n", 3),
+    "NaN": ("1\n1\n1, 1, 1, 1, 0, NaN, 0, 1\n", 3),
+    "radius": ("1\n1\n1, 1, 1, 1, 0, 0, 0, 0\n", 3),
+    "empty": ("", 1),
+    "binary": (b"\x00\x01\x02\x03", 1),
+}
+
+
+@pytest.mark.parametrize("fault", sorted(BAD))
+def test_bad_file_one_line_no_traceback_no_output(cli, write_awn, tmp_path, fault):
+    text, line = BAD[fault]
+    path = write_awn(text)
+    out = tmp_path / "out.glb"
+    result = cli("clouds", path, "-o", out)
+    assert result.returncode == 2
+    assert_one_line_error(result, f"{path}:{line}: expected ")
+    assert not out.exists()
+
+
+def test_failing_run_does_not_clobber_existing_output(cli, write_awn, tmp_path):
+    out = tmp_path / "cloud.ply"
+    assert cli("clouds", TABLES["4.3"], "-o", out).returncode == 0
+    before = out.read_bytes()
+    result = cli("clouds", write_awn("1\n1\n1, 1, 1, 1, 0, 0, 0, -1\n"), "-o", out)
+    assert_one_line_error(result, str(tmp_path))
+    assert out.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cloud.ply", "cubes.awn"]
+
+
+def test_limit_is_refused_at_once_naming_the_limit_and_the_option(cli, write_awn, tmp_path):
+    huge = write_awn("1000000000000\n1\n1000000000000, 1, 1, 1, 0, 0, 0, 1\n")
+    result = cli("clouds", huge, "-o", tmp_path / "x.ply")
+    assert_one_line_error(result, f"{huge}:1: expected at most 50,000,000 particles")
+    assert "--max-particles" in result.stderr
+    small = cli("clouds", TABLES["4.3"], TABLES["4.4"], "--max-particles", "1000", "-o", tmp_path / "y.ply")
+    assert_one_line_error(small, "fishgen: expected at most 1,000 particles in the scene")
+    assert "--max-particles" in small.stderr and "found 1,169" in small.stderr
+    assert not (tmp_path / "x.ply").exists() and not (tmp_path / "y.ply").exists()
+
+
+def test_total_mismatch_is_a_warning_on_stderr(cli, write_awn, tmp_path):
+    path = write_awn("99\n1\n5, 1, 1, 1, 0, 0, 0, 1\n")
+    result = cli("clouds", path, "-o", tmp_path / "c.csv")
+    assert result.returncode == 0
+    assert result.stderr.strip() == (f"{path}:1: warning: declared total 99 particles, "
+                                     "but the cubes hold 5; using the cubes' counts")
+    assert len((tmp_path / "c.csv").read_text().splitlines()) == 1 + 5
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--offset", "1,2"], "fishgen: expected --offset X,Y,Z with three finite numbers, found '1,2'"),
+    (["--offset", "0,0,0", "--offset", "1,1,1"], "fishgen: expected one --offset per input (1), found 2"),
+    (["--seed", "-4"], "fishgen: expected a --seed of 0 or more"),
+    (["--billboards"], "out.ply: expected a .glb or .gltf output with --billboards"),
+])
+def test_bad_options_are_one_line_errors(cli, tmp_path, args, message):
+    result = cli("clouds", TABLES["4.3"], "-o", tmp_path / "out.ply", *args)
+    assert_one_line_error(result, message if message.startswith("fishgen") else str(tmp_path))
+    assert message in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unknown_output_extension(cli, tmp_path):
+    result = cli("clouds", TABLES["4.3"], "-o", tmp_path / "cloud.obj")
+    assert_one_line_error(result, f"{tmp_path / 'cloud.obj'}: expected an output ending in .ply")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_help_documents_every_option_with_its_default(cli):
+    result = cli("clouds", "--help")
+    assert result.returncode == 0
+    text = " ".join(result.stdout.split())
+    for option, default in (("--output", "[required]"), ("--offset", "[default: 0,0,0"),
+                            ("--seed", "[default: 0]"), ("--method", "[default: paper]"),
+                            ("--billboards", "[default: off"),
+                            ("--max-particles", "[default: 50000000]")):
+        assert option in text and default in text, option
+
+
+def test_command_module_does_not_import_numpy():
+    code = "import sys, fishgen.cli.clouds; print('numpy' in sys.modules)"
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=True).stdout.strip() == "False"

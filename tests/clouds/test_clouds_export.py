@@ -1,0 +1,177 @@
+"""Every export format round-trips; glTF passes the Khronos validator; writes are atomic."""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import struct
+
+import numpy as np
+import pytest
+import trimesh
+from PIL import Image
+
+from fishgen.clouds import export_cloud, fill_cloud, load_cubes
+from fishgen.clouds.export import gltf, records
+from fishgen.errors import FishgenError
+
+from cloud_tables import TABLES
+
+
+@pytest.fixture(scope="module")
+def cloud():
+    return fill_cloud(load_cubes(TABLES["4.4"]), seed=21)
+
+
+def glb_parts(path):
+    data = path.read_bytes()
+    magic, version, length = struct.unpack_from("<4sII", data)
+    assert (magic, version, length) == (b"glTF", 2, len(data))
+    json_len, kind = struct.unpack_from("<I4s", data, 12)
+    assert kind == b"JSON"
+    doc = json.loads(data[20:20 + json_len])
+    bin_len, kind = struct.unpack_from("<I4s", data, 20 + json_len)
+    assert kind == b"BIN\0"
+    return doc, data[28 + json_len:28 + json_len + bin_len]
+
+
+def accessor_array(doc, blob, index, dtype, width):
+    acc = doc["accessors"][index]
+    view = doc["bufferViews"][acc["bufferView"]]
+    stride = view.get("byteStride", np.dtype(dtype).itemsize * width)
+    raw = np.frombuffer(blob, np.uint8, acc["count"] * stride, view["byteOffset"])
+    rows = raw.reshape(acc["count"], stride)[:, :np.dtype(dtype).itemsize * width]
+    return rows.copy().view(dtype).reshape(acc["count"], width)
+
+
+def test_ply_loads_in_trimesh_and_plyfile(cloud, tmp_path):
+    path = tmp_path / "cloud.ply"
+    export_cloud(cloud, path)
+    assert path.read_bytes().startswith(b"ply\nformat binary_little_endian 1.0\n")
+    points = trimesh.load(path)
+    np.testing.assert_array_equal(np.asarray(points.vertices, np.float32), cloud.centers)
+    np.testing.assert_array_equal(np.asarray(points.colors)[:, :3], cloud.colors)
+    plyfile = pytest.importorskip("plyfile")
+    vertex = plyfile.PlyData.read(str(path))["vertex"].data
+    assert vertex.dtype.names == ("x", "y", "z", "radius", "density", "red", "green", "blue")
+    np.testing.assert_array_equal(vertex["radius"], cloud.radii)
+    np.testing.assert_array_equal(vertex["density"], cloud.density)
+    np.testing.assert_array_equal(vertex["green"], cloud.colors[:, 1])
+
+
+def test_glb_points(cloud, tmp_path, gltf_validator):
+    path = tmp_path / "cloud.glb"
+    export_cloud(cloud, path)
+    gltf_validator(path)
+    doc, blob = glb_parts(path)
+    prim = doc["meshes"][0]["primitives"][0]
+    assert prim["mode"] == 0 and set(prim["attributes"]) == {"POSITION", "COLOR_0", "_RADIUS", "_DENSITY"}
+    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["POSITION"], "<f4", 3), cloud.centers)
+    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["COLOR_0"], "u1", 3), cloud.colors)
+    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_RADIUS"], "<f4", 1)[:, 0], cloud.radii)
+    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_DENSITY"], "<f4", 1)[:, 0], cloud.density)
+    pygltflib = pytest.importorskip("pygltflib")
+    gltf = pygltflib.GLTF2().load(str(path))
+    assert gltf.accessors[gltf.meshes[0].primitives[0].attributes.POSITION].count == len(cloud)
+    scene = trimesh.load(path)
+    (geometry,) = scene.geometry.values()
+    assert isinstance(geometry, trimesh.PointCloud) and len(geometry.vertices) == len(cloud)
+
+
+def test_glb_billboards(cloud, tmp_path, gltf_validator):
+    path = tmp_path / "billboards.glb"
+    export_cloud(cloud, path, billboards=True)
+    gltf_validator(path)
+    doc, blob = glb_parts(path)
+    material = doc["materials"][0]
+    assert material["alphaMode"] == "BLEND" and "KHR_materials_unlit" in doc["extensionsUsed"]
+    prim = doc["meshes"][0]["primitives"][0]
+    corners = accessor_array(doc, blob, prim["attributes"]["POSITION"], "<f4", 3).reshape(-1, 4, 3)
+    np.testing.assert_allclose(corners.mean(axis=1), cloud.centers, atol=1e-5)
+    np.testing.assert_allclose(corners[:, 2, 0] - corners[:, 0, 0], 2 * cloud.radii, rtol=1e-5)
+    np.testing.assert_array_equal(corners[:, :, 2], np.repeat(cloud.centers[:, 2:], 4, axis=1))
+    image = doc["images"][0]
+    view = doc["bufferViews"][image["bufferView"]]
+    sprite = Image.open(io.BytesIO(blob[view["byteOffset"]:view["byteOffset"] + view["byteLength"]]))
+    alpha = np.asarray(sprite.convert("RGBA"))[..., 3]
+    assert alpha[sprite.height // 2, sprite.width // 2] > 240 and alpha[0, 0] == 0
+    mesh = trimesh.load(path, force="mesh")
+    assert len(mesh.faces) == 2 * len(cloud)
+
+
+@pytest.mark.parametrize("billboards", [False, True])
+def test_gltf_with_bin(cloud, tmp_path, gltf_validator, billboards):
+    path = tmp_path / "cloud.gltf"
+    export_cloud(cloud, path, billboards=billboards)
+    gltf_validator(path)
+    doc = json.loads(path.read_text())
+    assert doc["buffers"][0]["uri"] == "cloud.bin"
+    assert (tmp_path / "cloud.bin").stat().st_size == doc["buffers"][0]["byteLength"]
+
+
+def test_csv_round_trip(cloud, tmp_path):
+    path = tmp_path / "cloud.csv"
+    export_cloud(cloud, path)
+    rows = list(csv.DictReader(path.open()))
+    assert list(rows[0]) == ["x", "y", "z", "radius", "density", "red", "green", "blue", "cube"]
+    assert len(rows) == len(cloud)
+    got = np.array([[float(r[k]) for k in ("x", "y", "z")] for r in rows], np.float32)
+    np.testing.assert_array_equal(got, cloud.centers)  # %.9g round-trips float32 exactly
+    np.testing.assert_array_equal(np.array([float(r["radius"]) for r in rows], np.float32), cloud.radii)
+    assert [int(r["cube"]) for r in rows] == cloud.cube_index.tolist()
+
+
+def test_npy_round_trip(cloud, tmp_path):
+    path = tmp_path / "cloud.npy"
+    export_cloud(cloud, path)
+    data = np.load(path)
+    assert data.shape == (len(cloud),)
+    np.testing.assert_array_equal(np.stack([data["x"], data["y"], data["z"]], 1), cloud.centers)
+    np.testing.assert_array_equal(data["density"], cloud.density)
+    np.testing.assert_array_equal(np.stack([data["red"], data["green"], data["blue"]], 1), cloud.colors)
+    np.testing.assert_array_equal(data["cube"], cloud.cube_index)
+
+
+@pytest.mark.parametrize("name", ["a.ply", "a.glb", "a.gltf", "a.csv", "a.npy"])
+def test_same_seed_byte_identical_files(tmp_path, name):
+    cubes = load_cubes(TABLES["4.3"])
+    for run, seed in (("1", 8), ("2", 8), ("3", 9)):
+        export_cloud(fill_cloud(cubes, seed=seed), tmp_path / run / name)
+    one, two, other = ((tmp_path / run / name).read_bytes() for run in "123")
+    assert one == two and one != other
+
+
+def test_failed_export_leaves_no_file_and_keeps_the_old_one(cloud, tmp_path, monkeypatch):
+    old = tmp_path / "keep.ply"
+    old.write_bytes(b"previous good output")
+
+    def broken(*args, **kwargs):
+        yield from ()
+        raise OSError("disk full")
+
+    monkeypatch.setattr("fishgen.clouds.export.ply.record_chunks", broken)
+    for target in (old, tmp_path / "new.ply"):
+        with pytest.raises(OSError):
+            export_cloud(cloud, target)
+    assert old.read_bytes() == b"previous good output"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.ply"]
+
+
+@pytest.mark.parametrize("name,billboards", [("a.ply", False), ("a.npy", False), ("a.csv", False),
+                                             ("a.glb", False), ("b.glb", True)])
+def test_streaming_in_small_blocks_gives_the_same_bytes(cloud, tmp_path, monkeypatch, name, billboards):
+    whole = tmp_path / "whole" / name
+    export_cloud(cloud, whole, billboards=billboards)
+    monkeypatch.setattr(records, "ROWS", 64)   # 615 particles -> 10 blocks
+    monkeypatch.setattr(gltf, "ROWS", 64)
+    blocks = tmp_path / "blocks" / name
+    export_cloud(cloud, blocks, billboards=billboards)
+    assert whole.read_bytes() == blocks.read_bytes()
+
+
+def test_unknown_extension_and_billboards_outside_gltf(cloud, tmp_path):
+    with pytest.raises(FishgenError, match=r"expected an output ending in .ply, .glb, .gltf, .csv, .npy, found '.obj'"):
+        export_cloud(cloud, tmp_path / "cloud.obj")
+    with pytest.raises(FishgenError, match="with --billboards"):
+        export_cloud(cloud, tmp_path / "cloud.ply", billboards=True)
+    assert list(tmp_path.iterdir()) == []
