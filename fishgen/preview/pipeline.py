@@ -1,0 +1,200 @@
+"""From inputs and options to finished images: stills, contact sheets and loops.
+
+The CLI is a thin layer over ``preview`` here; tests and docs/make_renders.py
+call it too.
+"""
+from __future__ import annotations
+
+import io
+import math
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Sequence
+
+import numpy as np
+
+from fishgen.errors import FishgenError
+from fishgen.preview.camera import VIEWS, frame, turned
+from fishgen.preview.scene import Scene
+
+OUTPUTS = (".png", ".webp", ".gif", ".jpg", ".jpeg")
+ANIMATED = (".gif", ".webp")
+DEFAULT_LOOP_FRAMES = 36
+TURNTABLE_SECONDS = 6.0
+"""One turn of a static asset's turntable loop."""
+MAX_PIXELS = 8192
+
+
+@dataclass
+class PreviewOptions:
+    view: str = "three-quarter"
+    width: int = 800
+    height: int = 600
+    time: float | None = None          # seconds into the clip; None is the rest pose
+    background: tuple[int, int, int, int] = (140, 173, 204, 255)  # sRGB 0-255, a=0 transparent
+    frames: int | None = None
+    columns: int | None = None
+    clip: str | None = None
+    seed: int = 0
+    textures_dir: str | None = None
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``"800x600"`` -> (800, 600)."""
+    m = re.fullmatch(r"\s*(\d+)\s*[xX×]\s*(\d+)\s*", text)
+    if not m or not (16 <= int(m[1]) <= MAX_PIXELS and 16 <= int(m[2]) <= MAX_PIXELS):
+        raise FishgenError(f"expected --size WxH with 16 to {MAX_PIXELS} pixels a side, found {text!r}")
+    return int(m[1]), int(m[2])
+
+
+def parse_background(text: str) -> tuple[int, int, int, int]:
+    """A CSS colour (``#8cadcc``, ``#rrggbbaa``, ``white``) or ``transparent``."""
+    from PIL import ImageColor
+
+    if text.strip().lower() in ("transparent", "none"):
+        return (0, 0, 0, 0)
+    try:
+        rgba = ImageColor.getcolor(text.strip(), "RGBA")
+    except ValueError:
+        raise FishgenError(f"expected --background as a colour (#8cadcc, white) or transparent, "
+                           f"found {text!r}") from None
+    return tuple(int(v) for v in rgba)
+
+
+def check_output(out: Path, options: PreviewOptions) -> int:
+    """Validate the output name against the options; returns the number of frames to render."""
+    ext = out.suffix.lower()
+    if ext not in OUTPUTS:
+        raise FishgenError(f"expected an output ending in {', '.join(OUTPUTS)}, found {out.name!r}")
+    frames = options.frames
+    if frames is not None and not 1 <= frames <= 1000:
+        raise FishgenError(f"expected --frames from 1 to 1000, found {frames}")
+    if frames is None:
+        frames = DEFAULT_LOOP_FRAMES if ext == ".gif" else 1
+    if frames > 1 and ext not in ANIMATED:
+        raise FishgenError(f"expected a .gif or .webp output for --frames {frames}, found {out.name!r}")
+    if options.view not in VIEWS:
+        raise FishgenError(f"expected --view {'|'.join(VIEWS)}, found {options.view!r}")
+    if ext in (".gif", ".jpg", ".jpeg") and options.background[3] < 255:
+        raise FishgenError(f"expected an opaque --background for {ext} (it has no alpha channel), "
+                           "found transparent")
+    return frames
+
+
+def subject_points(scene: Scene, times: Sequence[float | None], clip: str | None) -> np.ndarray:
+    """Every vertex (and particle extent) the camera must keep in frame, at each of ``times``."""
+    out = []
+    for t in times:
+        world = scene.world_matrices(t, clip)
+        for m in scene.meshes:
+            mat = world[m.node] if m.node is not None else np.eye(4)
+            out.append(m.positions @ mat[:3, :3].T + mat[:3, 3])
+        for p in scene.points:
+            mat = world[p.node] if p.node is not None else np.eye(4)
+            c = p.positions @ mat[:3, :3].T + mat[:3, 3]
+            r = p.radii[:, None] * float(np.cbrt(abs(np.linalg.det(mat[:3, :3]))) or 1.0)
+            out += [c - r, c + r]
+    return np.concatenate(out) if out else np.zeros((1, 3))
+
+
+def _frame_plan(scene: Scene, options: PreviewOptions, frames: int):
+    """(times, azimuths, seconds per frame) for one scene."""
+    clip = scene.clip(options.clip)
+    start = options.time or 0.0
+    if frames == 1:
+        return [options.time], [0.0], 0.0
+    if clip is not None and clip.duration > 0:
+        step = clip.duration / frames
+        return [(start + k * step) % clip.duration for k in range(frames)], [0.0] * frames, step
+    return ([options.time] * frames, [2 * math.pi * k / frames for k in range(frames)],
+            TURNTABLE_SECONDS / frames)
+
+
+def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
+                  progress: Callable[[int], None] | None = None):
+    """Render each scene's frames; returns (frames[scene][k] as PIL images, seconds per frame)."""
+    from PIL import Image
+
+    from fishgen.preview.render import Renderer
+
+    for scene in scenes:
+        if options.clip is not None and scene.animations and scene.clip(options.clip) is None:
+            names = ", ".join(a.name for a in scene.animations)
+            raise FishgenError(f"expected --clip to name one of {names}, found {options.clip!r}",
+                               scene.label)
+    renderer = Renderer(options.width, options.height)
+    bg = tuple(c / 255.0 for c in options.background)
+    out, seconds = [], []
+    try:
+        for scene in scenes:
+            times, azimuths, step = _frame_plan(scene, options, frames)
+            seconds.append(step)
+            points = subject_points(scene, sorted(set(times), key=lambda t: -1 if t is None else t),
+                                    options.clip)
+            base = frame(points, options.view, options.width / options.height,
+                         azimuths=tuple(sorted(set(azimuths))))
+            images = []
+            for t, az in zip(times, azimuths):
+                cam = turned(base, options.view, az) if az else base
+                images.append(Image.fromarray(renderer.render(scene, cam, t, bg, options.clip)))
+                if progress:
+                    progress(1)
+            out.append(images)
+    finally:
+        renderer.release()
+    return out, max(seconds)
+
+
+def compose(per_scene: list[list], labels: list[str], options: PreviewOptions) -> list:
+    """One image per frame: the render itself, or a contact sheet of all inputs."""
+    from fishgen.preview.sheet import contact_sheet
+
+    if len(per_scene) == 1:
+        return per_scene[0]
+    n = max(len(f) for f in per_scene)
+    return [contact_sheet([f[k % len(f)] for f in per_scene], labels, options.columns,
+                          options.background) for k in range(n)]
+
+
+def encode(images: list, out: Path, seconds_per_frame: float) -> bytes:
+    """The bytes of ``out`` in the format its extension names."""
+    ext = out.suffix.lower()
+    buf = io.BytesIO()
+    if ext in (".jpg", ".jpeg"):
+        images[0].convert("RGB").save(buf, "JPEG", quality=92)
+    elif ext == ".png":
+        images[0].save(buf, "PNG", optimize=False)
+    elif ext == ".webp":
+        kwargs = dict(lossless=False, quality=90, method=4)
+        if len(images) > 1:
+            kwargs.update(save_all=True, append_images=images[1:], loop=0,
+                          duration=max(20, round(seconds_per_frame * 1000)))
+        images[0].save(buf, "WEBP", **kwargs)
+    else:  # gif: one shared palette keeps the loop from flickering between frames
+        rgb = [im.convert("RGB") for im in images]
+        palette = rgb[0].quantize(colors=255, method=2)
+        frames = [im.quantize(palette=palette, dither=1) for im in rgb]
+        frames[0].save(buf, "GIF", save_all=True, append_images=frames[1:], loop=0,
+                       duration=max(20, round(seconds_per_frame * 1000)), disposal=1)
+    return buf.getvalue()
+
+
+def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options: PreviewOptions,
+            progress: Callable[[int], None] | None = None, on_loaded: Callable[[int], None] | None = None) -> Path:
+    """Render ``inputs`` to ``out`` (still, contact sheet, or loop); written atomically."""
+    from fishgen.atomic import write_bytes
+    from fishgen.preview.inputs import load_input
+
+    out = Path(out)
+    if not inputs:
+        raise FishgenError("expected at least one input, found none")
+    frames = check_output(out, options)
+    scenes = [load_input(p, textures_dir=options.textures_dir, seed=options.seed) for p in inputs]
+    if on_loaded:
+        on_loaded(len(scenes) * frames)
+    per_scene, step = render_frames(scenes, options, frames, progress)
+    images = compose(per_scene, [Path(p).name for p in inputs], options)
+    write_bytes(out, encode(images, out, step))
+    return out

@@ -1,0 +1,39 @@
+"""Lay renders out as a labelled contact sheet (Pillow only)."""
+from __future__ import annotations
+
+import math
+
+from PIL import Image, ImageDraw, ImageFont
+
+
+def label_height(tile_height: int) -> int:
+    return max(16, tile_height // 14)
+
+
+def contact_sheet(tiles: list[Image.Image], labels: list[str], columns: int | None,
+                  background: tuple[int, int, int, int]) -> Image.Image:
+    """Grid of equally sized ``tiles``, each with its label in a strip below it."""
+    columns = columns or math.ceil(math.sqrt(len(tiles)))
+    rows = math.ceil(len(tiles) / columns)
+    w, h = tiles[0].size
+    strip = label_height(h)
+    sheet = Image.new("RGBA", (columns * w, rows * (h + strip)), background)
+    draw = ImageDraw.Draw(sheet)
+    font = _font(int(strip * 0.7))
+    # Text colour picked against the background so labels stay readable on any --background.
+    r, g, b, a = background
+    ink = (20, 24, 28, 255) if a < 128 or (0.299 * r + 0.587 * g + 0.114 * b) > 140 else (245, 245, 245, 255)
+    for k, (tile, label) in enumerate(zip(tiles, labels)):
+        x, y = (k % columns) * w, (k // columns) * (h + strip)
+        sheet.paste(tile, (x, y))
+        box = draw.textbbox((0, 0), label, font=font)
+        draw.text((x + (w - (box[2] - box[0])) / 2, y + h + (strip - (box[3] - box[1])) / 2 - box[1]),
+                  label, fill=ink, font=font)
+    return sheet
+
+
+def _font(size: int):
+    try:
+        return ImageFont.load_default(size=size)  # Pillow >= 10.1 ships a scalable default
+    except TypeError:
+        return ImageFont.load_default()
