@@ -1,0 +1,84 @@
+"""`fishgen build` as a user meets it: outputs, one-line errors, nothing lost."""
+from __future__ import annotations
+
+import shutil
+
+import pytest
+
+from tests.conftest import PARAMS, ROOT, assert_valid_gltf, run_cli
+
+
+def test_build_default_species_to_glb(tmp_path):
+    out = tmp_path / "bonybream.glb"
+    result = run_cli("build", PARAMS / "bonybream.txt", "-o", out)
+    assert result.returncode == 0, result.stderr
+    assert "bonybream" in result.stderr and "swim loop 8.00 s" in result.stderr
+    assert_valid_gltf(out)
+
+
+def test_help_documents_every_option():
+    result = run_cli("build", "--help")
+    assert result.returncode == 0
+    for option in ("--output", "--fins", "--length", "--fps", "--textures"):
+        assert option in result.stdout
+    assert "default" in result.stdout and "30.0" in result.stdout
+
+
+def test_top_level_help_is_light():
+    import subprocess
+    import sys
+    code = ("import sys, fishgen.cli as c\n"
+            "sys.argv=['fishgen','--help']\n"
+            "try: c.main()\nexcept SystemExit: pass\n"
+            "print('numpy' in sys.modules, 'trimesh' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert out.stdout.strip().splitlines()[-1] == "False False"
+
+
+def _species_copy(tmp_path, transform=lambda t: t):
+    for tex in ("bonybream.png", "bonybream_mask.png"):
+        shutil.copy(ROOT / "textures" / tex, tmp_path / tex)
+    path = tmp_path / "fish.txt"
+    path.write_text(transform((PARAMS / "bonybream.txt").read_text()))
+    return path
+
+
+@pytest.mark.parametrize("transform,needle", [
+    (lambda t: t.replace("0.26 0.1 0.04", "0.26 0.1"), "expected the body scale record"),
+    (lambda t: t.replace("bonybream.png bonybream_mask.png", "../../etc/passwd bonybream_mask.png"),
+     "expected a texture path inside"),
+    (lambda t: t[:2000], "found end of file"),
+])
+def test_bad_input_one_line_error_no_output_no_clobber(tmp_path, transform, needle):
+    species = _species_copy(tmp_path, transform)
+    out = tmp_path / "fish.glb"
+    out.write_bytes(b"the good file from yesterday")
+    result = run_cli("build", species, "-o", out)
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.stderr
+    assert lines[0].startswith(f"{species}:") and needle in lines[0]
+    assert out.read_bytes() == b"the good file from yesterday"
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
+
+
+def test_failed_write_leaves_no_partial_file(tmp_path):
+    species = _species_copy(tmp_path)
+    blocker = tmp_path / "out"
+    blocker.write_text("a file where a folder should be")
+    result = run_cli("build", species, "-o", blocker / "fish.glb")
+    assert result.returncode != 0 and "Traceback" not in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+
+
+def test_every_format_from_the_command_line(tmp_path):
+    for ext in ("glb", "gltf", "obj", "ply"):
+        result = run_cli("build", PARAMS / "pineapplefish.txt", "-o", tmp_path / f"p.{ext}", "--fins", "opaque",
+                         "--length", "0.2")
+        assert result.returncode == 0, result.stderr
+    assert_valid_gltf(tmp_path / "p.glb", tmp_path / "p.gltf")
+
+
+def test_missing_species_file(tmp_path):
+    result = run_cli("build", tmp_path / "nope.txt", "-o", tmp_path / "x.glb")
+    assert result.returncode == 2 and "expected a species file, found no such file" in result.stderr

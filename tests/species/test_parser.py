@@ -1,0 +1,207 @@
+"""The species file (thesis Appendix A): what parses, and one test per fault class."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from fishgen.errors import FishgenError
+from fishgen.species.parser import load_species, parse_species
+from fishgen.species.writer import format_species
+from tests.conftest import PARAMS, ROOT
+
+BONY = (PARAMS / "bonybream.txt").read_text()
+SHIPPED = sorted(PARAMS.glob("*.txt"))
+
+
+def lines_of(text: str) -> list[str]:
+    return text.splitlines()
+
+
+def write(tmp_path: Path, text: str, name: str = "fish.txt") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    for tex in ("bonybream.png", "bonybream_mask.png"):
+        (tmp_path / tex).write_bytes((ROOT / "textures" / tex).read_bytes())
+    return path
+
+
+def error_of(tmp_path: Path, text: str) -> FishgenError:
+    with pytest.raises(FishgenError) as info:
+        load_species(write(tmp_path, text))
+    return info.value
+
+
+def replace_record(text: str, old: str, new: str) -> str:
+    assert old in text, old
+    return text.replace(old, new, 1)
+
+
+def line_number(text: str, needle: str) -> int:
+    return next(i for i, line in enumerate(lines_of(text), 1) if line.startswith(needle))
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.stem)
+def test_every_shipped_species_parses_with_its_textures(path):
+    sp = load_species(path)
+    assert sp.colour_texture.is_file() and sp.mask_texture.is_file()
+    assert len(sp.texture_points.body) == sp.body_sections * sp.circle_sections
+
+
+def test_bonybream_values_match_appendix_a():
+    sp = parse_species(BONY, "bonybream.txt")
+    assert (sp.name, sp.world_scale, sp.body_sections, sp.circle_sections) == ("bonybream", 25.5, 16, 12)
+    assert sp.scale == (0.26, 0.1, 0.04) and sp.textured and sp.masked
+    assert sp.caudal.connection == (0.95, 0.0, 0.0) and sp.caudal.movement_angle == 10.0
+    assert (sp.dorsal.start_section, sp.dorsal.end_section, sp.dorsal.start_angle) == (7, 10, 70.0)
+    assert sp.anal.start_angle == -55.0 and sp.pelvic.start_circle == 11
+    # the pectoral record holds 9 values although its printed header names 7
+    assert (sp.pectoral.movement_angle, sp.pectoral.step_size) == (4.0, 1.0)
+    assert [len(getattr(sp.texture_points, f)) for f in ("caudal", "dorsal", "adipose", "anal", "pectoral",
+                                                         "pelvic")] == [9, 8, 6, 8, 7, 8]
+    assert sp.behaviour.change_rate == 50.0 and sp.behaviour.flee == (0.04, 10.0)
+
+
+def test_writer_round_trips_every_shipped_species():
+    for path in SHIPPED:
+        sp = parse_species(path.read_text(), str(path))
+        again = parse_species(format_species(sp), "again.txt")
+        assert again == sp
+
+
+def test_untextured_species_may_omit_the_texture_block():
+    text = lines_of(BONY)
+    start = line_number(BONY, "bonybream.png")
+    end = line_number(BONY, "//movement of fish")
+    body = "\n".join(text[: start - 2] + text[end - 1:]).replace("16 12 true true", "16 12 false false")
+    sp = parse_species(body, "plain.txt")
+    assert not sp.textured and sp.texture_points is None
+
+
+# --------------------------------------------------------------------- the faults
+def test_appendix_a_as_printed_stops_at_the_wrapped_comment(tmp_path):
+    printed = (ROOT / "tests" / "fixtures" / "appendix_a_as_printed.txt").read_text()
+    err = error_of(tmp_path, printed)
+    assert err.line == 2
+    assert "wrapped comment" in str(err) and "//" in str(err)
+    assert str(err).startswith(f"{tmp_path / 'fish.txt'}:2: expected the header record")
+
+
+def test_cyrillic_letter_for_a_count_names_the_character(tmp_path):
+    text = BONY.replace("//no_of_adipose_texture_points\n6\n", "//no_of_adipose_texture_points\nб\n")
+    err = error_of(tmp_path, text)
+    assert err.line == line_number(text, "б")
+    assert "U+0431 CYRILLIC SMALL LETTER BE" in str(err) and "misprinted digit" in str(err)
+
+
+def test_wrong_value_count(tmp_path):
+    text = replace_record(BONY, "0.26 0.1 0.04", "0.26 0.1")
+    err = error_of(tmp_path, text)
+    assert err.line == line_number(text, "0.26 0.1") and "(3 values), found 2 values" in str(err)
+
+
+def test_non_number(tmp_path):
+    text = replace_record(BONY, "7.0 10.0 0.6 0.05 70.0 0.98", "7.0 10.0 0.6 0.05 seventy 0.98")
+    err = error_of(tmp_path, text)
+    assert "dorsal fin startangle_in_degrees as a number, found 'seventy'" in str(err)
+
+
+@pytest.mark.parametrize("bad", ["nan", "inf"])
+def test_nan_and_infinity_are_not_numbers(tmp_path, bad):
+    err = error_of(tmp_path, replace_record(BONY, "0.26 0.1 0.04", f"0.26 {bad} 0.04"))
+    assert "scaleY" in str(err)
+
+
+def test_body_point_count_must_match_level_of_detail(tmp_path):
+    text = replace_record(BONY, "\n192\n", "\n191\n")
+    err = error_of(tmp_path, text)
+    assert "expected 192 body texture points (BodySections 16 x CircleSections 12), found 191" in str(err)
+
+
+def test_fin_point_count_must_follow_fin_structure(tmp_path):
+    text = replace_record(BONY, "//no_of_dorsal_texture_points\n8", "//no_of_dorsal_texture_points\n9")
+    err = error_of(tmp_path, text)
+    assert "expected 8 dorsal fin texture points (2 x (endBodySection 10 - startBodySection 7 + 1))" in str(err)
+
+
+def test_fin_section_outside_the_body(tmp_path):
+    err = error_of(tmp_path, replace_record(BONY, "7.0 10.0 0.6 0.05 70.0 0.98", "7.0 16.0 0.6 0.05 70.0 0.98"))
+    assert "dorsal fin endBodySection as a BodySection number (from startBodySection 7) in 7..15, found '16.0'" \
+        in str(err)
+
+
+def test_pectoral_triangles_may_not_wrap_the_body(tmp_path):
+    err = error_of(tmp_path, replace_record(BONY, "6.0 2.0 3.0 0.95", "6.0 2.0 12.0 0.95"))
+    assert "pectoral no_of_triangles" in str(err) and "1..11" in str(err)
+
+
+def test_unknown_shape_class(tmp_path):
+    err = error_of(tmp_path, replace_record(BONY, "FishShapeSin 16", "FishShapeCos 16"))
+    assert "a shape class (one of FishShapeAngel, FishShapeHawk, FishShapeSin, FishShapeSpline)" in str(err)
+    assert "'FishShapeCos'" in str(err)
+
+
+def test_spline_shape_needs_control_points(tmp_path):
+    err = error_of(tmp_path, replace_record(BONY, "FishShapeSin 16 12 true true false false",
+                                            "FishShapeSpline 16 12 true true false false 0.5"))
+    assert "FishShapeSpline control points" in str(err)
+
+
+def test_missing_texture_file(tmp_path):
+    err = error_of(tmp_path, replace_record(BONY, "bonybream.png bonybream_mask.png",
+                                            "bonybream.png nothere.png"))
+    assert "expected an existing texture file, found 'nothere.png' missing" in str(err)
+
+
+@pytest.mark.parametrize("name", ["../../etc/passwd", "/etc/passwd", "../fish.png"])
+def test_texture_paths_may_not_leave_the_texture_folder(tmp_path, name):
+    (tmp_path / "fish.png").write_bytes(b"x")
+    inner = tmp_path / "species"
+    inner.mkdir()
+    text = replace_record(BONY, "bonybream.png bonybream_mask.png", f"{name} bonybream_mask.png")
+    path = write(inner, text)
+    with pytest.raises(FishgenError) as info:
+        load_species(path)
+    assert "expected a texture path inside" in str(info.value) and repr(name) in str(info.value)
+
+
+def test_textures_option_is_the_only_root_when_given(tmp_path):
+    path = write(tmp_path, BONY)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    with pytest.raises(FishgenError, match="missing from"):
+        load_species(path, textures_dir=elsewhere)
+    assert load_species(path, textures_dir=ROOT / "textures").colour_texture.parent == ROOT / "textures"
+
+
+def test_truncated_file(tmp_path):
+    text = "\n".join(lines_of(BONY)[:40]) + "\n"
+    err = error_of(tmp_path, text)
+    assert "found end of file (the file is truncated)" in str(err) and err.line == 41
+
+
+def test_trailing_garbage(tmp_path):
+    err = error_of(tmp_path, BONY + "1 2 3\n")
+    assert "expected end of file after the flee record" in str(err)
+
+
+def test_empty_file(tmp_path):
+    err = error_of(tmp_path, "")
+    assert str(err).endswith(":1: expected a VRFish species file, found an empty file")
+
+
+def test_binary_file(tmp_path):
+    path = tmp_path / "fish.txt"
+    path.write_bytes(b"bonybream 25.5\n\x89PNG\x00\x01")
+    with pytest.raises(FishgenError, match=r":2: expected a text species file, found binary data"):
+        load_species(path)
+
+
+def test_absurd_level_of_detail_is_refused_before_allocating(tmp_path):
+    err = error_of(tmp_path, replace_record(BONY, "FishShapeSin 16 12", "FishShapeSin 100000000 12"))
+    assert "BodySections in 3..1024" in str(err) and "'100000000'" in str(err)
+
+
+def test_step_size_required_for_a_moving_fin(tmp_path):
+    err = error_of(tmp_path, replace_record(BONY, "3.0 10.0 1.0\n", "3.0 10.0 0.0\n"))
+    assert "caudal step_size as a step size > 0" in str(err)
