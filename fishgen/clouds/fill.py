@@ -115,11 +115,16 @@ def _fill_chunk(out: Cloud, t: _Tables, start: int, stop: int, seed: int, method
     idx = out.cube_index[start:stop]
     s = _paper_offsets(rng, m) if method == "paper" else _uniform_offsets(rng, m)
 
+    # Particles are sorted by cube, so a chunk is a few runs of equal cube index: expand
+    # each per-cube table by run length (a scalar row when one cube covers the chunk).
+    first, last = int(idx[0]), int(idx[-1])
+    runs = None if first == last else np.bincount(idx - first, minlength=last - first + 1)
+
     def per_cube(table: np.ndarray) -> np.ndarray:
-        # Big cubes cover whole chunks: broadcast a scalar row instead of gathering.
-        if idx[0] == idx[-1]:
-            return table[idx[0]][..., None] if table.ndim == 2 else table[idx[0]]
-        return table[idx].T if table.ndim == 2 else table[idx]
+        if runs is None:
+            return table[first][:, None] if table.ndim == 2 else table[first]
+        part = table[first:last + 1]
+        return np.repeat(part.T, runs, axis=1) if table.ndim == 2 else np.repeat(part, runs)
 
     world = per_cube(t.centre) + s * per_cube(t.half)
     np.clip(world, per_cube(t.lo), per_cube(t.hi), out=world)
