@@ -145,8 +145,8 @@ def paint(sp: Species, palette: dict, seed: int) -> tuple[Image.Image, Image.Ima
     mask = Image.new("L", SIZE, 0)
     cd, md = ImageDraw.Draw(colour), ImageDraw.Draw(mask)
 
-    # Fins first (the body overlaps their bases): rays, a darker margin, and a frayed
-    # outline in the mask so the mask technique visibly cuts the fin shape.
+    # Fins first (the body overlaps their bases): membrane and rays. The mask's fin
+    # outline is rounded below, so the mask technique visibly cuts the fin shape.
     fin_rgb = np.array(palette["fin"])
     for poly, base, outer in _fin_outline(sp):
         cd.polygon(poly, fill=tuple(int(v) for v in fin_rgb * 0.85))
@@ -154,17 +154,6 @@ def paint(sp: Species, palette: dict, seed: int) -> tuple[Image.Image, Image.Ima
         for k, tip in enumerate(outer):
             root = base[min(int(k * len(base) / max(len(outer), 1)), len(base) - 1)]
             cd.line([root, tip], fill=tuple(int(v) for v in np.minimum(fin_rgb * 1.15, 255)), width=2)
-        for a, b in zip(outer[:-1], outer[1:]):
-            seg = math.dist(a, b)
-            for t in np.arange(0.5, max(seg / 9.0, 1.0)) / max(seg / 9.0, 1.0):
-                x, y = a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t
-                cx, cy = np.mean([p[0] for p in poly]), np.mean([p[1] for p in poly])
-                d = math.hypot(cx - x, cy - y) or 1.0
-                ix, iy = (cx - x) / d, (cy - y) / d
-                depth = min(9.0, 0.25 * d)
-                md.polygon([(x - iy * 3.5, y + ix * 3.5), (x + iy * 3.5, y - ix * 3.5),
-                            (x + ix * depth, y + iy * depth)], fill=0)
-
     # Body: dorsal-to-ventral gradient, pattern, lateral line, gill cover and eye.
     grad = Image.new("RGB", SIZE)
     top_v = min(v for _, v in body_poly)
@@ -212,6 +201,10 @@ def paint(sp: Species, palette: dict, seed: int) -> tuple[Image.Image, Image.Ima
     pd.ellipse([eye_u - r, eye_v - r, eye_u + r, eye_v + r], fill=(235, 235, 220))
     pd.ellipse([eye_u - r * 0.55, eye_v - r * 0.55, eye_u + r * 0.55, eye_v + r * 0.55], fill=(10, 10, 10))
     colour = colour.filter(ImageFilter.SMOOTH)
+    # Round and slightly erode the fins' cut-out so its edge reads as membrane; the
+    # body is pasted back whole so the body's own outline stays where the mesh is.
+    mask = mask.filter(ImageFilter.GaussianBlur(3.0)).point(lambda v: 255 if v >= 150 else 0)
+    mask.paste(255, (0, 0), body_mask)
     return colour, mask
 
 
