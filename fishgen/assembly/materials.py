@@ -16,7 +16,6 @@ from fishgen.species.model import Species
 
 FIN_MODES = ("blend", "mask", "opaque")
 MASK_CUTOFF = 0.5
-MAX_TEXTURE_SIDE = 8192
 
 
 @dataclass(frozen=True)

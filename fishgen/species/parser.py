@@ -11,7 +11,7 @@ import os
 import unicodedata
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterator, Sequence
+from typing import Callable, Sequence
 
 from fishgen.errors import FishgenError
 from fishgen.species.model import (Behaviour, CaudalFin, PectoralFin, PelvicFin, Species,
@@ -353,6 +353,7 @@ def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> P
             escaped = True
             continue
         if candidate.is_file():
+            _check_image(candidate, name, file, line)
             return candidate
     if escaped or os.path.isabs(name):
         raise FishgenError(f"expected a texture path inside {shown}, found {name!r} "
@@ -360,6 +361,25 @@ def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> P
                            file, line)
     raise FishgenError(f"expected an existing texture file, found {name!r} missing from {shown}",
                        file, line)
+
+
+#: Largest texture side accepted (pixels); larger files are refused before decoding.
+MAX_TEXTURE_SIDE = 8192
+
+
+def _check_image(path: Path, name: str, file: str, line: int) -> None:
+    """Read only the image header: a readable picture of a sane size, or a clear error."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as img:
+            width, height = img.size
+    except (UnidentifiedImageError, OSError):
+        raise FishgenError(f"expected a texture image (PNG, GIF, JPEG, ...), found {name!r} unreadable",
+                           file, line) from None
+    if max(width, height) > MAX_TEXTURE_SIDE:
+        raise FishgenError(f"expected a texture of at most {MAX_TEXTURE_SIDE} pixels a side, found {name!r} "
+                           f"{width}x{height}", file, line)
 
 
 def load_species(path: str | os.PathLike, textures_dir: str | os.PathLike | None = None) -> Species:
@@ -387,9 +407,3 @@ def load_species(path: str | os.PathLike, textures_dir: str | os.PathLike | None
     roots = texture_roots(path, textures_dir)
     return parse_species(text, file,
                          lambda name, line: resolve_texture(name, roots, file, line.number))
-
-
-def iter_records(text: str) -> Iterator[tuple[int, str]]:
-    """(line number, text) of every meaningful line: a helper for tools and tests."""
-    for line in _Reader(text, "<text>").lines:
-        yield line.number, line.text

@@ -205,3 +205,18 @@ def test_absurd_level_of_detail_is_refused_before_allocating(tmp_path):
 def test_step_size_required_for_a_moving_fin(tmp_path):
     err = error_of(tmp_path, replace_record(BONY, "3.0 10.0 1.0\n", "3.0 10.0 0.0\n"))
     assert "caudal step_size as a step size > 0" in str(err)
+
+
+def test_texture_that_is_not_an_image(tmp_path):
+    path = write(tmp_path, BONY)
+    (tmp_path / "bonybream_mask.png").write_text("not a picture")
+    with pytest.raises(FishgenError, match="expected a texture image .* found 'bonybream_mask.png' unreadable"):
+        load_species(path)
+
+
+def test_absurd_texture_size_is_refused_from_its_header(tmp_path):
+    from PIL import Image
+    path = write(tmp_path, BONY)
+    Image.new("1", (9000, 8)).save(tmp_path / "bonybream_mask.png")
+    with pytest.raises(FishgenError, match="at most 8192 pixels a side, found 'bonybream_mask.png' 9000x8"):
+        load_species(path)
