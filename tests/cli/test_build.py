@@ -82,3 +82,17 @@ def test_every_format_from_the_command_line(tmp_path):
 def test_missing_species_file(tmp_path):
     result = run_cli("build", tmp_path / "nope.txt", "-o", tmp_path / "x.glb")
     assert result.returncode == 2 and "expected a species file, found no such file" in result.stderr
+
+
+def test_batch_builds_every_good_file_and_reports_each_bad_one(tmp_path):
+    bad = tmp_path / "bad.txt"
+    bad.write_text("nothing like a species\n")
+    out = tmp_path / "assets"
+    result = run_cli("build", PARAMS / "bonybream.txt", bad, PARAMS / "pineapplefish.txt", "-o", out,
+                     "--format", "gltf")
+    assert result.returncode == 2
+    assert sorted(p.name for p in out.glob("*.gltf")) == ["bonybream.gltf", "pineapplefish.gltf"]
+    errors = [line for line in result.stderr.splitlines() if line.startswith(str(bad))]
+    assert len(errors) == 1 and ":1: expected the header record" in errors[0]
+    assert "Traceback" not in result.stderr
+    assert_valid_gltf(out / "bonybream.gltf", out / "pineapplefish.gltf")
