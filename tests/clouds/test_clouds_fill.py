@@ -155,3 +155,20 @@ def test_bad_method_and_seed():
         fill_cloud(one_cube(10), method="gaussian")
     with pytest.raises(ValueError, match="seed"):
         fill_cloud(one_cube(10), seed=-1)
+
+
+def test_phase_shift_is_eq_4_5_to_4_7_as_decided():
+    """The hot loop folds constants; check it against the equations written out in float64."""
+    from fishgen.clouds.fill import CLUMP, _phase_shift
+
+    s = np.random.default_rng(0).uniform(-1, 1, (3, 10_000)).astype(np.float32)
+    got = s.copy()
+    _phase_shift(got)
+    theta = math.pi * s.astype(np.float64)                        # a cube spans one period
+    px = math.pi / 2 * np.sin(0.5 * theta[1])                     # eq. 4.5
+    py = math.pi / 2 * np.sin(0.5 * theta[0])
+    pz = math.pi / 2 * np.sin(0.5 * theta[2])
+    px = px + math.pi * np.sin(px * theta[2] / 2)                 # eq. 4.6
+    py = py + math.pi * np.sin(py * theta[2] / 2)                 # P_y where the print has P_x
+    want = s + CLUMP / math.pi * np.stack([px, py, pz])           # eq. 4.7, in half extents
+    np.testing.assert_allclose(got, want, atol=1e-6)

@@ -1,0 +1,162 @@
+"""Benchmark `fishgen clouds`: fill rate vs. a plain Python loop, whole command, peak memory.
+
+    python benchmarks/clouds.py                 # full run (about a minute)
+    python benchmarks/clouds.py --quick         # smoke run, small sizes only
+
+The cloud shape is the report's Table 4.4 (23 cubes) with every cube's count
+scaled so the total is N. The baseline is the report's algorithm (section 4.5,
+Figure 4.2) written one particle at a time in plain Python, with the same
+departures as fishgen (docs/decisions-clouds.md), so both do the same work.
+It is run only up to --baseline-max particles; larger sizes are compared
+against its rate at the largest measured size (the loop is linear), marked "*".
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import random
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from fishgen.clouds import Cube, CubeFile, fill_cloud, load_cubes  # noqa: E402
+from fishgen.clouds.fill import BASE_COLOUR, CLUMP, TOP_COLOUR  # noqa: E402
+
+TABLE = ROOT / "params" / "clouds" / "table_4_4.awn"
+REPORT = "report: 50,000 particles in ~90 ms on a 3.2 GHz Pentium IV (section 5.2)"
+
+
+def scaled_cubes(n: int) -> CubeFile:
+    """Table 4.4's cubes with counts scaled to a total of n (remainder to the base cube)."""
+    cubes = load_cubes(TABLE).cubes
+    total = sum(c.particles for c in cubes)
+    counts = [c.particles * n // total for c in cubes]
+    counts[0] += n - sum(counts)
+    return CubeFile(f"table 4.4 x {n}", n, tuple(
+        Cube(k, c.size, c.centre, c.max_radius, c.line) for k, c in zip(counts, cubes)))
+
+
+def write_awn(cube_file: CubeFile, path: Path) -> None:
+    rows = [str(cube_file.total), str(len(cube_file.cubes))]
+    rows += [", ".join(map(str, (c.particles, *c.size, *c.centre, c.max_radius)))
+             for c in cube_file.cubes]
+    path.write_text("\n".join(rows) + "\n")
+
+
+def plain_fill(cube_file: CubeFile, seed: int) -> list[tuple]:
+    """The report's algorithm, one particle at a time: the baseline."""
+    rnd = random.Random(seed)
+    half_pi, k, norm = math.pi / 2, CLUMP / math.pi, 1 + math.pi / 2 * math.sin(1)
+    y0 = min(c.centre[1] - c.size[1] / 2 for c in cube_file.cubes)
+    y1 = max(c.centre[1] + c.size[1] / 2 for c in cube_file.cubes)
+    base, top = [float(v) for v in BASE_COLOUR], [float(v) for v in TOP_COLOUR]
+    out = []
+    for cube in cube_file.cubes:
+        (cx, cy, cz), (sx, sy, sz) = cube.centre, cube.size
+        for _ in range(cube.particles):
+            while True:  # Figure 4.2: get a new particle until its centre is in the cube
+                x, y, z = rnd.random() * 2 - 1, rnd.random() * 2 - 1, rnd.random() * 2 - 1
+                px = half_pi * math.sin(half_pi * y)                  # eq. 4.5
+                py = half_pi * math.sin(half_pi * x)
+                pz = half_pi * math.sin(half_pi * z)
+                px += math.pi * math.sin(px * half_pi * z)            # eq. 4.6
+                py += math.pi * math.sin(py * half_pi * z)
+                x, y, z = x + k * px, y + k * py, z + k * pz          # eq. 4.7
+                if -1 <= x <= 1 and -1 <= y <= 1 and -1 <= z <= 1:
+                    break
+            u = 1 - rnd.random()
+            radius = cube.max_radius * (u + half_pi * math.sin(u)) / norm  # eq. 4.9-4.12
+            density = math.exp(-(x * x + y * y + z * z))
+            wy = cy + y * sy / 2
+            h = math.sqrt(min(max((wy - y0) / (y1 - y0), 0.0), 1.0))
+            colour = tuple(int(b + (t - b) * h + 0.5) for b, t in zip(base, top))
+            out.append((cx + x * sx / 2, wy, cz + z * sz / 2, radius, density) + colour)
+    return out
+
+
+def median_time(run, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        run()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def whole_command(n: int, workdir: Path, repeats: int) -> tuple[float, int]:
+    """Median wall time and peak RSS (bytes) of `fishgen clouds big.awn -o big.ply`."""
+    awn, ply = workdir / f"cloud_{n}.awn", workdir / f"cloud_{n}.ply"
+    write_awn(scaled_cubes(n), awn)
+    # Each measurement runs in its own wrapper so RUSAGE_CHILDREN sees only that command.
+    probe = ("import resource, subprocess, sys, time\n"
+             "t = time.perf_counter()\n"
+             "subprocess.run(sys.argv[1:], check=True, stdout=subprocess.DEVNULL)\n"
+             "print(time.perf_counter() - t, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)")
+    times, peaks = [], []
+    for _ in range(repeats):
+        out = subprocess.run([sys.executable, "-c", probe, sys.executable, "-m", "fishgen",
+                              "clouds", str(awn), "-o", str(ply)],
+                             cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
+        times.append(float(out[0]))
+        peaks.append(int(out[1]) * 1024)  # ru_maxrss is in KiB on Linux
+    assert ply.stat().st_size > 23 * n
+    ply.unlink()
+    return statistics.median(times), max(peaks)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--sizes", default="1e4,5e4,1e5,1e6,1e7",
+                        help="particle counts to fill [default: %(default)s]")
+    parser.add_argument("--baseline-max", type=float, default=1e6,
+                        help="largest size run through the plain loop [default: %(default)s]")
+    parser.add_argument("--repeats", type=int, default=5, help="timings per size [default: 5]")
+    parser.add_argument("--command-size", type=float, default=1e7,
+                        help="particles for the whole-command PLY run [default: %(default)s]")
+    parser.add_argument("--quick", action="store_true", help="small sizes only (smoke test)")
+    args = parser.parse_args()
+    if args.quick:
+        args.sizes, args.baseline_max, args.repeats, args.command_size = "1e4,1e5", 1e4, 3, 1e5
+    sizes = [int(float(s)) for s in args.sizes.split(",")]
+
+    print(f"fishgen clouds benchmark on {os.cpu_count()} cores, Python {sys.version.split()[0]}")
+    print(REPORT)
+    print()
+    print("| particles | fishgen (median) | fishgen particles/s | plain loop (median) "
+          "| plain particles/s | speed-up |")
+    print("|---:|---:|---:|---:|---:|---:|")
+    fill_cloud(scaled_cubes(10_000), seed=0)  # warm-up: imports, thread pool, page cache
+    plain_rate = None
+    for n in sizes:
+        cubes = scaled_cubes(n)
+        fast = median_time(lambda: fill_cloud(cubes, seed=1), args.repeats if n < 10**7 else 3)
+        if n <= args.baseline_max:
+            reps = max(1, min(args.repeats, int(2e5 // n)))
+            slow = median_time(lambda: plain_fill(cubes, 1), reps)
+            plain_rate, mark = n / slow, ""
+        else:
+            slow, mark = n / plain_rate, "*"
+        print(f"| {n:,} | {fast * 1e3:,.1f} ms | {n / fast / 1e6:,.1f} M | "
+              f"{slow * 1e3:,.0f} ms{mark} | {n / slow / 1e6:,.2f} M{mark} | {slow / fast:,.0f}x{mark} |")
+    print("\n* extrapolated from the plain loop's rate at the largest size it ran (it is linear).")
+
+    n = int(args.command_size)
+    with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:
+        wall, peak = whole_command(n, Path(tmp), 3)
+        _, idle = whole_command(1000, Path(tmp), 1)
+    print(f"\nwhole command, {n:,} particles to PLY: {wall:.2f} s median of 3 "
+          f"({n / wall / 1e6:.1f} M particles/s end to end)")
+    print(f"peak memory: {peak / 2**20:,.0f} MiB = {peak / n:.1f} bytes/particle "
+          f"({(peak - idle) / n:.1f} bytes/particle above the {idle / 2**20:.0f} MiB "
+          f"of a 1,000-particle run)")
+
+
+if __name__ == "__main__":
+    main()
