@@ -1,0 +1,241 @@
+// fishgen viewer: shows one embedded asset with three.js; nothing is fetched from the network.
+// State for people and tests alike: window.fishgenViewer = {loaded, error, time, clip, clips, playing, counts}.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { PLYLoader } from 'three/addons/loaders/PLYLoader.js';
+import { OBJLoader } from 'three/addons/loaders/OBJLoader.js';
+import { MTLLoader } from 'three/addons/loaders/MTLLoader.js';
+
+const state = window.fishgenViewer = {
+	loaded: false, error: null, time: 0, clip: null, clips: [], playing: false,
+	counts: { vertices: 0, triangles: 0, particles: 0 },
+};
+const $ = ( id ) => document.getElementById( id );
+const fail = ( err ) => {
+	state.error = String( err && err.message || err );
+	$( 'status' ).textContent = 'could not show the asset: ' + state.error;
+	console.error( err );
+};
+
+// The asset and its side files (buffers, textures, MTL) are embedded as base64 and
+// handed to the loaders as blob: URLs under a fake folder, via the URL modifier.
+const embedded = JSON.parse( $( 'fishgen-asset' ).textContent );
+const blobs = {};
+for ( const [ name, b64 ] of Object.entries( embedded.files ) ) {
+	const bytes = Uint8Array.from( atob( b64 ), ( c ) => c.charCodeAt( 0 ) );
+	blobs[ name ] = URL.createObjectURL( new Blob( [ bytes ] ) );
+}
+const FOLDER = 'fishgen-asset/';
+const manager = new THREE.LoadingManager();
+manager.setURLModifier( ( url ) => {
+	const at = url.lastIndexOf( FOLDER );
+	if ( at < 0 ) return url;
+	// MTL map options ("-imfchan m skin.png") reach us glued to the name: the file is the last word.
+	const name = decodeURIComponent( url.slice( at + FOLDER.length ) ).trim().split( /\s+/ ).pop().replace( /^\.\//, '' );
+	return blobs[ name ] || blobs[ name.split( '/' ).pop() ] || url;
+} );
+
+const canvas = $( 'view' );
+const renderer = new THREE.WebGLRenderer( { canvas, antialias: true } );
+renderer.setPixelRatio( window.devicePixelRatio );
+const scene = new THREE.Scene();
+scene.background = new THREE.Color( embedded.background );
+const camera = new THREE.PerspectiveCamera( 30, 1, 0.01, 1000 );
+const controls = new OrbitControls( camera, canvas );
+controls.enableDamping = true;
+// Same light rig as `fishgen preview`: sun from above-front, weak fill, sky/ground hemisphere.
+scene.add( new THREE.HemisphereLight( 0xc4cdd8, 0x3a3530, 1.6 ) );
+const sun = new THREE.DirectionalLight( 0xfff8eb, 2.2 );
+sun.position.set( 0.35, 1.0, 0.55 );
+scene.add( sun );
+const fill = new THREE.DirectionalLight( 0x6b7f95, 0.7 );
+fill.position.set( - 0.6, 0.1, - 0.4 );
+scene.add( fill );
+
+// Particles: each a soft disc of its world radius (`_radius`, fishgen's _RADIUS / PLY radius).
+const particleMaterial = new THREE.ShaderMaterial( {
+	uniforms: { viewportHeight: { value: 1 } },
+	vertexColors: true, transparent: true, depthWrite: false,
+	vertexShader: /* glsl */`
+		attribute float _radius;
+		attribute float _density;
+		uniform float viewportHeight;
+		varying vec3 vColor;
+		varying float vAlpha;
+		void main() {
+			vec4 mv = modelViewMatrix * vec4( position, 1.0 );
+			gl_Position = projectionMatrix * mv;
+			gl_PointSize = 2.0 * _radius * projectionMatrix[ 1 ][ 1 ] * 0.5 * viewportHeight / max( - mv.z, 1e-4 );
+			vColor = color;
+			vAlpha = clamp( _density, 0.0, 1.0 );
+		}`,
+	fragmentShader: /* glsl */`
+		varying vec3 vColor;
+		varying float vAlpha;
+		void main() {
+			vec2 p = gl_PointCoord * 2.0 - 1.0;
+			p.y = - p.y;
+			float r2 = dot( p, p );
+			if ( r2 > 1.0 ) discard;
+			vec3 n = vec3( p, sqrt( 1.0 - r2 ) );
+			float light = 0.62 + 0.38 * dot( n, normalize( vec3( 0.3, 0.9, 0.4 ) ) );
+			float a = 0.55 * vAlpha * smoothstep( 1.0, 0.35, sqrt( r2 ) );
+			gl_FragColor = vec4( vColor * light, a );
+			#include <colorspace_fragment>
+		}`,
+} );
+
+function prepareParticles( points, diagonal ) {
+	const g = points.geometry;
+	const n = g.getAttribute( 'position' ).count;
+	if ( ! g.getAttribute( '_radius' ) ) g.setAttribute( '_radius', new THREE.BufferAttribute( new Float32Array( n ).fill( 0.004 * diagonal ), 1 ) );
+	if ( ! g.getAttribute( '_density' ) ) g.setAttribute( '_density', new THREE.BufferAttribute( new Float32Array( n ).fill( 1 ), 1 ) );
+	if ( ! g.getAttribute( 'color' ) ) g.setAttribute( 'color', new THREE.BufferAttribute( new Float32Array( n * 3 ).fill( 1 ), 3 ) );
+	points.material = particleMaterial;
+}
+
+async function load() {
+	const url = FOLDER + encodeURIComponent( embedded.main );
+	const kind = embedded.kind;
+	if ( kind === 'glb' || kind === 'gltf' ) {
+		const gltf = await new GLTFLoader( manager ).loadAsync( url );
+		return { root: gltf.scene, clips: gltf.animations };
+	}
+	if ( kind === 'ply' ) {
+		const loader = new PLYLoader( manager );
+		loader.setCustomPropertyNameMapping( { _radius: [ 'radius' ], _density: [ 'density' ] } );
+		const geometry = await loader.loadAsync( url );
+		const root = new THREE.Group();
+		if ( geometry.index ) {
+			if ( ! geometry.getAttribute( 'normal' ) ) geometry.computeVertexNormals();
+			root.add( new THREE.Mesh( geometry, new THREE.MeshStandardMaterial( {
+				vertexColors: !! geometry.getAttribute( 'color' ), side: THREE.DoubleSide, roughness: 0.8 } ) ) );
+		} else {
+			root.add( new THREE.Points( geometry ) );
+		}
+		return { root, clips: [] };
+	}
+	const loader = new OBJLoader( manager );
+	if ( embedded.mtl ) {
+		const materials = await new MTLLoader( manager ).setResourcePath( FOLDER ).loadAsync( FOLDER + encodeURIComponent( embedded.mtl ) );
+		materials.preload();
+		loader.setMaterials( materials );
+	}
+	return { root: await loader.loadAsync( url ), clips: [] };
+}
+
+function count( root ) {
+	const c = { vertices: 0, triangles: 0, particles: 0 };
+	root.traverse( ( o ) => {
+		const g = o.geometry;
+		if ( ! g || ! g.getAttribute( 'position' ) ) return;
+		const n = g.getAttribute( 'position' ).count;
+		if ( o.isPoints ) c.particles += n;
+		else if ( o.isMesh ) {
+			c.vertices += n;
+			c.triangles += ( g.index ? g.index.count : n ) / 3;
+		}
+	} );
+	return c;
+}
+
+function frameCamera( root ) {
+	const box = new THREE.Box3().setFromObject( root );
+	const size = box.getSize( new THREE.Vector3() ).length() || 1;
+	const centre = box.getCenter( new THREE.Vector3() );
+	// Three-quarter view, as `fishgen preview` defaults to: a fish faces left, slightly toward us.
+	const dir = new THREE.Vector3( 1, 0.45, 0.7 ).normalize();
+	camera.position.copy( centre ).addScaledVector( dir, size * 2.0 );
+	camera.near = size / 100;
+	camera.far = size * 100;
+	camera.updateProjectionMatrix();
+	controls.target.copy( centre );
+	controls.update();
+	return size;
+}
+
+let mixer = null;
+let clipObjects = [];
+let action = null;
+let duration = 0;
+const timer = new THREE.Timer();
+const slider = $( 'time' );
+
+function choose( index ) {
+	if ( ! mixer ) return;
+	mixer.stopAllAction();
+	const clip = clipObjects[ index ];
+	action = mixer.clipAction( clip );
+	action.play();
+	duration = clip.duration;
+	state.clip = clip.name;
+	slider.max = String( duration );
+	setPlaying( true );
+}
+
+function setPlaying( on ) {
+	state.playing = on && !! action;
+	$( 'play' ).textContent = state.playing ? 'Pause' : 'Play';
+}
+
+function resize() {
+	const w = canvas.clientWidth, h = canvas.clientHeight;
+	if ( canvas.width !== Math.floor( w * renderer.getPixelRatio() ) || canvas.height !== Math.floor( h * renderer.getPixelRatio() ) ) {
+		renderer.setSize( w, h, false );
+		camera.aspect = w / Math.max( h, 1 );
+		camera.updateProjectionMatrix();
+	}
+	particleMaterial.uniforms.viewportHeight.value = h * renderer.getPixelRatio();
+}
+
+function tick( now ) {
+	timer.update( now );
+	const dt = timer.getDelta();
+	resize();
+	if ( mixer && state.playing ) {
+		mixer.update( dt );
+		state.time = duration > 0 ? mixer.time % duration : 0;
+		slider.value = String( state.time );
+	}
+	$( 'clock' ).textContent = mixer ? `${ state.time.toFixed( 2 ) } / ${ duration.toFixed( 2 ) } s` : '';
+	controls.update();
+	renderer.render( scene, camera );
+	requestAnimationFrame( tick );
+}
+
+load().then( ( { root, clips } ) => {
+	scene.add( root );
+	const diagonal = frameCamera( root );
+	root.traverse( ( o ) => { if ( o.isPoints ) prepareParticles( o, diagonal ); } );
+	state.counts = count( root );
+	const c = state.counts;
+	$( 'counts' ).textContent = `${ c.vertices } vertices · ${ c.triangles } triangles · ${ c.particles } particles`;
+	const select = $( 'clip' );
+	clipObjects = clips;
+	state.clips = clips.map( ( clip ) => clip.name );
+	clips.forEach( ( clip, i ) => select.add( new Option( clip.name || `clip ${ i }`, String( i ) ) ) );
+	const animated = clips.length > 0;
+	for ( const id of [ 'clip', 'play', 'time' ] ) $( id ).disabled = ! animated;
+	if ( animated ) {
+		mixer = new THREE.AnimationMixer( root );
+		choose( 0 );
+	}
+	$( 'status' ).textContent = embedded.main;
+	state.loaded = true;
+} ).catch( fail );
+
+$( 'clip' ).addEventListener( 'change', ( e ) => choose( Number( e.target.value ) ) );
+$( 'play' ).addEventListener( 'click', () => setPlaying( ! state.playing ) );
+slider.addEventListener( 'input', () => {
+	if ( ! mixer ) return;
+	setPlaying( false );
+	mixer.setTime( Number( slider.value ) );
+	state.time = Number( slider.value );
+} );
+$( 'wireframe' ).addEventListener( 'change', ( e ) => {
+	scene.traverse( ( o ) => {
+		if ( o.isMesh ) for ( const m of [].concat( o.material ) ) m.wireframe = e.target.checked;
+	} );
+} );
+requestAnimationFrame( tick );

@@ -1,0 +1,98 @@
+"""Write the self-contained viewer page: three.js modules, app and asset in one HTML file.
+
+Everything the page needs is inside it (base64), so it works opened from disk,
+served on loopback, or mailed to someone - and never touches the network.
+"""
+from __future__ import annotations
+
+import base64
+import json
+import re
+from pathlib import Path
+
+from fishgen.errors import FishgenError
+
+HERE = Path(__file__).resolve().parent
+STATIC = HERE / "static"
+KINDS = {".glb": "glb", ".gltf": "gltf", ".ply": "ply", ".obj": "obj"}
+MAX_EMBED_BYTES = 256 << 20
+"""Beyond this a browser struggles with a base64 page; such assets need a desktop tool."""
+_MTL_MAPS = re.compile(r"^\s*(?:map_\w+|bump|disp|decal|refl|norm)\s+(.+?)\s*$", re.M | re.I)
+
+
+def page_path(asset: Path) -> Path:
+    """Where the page goes by default: beside the asset, named after it in full."""
+    return asset.with_name(asset.name + ".html")
+
+
+def sidecars(asset: Path) -> tuple[dict[str, Path], str | None]:
+    """Files the asset refers to (glTF buffers/images, OBJ materials and textures), and the MTL."""
+    found: dict[str, Path] = {}
+    mtl_name = None
+    ext = asset.suffix.lower()
+
+    def add(ref: str) -> None:
+        ref = ref.strip().replace("\\", "/")
+        target = (asset.parent / ref).resolve()
+        if ref.startswith("data:") or ref in found:
+            return
+        if not target.is_file():
+            raise FishgenError(f"expected the file {ref!r} it refers to beside the asset, found none", asset)
+        found[ref] = target
+
+    if ext == ".gltf":
+        try:
+            doc = json.loads(asset.read_text(encoding="utf-8"))
+        except (ValueError, UnicodeDecodeError) as err:
+            raise FishgenError(f"expected glTF JSON, found unreadable text ({err})", asset)
+        for item in doc.get("buffers", []) + doc.get("images", []):
+            if isinstance(item, dict) and isinstance(item.get("uri"), str):
+                add(item["uri"])
+    elif ext == ".obj":
+        text = asset.read_text(encoding="utf-8", errors="replace")
+        for lib in re.findall(r"^\s*mtllib\s+(.+?)\s*$", text, re.M):
+            add(lib)
+            mtl_name = mtl_name or lib.strip()
+            mtl = found[lib.strip().replace("\\", "/")]
+            for ref in _MTL_MAPS.findall(mtl.read_text(encoding="utf-8", errors="replace")):
+                add(ref.split()[-1])  # options such as "-imfchan m" come before the file name
+    return found, mtl_name
+
+
+def build_page(asset: str | Path, background: str = "#8cadcc") -> str:
+    """The viewer page for ``asset`` as HTML text."""
+    asset = Path(asset)
+    kind = KINDS.get(asset.suffix.lower())
+    if kind is None:
+        raise FishgenError(f"expected an asset ending in {', '.join(KINDS)}, found {asset.name!r}")
+    if not asset.is_file():
+        raise FishgenError("expected an existing file, found none", asset)
+    extra, mtl = sidecars(asset)
+    files = {asset.name: asset, **extra}
+    total = sum(p.stat().st_size for p in files.values())
+    if total > MAX_EMBED_BYTES:
+        raise FishgenError(f"expected at most {MAX_EMBED_BYTES >> 20} MiB to embed in a page, "
+                           f"found {total / 2**20:.0f} MiB", asset)
+    payload = {"main": asset.name, "kind": kind, "mtl": mtl, "background": background,
+               "files": {name: base64.b64encode(p.read_bytes()).decode("ascii") for name, p in files.items()}}
+    manifest = json.loads((STATIC / "manifest.json").read_text())
+    modules = "\n".join(
+        f'<script type="application/octet-stream" data-module="{spec}">'
+        f'{base64.b64encode((STATIC / entry["file"]).read_bytes()).decode("ascii")}</script>'
+        for spec, entry in manifest["modules"].items())
+    template = (HERE / "template.html").read_text(encoding="utf-8")
+    # "<" escaped so no file name can close the JSON script element early.
+    data = json.dumps(payload).replace("<", "\\u003c")
+    title = asset.name.replace("&", "&amp;").replace("<", "&lt;")
+    html = template.replace("{{ASSET}}", data).replace("{{MODULES}}", modules)
+    return html.replace("{{APP}}", (HERE / "app.js").read_text(encoding="utf-8")).replace("{{TITLE}}", title)
+
+
+def write_page(asset: str | Path, page: str | Path | None = None, background: str = "#8cadcc") -> Path:
+    """Write the page (atomically) and return its path."""
+    from fishgen.atomic import write_bytes
+
+    asset = Path(asset)
+    out = Path(page) if page is not None else page_path(asset)
+    write_bytes(out, build_page(asset, background).encode("utf-8"))
+    return out
