@@ -1,0 +1,56 @@
+#!/usr/bin/env python3
+"""Regenerate the README's renders in docs/images/ with `fishgen preview`.
+
+    python docs/make_renders.py          # every render
+    python docs/make_renders.py --list   # what would be rendered
+
+One still per shipped species (params/*.txt) and per report cloud
+(params/clouds/*.awn), a side-view contact sheet of the species, and a swim
+loop. tests/preview/test_reference.py renders the stills again and compares
+them with these files, so run this script (and look at the images) whenever a
+change is meant to alter how an asset looks.
+"""
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+IMAGES = ROOT / "docs" / "images"
+STILL_SIZE = "640x480"
+
+
+def stills() -> list[tuple[str, list[str]]]:
+    """(output name, `fishgen preview` arguments without -o) for every still render."""
+    inputs = sorted((ROOT / "params").glob("*.txt")) + sorted((ROOT / "params" / "clouds").glob("*.awn"))
+    return [(f"{p.stem}.png", [str(p.relative_to(ROOT)), "--size", STILL_SIZE]) for p in inputs]
+
+
+def extras() -> list[tuple[str, list[str]]]:
+    species = [str(p.relative_to(ROOT)) for p in sorted((ROOT / "params").glob("*.txt"))]
+    out = []
+    if species:
+        out.append(("species-side.png", [*species, "--view", "side", "--size", "400x300"]))
+    if (ROOT / "params" / "bonybream.txt").is_file():
+        out.append(("bonybream-swim.gif", ["params/bonybream.txt", "--frames", "24", "--size", "400x300"]))
+    return out
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--list", action="store_true", help="print the renders and exit")
+    args = parser.parse_args()
+    jobs = stills() + extras()
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    for name, argv in jobs:
+        command = [sys.executable, "-m", "fishgen", "preview", *argv, "-o", str(IMAGES / name)]
+        print(" ".join(["fishgen", "preview", *argv, "-o", f"docs/images/{name}"]))
+        if not args.list:
+            subprocess.run(command, cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

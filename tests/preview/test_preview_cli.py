@@ -1,0 +1,119 @@
+"""`fishgen preview` as a user meets it: outputs, views, sheets, loops and one-line errors."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from tests.conftest import PARAMS, run_cli
+from tests.preview.imagecompare import difference
+
+pytestmark = pytest.mark.usefixtures("gl_available")
+BREAM = PARAMS / "bonybream.txt"
+
+
+def _ok(*args):
+    result = run_cli("preview", *args)
+    assert result.returncode == 0, result.stderr
+    assert "Traceback" not in result.stderr
+    return result
+
+
+def test_default_still_is_800x600_with_a_subject(tmp_path):
+    out = tmp_path / "bream.png"
+    _ok(BREAM, "-o", out)
+    img = np.asarray(Image.open(out).convert("RGB"), np.float32)
+    assert img.shape == (600, 800, 3)
+    background = np.array([0x8C, 0xAD, 0xCC])
+    subject = np.abs(img - background).max(-1) > 10
+    assert 0.05 < subject.mean() < 0.8  # framed: neither lost in the distance nor cropped to fill
+
+
+def test_fish_faces_left_in_side_view(tmp_path):
+    # Field-guide convention; upside-down renders are caught by test_reference.py.
+    out = tmp_path / "side.png"
+    _ok(BREAM, "-o", out, "--view", "side", "--size", "400x300")
+    img = np.asarray(Image.open(out).convert("RGB"), np.float32)
+    eye_x = np.nonzero(img.sum(-1) < 120)[1]  # the pupil is the darkest thing in the picture
+    subject_x = np.nonzero(np.abs(img - np.array([0x8C, 0xAD, 0xCC])).max(-1) > 10)[1]
+    assert len(eye_x) > 0 and eye_x.mean() < subject_x.mean()
+
+
+def test_views_time_and_background_change_the_image(tmp_path):
+    paths = {}
+    for key, extra in {"side": ["--view", "side"], "top": ["--view", "top"],
+                       "front": ["--view", "front"], "posed": ["--view", "side", "--time", "1.0"],
+                       "white": ["--view", "side", "--background", "white"]}.items():
+        paths[key] = tmp_path / f"{key}.png"
+        _ok(BREAM, "-o", paths[key], "--size", "320x240", *extra)
+    for other in ("top", "front", "posed", "white"):
+        assert not difference(paths["side"], paths[other]).within_tolerance, other
+
+
+def test_transparent_background_keeps_alpha(tmp_path):
+    out = tmp_path / "cut.png"
+    _ok(BREAM, "-o", out, "--size", "200x150", "--background", "transparent")
+    alpha = np.asarray(Image.open(out))[..., 3]
+    assert alpha[0, 0] == 0 and alpha.max() == 255
+
+
+def test_contact_sheet_is_a_labelled_grid(tmp_path):
+    out = tmp_path / "sheet.png"
+    _ok(BREAM, PARAMS / "clouds" / "table_4_2.awn", PARAMS / "centroberyx.txt", "-o", out,
+        "--size", "200x150", "--columns", "3")
+    w, h = Image.open(out).size
+    assert w == 600 and 150 < h < 200  # one row of three tiles plus a label strip
+
+
+def test_gif_swim_loop_moves(tmp_path):
+    out = tmp_path / "swim.gif"
+    _ok(BREAM, "-o", out, "--frames", "6", "--size", "200x150", "--view", "top")
+    gif = Image.open(out)
+    assert gif.n_frames == 6
+    frames = []
+    for k in range(6):
+        gif.seek(k)
+        frames.append(np.asarray(gif.convert("RGB"), np.int16))
+    assert any(np.abs(frames[0] - f).max() > 40 for f in frames[1:]), "the fins should move"
+
+
+def test_webp_turntable_of_a_static_cloud(tmp_path):
+    out = tmp_path / "spin.webp"
+    _ok(PARAMS / "clouds" / "table_4_3.awn", "-o", out, "--frames", "4", "--size", "160x120")
+    webp = Image.open(out)
+    assert webp.n_frames == 4
+
+
+def test_help_lists_every_option_with_default():
+    text = " ".join(run_cli("preview", "--help").stdout.split())
+    for option in ("--view", "--size", "--time", "--background", "--frames", "--columns", "--seed",
+                   "--clip", "--textures", "--output"):
+        assert option in text
+    assert "default: 800x600" in text and "default: three-quarter" in text
+
+
+@pytest.mark.parametrize("args,message", [
+    (["-o", "x.bmp"], "expected an output ending in"),
+    (["-o", "x.png", "--frames", "5"], "expected a .gif or .webp output"),
+    (["-o", "x.png", "--size", "800"], "expected --size WxH"),
+    (["-o", "x.png", "--background", "mauvish"], "expected --background"),
+    (["-o", "x.gif", "--background", "transparent"], "expected an opaque --background"),
+    (["-o", "x.png", "--clip", "dance"], "expected --clip to name one of swim"),
+])
+def test_bad_options_are_one_line_errors_and_write_nothing(tmp_path, args, message):
+    args = [a if a not in ("x.bmp", "x.png", "x.gif") else str(tmp_path / a) for a in args]
+    result = run_cli("preview", BREAM, *args)
+    assert result.returncode == 2
+    assert message in result.stderr and "Traceback" not in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_missing_and_bad_inputs_name_the_file(tmp_path):
+    bad = tmp_path / "bad.txt"
+    bad.write_text("this is not a species file\n")
+    for path in (tmp_path / "nope.glb", bad):
+        result = run_cli("preview", path, "-o", tmp_path / "out.png")
+        assert result.returncode == 2, result.stderr
+        assert str(path) in result.stderr and "Traceback" not in result.stderr
+    assert not (tmp_path / "out.png").exists()
