@@ -6,7 +6,7 @@
 The cloud shape is the report's Table 4.4 (23 cubes) with every cube's count
 scaled so the total is N. The baseline is the report's algorithm (section 4.5,
 Figure 4.2) written one particle at a time in plain Python, with the same
-departures as fishgen (docs/decisions-clouds.md), so both do the same work.
+departures as fishgen (docs/decisions.md), so both do the same work.
 It is run only up to --baseline-max particles; larger sizes are compared
 against its rate at the largest measured size (the loop is linear), marked "*".
 """

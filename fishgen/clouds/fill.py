@@ -8,7 +8,7 @@ chunk-sized, so memory stays close to the ~31 bytes per particle of the result.
 
 Positions are drawn in *normalised cube coordinates* ``s`` in [-1, 1] per axis
 (the centred form of eq. 4.4/4.8), shifted by the report's sine phase shifts
-(eq. 4.5-4.7, with the departures listed in docs/decisions-clouds.md), and
+(eq. 4.5-4.7, with the departures listed in docs/decisions.md), and
 redrawn in batches while outside the cube (Figure 4.2).
 """
 from __future__ import annotations

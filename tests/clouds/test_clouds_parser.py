@@ -32,7 +32,7 @@ def test_table_4_3_line_with_missing_comma_parses():
 
 
 def test_axis_order_makes_the_first_cube_a_flat_wide_base():
-    # The decision: sizes are x, y, z extents with y up (docs/decisions-clouds.md).
+    # The decision: sizes are x, y, z extents with y up (docs/decisions.md).
     for table in ("4.3", "4.4"):
         cubes = load_cubes(TABLES[table]).cubes
         base = cubes[0]
