@@ -1,0 +1,159 @@
+"""`fishgen view` in a real headless Chromium: the model loads, plays, and shows something.
+
+Needs Debian's chromium (apt-get install chromium) and the `playwright` package
+from the test extra; Playwright drives the system browser, never a downloaded one.
+"""
+from __future__ import annotations
+
+import io
+import os
+import queue
+import shutil
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from tests.conftest import ROOT
+
+CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium",
+                             shutil.which("chromium")) if p and Path(p).is_file()), None)
+pytestmark = pytest.mark.skipif(CHROMIUM is None,
+                                reason="chromium is not installed (Debian: apt-get install chromium)")
+# The machine has no network and no GPU: no background services, WebGL on SwiftShader.
+ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+        "--disable-background-networking", "--disable-component-update", "--disable-sync",
+        "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+LOAD_TIMEOUT_MS = 30_000
+
+
+@pytest.fixture(scope="module")
+def browser():
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture
+def served():
+    """Start the real `fishgen view ASSET --port 0`; yields a function returning the page URL."""
+    procs = []
+
+    def start(asset: Path) -> str:
+        proc = subprocess.Popen([sys.executable, "-u", "-m", "fishgen", "view", str(asset), "--port", "0"],
+                                cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        procs.append(proc)
+        lines: queue.Queue = queue.Queue()
+        threading.Thread(target=lambda: [lines.put(l) for l in proc.stdout], daemon=True).start()
+        while True:
+            try:
+                line = lines.get(timeout=20)
+            except queue.Empty:
+                pytest.fail(f"fishgen view printed no URL: {proc.stderr.read() if proc.poll() else ''}")
+            if line.startswith("serving "):
+                url = line.split()[1]
+                assert url.startswith("http://127.0.0.1:")
+                return url
+
+    yield start
+    for proc in procs:
+        proc.terminate()
+        proc.wait(timeout=10)
+
+
+def _open(browser, url):
+    page = browser.new_page(viewport={"width": 800, "height": 600})
+    problems, requests = [], []
+    page.on("console", lambda m: problems.append(m.text) if m.type == "error" else None)
+    page.on("pageerror", lambda e: problems.append(str(e)))
+    page.on("request", lambda r: requests.append(r.url))
+    page.goto(url)
+    page.wait_for_function("window.fishgenViewer && (window.fishgenViewer.loaded || window.fishgenViewer.error)",
+                           timeout=LOAD_TIMEOUT_MS)
+    state = page.evaluate("window.fishgenViewer")
+    assert state["error"] is None, state["error"]
+    return page, problems, requests
+
+
+def _canvas(page) -> np.ndarray:
+    shot = page.locator("#view").screenshot()
+    return np.asarray(Image.open(io.BytesIO(shot)).convert("RGB"), np.float32)
+
+
+def _assert_not_blank(img: np.ndarray) -> None:
+    background = np.median(img.reshape(-1, 3), axis=0)
+    subject = np.abs(img - background).max(-1) > 20
+    assert img.std() > 5 and subject.mean() > 0.03, "the canvas shows (almost) nothing but background"
+
+
+def _assert_offline(requests) -> None:
+    outside = [u for u in requests if not u.startswith(("http://127.0.0.1", "blob:", "data:"))]
+    assert not outside, f"the page fetched from outside: {outside[:5]}"
+
+
+def test_fish_loads_plays_scrubs_and_toggles_wireframe(browser, served, viewer_assets):
+    from fishgen.preview.inputs import load_input
+
+    page, problems, requests = _open(browser, served(viewer_assets["fish"]))
+    try:
+        state = page.evaluate("window.fishgenViewer")
+        expected = load_input(viewer_assets["fish"]).counts()
+        assert state["counts"] == expected
+        assert state["clips"] == ["swim"] and state["playing"]
+        assert page.locator("#counts").inner_text().startswith(f"{expected['vertices']} vertices")
+        t0 = page.evaluate("window.fishgenViewer.time")
+        page.wait_for_timeout(600)
+        assert page.evaluate("window.fishgenViewer.time") != t0, "the animation should advance"
+        img = _canvas(page)
+        _assert_not_blank(img)
+
+        page.click("#play")  # pause holds the time still
+        paused = page.evaluate("window.fishgenViewer.time")
+        page.wait_for_timeout(300)
+        assert page.evaluate("window.fishgenViewer.time") == paused
+        page.fill("#time", "2")  # the scrubber poses the clip
+        page.dispatch_event("#time", "input")
+        assert page.evaluate("window.fishgenViewer.time") == pytest.approx(2.0)
+
+        page.check("#wireframe")
+        page.wait_for_timeout(200)
+        assert np.abs(_canvas(page) - img).mean() > 1, "wireframe should change the picture"
+        assert problems == []
+        _assert_offline(requests)
+    finally:
+        page.close()
+
+
+def test_cloud_shows_its_particles(browser, served, viewer_assets):
+    page, problems, requests = _open(browser, served(viewer_assets["cloud"]))
+    try:
+        state = page.evaluate("window.fishgenViewer")
+        assert state["counts"] == {"vertices": 0, "triangles": 0, "particles": viewer_assets["particles"]}
+        assert state["clips"] == [] and page.locator("#play").is_disabled()
+        page.wait_for_timeout(200)
+        _assert_not_blank(_canvas(page))
+        assert problems == []
+        _assert_offline(requests)
+    finally:
+        page.close()
+
+
+def test_page_works_from_disk_without_a_server(browser, viewer_assets):
+    from fishgen.viewer.page import write_page
+
+    page_file = write_page(viewer_assets["obj"])
+    page, problems, requests = _open(browser, page_file.as_uri())
+    try:
+        assert page.evaluate("window.fishgenViewer.counts.triangles") > 0
+        _assert_not_blank(_canvas(page))
+        assert problems == []
+        assert all(u.startswith(("file:", "blob:", "data:")) for u in requests), requests
+    finally:
+        page.close()

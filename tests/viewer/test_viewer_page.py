@@ -1,0 +1,86 @@
+"""The viewer page and server without a browser: what is embedded, where it is written, who may connect."""
+from __future__ import annotations
+
+import base64
+import json
+import re
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from fishgen.errors import FishgenError
+from fishgen.viewer.page import build_page, page_path
+from tests.conftest import ROOT, run_cli
+
+
+def _payload(html: str) -> dict:
+    m = re.search(r'<script type="application/json" id="fishgen-asset">(.*?)</script>', html, re.S)
+    return json.loads(m.group(1))
+
+
+def test_no_serve_writes_only_the_page_beside_the_asset(viewer_assets):
+    result = run_cli("view", viewer_assets["fish"], "--no-serve")
+    assert result.returncode == 0, result.stderr
+    page = page_path(viewer_assets["fish"])
+    assert page.name == "bream.glb.html" and page.is_file()
+    assert "serving" not in result.stdout
+
+
+def test_page_embeds_three_modules_and_the_asset(viewer_assets):
+    html = build_page(viewer_assets["fish"])
+    payload = _payload(html)
+    assert payload["kind"] == "glb"
+    assert base64.b64decode(payload["files"]["bream.glb"]) == viewer_assets["fish"].read_bytes()
+    modules = set(re.findall(r'data-module="([^"]+)"', html))
+    assert {"three", "three/core", "three/addons/loaders/GLTFLoader.js",
+            "three/addons/controls/OrbitControls.js"} <= modules
+    assert not re.search(r'<script[^>]+src=', html), "nothing may be loaded from outside the page"
+
+
+def test_obj_page_carries_its_mtl_and_texture(viewer_assets):
+    payload = _payload(build_page(viewer_assets["obj"]))
+    assert payload["mtl"] == "bream.mtl"
+    assert {"bream.obj", "bream.mtl", "bream_skin.png"} <= set(payload["files"])
+
+
+def test_missing_side_file_is_a_one_line_error(viewer_assets, tmp_path):
+    shutil.copy(viewer_assets["obj"], tmp_path / "lonely.obj")
+    result = run_cli("view", tmp_path / "lonely.obj", "--no-serve")
+    assert result.returncode == 2 and "bream.mtl" in result.stderr and "Traceback" not in result.stderr
+    assert not (tmp_path / "lonely.obj.html").exists()
+
+
+def test_unsupported_asset_is_refused(tmp_path):
+    (tmp_path / "fish.txt").write_text("x")
+    with pytest.raises(FishgenError, match="expected an asset ending in"):
+        build_page(tmp_path / "fish.txt")
+
+
+def test_server_listens_on_loopback_only(tmp_path):
+    from fishgen.viewer.server import make_server
+
+    server = make_server(tmp_path, 0)
+    try:
+        assert server.server_address[0] == "127.0.0.1"
+    finally:
+        server.server_close()
+
+
+def test_help_documents_options():
+    text = " ".join(run_cli("view", "--help").stdout.split())
+    for option in ("--port", "--no-serve", "--output", "--background"):
+        assert option in text
+    assert "default: 8765" in text
+
+
+def test_bundled_three_matches_the_npm_install():
+    if not (ROOT / "node_modules" / "three").is_dir():
+        pytest.fail("node_modules/three is missing: run `npm ci` (the README's test command does)")
+    manifest = json.loads((ROOT / "fishgen" / "viewer" / "static" / "manifest.json").read_text())
+    installed = json.loads((ROOT / "node_modules" / "three" / "package.json").read_text())["version"]
+    assert manifest["three"] == installed
+    check = subprocess.run([sys.executable, "tools/bundle_viewer.py", "--check"], cwd=ROOT,
+                           capture_output=True, text=True)
+    assert check.returncode == 0, "stale bundle: run python tools/bundle_viewer.py\n" + check.stderr
