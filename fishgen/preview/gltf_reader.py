@@ -55,7 +55,9 @@ class _Reader:
     def _uri(self, uri: str) -> bytes:
         if uri.startswith("data:"):
             return base64.b64decode(uri.split(",", 1)[1])
-        target = self.base / uri
+        from urllib.parse import unquote
+
+        target = self.base / unquote(uri)  # glTF URIs are percent-encoded ("my%20skin.png")
         if not target.is_file():
             raise FishgenError(f"expected a file beside the asset, found no {uri!r}", self.where)
         return target.read_bytes()

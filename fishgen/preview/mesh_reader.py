@@ -15,7 +15,7 @@ import numpy as np
 
 from fishgen.errors import FishgenError
 from fishgen.preview.gltf_reader import POINT_SIZE_FRACTION
-from fishgen.preview.scene import Material, MeshPart, PointPart, Scene, srgb_to_linear, vertex_normals
+from fishgen.preview.scene import Material, MeshPart, PointPart, Scene, srgb_to_linear
 
 
 def read_mesh_file(path: str | Path) -> Scene:
@@ -68,8 +68,8 @@ def _mtl_alpha(obj: Path) -> dict[str, tuple[str, float]]:
 def _mesh(geom, alpha: dict[str, tuple[str, float]]) -> MeshPart:
     positions = np.asarray(geom.vertices, np.float32)
     indices = np.asarray(geom.faces, np.uint32)
-    normals = (np.asarray(geom.vertex_normals, np.float32) if "vertex_normals" in geom._cache
-               else vertex_normals(positions, indices))
+    # trimesh keeps the file's normals, or computes smooth ones when it has none
+    normals = np.asarray(geom.vertex_normals, np.float32)
     material, uvs, colors = Material(), None, None
     visual = geom.visual
     if visual.kind == "texture":
@@ -84,7 +84,7 @@ def _mesh(geom, alpha: dict[str, tuple[str, float]]) -> MeshPart:
             diffuse = getattr(mat, "baseColorFactor", None)
         rgba = np.asarray(diffuse if diffuse is not None else [255] * 4, np.float32).ravel()
         rgba = rgba / 255.0 if rgba.max() > 1.0 else rgba
-        rgb = srgb_to_linear(rgba[:3]) if image is None or True else rgba[:3]
+        rgb = srgb_to_linear(rgba[:3])  # MTL Kd is authored as a display (sRGB) colour
         mode, opacity = alpha.get(getattr(mat, "name", None) or "", ("OPAQUE", 1.0))
         material = Material(base_color=(*map(float, rgb), float(opacity)),
                             texture=np.asarray(image.convert("RGBA")) if image is not None and uvs is not None else None,
