@@ -67,7 +67,10 @@ def test_glb_points(cloud, tmp_path, gltf_validator):
     prim = doc["meshes"][0]["primitives"][0]
     assert prim["mode"] == 0 and set(prim["attributes"]) == {"POSITION", "COLOR_0", "_RADIUS", "_DENSITY"}
     np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["POSITION"], "<f4", 3), cloud.centers)
-    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["COLOR_0"], "u1", 3), cloud.colors)
+    # glTF's COLOR_0 is linear; the cloud's colours are sRGB bytes
+    from fishgen.clouds.export.gltf import SRGB_TO_LINEAR
+    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["COLOR_0"], "u1", 3),
+                                  SRGB_TO_LINEAR[cloud.colors])
     np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_RADIUS"], "<f4", 1)[:, 0], cloud.radii)
     np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_DENSITY"], "<f4", 1)[:, 0], cloud.density)
     pygltflib = pytest.importorskip("pygltflib")

@@ -92,6 +92,16 @@ def write_gltf(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = Fals
             handle.write(block)
 
 
+def _srgb_to_linear_lut() -> np.ndarray:
+    c = np.arange(256) / 255.0
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return np.round(lin * 255.0).astype(np.uint8)
+
+
+#: Cloud colours are sRGB bytes (as PLY/CSV carry them); glTF defines COLOR_0 as linear.
+SRGB_TO_LINEAR = _srgb_to_linear_lut()
+
+
 def _pad4(n: int) -> int:
     return (n + 3) & ~3
 
@@ -120,7 +130,7 @@ def _points(cloud: Cloud):
     def colours(a: int, b: int) -> np.ndarray:
         # A VEC3 of bytes is padded to a 4-byte stride, as vertex attributes must be aligned.
         out = np.zeros((b - a, 4), np.uint8)
-        out[:, :3] = cloud.colors[a:b]
+        out[:, :3] = SRGB_TO_LINEAR[cloud.colors[a:b]]
         return out
 
     views = [
@@ -156,7 +166,7 @@ def _billboards(cloud: Cloud):
     def colours(a: int, b: int) -> np.ndarray:
         # Vertex alpha carries the density, so the sprite fades more where the cloud is thin.
         rgba = np.empty((b - a, 4), np.uint8)
-        rgba[:, :3] = cloud.colors[a:b]
+        rgba[:, :3] = SRGB_TO_LINEAR[cloud.colors[a:b]]
         rgba[:, 3] = np.round(cloud.density[a:b] * 255)
         return np.repeat(rgba[:, None, :], 4, axis=1)
 
