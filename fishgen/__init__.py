@@ -16,6 +16,10 @@ _API = {
     "FishAsset": "fishgen.assembly.fish",
     "export": "fishgen.exchange",
     "FishgenError": "fishgen.errors",
+    "load_cubes": "fishgen.clouds",
+    "fill_cloud": "fishgen.clouds",
+    "merge_clouds": "fishgen.clouds",
+    "export_cloud": "fishgen.clouds",
 }
 
 __all__ = sorted(_API)
