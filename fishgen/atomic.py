@@ -2,7 +2,8 @@
 
 A failed or interrupted run never leaves a partial file and never clobbers a
 good one. Multi-file outputs (OBJ + MTL + textures, glTF + bin + images) are
-staged together and renamed only once every part was written.
+staged together and renamed only once every part was written; if a rename
+fails part-way, the targets already replaced get their old contents back.
 """
 from __future__ import annotations
 
@@ -11,18 +12,39 @@ import tempfile
 from pathlib import Path
 from typing import Mapping
 
+from fishgen.errors import FishgenError
+
+
+def _fail(target: Path, err: OSError) -> FishgenError:
+    """An OS error about a temp file or rename, reported against the user's target."""
+    reason = err.strerror or str(err)
+    if target.is_dir():
+        reason = "a folder is in the way"
+    return FishgenError(f"cannot write {target}: {reason}")
+
+
+def _check_target(target: Path) -> None:
+    if target.is_dir():
+        raise FishgenError(f"expected an output file, found a folder at {target}")
+
 
 def _stage(path: Path, data: bytes) -> str:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    _check_target(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as err:
+        raise _fail(path, err) from None
     try:
         with os.fdopen(fd, "wb") as handle:
             handle.write(data)
             handle.flush()
             os.fsync(handle.fileno())
         os.chmod(tmp, 0o644)
-    except BaseException:
+    except BaseException as err:
         _discard(tmp)
+        if isinstance(err, OSError):
+            raise _fail(path, err) from None
         raise
     return tmp
 
@@ -35,18 +57,48 @@ def _discard(tmp: str) -> None:
 
 
 def write_files(files: Mapping[str | os.PathLike, bytes]) -> None:
-    """Write every ``path -> bytes`` entry atomically, all or (as far as possible) nothing."""
+    """Write every ``path -> bytes`` entry atomically: all of them, or none."""
+    targets = [Path(p) for p in files]
+    for target in targets:
+        _check_target(target)
     staged: list[tuple[str, Path]] = []
     try:
-        for path, data in files.items():
-            target = Path(path)
+        for target, data in zip(targets, files.values()):
             staged.append((_stage(target, data), target))
     except BaseException:
         for tmp, _ in staged:
             _discard(tmp)
         raise
-    for tmp, target in staged:
-        os.replace(tmp, target)
+    _commit(staged)
+
+
+def _commit(staged: list[tuple[str, Path]]) -> None:
+    """Rename every staged file over its target, undoing earlier renames if one fails."""
+    backups: list[tuple[str | None, Path]] = []
+    try:
+        for tmp, target in staged:
+            backup = None
+            if len(staged) > 1 and target.is_file():
+                fd, backup = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent)
+                os.close(fd)
+                os.replace(target, backup)
+            backups.append((backup, target))
+            try:
+                os.replace(tmp, target)
+            except OSError as err:
+                raise _fail(target, err) from None
+    except BaseException:
+        for backup, target in reversed(backups):
+            if backup is not None:
+                os.replace(backup, target)
+            elif target.is_file():
+                os.unlink(target)
+        for tmp, _ in staged:
+            _discard(tmp)
+        raise
+    for backup, _ in backups:
+        if backup is not None:
+            _discard(backup)
 
 
 def write_bytes(path: str | os.PathLike, data: bytes) -> None:
@@ -67,9 +119,13 @@ class atomic_open:
         self._handle = None
 
     def __enter__(self):
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, self._tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp",
-                                         dir=self.path.parent)
+        _check_target(self.path)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            fd, self._tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp",
+                                             dir=self.path.parent)
+        except OSError as err:
+            raise _fail(self.path, err) from None
         self._handle = os.fdopen(fd, "wb")
         return self._handle
 
@@ -84,8 +140,13 @@ class atomic_open:
                 os.chmod(self._tmp, 0o644)
                 os.replace(self._tmp, self.path)
                 return False
+        except OSError as err:
+            _discard(self._tmp)
+            raise _fail(self.path, err) from None
         except BaseException:
             _discard(self._tmp)
             raise
         _discard(self._tmp)
+        if isinstance(exc, OSError) and not isinstance(exc, FishgenError):
+            raise _fail(self.path, exc) from None
         return False

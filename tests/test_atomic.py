@@ -1,0 +1,65 @@
+"""Atomic output: all or nothing, no temp files left, errors name the user's target."""
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from fishgen.atomic import atomic_open, write_bytes, write_files
+from fishgen.errors import FishgenError
+
+
+def leftovers(folder):
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith("."))
+
+
+def test_replaces_a_file(tmp_path):
+    target = tmp_path / "a.bin"
+    target.write_bytes(b"old")
+    write_bytes(target, b"new")
+    assert target.read_bytes() == b"new" and leftovers(tmp_path) == []
+
+
+def test_folder_in_the_way_is_refused_before_writing(tmp_path):
+    (tmp_path / "x.glb").mkdir()
+    with pytest.raises(FishgenError, match=r"expected an output file, found a folder at .*x\.glb"):
+        write_bytes(tmp_path / "x.glb", b"data")
+    assert leftovers(tmp_path) == []
+
+
+def test_multi_file_output_is_all_or_nothing(tmp_path):
+    good = tmp_path / "x.gltf"
+    good.write_bytes(b"yesterday")
+    (tmp_path / "x.bin").mkdir()
+    with pytest.raises(FishgenError):
+        write_files({good: b"today", tmp_path / "x.bin": b"buffer"})
+    assert good.read_bytes() == b"yesterday" and leftovers(tmp_path) == []
+
+
+def test_failed_rename_restores_earlier_targets(tmp_path, monkeypatch):
+    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
+    a.write_bytes(b"old a")
+    b.write_bytes(b"old b")
+    real = os.replace
+    calls = []
+
+    def flaky(src, dst):
+        calls.append(dst)
+        if str(dst) == str(b) and str(src).endswith(".tmp"):
+            raise OSError(28, "No space left on device")
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", flaky)
+    with pytest.raises(FishgenError, match="cannot write .*b.txt: No space left on device"):
+        write_files({a: b"new a", b: b"new b"})
+    assert a.read_bytes() == b"old a" and b.read_bytes() == b"old b" and leftovers(tmp_path) == []
+
+
+def test_streaming_writer_discards_on_error(tmp_path):
+    target = tmp_path / "big.ply"
+    target.write_bytes(b"good")
+    with pytest.raises(RuntimeError):
+        with atomic_open(target) as handle:
+            handle.write(b"partial")
+            raise RuntimeError("interrupted")
+    assert target.read_bytes() == b"good" and leftovers(tmp_path) == []
