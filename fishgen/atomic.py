@@ -147,6 +147,4 @@ class atomic_open:
             _discard(self._tmp)
             raise
         _discard(self._tmp)
-        if isinstance(exc, OSError) and not isinstance(exc, FishgenError):
-            raise _fail(self.path, exc) from None
         return False
