@@ -91,7 +91,7 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
         raise FishgenError(f"expected a fin mode ({', '.join(FIN_MODES)}), found {mode!r}")
     if mode == "mask" and not species.textured:
         raise FishgenError("expected a textured species for --fins mask (the mask is a texture), "
-                           "found textured false", species.source)
+                           "found textured false", species.source, species.line_of("shape"))
     if not fps > 0 or fps > 1000:
         raise FishgenError(f"expected --fps in (0, 1000], found {fps}")
     if length is not None and not (0 < length < 1e4):
@@ -118,23 +118,24 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
 
     parts = [Part("body", Mesh(place(body.mesh.positions), body.mesh.faces, body.mesh.uvs), "body",
                   np.zeros(3))]
-    motions = []
+    motions: list[tuple[str, FinMotion]] = []
     for fin in fin_list:
         motion = FinMotion.from_fin(fin.movement_angle, fin.step_size,
                                     -1.0 if fin.mirror_of else 1.0) if fin.pivot is not None else None
         if motion is not None:
             pivot = place(fin.pivot[None, :])[0]
-            motions.append(motion)
+            motions.append((fin.name, motion))
         else:
             pivot = np.zeros(3)
         mesh = Mesh(place(fin.mesh.positions) - pivot, fin.mesh.faces, fin.mesh.uvs)
         parts.append(Part(fin.name, mesh, "fins", pivot, motion))
 
-    frames = clip_frames(motions)
+    frames = clip_frames([m for _, m in motions])
     if frames > MAX_CLIP_FRAMES:
+        slowest, _ = max(motions, key=lambda nm: nm[1].period_frames)
         raise FishgenError(f"expected fin cycles that loop within {MAX_CLIP_FRAMES} frames, found "
-                           f"{frames} (periods {sorted({m.period_frames for m in motions})}); "
+                           f"{frames} (periods {sorted({m.period_frames for _, m in motions})}); "
                            "choose movement angles and step sizes with a small common multiple",
-                           species.source)
+                           species.source, species.line_of(slowest.split("_")[0]))
     return FishAsset(species.name, tuple(parts), make_materials(species, mode),
                      load_textures(species, mode), float(fps), frames, mode, species)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import io
 from dataclasses import dataclass
 
+from fishgen.errors import FishgenError
 from fishgen.species.model import Species
 
 FIN_MODES = ("blend", "mask", "opaque")
@@ -47,16 +48,26 @@ def load_textures(species: Species, mode: str) -> dict[str, bytes]:
 
     if not species.textured or species.colour_texture is None:
         return {}
-    with Image.open(species.colour_texture) as img:
-        colour = ImageOps.flip(img.convert("RGB"))
+    colour = ImageOps.flip(_decode(species, species.colour_texture, "RGB"))
     if mode == "mask":
-        with Image.open(species.mask_texture) as img:
-            mask = ImageOps.flip(img.convert("L"))
+        mask = ImageOps.flip(_decode(species, species.mask_texture, "L"))
         if mask.size != colour.size:
             mask = mask.resize(colour.size, Image.Resampling.NEAREST)
         colour = colour.convert("RGBA")
         colour.putalpha(mask)
     return {"skin": _png(colour)}
+
+
+def _decode(species: Species, path, mode: str):
+    """Decode a whole texture; a damaged file is the species file's error, at its texture line."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as img:
+            return img.convert(mode)
+    except (OSError, ValueError, Image.DecompressionBombError) as err:
+        raise FishgenError(f"expected a readable texture image, found {path.name!r} damaged ({err})",
+                           species.source, species.line_of("texture")) from None
 
 
 def _png(image) -> bytes:

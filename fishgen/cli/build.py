@@ -47,6 +47,17 @@ def build(species_files: tuple[Path, ...], output: Path | None, fmt: str, fins: 
         raise FishgenError(f"expected an output ending in {', '.join(WRITERS)} (or a folder), "
                            f"found {output.name!r}")
     folder = output if output is not None else Path("out")
+    if len(species_files) > 1:
+        if output is not None and output.suffix.lower() in WRITERS:
+            raise FishgenError(f"expected a folder for {len(species_files)} species files, found "
+                               f"{output.name!r} (name a folder and pick the format with --format)")
+        seen: dict[str, Path] = {}
+        for species_file in species_files:
+            if species_file.stem in seen:
+                raise FishgenError(f"expected species files with distinct names for one folder, found "
+                                   f"{seen[species_file.stem]} and {species_file} (both make "
+                                   f"{species_file.stem}.{fmt})")
+            seen[species_file.stem] = species_file
 
     failures = 0
     for species_file in species_files:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from urllib.parse import quote
 
 import numpy as np
 import pygltflib as gl
@@ -150,8 +151,9 @@ def write_glb(asset, path: Path) -> list[Path]:
 def write_gltf(asset, path: Path) -> list[Path]:
     """``.gltf`` JSON with the buffer and textures as files beside it."""
     stem = path.stem
-    gltf, data, images = build_gltf(asset, image_uri=lambda key: f"{stem}_{key}.png")
-    gltf.buffers[0].uri = f"{stem}.bin"
+    # URIs are percent-encoded: a file named "a b.bin" is referenced as "a%20b.bin".
+    gltf, data, images = build_gltf(asset, image_uri=lambda key: quote(f"{stem}_{key}.png"))
+    gltf.buffers[0].uri = quote(f"{stem}.bin")
     files = {path: _json(gltf), path.with_name(f"{stem}.bin"): data}
     for key, png in images.items():
         files[path.with_name(f"{stem}_{key}.png")] = png

@@ -8,9 +8,20 @@ import numpy as np
 from fishgen.atomic import write_files
 
 
-def _rows(prefix: str, values: np.ndarray) -> str:
-    fmt = prefix + " " + " ".join(["%.6f"] * values.shape[1])
-    return "\n".join(fmt % tuple(row) for row in values.tolist())
+def _rows(prefix: str, values: np.ndarray, fmt: str = "%.6f") -> str:
+    """All rows in one C-level formatting pass (a per-row Python loop is 5x slower)."""
+    if len(values) == 0:
+        return ""
+    row = prefix + (" " + fmt) * values.shape[1] + "\n"
+    return (row * len(values) % tuple(values.ravel().tolist()))[:-1]
+
+
+def _face_rows(faces: np.ndarray) -> str:
+    """``f a/a/a b/b/b c/c/c`` rows: position, texture and normal share one index."""
+    if len(faces) == 0:
+        return ""
+    row = "f %d/%d/%d %d/%d/%d %d/%d/%d\n"
+    return (row * len(faces) % tuple(np.repeat(faces, 3, axis=1).ravel().tolist()))[:-1]
 
 
 def write_obj(asset, path: Path) -> list[Path]:
@@ -23,8 +34,7 @@ def write_obj(asset, path: Path) -> list[Path]:
         n = len(mesh.positions)
         uv = mesh.uvs.copy()
         uv[:, 1] = 1.0 - uv[:, 1]          # OBJ's texture origin is bottom-left
-        f = mesh.faces + offset + 1
-        face_rows = "\n".join(f"f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}" for a, b, c in f.tolist())
+        face_rows = _face_rows(mesh.faces + offset + 1)
         lines += [f"o {part.name}", _rows("v", mesh.positions), _rows("vt", uv), _rows("vn", mesh.normals),
                   f"usemtl {part.material}", "s 1", face_rows]
         offset += n

@@ -29,7 +29,9 @@ def write_ply(asset, path: Path) -> list[Path]:
     faces["n"] = 3
     faces["v"] = faces_idx
     texture = f"{path.stem}_skin.png" if "skin" in asset.images else None
-    header = ["ply", "format binary_little_endian 1.0", f"comment fishgen {asset.name} rest pose, metres, +Y up"]
+    # A PLY header is ASCII: non-ASCII names are escaped rather than refused.
+    name = asset.name.encode("ascii", "backslashreplace").decode("ascii")
+    header = ["ply", "format binary_little_endian 1.0", f"comment fishgen {name} rest pose, metres, +Y up"]
     if texture:
         header.append(f"comment TextureFile {texture}")
     header += [f"element vertex {len(vertices)}"] + [f"property float {n}" for n in VERTEX.names]

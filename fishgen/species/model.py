@@ -138,3 +138,8 @@ class Species:
     texture_points: TexturePoints | None = None
     behaviour: Behaviour | None = None
     source: Path | None = field(default=None, compare=False)
+    #: line number of each record ("shape", "caudal", "pelvic", "pectoral", "texture")
+    record_lines: dict[str, int] = field(default_factory=dict, compare=False, repr=False)
+
+    def line_of(self, record: str) -> int | None:
+        return self.record_lines.get(record)

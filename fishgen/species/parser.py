@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import stat
 import unicodedata
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,6 +21,12 @@ from fishgen.species.model import (Behaviour, CaudalFin, PectoralFin, PelvicFin,
 #: Largest level of detail accepted; refused before anything is allocated.
 MAX_SECTIONS = 1024
 MAX_SPECIES_FILE_BYTES = 16 * 1024 * 1024
+#: No value in a species file is meaningful beyond this; larger ones would overflow
+#: float32 geometry long before anything is drawn.
+MAX_MAGNITUDE = 1e6
+MAX_WORLD_SCALE = 1e4
+MAX_SCALE = 100.0
+MAX_FIN_LENGTH = 100.0
 
 
 @dataclass(frozen=True)
@@ -37,10 +44,14 @@ class _Reader:
 
     def __init__(self, text: str, file: str):
         self.file = file
-        self.lines = [_Line(n, raw.strip()) for n, raw in enumerate(text.splitlines(), 1)
+        # Only \n, \r\n and \r end a line: str.splitlines() would also split on form
+        # feeds and U+2028 inside comments, and the line numbers would drift.
+        raw_lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+        self.lines = [_Line(n, raw.strip()) for n, raw in enumerate(raw_lines, 1)
                       if raw.strip() and not raw.lstrip().startswith("//")]
         self.pos = 0
-        self.last_line = text.count("\n") + 1
+        self.record_lines: dict[str, int] = {}
+        self.last_line = len(raw_lines)
 
     def peek(self) -> _Line | None:
         return self.lines[self.pos] if self.pos < len(self.lines) else None
@@ -49,7 +60,8 @@ class _Reader:
         number = line.number if line else self.last_line
         return FishgenError(f"expected {what}, found {found}", self.file, number)
 
-    def record(self, what: str, count: int | None = None, at_least: int | None = None) -> _Line:
+    def record(self, what: str, count: int | None = None, at_least: int | None = None,
+               key: str | None = None) -> _Line:
         line = self.peek()
         if line is None:
             raise self.error(None, what, "end of file (the file is truncated)")
@@ -58,6 +70,8 @@ class _Reader:
         if (count is not None and n != count) or (at_least is not None and n < at_least):
             wanted = f"{count}" if count is not None else f"at least {at_least}"
             raise self.error(line, f"{what} ({wanted} values)", _found_values(line))
+        if key is not None:
+            self.record_lines[key] = line.number
         return line
 
 
@@ -67,9 +81,12 @@ def _hint(token: str) -> str:
         c = odd[0]
         name = unicodedata.name(c, "unnamed character")
         return f" (U+{ord(c):04X} {name}: a misprinted digit?)"
-    if token[:1].isalpha() and len(token) > 1:
+    if token[:1].isalpha() and len(token) > 1 and token.lower() not in _NOT_WORDS:
         return " (a wrapped comment line? every comment line must start with //)"
     return ""
+
+
+_NOT_WORDS = {"nan", "inf", "infinity", "true", "false", "yes", "no"}
 
 
 def _found_values(line: _Line) -> str:
@@ -100,7 +117,7 @@ class _Fields:
         token = self.tokens[i]
         return self.reader.error(self.line, f"{self.names[i]} as {what}", f"{token!r}{_hint(token)}")
 
-    def number(self, i: int, low: float | None = None, high: float | None = None,
+    def number(self, i: int, low: float = -MAX_MAGNITUDE, high: float = MAX_MAGNITUDE,
                open_low: bool = False) -> float:
         try:
             value = float(self.tokens[i])
@@ -108,11 +125,9 @@ class _Fields:
             raise self._fail(i, "a number") from None
         if not math.isfinite(value):
             raise self._fail(i, "a finite number")
-        if (low is not None and (value < low or (open_low and value == low))) or \
-                (high is not None and value > high):
-            lo = "" if low is None else (f"> {low:g}" if open_low else f">= {low:g}")
-            hi = "" if high is None else f"<= {high:g}"
-            raise self._fail(i, "a number " + " and ".join(x for x in (lo, hi) if x))
+        if value < low or (open_low and value == low) or value > high:
+            lo = f"> {low:g}" if open_low else f">= {low:g}"
+            raise self._fail(i, f"a number {lo} and <= {high:g}")
         return value
 
     def whole(self, i: int, low: int = 0, high: int | None = None, what: str = "a whole number") -> int:
@@ -164,8 +179,8 @@ def _vertical(reader: _Reader, label: str, bodies: int) -> VerticalFin:
     f = _Fields(reader, line, [f"{label} {n}" for n in VERTICAL])
     start = f.whole(0, 0, bodies - 1, "a BodySection number")
     end = f.whole(1, start, bodies - 1, f"a BodySection number (from startBodySection {start})")
-    return VerticalFin(start, end, f.number(2, 0), f.number(3, 0), f.number(4, -180, 180),
-                       f.number(5, 0, 1))
+    return VerticalFin(start, end, f.number(2, 0, MAX_FIN_LENGTH), f.number(3, 0, MAX_FIN_LENGTH),
+                       f.number(4, -180, 180), f.number(5, 0, 1))
 
 
 def _points(reader: _Reader, label: str, expected: int, why: str) -> tuple[tuple[float, float], ...]:
@@ -178,7 +193,7 @@ def _points(reader: _Reader, label: str, expected: int, why: str) -> tuple[tuple
     for _ in range(count):
         pl = reader.record(f"a {label} texture point `u v`", 2)
         pf = _Fields(reader, pl, ("u", "v"))
-        points.append((pf.number(0), pf.number(1)))
+        points.append((pf.number(0, 0, 1), pf.number(1, 0, 1)))
     return tuple(points)
 
 
@@ -197,7 +212,7 @@ def _body_points(reader: _Reader, bodies: int, circles: int) -> tuple[tuple[floa
             if pf.whole(0) != j or pf.whole(1) != i:
                 raise reader.error(pl, f"body texture point for section {j}, circle {i}",
                                    f"section {pl.tokens[0]}, circle {pl.tokens[1]}")
-            points.append((pf.number(2), pf.number(3)))
+            points.append((pf.number(2, 0, 1), pf.number(3, 0, 1)))
     return tuple(points)
 
 
@@ -213,7 +228,7 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     line = reader.record(f"the header record `{' '.join(HEADER)}`", 7)
     f = _Fields(reader, line, HEADER)
     name = line.tokens[0]
-    world_scale = f.number(1, 0, open_low=True)
+    world_scale = f.number(1, 0, MAX_WORLD_SCALE, open_low=True)
     urge = f.number(2)
     start = f.vec(3, 3)
     cube = f.number(6)
@@ -222,7 +237,7 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     f = _Fields(reader, line, ("red", "green", "blue"))
     colour = (f.number(0, 0, 1), f.number(1, 0, 1), f.number(2, 0, 1))
 
-    line = reader.record(f"the shape record `{' '.join(SHAPE)}`", at_least=7)
+    line = reader.record(f"the shape record `{' '.join(SHAPE)}`", at_least=7, key="shape")
     f = _Fields(reader, line, SHAPE + tuple(f"shape parameter {k + 1}" for k in range(len(line.tokens))))
     shape_class = line.tokens[0]
     known = _shape_classes()
@@ -240,15 +255,17 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
 
     line = reader.record("the body scale record `scaleX scaleY scaleZ`", 3)
     f = _Fields(reader, line, ("scaleX", "scaleY", "scaleZ"))
-    scale = tuple(f.number(k, 0, open_low=True) for k in range(3))
+    scale = tuple(f.number(k, 0, MAX_SCALE, open_low=True) for k in range(3))
 
-    line = reader.record("the caudal fin record (13 values)", 13)
+    line = reader.record("the caudal fin record", 13, key="caudal")
     f = _Fields(reader, line, [f"caudal {n}" for n in CAUDAL])
     caudal = CaudalFin(
-        top_line=f.number(0, 0), middle_line=f.number(1, 0), top_angle=f.number(2, -180, 180),
+        top_line=f.number(0, 0, MAX_FIN_LENGTH), middle_line=f.number(1, 0, MAX_FIN_LENGTH),
+        top_angle=f.number(2, -180, 180),
         top_triangles=f.whole(3, 1, 256, "a number of triangles"),
-        connection=(f.number(4, 0, 1), f.number(5), f.number(6)), rotation_angle=f.number(7, -180, 180),
-        bottom_line=f.number(8, 0), bottom_angle=f.number(9, -180, 180),
+        connection=(f.number(4, 0, 1), f.number(5, -1, 1), f.number(6, -1, 1)),
+        rotation_angle=f.number(7, -180, 180),
+        bottom_line=f.number(8, 0, MAX_FIN_LENGTH), bottom_angle=f.number(9, -180, 180),
         bottom_triangles=f.whole(10, 1, 256, "a number of triangles"),
         movement_angle=f.number(11, 0, 90), step_size=f.number(12, 0))
     _check_motion(reader, line, f, 11, 12)
@@ -256,24 +273,26 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     adipose = _vertical(reader, "adipose fin", bodies)
     dorsal = _vertical(reader, "dorsal fin", bodies)
 
-    line = reader.record(f"the pelvic fin record `{' '.join(PELVIC)}`", 8)
+    line = reader.record(f"the pelvic fin record `{' '.join(PELVIC)}`", 8, key="pelvic")
     f = _Fields(reader, line, [f"pelvic {n}" for n in PELVIC])
     p_circle = f.whole(0, 0, circles - 1, "a CircleSection number")
     p_start = f.whole(1, 0, bodies - 1, "a BodySection number")
     p_end = f.whole(2, p_start, bodies - 1, f"a BodySection number (from startBodySection {p_start})")
-    pelvic = PelvicFin(p_circle, p_start, p_end, f.number(3, 0), f.number(4, 0), f.number(5, -180, 180),
+    pelvic = PelvicFin(p_circle, p_start, p_end, f.number(3, 0, MAX_FIN_LENGTH),
+                       f.number(4, 0, MAX_FIN_LENGTH), f.number(5, -180, 180),
                        f.number(6, 0, 90), f.number(7, 0))
     _check_motion(reader, line, f, 6, 7)
 
     anal = _vertical(reader, "anal fin", bodies)
 
-    line = reader.record(f"the pectoral fin record `{' '.join(PECTORAL)}`", 9)
+    line = reader.record(f"the pectoral fin record `{' '.join(PECTORAL)}`", 9, key="pectoral")
     f = _Fields(reader, line, [f"pectoral {n}" for n in PECTORAL])
     pectoral = PectoralFin(
         start_section=f.whole(0, 0, bodies - 1, "a BodySection number"),
         start_circle=f.whole(1, 0, circles - 1, "a CircleSection number"),
         triangles=f.whole(2, 1, circles - 1, "a number of triangles (each spans one CircleSection)"),
-        start_length=f.number(3, 0), start_angle=f.number(4, -180, 180), proportion=f.number(5, 0, 1),
+        start_length=f.number(3, 0, MAX_FIN_LENGTH), start_angle=f.number(4, -180, 180),
+        proportion=f.number(5, 0, 1),
         version=f.number(6), movement_angle=f.number(7, 0, 90), step_size=f.number(8, 0))
     _check_motion(reader, line, f, 7, 8)
 
@@ -283,7 +302,7 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     nxt = reader.peek()
     has_texture_block = textured or (nxt is not None and len(nxt.tokens) == 2 and not _is_number(nxt.tokens[0]))
     if has_texture_block:
-        line = reader.record("the texture record `texture_file black_and_white_file`", 2)
+        line = reader.record("the texture record `texture_file black_and_white_file`", 2, key="texture")
         if textured and textures is not None:
             colour_tex = textures(line.tokens[0], line)
             mask_tex = textures(line.tokens[1], line)
@@ -313,7 +332,7 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     velocity = _Fields(reader, line, ("vx", "vy", "vz")).vec(0, 3)
     line = reader.record(f"the urge weightings record `{' '.join(URGES)}`", 7)
     urges = _Fields(reader, line, URGES).vec(0, 7)
-    line = reader.record("the flee record (2 values)", 2)
+    line = reader.record("the flee record", 2)
     flee = _Fields(reader, line, ("flee 1", "flee 2")).vec(0, 2)
     extra = reader.peek()
     if extra is not None:
@@ -326,7 +345,8 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
         catchfish_test=catch, scale=scale, caudal=caudal, adipose=adipose, dorsal=dorsal,
         pelvic=pelvic, anal=anal, pectoral=pectoral, transparency=transparency,
         colour_texture=colour_tex, mask_texture=mask_tex, texture_points=points,
-        behaviour=Behaviour(velocity, *urges, flee=flee), source=Path(file))
+        behaviour=Behaviour(velocity, *urges, flee=flee), source=Path(file),
+        record_lines=dict(reader.record_lines))
 
 
 def _check_motion(reader: _Reader, line: _Line, f: _Fields, angle: int, step: int) -> None:
@@ -387,11 +407,14 @@ def load_species(path: str | os.PathLike, textures_dir: str | os.PathLike | None
     path = Path(path)
     file = os.fspath(path)
     try:
-        size = path.stat().st_size
-        if size > MAX_SPECIES_FILE_BYTES:
+        if not stat.S_ISREG(path.stat().st_mode):
+            raise FishgenError("expected a regular species file, found a device, pipe or other special file",
+                               file)
+        with path.open("rb") as handle:
+            data = handle.read(MAX_SPECIES_FILE_BYTES + 1)
+        if len(data) > MAX_SPECIES_FILE_BYTES:
             raise FishgenError(f"expected a species file of at most {MAX_SPECIES_FILE_BYTES} bytes, "
-                               f"found {size} bytes", file, 1)
-        data = path.read_bytes()
+                               "found a larger file", file, 1)
     except FileNotFoundError:
         raise FishgenError("expected a species file, found no such file", file) from None
     except IsADirectoryError:

@@ -128,3 +128,13 @@ def test_untextured_species_uses_its_colour(bony):
 def test_bad_options(bony, kwargs):
     with pytest.raises(FishgenError):
         build_fish(bony, **kwargs)
+
+
+def test_loop_length_error_points_at_the_fin_record():
+    text = (PARAMS / "bonybream.txt").read_text().replace("3.0 10.0 1.0\n", "3.0 10.0 0.0001\n")
+    from fishgen.species.parser import parse_species
+    sp = parse_species(text, "slow.txt")
+    with pytest.raises(FishgenError) as info:
+        build_fish(sp)
+    caudal_line = next(i for i, l in enumerate(text.splitlines(), 1) if l.endswith("3.0 10.0 0.0001"))
+    assert info.value.line == caudal_line and "loop within 100000 frames" in str(info.value)

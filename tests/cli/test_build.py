@@ -96,3 +96,47 @@ def test_batch_builds_every_good_file_and_reports_each_bad_one(tmp_path):
     assert len(errors) == 1 and ":1: expected the header record" in errors[0]
     assert "Traceback" not in result.stderr
     assert_valid_gltf(out / "bonybream.gltf", out / "pineapplefish.gltf")
+
+
+def test_batch_refuses_two_files_that_would_write_one_output(tmp_path):
+    for sub in ("a", "b"):
+        (tmp_path / sub).mkdir()
+        shutil.copy(PARAMS / "bonybream.txt", tmp_path / sub / "fish.txt")
+    result = run_cli("build", tmp_path / "a" / "fish.txt", tmp_path / "b" / "fish.txt", "-o", tmp_path / "out")
+    assert result.returncode == 2 and "distinct names" in result.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_batch_refuses_a_file_name_as_its_folder(tmp_path):
+    result = run_cli("build", PARAMS / "bonybream.txt", PARAMS / "centroberyx.txt", "-o", tmp_path / "two.glb")
+    assert result.returncode == 2 and "expected a folder for 2 species files" in result.stderr
+    assert not (tmp_path / "two.glb").exists()
+
+
+def test_damaged_texture_is_reported_at_the_texture_line_and_the_batch_goes_on(tmp_path):
+    species = _species_copy(tmp_path)
+    png = (ROOT / "textures" / "bonybream.png").read_bytes()
+    (tmp_path / "bonybream.png").write_bytes(png[: len(png) // 3])
+    result = run_cli("build", species, PARAMS / "centroberyx.txt", "-o", tmp_path / "batch")
+    assert result.returncode == 2
+    line = next(i for i, l in enumerate(species.read_text().splitlines(), 1) if l.startswith("bonybream.png"))
+    assert f"{species}:{line}: expected a readable texture image, found 'bonybream.png' damaged" in result.stderr
+    assert (tmp_path / "batch" / "centroberyx.glb").is_file() and not (tmp_path / "batch" / "fish.glb").exists()
+
+
+def test_output_names_that_need_percent_encoding(tmp_path):
+    out = tmp_path / "a b#1.gltf"
+    assert run_cli("build", PARAMS / "pineapplefish.txt", "-o", out).returncode == 0
+    assert_valid_gltf(out)
+
+
+def test_output_onto_a_folder_leaves_nothing_behind(tmp_path):
+    (tmp_path / "x.glb").mkdir()
+    result = run_cli("build", PARAMS / "bonybream.txt", "-o", tmp_path / "x.glb")
+    assert result.returncode == 2 and "found a folder at" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["x.glb"]
+
+
+def test_special_files_are_refused_without_reading(tmp_path):
+    result = run_cli("build", "/dev/zero", "-o", tmp_path / "x.glb")
+    assert result.returncode == 2 and "expected a regular species file" in result.stderr

@@ -220,3 +220,24 @@ def test_absurd_texture_size_is_refused_from_its_header(tmp_path):
     Image.new("1", (9000, 8)).save(tmp_path / "bonybream_mask.png")
     with pytest.raises(FishgenError, match="at most 8192 pixels a side, found 'bonybream_mask.png' 9000x8"):
         load_species(path)
+
+
+@pytest.mark.parametrize("old,new,needle", [
+    ("0.26 0.1 0.04", "1e300 0.1 0.04", "scaleX as a number > 0 and <= 100"),
+    ("bonybream 25.5", "bonybream 1e308", "world_scale as a number > 0 and <= 10000"),
+    ("0 0 0.015625 0.3046875", "0 0 1e300 -1e300", "u as a number >= 0 and <= 1"),
+    ("7.0 10.0 0.6 0.05 70.0 0.98", "7.0 10.0 6e6 0.05 70.0 0.98", "startLength as a number >= 0 and <= 100"),
+])
+def test_values_beyond_any_sensible_size_are_refused(tmp_path, old, new, needle):
+    err = error_of(tmp_path, replace_record(BONY, old, new))
+    assert needle in str(err) and err.line == line_number(replace_record(BONY, old, new), new)
+
+
+def test_form_feed_in_a_comment_does_not_split_the_line():
+    text = BONY.replace("//fish_colours_RGB", "//fish_colours\x0cRGB \u2028 (yellow)")
+    assert parse_species(text, "ff.txt").colour == (1.0, 1.0, 0.0)
+
+
+def test_nan_gets_no_wrapped_comment_hint(tmp_path):
+    err = error_of(tmp_path, replace_record(BONY, "0.26 0.1 0.04", "0.26 nan 0.04"))
+    assert "wrapped comment" not in str(err) and "scaleY as a finite number" in str(err)
