@@ -241,3 +241,10 @@ def test_form_feed_in_a_comment_does_not_split_the_line():
 def test_nan_gets_no_wrapped_comment_hint(tmp_path):
     err = error_of(tmp_path, replace_record(BONY, "0.26 0.1 0.04", "0.26 nan 0.04"))
     assert "wrapped comment" not in str(err) and "scaleY as a finite number" in str(err)
+
+
+def test_body_point_split_across_lines_is_still_a_value_count_error(tmp_path):
+    text = replace_record(BONY, "1 0 0.064453125 0.32421875\n1 1 0.064453125 0.296875\n",
+                          "1 0 0.064453125\n0.32421875 1 1 0.064453125 0.296875\n")
+    err = error_of(tmp_path, text)
+    assert err.line == line_number(text, "1 0 0.064453125") and "(4 values), found 3 values" in str(err)
