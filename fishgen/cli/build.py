@@ -13,7 +13,7 @@ FORMATS = ("glb", "gltf", "obj", "ply")
                 type=click.Path(dir_okay=False, path_type=Path), metavar="SPECIES_FILE...")
 @click.option("-o", "--output", type=click.Path(path_type=Path), default=None,
               help="Output file for one species (its extension picks the format: .glb, .gltf, .obj, "
-                   ".ply), or a folder for several. [default: out/<species name>.<format>]")
+                   ".ply), or a folder for several. [default: out/<species file stem>.<format>]")
 @click.option("--format", "fmt", type=click.Choice(FORMATS), default="glb",
               help="Format when writing into a folder.")
 @click.option("--fins", type=click.Choice(["blend", "mask", "opaque"]), default=None,
