@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import stat
 import warnings
 from pathlib import Path
 
@@ -22,6 +23,16 @@ _SEPARATOR = re.compile(r"[ \t]*,[ \t]*|[ \t]+")
 _INTEGER = re.compile(r"[+-]?[0-9]+")
 _REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _CONTROL = re.compile(rb"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
+_LINE_END = re.compile(r"\r\n|\r|\n")  # Unix, Windows and old Mac files alike
+_LINE_END_BYTES = re.compile(rb"\r\n|\r|\n")
+
+MAX_FILE_BYTES = 16 << 20
+"""A cube file is a few KB; refuse anything bigger before reading it all. (64 MiB of minimal
+cube lines took 63 s and 3 GB to parse, so the cap is 16 MiB, with MAX_CUBES below.)"""
+MAX_CUBES = 100_000
+"""The editor's files hold tens of cubes; more is refused at line 2, before any cube is parsed."""
+MAX_DIGITS = 18
+"""Longer whole numbers are far beyond any particle limit (and int() refuses > 4300 digits)."""
 
 _FLOAT32_MAX = 3.4028234663852886e38
 _FLOAT32_TINY = 1.1754943508222875e-38
@@ -37,38 +48,91 @@ class CubeFileWarning(UserWarning):
 def load_cubes(path: str | os.PathLike, *, max_particles: int = DEFAULT_MAX_PARTICLES) -> CubeFile:
     """Read and check a .awn cube file; raise FishgenError naming FILE:LINE on bad input."""
     name = os.fspath(path)
+    return parse_cubes(_read_capped(name), name, max_particles=max_particles)
+
+
+def _read_capped(name: str) -> bytes:
+    """The file's bytes: only a regular file, and at most MAX_FILE_BYTES of it.
+
+    Devices (/dev/zero), FIFOs and sockets never end or block, so they are refused
+    by fstat before any read; O_NONBLOCK keeps opening a FIFO from waiting for a writer.
+    At most MAX_FILE_BYTES + 1 bytes are read, so a growing file cannot eat memory.
+    """
     try:
-        data = Path(path).read_bytes()
+        fd = os.open(name, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except (FileNotFoundError, NotADirectoryError):
+        raise FishgenError("expected an existing cube file, found no such file", name) from None
     except IsADirectoryError:
         raise FishgenError("expected a cube file, found a directory", name) from None
-    except FileNotFoundError:
-        raise FishgenError("expected an existing cube file, found no such file", name) from None
-    return parse_cubes(data, name, max_particles=max_particles)
+    except OSError as err:
+        raise FishgenError(f"expected a readable cube file, found {_reason(err)}", name) from None
+    try:
+        mode = os.fstat(fd).st_mode
+    except OSError:
+        os.close(fd)
+        raise
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        raise FishgenError(f"expected a cube file, found {_file_kind(mode)}", name)
+    with os.fdopen(fd, "rb", buffering=0) as handle:
+        chunks, left = [], MAX_FILE_BYTES + 1
+        try:
+            while left > 0:
+                chunk = handle.read(min(left, 1 << 20))
+                if not chunk:
+                    break
+                chunks.append(chunk)
+                left -= len(chunk)
+        except OSError as err:
+            raise FishgenError(f"expected a readable cube file, found {_reason(err)}", name) from None
+    data = b"".join(chunks)
+    if len(data) > MAX_FILE_BYTES:
+        raise FishgenError(f"expected a cube file of at most {MAX_FILE_BYTES >> 20} MiB "
+                           "(a cube file is a few KB), found a larger file", name)
+    return data
+
+
+def _file_kind(mode: int) -> str:
+    if stat.S_ISDIR(mode):
+        return "a directory"
+    if stat.S_ISFIFO(mode):
+        return "a pipe (FIFO)"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "a special file"
+
+
+def _reason(err: OSError) -> str:
+    return (err.strerror or type(err).__name__).lower()
 
 
 def parse_cubes(data: bytes, name: str = "<cubes>", *,
                 max_particles: int = DEFAULT_MAX_PARTICLES) -> CubeFile:
     """Parse the bytes of a cube file; ``name`` is used in messages."""
     text = _decode(data, name)
-    rows = [(number, line.strip(" \t\r")) for number, line in enumerate(text.split("\n"), 1)]
-    rows = [(number, line) for number, line in rows if line]
+    rows = [(number, row) for number, line in enumerate(_LINE_END.split(text), 1)
+            if (row := line.strip(" \t"))]
     if not rows:
         raise expected("the total particle count on line 1", "an empty file", name, 1)
 
-    declared_total = _header(rows[0], "the total particle count", name)
+    declared_total = _header(rows[0], "total particle count", name)
     if declared_total > max_particles:
         raise _over_limit(declared_total, max_particles, name, rows[0][0])
     if len(rows) < 2:
         raise expected("the number of cubes on the next line", "the end of the file",
                        name, rows[0][0] + 1)
-    declared_cubes = _header(rows[1], "the number of cubes", name)
+    declared_cubes = _header(rows[1], "number of cubes", name)
     if declared_cubes == 0:
         raise expected("at least 1 cube", "0", name, rows[1][0])
+    if declared_cubes > MAX_CUBES:
+        raise expected(f"at most {MAX_CUBES:,} cubes", f"{declared_cubes:,}", name, rows[1][0])
 
     cube_rows = rows[2:]
     if len(cube_rows) > declared_cubes:
         extra = cube_rows[declared_cubes][0]
-        raise expected(f"the end of the file after the {declared_cubes} cubes declared on line "
+        raise expected(f"the end of the file after the {declared_cubes:,} cubes declared on line "
                        f"{rows[1][0]}", "another cube line", name, extra)
     if len(cube_rows) < declared_cubes:
         last = cube_rows[-1][0] if cube_rows else rows[1][0]
@@ -106,7 +170,7 @@ def _decode(data: bytes, name: str) -> str:
         position = min(err.start, bad.start()) if bad else err.start
     if position is None:
         return text
-    line = data[:position].count(b"\n") + 1
+    line = len(_LINE_END_BYTES.findall(data, 0, position)) + 1
     raise expected("a text cube file", "binary data", name, line)
 
 
@@ -118,18 +182,24 @@ def _header(row: tuple[int, str], what: str, name: str) -> int:
     number, line = row
     fields = _fields(line)
     if len(fields) != 1:
-        raise expected(f"1 field ({what})", f"{len(fields)} fields", name, number)
+        raise expected(f"1 field (the {what})", f"{len(fields)} fields", name, number)
     return _count(fields[0], what, name, number)
 
 
 def _count(token: str, what: str, name: str, number: int) -> int:
+    """A whole number of 0 or more; ``what`` has no article ("particle count")."""
+    if token == "":
+        raise expected(f"a whole number for the {what}", "an empty field", name, number)
     if not _INTEGER.fullmatch(token):
-        _reject_non_number(token, what, name, number)
         raise expected(f"a whole number for the {what}", describe(token), name, number)
-    value = int(token)
-    if value < 0:
-        raise expected(f"a {what} of 0 or more", describe(token), name, number)
-    return value
+    negative = token.startswith("-") and token.strip("+-0") != ""
+    if negative:
+        raise expected(f"a whole number of 0 or more for the {what}", describe(token), name, number)
+    digits = token.lstrip("+-").lstrip("0")
+    if len(digits) > MAX_DIGITS:  # int() would refuse 4300+ digits; no limit is this large
+        raise expected(f"a whole number of at most {MAX_DIGITS} digits for the {what}",
+                       f"a number with {len(digits):,} digits", name, number)
+    return int(digits or "0")
 
 
 def _real(token: str, what: str, name: str, number: int, positive: bool) -> float:
@@ -143,7 +213,8 @@ def _real(token: str, what: str, name: str, number: int, positive: bool) -> floa
         raise expected(f"a {what} greater than 0", describe(token), name, number)
     # Particles are stored as float32: values it cannot hold would turn into 0 or infinity.
     if abs(value) > _FLOAT32_MAX or (positive and value < _FLOAT32_TINY):
-        raise expected(f"a {what} within float32 range ({_FLOAT32_TINY:.3g} to {_FLOAT32_MAX:.3g})",
+        low = f"{_FLOAT32_TINY:.3g}" if positive else f"{-_FLOAT32_MAX:.3g}"
+        raise expected(f"a {what} within float32 range ({low} to {_FLOAT32_MAX:.3g})",
                        describe(token), name, number)
     return value
 
@@ -163,7 +234,7 @@ def _cube(line: str, name: str, number: int) -> Cube:
     fields = _fields(line)
     if len(fields) != len(CUBE_FIELDS):
         raise expected(f"{len(CUBE_FIELDS)} fields (particles, x y z size, centre x y z, "
-                       "maximum radius)", f"{len(fields)}", name, number)
+                       "maximum radius)", f"{len(fields)} fields", name, number)
     particles = _count(fields[0], CUBE_FIELDS[0], name, number)
     size = tuple(_real(fields[i], CUBE_FIELDS[i], name, number, True) for i in (1, 2, 3))
     centre = tuple(_real(fields[i], CUBE_FIELDS[i], name, number, False) for i in (4, 5, 6))

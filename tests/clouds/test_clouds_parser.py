@@ -50,6 +50,17 @@ def test_separators_crlf_bom_tabs_and_blank_lines(write_awn):
     assert cubes.cubes[1].size == (2.0, 2.0, 2.0)
 
 
+@pytest.mark.parametrize("ending", ["\n", "\r\n", "\r"], ids=["LF", "CRLF", "CR (old Mac)"])
+def test_every_line_ending_parses_with_the_same_line_numbers(write_awn, ending):
+    text = ending.join(["3", "", "2", "1 1 1 1 0 0 0 1", "2, 2, 2, 2, 1, 1, 1, 0.5", ""])
+    cubes = load_cubes(write_awn(text))
+    assert [c.particles for c in cubes.cubes] == [1, 2]
+    assert [c.line for c in cubes.cubes] == [4, 5]
+    bad = write_awn(ending.join(["3", "2", GOOD, "1, 1, x, 1, 0, 0, 0, 1"]), "bad.awn")
+    with pytest.raises(FishgenError, match=r"bad.awn:4: expected a number for the y size"):
+        load_cubes(bad)
+
+
 def test_declared_total_mismatch_warns_and_cube_counts_win(write_awn):
     path = write_awn("10\n1\n5, 1, 1, 1, 0, 0, 0, 1\n")
     with pytest.warns(CubeFileWarning, match=rf"{path}:1: warning: declared total 10.*hold 5"):
@@ -64,6 +75,7 @@ FAULTS = [
     ("empty file", "", 1, "found an empty file"),
     ("blank file", "\n  \n\t\n", 1, "found an empty file"),
     ("binary NUL", b"1\n1\n\x00\x01\x02garbage", 3, "expected a text cube file, found binary data"),
+    ("binary NUL, CR lines", b"1\r1\r\x00garbage", 3, "found binary data"),
     ("binary PNG", b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR", 1, "found binary data"),
     ("invalid UTF-8", b"1\n1\n1, 1, 1, 1, 0, 0, 0, \xff\n", 3, "found binary data"),
     ("missing cube count", "1\n", 2, "expected the number of cubes"),
@@ -71,10 +83,10 @@ FAULTS = [
     ("fewer cube lines", f"2\n2\n{GOOD}\n", 4, "expected 2 cube lines (declared on line 2), found 1"),
     ("more cube lines", f"2\n1\n{GOOD}\n{GOOD}\n", 4, "found another cube line"),
     ("too few fields", "1\n1\n1, 1, 1, 1, 0, 0, 1\n", 3, "expected 8 fields"),
-    ("too many fields", "1\n1\n1, 1, 1, 1, 0, 0, 0, 1, 9\n", 3, "found 9"),
+    ("too many fields", "1\n1\n1, 1, 1, 1, 0, 0, 0, 1, 9\n", 3, "maximum radius), found 9 fields"),
     ("two fields on line 1", "1 2\n1\n" + GOOD, 1, "expected 1 field (the total particle count)"),
     ("empty field", "1\n1\n1, 1,, 1, 0, 0, 0, 1\n", 3, "found an empty field"),
-    ("negative count", "1\n1\n-1, 1, 1, 1, 0, 0, 0, 1\n", 3, "particle count of 0 or more, found '-1'"),
+    ("negative count", "1\n1\n-1, 1, 1, 1, 0, 0, 0, 1\n", 3, "a whole number of 0 or more for the particle count, found '-1'"),
     ("negative total", "-5\n1\n" + GOOD, 1, "found '-5'"),
     ("fractional count", "1\n1\n2.5, 1, 1, 1, 0, 0, 0, 1\n", 3, "whole number for the particle count"),
     ("non-number", "1\n1\n1, 1, wide, 1, 0, 0, 0, 1\n", 3, "a number for the y size, found 'wide'"),
@@ -82,7 +94,18 @@ FAULTS = [
     ("NaN", "1\n1\n1, 1, 1, 1, nan, 0, 0, 1\n", 3, "finite number for the centre x, found 'nan'"),
     ("infinity", "1\n1\n1, inf, 1, 1, 0, 0, 0, 1\n", 3, "finite number for the x size, found 'inf'"),
     ("overflow", "1\n1\n1, 1, 1, 1, 0, 1e999, 0, 1\n", 3, "finite number for the centre y"),
-    ("NaN count", "1\n1\nNaN, 1, 1, 1, 0, 0, 0, 1\n", 3, "finite number for the particle count"),
+    ("NaN count", "1\n1\nNaN, 1, 1, 1, 0, 0, 0, 1\n", 3, "a whole number for the particle count, found 'NaN'"),
+    ("inf total", "inf\n1\n" + GOOD, 1, "expected a whole number for the total particle count, found 'inf'"),
+    ("yes total", "yes\n1\n" + GOOD, 1, "expected a whole number for the total particle count, found 'yes'"),
+    ("negative cube count", "1\n-2\n" + GOOD, 2, "expected a whole number of 0 or more for the number of cubes, found '-2'"),
+    ("4300+ digit total", "9" * 5000 + "\n1\n" + GOOD, 1,
+     "expected a whole number of at most 18 digits for the total particle count, found a number with 5,000 digits"),
+    ("4300+ digit cube count", "1\n" + "1" * 4301 + "\n" + GOOD, 2, "at most 18 digits for the number of cubes"),
+    ("4300+ digit particles", "1\n1\n" + "7" * 4400 + ", 1, 1, 1, 0, 0, 0, 1\n", 3,
+     "at most 18 digits for the particle count, found a number with 4,400 digits"),
+    ("4300+ digit negative", "1\n1\n-" + "7" * 4400 + ", 1, 1, 1, 0, 0, 0, 1\n", 3, "of 0 or more for the particle count"),
+    ("centre out of float32", "1\n1\n1, 1, 1, 1, 0, -1e39, 0, 1\n", 3,
+     "centre y within float32 range (-3.4e+38 to 3.4e+38), found '-1e39'"),
     ("zero size", "1\n1\n1, 1, 1, 0, 0, 0, 0, 1\n", 3, "z size greater than 0, found '0'"),
     ("negative size", "1\n1\n1, -2, 1, 1, 0, 0, 0, 1\n", 3, "x size greater than 0, found '-2'"),
     ("zero radius", "1\n1\n1, 1, 1, 1, 0, 0, 0, 0.0\n", 3, "maximum radius greater than 0"),
@@ -90,6 +113,15 @@ FAULTS = [
     ("float32 underflow", "1\n1\n1, 1, 1, 1, 0, 0, 0, 1e-50\n", 3, "within float32 range"),
     ("no particles at all", "0\n1\n0, 1, 1, 1, 0, 0, 0, 1\n", 3, "at least 1 particle"),
 ]
+
+
+def test_messages_read_well(write_awn):
+    # No doubled articles ("a the ...", "the the ...") in any fault message.
+    for _, text, _, _ in FAULTS:
+        try:
+            load_cubes(write_awn(text))
+        except FishgenError as err:
+            assert " a the " not in str(err) and " the the " not in str(err), str(err)
 
 
 @pytest.mark.parametrize("name,text,line,message", FAULTS, ids=[f[0] for f in FAULTS])
@@ -123,3 +155,31 @@ def test_missing_file_and_directory(tmp_path):
         load_cubes(tmp_path / "nope.awn")
     with pytest.raises(FishgenError, match="found a directory"):
         load_cubes(tmp_path)
+
+
+def test_devices_and_fifos_are_refused_without_reading(tmp_path):
+    import os
+    with pytest.raises(FishgenError, match=r"^/dev/zero: expected a cube file, found a device$"):
+        load_cubes("/dev/zero")  # used to read forever, then MemoryError
+    fifo = tmp_path / "pipe.awn"
+    os.mkfifo(fifo)  # no writer: opening must not block
+    with pytest.raises(FishgenError, match=r"pipe.awn: expected a cube file, found a pipe \(FIFO\)$"):
+        load_cubes(fifo)
+
+
+def test_files_over_the_size_cap_are_refused_reading_at_most_cap_plus_one(tmp_path, monkeypatch):
+    from fishgen.clouds import parser
+    monkeypatch.setattr(parser, "MAX_FILE_BYTES", 100)
+    path = tmp_path / "big.awn"
+    path.write_bytes(b"1\n1\n" + b" " * 200 + GOOD.encode())
+    with pytest.raises(FishgenError, match=r"big.awn: expected a cube file of at most 0 MiB"):
+        load_cubes(path)
+    path.write_bytes(b"1\n1\n" + GOOD.encode() + b" " * (100 - 4 - len(GOOD)))  # exactly the cap
+    assert len(path.read_bytes()) == 100 and load_cubes(path).total == 1
+
+
+def test_default_caps_refuse_absurd_files_before_parsing_cubes(write_awn):
+    from fishgen.clouds import parser
+    assert parser.MAX_FILE_BYTES == 16 << 20
+    with pytest.raises(FishgenError, match=r":2: expected at most 100,000 cubes, found 100,001$"):
+        load_cubes(write_awn(f"1\n100001\n{GOOD}\n"))
