@@ -8,6 +8,7 @@ from __future__ import annotations
 import click
 
 DEFAULT_MAX_PARTICLES = 50_000_000  # mirrors fishgen.clouds.model without importing numpy
+FLOAT32_MAX = 3.4028234663852886e38  # particle coordinates are float32
 
 
 @click.command("clouds", context_settings={"help_option_names": ["-h", "--help"]})
@@ -95,4 +96,7 @@ def _offset(text: str, describe) -> tuple[float, float, float]:
     if len(values) != 3 or not all(math.isfinite(v) for v in values):
         raise FishgenError(f"expected --offset X,Y,Z with three finite numbers, "
                            f"found {describe(text)}")
+    if not all(abs(v) <= FLOAT32_MAX for v in values):  # particles are float32
+        raise FishgenError(f"expected --offset X,Y,Z within float32 range (-{FLOAT32_MAX:.3g} "
+                           f"to {FLOAT32_MAX:.3g}), found {describe(text)}")
     return values  # type: ignore[return-value]

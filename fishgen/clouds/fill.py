@@ -21,6 +21,7 @@ from typing import Sequence
 import numpy as np
 
 from fishgen.clouds.model import Cloud, CubeFile
+from fishgen.errors import FishgenError
 
 METHODS = ("paper", "uniform")
 CHUNK = 1 << 16
@@ -54,6 +55,7 @@ def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
     centre = np.array([c.centre for c in cubes], np.float64).reshape(-1, 3)
     centre = centre + np.asarray(offset, np.float64).reshape(1, 3)
     lo, hi = centre - size / 2, centre + size / 2
+    _check_float32_bounds(cube_file, offset, lo, hi)
     tables = _Tables(
         centre=centre.astype(_F32), half=(size / 2).astype(_F32),
         lo=_round_inward(lo, up=True), hi=_round_inward(hi, up=False),
@@ -80,6 +82,37 @@ def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
     return out
 
 
+def _check_float32_bounds(cube_file: CubeFile, offset, lo: np.ndarray, hi: np.ndarray) -> None:
+    """Refuse cubes (after the offset) that float32 particles cannot hold, before allocating.
+
+    Outside +-3.4e38 every particle would be clamped to the float32 maximum (or
+    become infinite), so the output would be silently wrong.
+    """
+    limit = float(np.finfo(np.float32).max)
+    shift = tuple(float(v) for v in np.asarray(offset, np.float64).reshape(3))
+    if not all(math.isfinite(v) and abs(v) <= limit for v in shift):
+        raise FishgenError(f"expected an offset within float32 range (-{limit:.3g} to "
+                           f"{limit:.3g} per axis), found {_xyz(shift)}", cube_file.path)
+    outside = ~(np.isfinite(lo) & np.isfinite(hi) & (np.abs(lo) <= limit) & (np.abs(hi) <= limit))
+    if outside.any():
+        k = int(np.flatnonzero(outside.any(axis=1))[0])
+        cube = cube_file.cubes[k]
+        moved = " after the offset" if any(shift) else ""
+        raise FishgenError(f"expected a cube within float32 range (-{limit:.3g} to {limit:.3g} "
+                           f"per axis){moved}, found corners {_xyz(lo[k])} to {_xyz(hi[k])}",
+                           cube_file.path, cube.line or None)
+    thin = _round_inward(lo, up=True) > _round_inward(hi, up=False)
+    if thin.any():  # e.g. 1 unit wide at y = 3e38, where float32 steps are 2e31
+        k = int(np.flatnonzero(thin.any(axis=1))[0])
+        raise FishgenError(f"expected a cube at least one float32 step wide on each axis, found "
+                           f"corners {_xyz(lo[k])} to {_xyz(hi[k])} (too thin for float32 there)",
+                           cube_file.path, cube_file.cubes[k].line or None)
+
+
+def _xyz(values) -> str:
+    return "(" + ", ".join(f"{float(v):.6g}" for v in values) + ")"
+
+
 def merge_clouds(clouds: Sequence[Cloud]) -> Cloud:
     """One scene from several clouds; cube indices are renumbered to stay unique."""
     if not clouds:
@@ -101,7 +134,15 @@ class _Tables:
 
     def __init__(self, centre, half, lo, hi, rmax, y_range):
         self.centre, self.half, self.lo, self.hi, self.rmax = centre, half, lo, hi, rmax
-        self.y_range = y_range
+        # Height-to-colour scale. A y range wider than float32 can hold (up to 6.8e38)
+        # would overflow ``world - y0``, so it is scaled first; a range thinner than one
+        # float32 step at its height gives every particle the base colour.
+        y0, y1 = y_range
+        extent = y1 - y0
+        step = float(np.spacing(_F32(max(abs(y0), abs(y1)))))
+        self.scale_first = extent > float(np.finfo(_F32).max) / 2
+        self.y_scale = _F32(255 / extent if extent >= step else 0.0)
+        self.y_shift = _F32(y0 * (255 / extent) if self.scale_first else y0)
 
 
 def _round_inward(bound: np.ndarray, up: bool) -> np.ndarray:
@@ -146,9 +187,12 @@ def _fill_chunk(out: Cloud, t: _Tables, start: int, stop: int, seed: int, method
 
     # Colour by height in the cloud through a 256-entry table (one gather instead of
     # per-channel float maths): a grey base brightening to a white top.
-    y0, y1 = t.y_range
-    level = world[1] - _F32(y0)
-    level *= _F32(255 / max(y1 - y0, 1e-30))
+    if t.scale_first:
+        level = world[1] * t.y_scale
+        level -= t.y_shift
+    else:
+        level = world[1] - t.y_shift
+        level *= t.y_scale
     np.clip(level, 0, 255, out=level)
     np.take(_COLOUR_LUT, (level + _F32(0.5)).astype(np.uint8), axis=0,
             out=out.colors[start:stop])

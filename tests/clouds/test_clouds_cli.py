@@ -103,6 +103,11 @@ def test_total_mismatch_is_a_warning_on_stderr(cli, write_awn, tmp_path):
     (["--offset", "1,2"], "fishgen: expected --offset X,Y,Z with three finite numbers, found '1,2'"),
     (["--offset", "0,0,0", "--offset", "1,1,1"], "fishgen: expected one --offset per input (1), found 2"),
     (["--seed", "-4"], "fishgen: expected a --seed of 0 or more"),
+    (["--offset", "1e300,0,0"], "fishgen: expected --offset X,Y,Z within float32 range "
+                                "(-3.4e+38 to 3.4e+38), found '1e300,0,0'"),
+    (["--offset", "0,-1e39,0"], "fishgen: expected --offset X,Y,Z within float32 range"),
+    (["--offset", "0,0,inf"], "fishgen: expected --offset X,Y,Z with three finite numbers, found '0,0,inf'"),
+    (["--offset", "nan,0,0"], "fishgen: expected --offset X,Y,Z with three finite numbers"),
     (["--billboards"], "out.ply: expected a .glb or .gltf output with --billboards"),
 ])
 def test_bad_options_are_one_line_errors(cli, tmp_path, args, message):
@@ -133,3 +138,18 @@ def test_command_module_does_not_import_numpy():
     code = "import sys, fishgen.cli.clouds; print('numpy' in sys.modules)"
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           check=True).stdout.strip() == "False"
+
+
+def test_offset_pushing_a_cube_past_float32_is_refused_at_its_line(cli, tmp_path, write_awn):
+    # The offset fits float32, but the cube then reaches past 3.4e38: every particle
+    # used to be clamped to 3.4e38 with overflow warnings, and exit 0.
+    path = write_awn("5\n1\n5, 2e37, 1, 1, 2e38, 0, 0, 1\n")
+    result = cli("clouds", path, "--offset", "1.5e38,0,0", "-o", tmp_path / "x.ply")
+    assert_one_line_error(result, f"{path}:3: expected a cube within float32 range "
+                                  "(-3.4e+38 to 3.4e+38 per axis) after the offset, found corners "
+                                  "(3.4e+38, -0.5, -0.5) to (3.6e+38, 0.5, 0.5)")
+    # Table 4.2 moved to x = 3.4e38, where float32 steps are 2e31: no x inside its cubes.
+    result = cli("clouds", TABLES["4.2"], "--offset", "3.4e38,0,0", "-o", tmp_path / "x.ply")
+    assert_one_line_error(result, f"{TABLES['4.2']}:3: expected a cube at least one float32 "
+                                  "step wide on each axis")
+    assert list(tmp_path.iterdir()) == [path]

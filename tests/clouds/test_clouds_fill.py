@@ -172,3 +172,47 @@ def test_phase_shift_is_eq_4_5_to_4_7_as_decided():
     py = py + math.pi * np.sin(py * theta[2] / 2)                 # P_y where the print has P_x
     want = s + CLUMP / math.pi * np.stack([px, py, pz])           # eq. 4.7, in half extents
     np.testing.assert_allclose(got, want, atol=1e-6)
+
+
+@pytest.mark.parametrize("offset,message", [
+    ((1e300, 0, 0), r"^test: expected an offset within float32 range .*found \(1e\+300, 0, 0\)"),
+    ((0, float("nan"), 0), r"^test: expected an offset within float32 range"),
+    ((0, 0, 3.4e38), r"^test:7: expected a cube at least one float32 step wide"),
+    ((0, 0, -3.4e38), r"^test:7: expected a cube at least one float32 step wide"),
+])
+def test_offsets_and_cubes_outside_float32_are_refused(offset, message):
+    from fishgen.errors import FishgenError
+    cube_file = CubeFile("test", 5, (Cube(5, (8.0, 3.0, 7.0), (1.0, 2.0, -3.0), 2.0, 7),))
+    with pytest.raises(FishgenError, match=message):
+        fill_cloud(cube_file, offset=offset)
+
+
+def test_cube_past_float32_after_the_offset_is_refused():
+    from fishgen.errors import FishgenError
+    cube_file = CubeFile("test", 5, (Cube(5, (2e37, 1.0, 1.0), (2e38, 0.0, 0.0), 2.0, 3),))
+    with pytest.raises(FishgenError, match=r"^test:3: expected a cube within float32 range "
+                                           r".* after the offset, found corners \(3.4e\+38"):
+        fill_cloud(cube_file, offset=(1.5e38, 0, 0))
+
+
+def test_cube_too_thin_for_float32_at_its_position_is_refused():
+    from fishgen.errors import FishgenError
+    # 1 unit tall at y = 3e38, where float32 steps are 2e31: no float32 y lies inside it.
+    with pytest.raises(FishgenError, match=r"^test: expected a cube at least one float32 step wide"):
+        fill_cloud(one_cube(3, size=(1.0, 1.0, 1.0), centre=(0.0, 3e38, 0.0)))
+
+
+def test_cubes_at_the_ends_of_float32_fill_without_overflow_warnings():
+    import warnings
+    cubes = CubeFile("test", 400, (Cube(200, (1.0, 1e37, 1.0), (0.0, 3e38, 0.0), 1.0),
+                                   Cube(200, (1.0, 1e37, 1.0), (0.0, -3e38, 0.0), 1.0)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        cloud = fill_cloud(cubes, seed=1)
+    assert np.isfinite(cloud.centers).all()
+    assert (cloud.colors[:200] >= 250).all()          # top of the scene: white
+    assert (cloud.colors[200:, 0] < 200).all()        # bottom: towards the grey base
+    for k in range(2):
+        lo, hi = cloud.cube_bounds[k]
+        part = cloud.centers[cloud.cube_index == k].astype(np.float64)
+        assert ((part >= lo) & (part <= hi)).all()
