@@ -112,6 +112,19 @@ def test_gltf_with_bin(cloud, tmp_path, gltf_validator, billboards):
     assert (tmp_path / "cloud.bin").stat().st_size == doc["buffers"][0]["byteLength"]
 
 
+@pytest.mark.parametrize("stem,uri", [("a%20b", "a%2520b.bin"), ("x#y", "x%23y.bin"),
+                                      ("sky cloud?v=1", "sky%20cloud%3Fv%3D1.bin"),
+                                      ("wolke ü", "wolke%20%C3%BC.bin")])
+def test_gltf_bin_uri_is_percent_encoded(cloud, tmp_path, gltf_validator, stem, uri):
+    # Unencoded, "a%20b.bin" made loaders look for "a b.bin" (IO_ERROR) and "x#y.bin"
+    # was read as "x" plus a fragment (NON_RELATIVE_URI warnings).
+    path = tmp_path / f"{stem}.gltf"
+    export_cloud(cloud, path)
+    assert json.loads(path.read_text())["buffers"][0]["uri"] == uri
+    assert (tmp_path / f"{stem}.bin").is_file()
+    gltf_validator(path)
+
+
 def test_csv_round_trip(cloud, tmp_path):
     path = tmp_path / "cloud.csv"
     export_cloud(cloud, path)

@@ -15,6 +15,7 @@ import struct
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterator
+from urllib.parse import quote
 
 import numpy as np
 
@@ -76,7 +77,8 @@ def write_gltf(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = Fals
 
     if path.suffix.lower() == ".gltf":
         bin_path = path.with_suffix(".bin")
-        doc["buffers"][0]["uri"] = bin_path.name
+        # A URI, not a file name: "a%20b.bin" would load "a b.bin", "x#y.bin" only "x".
+        doc["buffers"][0]["uri"] = quote(bin_path.name)
         text = json.dumps(doc, indent=1).encode("utf-8")
         write_files({path: text, bin_path: b"".join(body())})
         return
