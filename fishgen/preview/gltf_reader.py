@@ -12,10 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, describe
 from fishgen.preview.animation import INTERPOLATIONS, PATHS, Animation, Channel, Node
 from fishgen.preview.scene import (Material, MeshPart, PointPart, Scene, srgb_to_linear,
                                    vertex_normals)
+from fishgen.preview.sidefiles import side_file
 
 _DTYPES = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16,
            5125: np.uint32, 5126: np.float32}
@@ -37,27 +38,34 @@ def read_gltf(path: str | Path | None = None, *, data: bytes | None = None,
             gltf = pygltflib.GLTF2.load(str(path))
         if gltf is None:
             raise ValueError("empty file")
-        return _Reader(gltf, Path(path).parent if path else Path("."), where).scene(
+        return _Reader(gltf, Path(path) if path is not None else None, where).scene(
             label if label is not None else (Path(path).stem if path else ""))
     except FishgenError:
         raise
     except Exception as err:  # pygltflib raises anything from KeyError to JSONDecodeError
-        raise FishgenError(f"not a readable glTF asset ({type(err).__name__}: {err})", where)
+        raise FishgenError(f"not a readable glTF asset ({type(err).__name__}: {one_line(err)})", where) from None
+
+
+def one_line(err: BaseException, limit: int = 200) -> str:
+    """A library's error message squeezed onto one short line for ours."""
+    text = " ".join(str(err).split())
+    return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
 class _Reader:
-    def __init__(self, gltf, base: Path, where: str):
-        self.g, self.base, self.where = gltf, base, where
+    def __init__(self, gltf, asset: Path | None, where: str):
+        self.g, self.asset, self.where = gltf, asset, where
         self._buffers: dict[int, bytes] = {}
         self._images: dict[int, np.ndarray] = {}
 
     # -- raw data -------------------------------------------------------------
     def _uri(self, uri: str) -> bytes:
-        if uri.startswith("data:"):
+        if uri.strip().startswith("data:"):
             return base64.b64decode(uri.split(",", 1)[1])
-        from urllib.parse import unquote
-
-        target = self.base / unquote(uri)  # glTF URIs are percent-encoded ("my%20skin.png")
+        if self.asset is None:  # GLB bytes from memory have no folder to take side files from
+            raise FishgenError(f"expected only embedded data, found a reference to {describe(uri)}", self.where)
+        # Only files in the asset's folder (glTF URIs are percent-encoded: "my%20skin.png").
+        target = side_file(self.asset, uri, uri=True)
         if not target.is_file():
             raise FishgenError(f"expected a file beside the asset, found no {uri!r}", self.where)
         return target.read_bytes()
@@ -162,6 +170,9 @@ class _Reader:
             flat = self.accessor(prim.indices).ravel().astype(np.uint32)
         else:
             flat = np.arange(len(positions), dtype=np.uint32)
+        if len(flat) and int(flat.max()) >= len(positions):  # the GPU would read past the vertices
+            raise FishgenError(f"expected vertex indices below {len(positions)}, found {int(flat.max())}",
+                               self.where)
         indices = _triangles(flat, mode)
         normals = self.accessor(attrs.NORMAL).astype(np.float32) if attrs.NORMAL is not None else None
         uvs = self.accessor(attrs.TEXCOORD_0).astype(np.float32) if attrs.TEXCOORD_0 is not None else None

@@ -9,8 +9,10 @@ import base64
 import json
 import re
 from pathlib import Path
+from urllib.parse import unquote
 
 from fishgen.errors import FishgenError
+from fishgen.preview.sidefiles import side_file
 
 HERE = Path(__file__).resolve().parent
 STATIC = HERE / "static"
@@ -31,29 +33,34 @@ def sidecars(asset: Path) -> tuple[dict[str, Path], str | None]:
     mtl_name = None
     ext = asset.suffix.lower()
 
-    def add(ref: str) -> None:
-        ref = ref.strip().replace("\\", "/")
-        target = (asset.parent / ref).resolve()
-        if ref.startswith("data:") or ref in found:
-            return
-        if not target.is_file():
-            raise FishgenError(f"expected the file {ref!r} it refers to beside the asset, found none", asset)
-        found[ref] = target
+    def add(ref: str, uri: bool = False) -> Path | None:
+        # Only files in the asset's folder: a reference to "../x" or "/etc/x" must not end up in the page.
+        if ref.strip().startswith("data:"):
+            return None  # inline already
+        target = side_file(asset, ref, uri=uri, must_exist=True)
+        key = ref.strip().replace("\\", "/")
+        found[unquote(key) if uri else key] = target  # the page's loader looks files up by decoded name
+        return target
 
     if ext == ".gltf":
         try:
             doc = json.loads(asset.read_text(encoding="utf-8"))
         except (ValueError, UnicodeDecodeError) as err:
             raise FishgenError(f"expected glTF JSON, found unreadable text ({err})", asset)
-        for item in doc.get("buffers", []) + doc.get("images", []):
-            if isinstance(item, dict) and isinstance(item.get("uri"), str):
-                add(item["uri"])
+        if not isinstance(doc, dict):
+            raise FishgenError(f"expected a glTF JSON object, found {type(doc).__name__}", asset)
+        for key in ("buffers", "images"):
+            items = doc.get(key, [])
+            for item in items if isinstance(items, list) else []:
+                if isinstance(item, dict) and isinstance(item.get("uri"), str):
+                    add(item["uri"], uri=True)
     elif ext == ".obj":
         text = asset.read_text(encoding="utf-8", errors="replace")
         for lib in re.findall(r"^\s*mtllib\s+(.+?)\s*$", text, re.M):
-            add(lib)
+            mtl = add(lib)
+            if mtl is None:
+                continue
             mtl_name = mtl_name or lib.strip()
-            mtl = found[lib.strip().replace("\\", "/")]
             for ref in _MTL_MAPS.findall(mtl.read_text(encoding="utf-8", errors="replace")):
                 add(ref.split()[-1])  # options such as "-imfchan m" come before the file name
     return found, mtl_name
