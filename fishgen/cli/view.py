@@ -20,7 +20,7 @@ def view(asset, output, port, no_serve, background):
     The page embeds three.js (bundled in fishgen, never fetched) and the asset:
     orbit with the mouse, play/pause, scrub the timeline, pick a clip, toggle
     wireframe; it shows vertex, triangle and particle counts. It is served on
-    127.0.0.1 only, until Ctrl-C.
+    127.0.0.1 only (that one page, nothing else in its folder), until Ctrl-C.
     """
     from pathlib import Path
 
@@ -37,7 +37,7 @@ def view(asset, output, port, no_serve, background):
     from fishgen.viewer.server import make_server, url_of
 
     try:
-        server = make_server(Path(page).resolve().parent, port)
+        server = make_server(Path(page), port)  # that one page, never its folder
     except OSError as err:
         raise FishgenError(f"expected a free port {port} on 127.0.0.1, found it taken ({err.strerror}); "
                            "try --port 0") from None

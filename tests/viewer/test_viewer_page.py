@@ -61,7 +61,9 @@ def test_unsupported_asset_is_refused(tmp_path):
 def test_server_listens_on_loopback_only(tmp_path):
     from fishgen.viewer.server import make_server
 
-    server = make_server(tmp_path, 0)
+    page = tmp_path / "page.html"
+    page.write_text("<!doctype html>")
+    server = make_server(page, 0)
     try:
         assert server.server_address[0] == "127.0.0.1"
     finally:
