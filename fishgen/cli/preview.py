@@ -15,7 +15,8 @@ VIEW_NAMES = ("side", "top", "front", "three-quarter")
 @click.option("--view", type=click.Choice(VIEW_NAMES), default="three-quarter", show_default=True,
               help="Camera direction; fish face left in side, top and three-quarter views.")
 @click.option("--size", default="800x600", show_default=True, metavar="WxH",
-              help="Pixel size of one render (each tile of a contact sheet).")
+              help="Pixel size of one render (each tile of a contact sheet), 16 to 8192 a side. "
+                   "A contact sheet may hold at most 2^28 pixels, all frames and sheets together 2^30.")
 @click.option("--time", "time_", type=float, default=None, metavar="SECONDS",
               help="Pose the animation at this time  [default: rest pose; a loop's start]")
 @click.option("--clip", default=None, metavar="NAME",
@@ -24,11 +25,12 @@ VIEW_NAMES = ("side", "top", "front", "three-quarter")
               help="Background colour (#rrggbb, #rrggbbaa, a CSS name) or `transparent` (PNG/WebP).")
 @click.option("--frames", type=int, default=None, metavar="N",
               help="Frames of an animated .gif/.webp: one swim cycle, or a turntable for static "
-                   "assets  [default: 36 for .gif, 1 otherwise]")
+                   "assets; 1 to 1000, with frames x inputs x W x H at most 2^30 pixels  "
+                   "[default: 36 for .gif, 1 otherwise]")
 @click.option("--columns", type=int, default=None, metavar="N",
               help="Columns of a contact sheet of several inputs  [default: about a square grid]")
 @click.option("--seed", type=int, default=0, show_default=True,
-              help="Random seed for filling .awn cube files, as `fishgen clouds` uses it.")
+              help="Random seed (0 or more) for filling .awn cube files, as `fishgen clouds` uses it.")
 @click.option("--textures", type=click.Path(file_okay=False), default=None, metavar="DIR",
               help="Folder of species textures  [default: as `fishgen build` resolves them]")
 def preview(inputs, output, view, size, time_, clip, background, frames, columns, seed, textures):
@@ -52,6 +54,8 @@ def preview(inputs, output, view, size, time_, clip, background, frames, columns
     width, height = parse_size(size)
     if columns is not None and columns < 1:
         raise FishgenError(f"expected --columns of 1 or more, found {columns}")
+    if seed < 0:  # as `fishgen clouds` checks it; the filler itself would raise
+        raise FishgenError(f"expected a --seed of 0 or more, found {seed}")
     if time_ is not None and not (0 <= time_ < 1e6):
         raise FishgenError(f"expected --time in seconds, 0 or more, found {time_}")
     options = PreviewOptions(view=view, width=width, height=height, time=time_,

@@ -25,6 +25,13 @@ DEFAULT_LOOP_FRAMES = 36
 TURNTABLE_SECONDS = 6.0
 """One turn of a static asset's turntable loop."""
 MAX_PIXELS = 8192
+"""Largest side of one render (--size)."""
+MAX_FRAMES = 1000
+MAX_TOTAL_PIXELS = 1 << 30
+"""All pixels one preview holds at once: every render (inputs x frames x W x H) plus every
+contact-sheet frame; 2^30 pixels is 4 GiB as RGBA. Checked before anything is loaded or drawn."""
+MAX_SHEET_PIXELS = 1 << 28
+"""One contact-sheet frame (W x H of the whole sheet, label strips included): 1 GiB as RGBA."""
 
 
 @dataclass
@@ -63,14 +70,19 @@ def parse_background(text: str) -> tuple[int, int, int, int]:
     return tuple(int(v) for v in rgba)
 
 
-def check_output(out: Path, options: PreviewOptions) -> int:
-    """Validate the output name against the options; returns the number of frames to render."""
+def check_output(out: Path, options: PreviewOptions, inputs: int = 1) -> int:
+    """Validate the output name against the options; returns the number of frames to render.
+
+    Also refuses, before anything is allocated, a request whose contact sheet
+    would exceed ``MAX_SHEET_PIXELS`` or whose frames and sheets for ``inputs``
+    inputs would together exceed ``MAX_TOTAL_PIXELS``.
+    """
     ext = out.suffix.lower()
     if ext not in OUTPUTS:
         raise FishgenError(f"expected an output ending in {', '.join(OUTPUTS)}, found {out.name!r}")
     frames = options.frames
-    if frames is not None and not 1 <= frames <= 1000:
-        raise FishgenError(f"expected --frames from 1 to 1000, found {frames}")
+    if frames is not None and not 1 <= frames <= MAX_FRAMES:
+        raise FishgenError(f"expected --frames from 1 to {MAX_FRAMES}, found {frames}")
     if frames is None:
         frames = DEFAULT_LOOP_FRAMES if ext == ".gif" else 1
     if frames > 1 and ext not in ANIMATED:
@@ -80,7 +92,35 @@ def check_output(out: Path, options: PreviewOptions) -> int:
     if ext in (".gif", ".jpg", ".jpeg") and options.background[3] < 255:
         raise FishgenError(f"expected an opaque --background for {ext} (it has no alpha channel), "
                            "found transparent")
+    if inputs > 1:
+        w, h = sheet_size(options, inputs)
+        if w * h > MAX_SHEET_PIXELS:
+            raise FishgenError(f"expected a contact sheet of at most {MAX_SHEET_PIXELS} pixels (2^28), "
+                               f"found {w}x{h} = {w * h} for {inputs} inputs at {options.width}x"
+                               f"{options.height}; use a smaller --size or fewer --columns")
+    total = total_pixels(options, frames, inputs)
+    if total > MAX_TOTAL_PIXELS:
+        raise FishgenError(f"expected at most {MAX_TOTAL_PIXELS} pixels (2^30) in all frames and "
+                           f"contact sheets, found {total} for {inputs} input(s) x {frames} frame(s) "
+                           f"at {options.width}x{options.height}; use a smaller --size or fewer --frames")
     return frames
+
+
+def sheet_size(options: PreviewOptions, inputs: int) -> tuple[int, int]:
+    """Pixel size of one contact-sheet frame for ``inputs`` tiles, as ``contact_sheet`` lays it out."""
+    from fishgen.preview.sheet import grid, label_height
+
+    columns, rows = grid(inputs, options.columns)
+    return columns * options.width, rows * (options.height + label_height(options.height))
+
+
+def total_pixels(options: PreviewOptions, frames: int, inputs: int = 1) -> int:
+    """Pixels held at once: every render of every input, plus each contact-sheet frame."""
+    per_frame = inputs * options.width * options.height
+    if inputs > 1:
+        w, h = sheet_size(options, inputs)
+        per_frame += w * h
+    return frames * per_frame
 
 
 def subject_points(scene: Scene, times: Sequence[float | None], clip: str | None) -> np.ndarray:
@@ -190,7 +230,7 @@ def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options
     out = Path(out)
     if not inputs:
         raise FishgenError("expected at least one input, found none")
-    frames = check_output(out, options)
+    frames = check_output(out, options, len(inputs))
     scenes = [load_input(p, textures_dir=options.textures_dir, seed=options.seed) for p in inputs]
     if on_loaded:
         on_loaded(len(scenes) * frames)

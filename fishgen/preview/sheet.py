@@ -10,11 +10,16 @@ def label_height(tile_height: int) -> int:
     return max(16, tile_height // 14)
 
 
+def grid(tiles: int, columns: int | None) -> tuple[int, int]:
+    """(columns, rows) of a sheet of ``tiles``: about square unless ``columns`` is given."""
+    columns = columns or math.ceil(math.sqrt(tiles))
+    return columns, math.ceil(tiles / columns)
+
+
 def contact_sheet(tiles: list[Image.Image], labels: list[str], columns: int | None,
                   background: tuple[int, int, int, int]) -> Image.Image:
     """Grid of equally sized ``tiles``, each with its label in a strip below it."""
-    columns = columns or math.ceil(math.sqrt(len(tiles)))
-    rows = math.ceil(len(tiles) / columns)
+    columns, rows = grid(len(tiles), columns)
     w, h = tiles[0].size
     strip = label_height(h)
     sheet = Image.new("RGBA", (columns * w, rows * (h + strip)), background)

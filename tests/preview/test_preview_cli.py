@@ -99,6 +99,9 @@ def test_help_lists_every_option_with_default():
     (["-o", "x.png", "--background", "mauvish"], "expected --background"),
     (["-o", "x.gif", "--background", "transparent"], "expected an opaque --background"),
     (["-o", "x.png", "--clip", "dance"], "expected --clip to name one of swim"),
+    (["-o", "x.png", "--seed", "-1"], "expected a --seed of 0 or more, found -1"),
+    (["-o", "x.gif", "--size", "8192x8192", "--frames", "1000"], "expected at most 1073741824 pixels"),
+    (["-o", "x.webp", "--size", "8192x8192", "--frames", "17"], "expected at most 1073741824 pixels"),
 ])
 def test_bad_options_are_one_line_errors_and_write_nothing(tmp_path, args, message):
     args = [a if a not in ("x.bmp", "x.png", "x.gif") else str(tmp_path / a) for a in args]
@@ -117,3 +120,33 @@ def test_missing_and_bad_inputs_name_the_file(tmp_path):
         assert result.returncode == 2, result.stderr
         assert str(path) in result.stderr and "Traceback" not in result.stderr
     assert not (tmp_path / "out.png").exists()
+
+
+def test_negative_seed_for_a_cube_file_is_a_one_line_error(tmp_path):
+    result = run_cli("preview", PARAMS / "clouds" / "table_4_2.awn", "-o", tmp_path / "s.png", "--seed", "-1")
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert result.stderr.strip() == "fishgen: expected a --seed of 0 or more, found -1"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_pixel_budget_is_checked_before_any_input_is_read(tmp_path):
+    from fishgen.errors import FishgenError
+    from fishgen.preview.pipeline import (MAX_SHEET_PIXELS, MAX_TOTAL_PIXELS, PreviewOptions, preview,
+                                          sheet_size, total_pixels)
+
+    missing = [tmp_path / "a.glb", tmp_path / "b.glb"]
+    huge = PreviewOptions(width=8192, height=8192, frames=1000)
+    with pytest.raises(FishgenError, match=f"expected at most {MAX_TOTAL_PIXELS} pixels"):
+        preview(missing, tmp_path / "x.gif", huge)
+    wide = PreviewOptions(width=800, height=600, columns=10**9)  # a sheet a billion tiles wide
+    with pytest.raises(FishgenError, match=f"expected a contact sheet of at most {MAX_SHEET_PIXELS}"):
+        preview(missing, tmp_path / "x.png", wide)
+    big_tiles = PreviewOptions(width=8192, height=8192)  # 2x2 tiles of 8192 px: a 17k x 17k sheet
+    with pytest.raises(FishgenError, match="contact sheet"):
+        preview(missing * 2, tmp_path / "x.png", big_tiles)
+    # Ordinary requests stay well inside: a 36-frame HD loop, a 4K still, a sheet of 16 tiles.
+    assert total_pixels(PreviewOptions(width=1920, height=1080), 36) < MAX_TOTAL_PIXELS
+    assert total_pixels(PreviewOptions(width=3840, height=2160), 1) < MAX_TOTAL_PIXELS
+    assert total_pixels(PreviewOptions(), 36, inputs=16) < MAX_TOTAL_PIXELS
+    assert sheet_size(PreviewOptions(width=1920, height=1080), 16)[0] == 4 * 1920
+    assert list(tmp_path.iterdir()) == []
