@@ -55,10 +55,9 @@ def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
     centre = np.array([c.centre for c in cubes], np.float64).reshape(-1, 3)
     centre = centre + np.asarray(offset, np.float64).reshape(1, 3)
     lo, hi = centre - size / 2, centre + size / 2
-    _check_float32_bounds(cube_file, offset, lo, hi)
+    lo32, hi32 = _float32_bounds(cube_file, offset, lo, hi)
     tables = _Tables(
-        centre=centre.astype(_F32), half=(size / 2).astype(_F32),
-        lo=_round_inward(lo, up=True), hi=_round_inward(hi, up=False),
+        centre=centre.astype(_F32), half=(size / 2).astype(_F32), lo=lo32, hi=hi32,
         rmax=np.array([c.max_radius for c in cubes], np.float32),
         y_range=(float(lo[:, 1].min()), float(hi[:, 1].max())))
 
@@ -72,7 +71,7 @@ def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
         _fill_chunk(out, tables, start, min(start + CHUNK, n), int(seed), method)
 
     starts = range(0, n, CHUNK)
-    threads = min(workers or os.cpu_count() or 1, len(starts))
+    threads = 1 if len(starts) <= 1 else min(workers or os.cpu_count() or 1, len(starts))
     if threads <= 1:
         for start in starts:
             work(start)
@@ -82,8 +81,9 @@ def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
     return out
 
 
-def _check_float32_bounds(cube_file: CubeFile, offset, lo: np.ndarray, hi: np.ndarray) -> None:
-    """Refuse cubes (after the offset) that float32 particles cannot hold, before allocating.
+def _float32_bounds(cube_file: CubeFile, offset, lo: np.ndarray, hi: np.ndarray):
+    """The cube bounds rounded inward to float32; refuse cubes (after the offset) that
+    float32 particles cannot hold, before allocating.
 
     Outside +-3.4e38 every particle would be clamped to the float32 maximum (or
     become infinite), so the output would be silently wrong.
@@ -93,7 +93,7 @@ def _check_float32_bounds(cube_file: CubeFile, offset, lo: np.ndarray, hi: np.nd
     if not all(math.isfinite(v) and abs(v) <= limit for v in shift):
         raise FishgenError(f"expected an offset within float32 range (-{limit:.3g} to "
                            f"{limit:.3g} per axis), found {_xyz(shift)}", cube_file.path)
-    outside = ~(np.isfinite(lo) & np.isfinite(hi) & (np.abs(lo) <= limit) & (np.abs(hi) <= limit))
+    outside = ~((np.abs(lo) <= limit) & (np.abs(hi) <= limit))   # NaN compares False too
     if outside.any():
         k = int(np.flatnonzero(outside.any(axis=1))[0])
         cube = cube_file.cubes[k]
@@ -101,12 +101,14 @@ def _check_float32_bounds(cube_file: CubeFile, offset, lo: np.ndarray, hi: np.nd
         raise FishgenError(f"expected a cube within float32 range (-{limit:.3g} to {limit:.3g} "
                            f"per axis){moved}, found corners {_xyz(lo[k])} to {_xyz(hi[k])}",
                            cube_file.path, cube.line or None)
-    thin = _round_inward(lo, up=True) > _round_inward(hi, up=False)
+    lo32, hi32 = _round_inward(lo, up=True), _round_inward(hi, up=False)
+    thin = lo32 > hi32
     if thin.any():  # e.g. 1 unit wide at y = 3e38, where float32 steps are 2e31
         k = int(np.flatnonzero(thin.any(axis=1))[0])
         raise FishgenError(f"expected a cube at least one float32 step wide on each axis, found "
                            f"corners {_xyz(lo[k])} to {_xyz(hi[k])} (too thin for float32 there)",
                            cube_file.path, cube_file.cubes[k].line or None)
+    return lo32, hi32
 
 
 def _xyz(values) -> str:
