@@ -2,6 +2,7 @@
 
     python benchmarks/clouds.py                 # full run (about a minute)
     python benchmarks/clouds.py --quick         # smoke run, small sizes only
+    python benchmarks/clouds.py --writers-only  # CSV vs PLY writer, 10^6 particles
 
 The cloud shape is the report's Table 4.4 (23 cubes) with every cube's count
 scaled so the total is N. The baseline is the report's algorithm (section 4.5,
@@ -27,6 +28,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from fishgen.clouds import Cube, CubeFile, fill_cloud, load_cubes  # noqa: E402
+from fishgen.clouds.export.ply import write_ply  # noqa: E402
+from fishgen.clouds.export.table import write_csv  # noqa: E402
 from fishgen.clouds.fill import BASE_COLOUR, CLUMP, TOP_COLOUR  # noqa: E402
 
 TABLE = ROOT / "params" / "clouds" / "table_4_4.awn"
@@ -111,6 +114,21 @@ def whole_command(n: int, workdir: Path, repeats: int) -> tuple[float, int]:
     return statistics.median(times), max(peaks)
 
 
+def writers(n: int, workdir: Path, repeats: int) -> None:
+    """Median time of the CSV and PLY writers for one n-particle cloud, interleaved."""
+    cloud = fill_cloud(scaled_cubes(n), seed=1)
+    times: dict[str, list[float]] = {"csv": [], "ply": []}
+    for _ in range(repeats):
+        for ext, write in (("csv", write_csv), ("ply", write_ply)):
+            start = time.perf_counter()
+            write(cloud, workdir / f"cloud.{ext}")
+            times[ext].append(time.perf_counter() - start)
+    size = (workdir / "cloud.csv").stat().st_size
+    print(f"\nwriters, {n:,} particles: CSV {statistics.median(times['csv']):.2f} s "
+          f"({size / 1e6:.1f} MB), PLY {statistics.median(times['ply']):.2f} s, "
+          f"median of {repeats}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--sizes", default="1e4,5e4,1e5,1e6,1e7",
@@ -121,7 +139,13 @@ def main() -> None:
     parser.add_argument("--command-size", type=float, default=1e7,
                         help="particles for the whole-command PLY run [default: %(default)s]")
     parser.add_argument("--quick", action="store_true", help="small sizes only (smoke test)")
+    parser.add_argument("--writers-only", action="store_true",
+                        help="only time the CSV and PLY writers at 10^6 particles")
     args = parser.parse_args()
+    if args.writers_only:
+        with tempfile.TemporaryDirectory() as tmp:
+            writers(10**6, Path(tmp), 3)
+        return
     if args.quick:
         args.sizes, args.baseline_max, args.repeats, args.command_size = "1e4,1e5", 1e4, 3, 1e5
     sizes = [int(float(s)) for s in args.sizes.split(",")]
@@ -156,6 +180,8 @@ def main() -> None:
     print(f"peak memory: {peak / 2**20:,.0f} MiB = {peak / n:.1f} bytes/particle "
           f"({(peak - idle) / n:.1f} bytes/particle above the {idle / 2**20:.0f} MiB "
           f"of a 1,000-particle run)")
+    with tempfile.TemporaryDirectory() as tmp:
+        writers(10**5 if args.quick else 10**6, Path(tmp), 3)
 
 
 if __name__ == "__main__":
