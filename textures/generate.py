@@ -10,9 +10,7 @@ the files are stored upside down (chapter 6); fishgen flips them on load.
 """
 from __future__ import annotations
 
-import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -96,7 +94,7 @@ def _px(points) -> list[tuple[float, float]]:
     return [(u * SIZE[0], v * SIZE[1]) for u, v in points]
 
 
-def _rows(points, n_base: int, order: str):
+def _rows(points, order: str):
     """Split Fixel-ordered fin points into (base row, outer row)."""
     p = list(points)
     if order == "vertical":      # T0, B0, Bn, Tn, B1.., T1..
@@ -126,7 +124,7 @@ def _fin_outline(sp: Species):
                        ("pectoral", "pectoral"), ("pelvic", "pelvic")):
         if name in ("dorsal", "adipose", "anal") and not getattr(sp, name).present:
             continue
-        base, top = _rows(getattr(tp, name), 0, kind)
+        base, top = _rows(getattr(tp, name), kind)
         fins.append((base + list(reversed(top)), base, top))
     return [(_px(poly), _px(base), _px(top)) for poly, base, top in fins]
 

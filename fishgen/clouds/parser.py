@@ -13,7 +13,6 @@ import os
 import re
 import stat
 import warnings
-from pathlib import Path
 
 from fishgen.errors import FishgenError, describe, expected
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, Cube, CubeFile

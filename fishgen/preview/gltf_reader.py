@@ -14,8 +14,7 @@ import numpy as np
 
 from fishgen.errors import FishgenError, describe
 from fishgen.preview.animation import INTERPOLATIONS, PATHS, Animation, Channel, Node
-from fishgen.preview.scene import (Material, MeshPart, PointPart, Scene, srgb_to_linear,
-                                   vertex_normals)
+from fishgen.preview.scene import (Material, MeshPart, PointPart, Scene, vertex_normals)
 from fishgen.preview.sidefiles import side_file
 
 _DTYPES = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16,

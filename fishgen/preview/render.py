@@ -15,7 +15,7 @@ import numpy as np
 
 from fishgen.errors import FishgenError
 from fishgen.preview.camera import Camera
-from fishgen.preview.scene import MeshPart, Scene, srgb_to_linear
+from fishgen.preview.scene import MeshPart, Scene
 
 SAMPLES = 4
 # World-fixed lights: a sun from above and in front, a weak fill from behind, a

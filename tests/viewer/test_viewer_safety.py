@@ -12,7 +12,7 @@ import sys
 import pytest
 
 from fishgen.errors import FishgenError
-from fishgen.viewer.page import build_page, page_path, write_page
+from fishgen.viewer.page import build_page, page_path
 from tests.conftest import ROOT, run_cli
 from tests.viewer.test_viewer_page import _payload
 
