@@ -1,0 +1,233 @@
+"""The neutral scene every asset passes through: assembly builds it, writers and the renderer read it.
+
+It mirrors the parts of glTF 2.0 fishgen uses, with numpy arrays instead of
+buffers: nodes (TRS, children, a mesh and a skin), meshes that many nodes can
+share, primitives of triangles or points with any vertex attributes, skins and
+morph targets, materials, images, and animation clips of node x path channels.
+Conventions are glTF's: metres, +Y up, colours linear, UV origin top-left,
+rotations as (x, y, z, w) quaternions. Nothing here knows a file format.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Literal
+
+if TYPE_CHECKING:  # numpy stays out of `fishgen --help`
+    import numpy as np
+
+AlphaMode = Literal["OPAQUE", "MASK", "BLEND"]
+PrimitiveMode = Literal["TRIANGLES", "POINTS"]
+Path_ = Literal["translation", "rotation", "scale", "weights"]
+Interpolation = Literal["LINEAR", "STEP", "CUBICSPLINE"]
+
+PATHS: tuple[Path_, ...] = ("translation", "rotation", "scale", "weights")
+INTERPOLATIONS: tuple[Interpolation, ...] = ("LINEAR", "STEP", "CUBICSPLINE")
+
+
+@dataclass
+class Image:
+    """A texture source: encoded PNG/JPEG ``data``, and/or ``pixels`` a reader already decoded."""
+
+    name: str
+    data: bytes
+    mime_type: str = "image/png"
+    pixels: np.ndarray | None = None    # (H, W, 4) uint8 RGBA, sRGB-encoded
+
+    def rgba(self) -> np.ndarray:
+        """The picture as (H, W, 4) uint8 RGBA, decoded once."""
+        if self.pixels is None:
+            import io
+
+            import numpy as np
+            from PIL import Image as PILImage
+
+            with PILImage.open(io.BytesIO(self.data)) as img:
+                self.pixels = np.asarray(img.convert("RGBA"))
+        return self.pixels
+
+
+@dataclass
+class Material:
+    """glTF metallic-roughness subset; ``base_color`` is linear RGBA."""
+
+    name: str
+    base_color: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)
+    texture: int | None = None          # index into Scene.images (base colour, sRGB-encoded)
+    alpha_mode: AlphaMode = "OPAQUE"
+    alpha_cutoff: float | None = None   # MASK only; None means glTF's default 0.5
+    double_sided: bool = False
+    unlit: bool = False
+    metallic: float = 0.0
+    roughness: float = 0.55
+
+
+@dataclass
+class Primitive:
+    """One draw: triangles (``indices`` (m, 3)) or points, with per-vertex attributes.
+
+    ``attributes`` uses glTF semantics: POSITION (n, 3) float32 is required;
+    NORMAL, TEXCOORD_0, COLOR_0 (float32 linear, or normalized uint8/uint16),
+    JOINTS_0 (uint8/uint16) and WEIGHTS_0 (float32) are optional, and names
+    starting with ``_`` are application data (``_RADIUS`` of a particle).
+    ``targets`` are morph targets: displacement arrays keyed like attributes.
+    """
+
+    attributes: dict[str, np.ndarray]
+    indices: np.ndarray | None = None   # (m, 3) for TRIANGLES; None for POINTS
+    material: int | None = None         # index into Scene.materials
+    mode: PrimitiveMode = "TRIANGLES"
+    targets: list[dict[str, np.ndarray]] = field(default_factory=list)
+
+    @property
+    def positions(self) -> np.ndarray:
+        return self.attributes["POSITION"]
+
+    @property
+    def vertex_count(self) -> int:
+        return len(self.attributes["POSITION"])
+
+    @property
+    def triangle_count(self) -> int:
+        return 0 if self.indices is None or self.mode != "TRIANGLES" else len(self.indices)
+
+
+@dataclass
+class Mesh:
+    name: str
+    primitives: list[Primitive]
+    weights: list[float] = field(default_factory=list)  # default morph weights, one per target
+
+
+@dataclass
+class Skin:
+    """Joints (node indices) and their inverse bind matrices (j, 4, 4), column vectors."""
+
+    name: str
+    joints: list[int]
+    inverse_bind_matrices: np.ndarray
+    skeleton: int | None = None
+
+
+@dataclass
+class Node:
+    name: str = ""
+    translation: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rotation: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
+    scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    children: list[int] = field(default_factory=list)
+    mesh: int | None = None
+    skin: int | None = None
+    matrix: np.ndarray | None = None    # 4x4 column-vector local matrix; wins over TRS, not animatable
+
+
+@dataclass
+class Sampler:
+    """Keyframes: ``times`` (k,) seconds, ``values`` (k, width), or (3k, width) for CUBICSPLINE."""
+
+    times: np.ndarray
+    values: np.ndarray
+    interpolation: Interpolation = "LINEAR"
+
+
+@dataclass
+class Channel:
+    node: int
+    path: Path_
+    sampler: Sampler
+
+
+@dataclass
+class Clip:
+    name: str
+    channels: list[Channel]
+
+    @property
+    def duration(self) -> float:
+        return max((float(c.sampler.times[-1]) for c in self.channels if len(c.sampler.times)), default=0.0)
+
+
+@dataclass
+class Scene:
+    """A whole asset. ``roots`` are the top-level nodes; ``info`` carries summary facts
+    (``fin_mode`` of a fish, ``source`` of a reader) that writers may ignore."""
+
+    name: str = ""
+    nodes: list[Node] = field(default_factory=list)
+    roots: list[int] = field(default_factory=list)
+    meshes: list[Mesh] = field(default_factory=list)
+    materials: list[Material] = field(default_factory=list)
+    images: list[Image] = field(default_factory=list)
+    skins: list[Skin] = field(default_factory=list)
+    clips: list[Clip] = field(default_factory=list)
+    info: dict[str, str | float | int] = field(default_factory=dict)
+
+    # -- building ------------------------------------------------------------------
+    def add_node(self, node: Node, parent: int | None = None) -> int:
+        self.nodes.append(node)
+        index = len(self.nodes) - 1
+        if parent is None:
+            self.roots.append(index)
+        else:
+            self.nodes[parent].children.append(index)
+        return index
+
+    def add_mesh(self, mesh: Mesh) -> int:
+        self.meshes.append(mesh)
+        return len(self.meshes) - 1
+
+    def add_material(self, material: Material) -> int:
+        self.materials.append(material)
+        return len(self.materials) - 1
+
+    def add_image(self, image: Image) -> int:
+        self.images.append(image)
+        return len(self.images) - 1
+
+    # -- questions -----------------------------------------------------------------
+    def clip(self, name: str | None = None) -> Clip | None:
+        """The named clip, else the first (fishgen fish carry one named ``swim``)."""
+        for clip in self.clips:
+            if name is None or clip.name == name:
+                return clip
+        return None
+
+    def reachable(self) -> list[int]:
+        """Nodes under the roots, parents before children (each once, cycles cut)."""
+        order: list[int] = []
+        seen: set[int] = set()
+        stack = list(reversed(self.roots))
+        while stack:
+            i = stack.pop()
+            if i in seen:
+                continue
+            seen.add(i)
+            order.append(i)
+            stack.extend(reversed(self.nodes[i].children))
+        return order
+
+    def drawn(self) -> list[tuple[int, Primitive]]:
+        """(node, primitive) for every primitive a renderer draws, in node order."""
+        return [(i, prim) for i in self.reachable() if self.nodes[i].mesh is not None
+                for prim in self.meshes[self.nodes[i].mesh].primitives]  # type: ignore[index]
+
+    def counts(self) -> dict[str, int]:
+        """Vertices and triangles of drawn meshes, and particles of drawn point sets."""
+        drawn = self.drawn()
+        return {"vertices": sum(p.vertex_count for _, p in drawn if p.mode == "TRIANGLES"),
+                "triangles": sum(p.triangle_count for _, p in drawn),
+                "particles": sum(p.vertex_count for _, p in drawn if p.mode == "POINTS")}
+
+    def has(self) -> set[str]:
+        """What this scene holds, in the registry's words (see fishgen.exchange.registry)."""
+        kinds = set()
+        for _, prim in self.drawn():
+            kinds.add("meshes" if prim.mode == "TRIANGLES" else "points")
+            if prim.targets:
+                kinds.add("morph targets")
+        if any(m.texture is not None for m in self.materials):
+            kinds.add("textures")
+        if self.skins:
+            kinds.add("skins")
+        if any(c.channels for c in self.clips):
+            kinds.add("node animation")
+        return kinds
