@@ -13,7 +13,7 @@ _API = {
     "load_species": "fishgen.species.parser",
     "Species": "fishgen.species.model",
     "build_fish": "fishgen.assembly.fish",
-    "FishAsset": "fishgen.assembly.fish",
+    "Scene": "fishgen.scene.model",
     "export": "fishgen.exchange",
     "FishgenError": "fishgen.errors",
     "load_cubes": "fishgen.clouds",

@@ -1,20 +1,22 @@
-"""Build a game-ready fish from a species: parts in glTF axes and metres, materials,
-textures and the looping ``swim`` clip.
+"""Build a game-ready fish from a species: a scene of parts in glTF axes and metres,
+materials, textures and the looping ``swim`` clip.
+
+The scene has one root node named after the species and one child node per
+part, each with its own mesh; moving fins carry their pivot as the node
+translation and swing about +Y in the ``swim`` clip.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
-from fishgen.assembly.animation import MAX_CLIP_FRAMES, FinMotion, clip_frames
-from fishgen.assembly.materials import (FIN_MODES, Material, default_fin_mode, load_textures,
-                                        make_materials)
+from fishgen.assembly.animation import MAX_CLIP_FRAMES, FinMotion, clip_frames, y_rotation_quaternions
+from fishgen.assembly.materials import FIN_MODES, default_fin_mode, load_textures, make_materials
 from fishgen.errors import FishgenError
 from fishgen.geometry.body import build_body
 from fishgen.geometry.fins import Fin, caudal_fin, mirrored, pectoral_fin, pelvic_fin, vertical_fin
-from fishgen.geometry.mesh import Mesh
+from fishgen.geometry.mesh import vertex_normals
 from fishgen.geometry.shapes import profile_for
+from fishgen.scene.model import Channel, Clip, Image, Mesh, Node, Primitive, Sampler, Scene
 from fishgen.species.model import Species
 
 #: One VRFish world unit in metres (docs/decisions.md): BonyBream's world scale
@@ -25,40 +27,6 @@ METRES_PER_WORLD_UNIT = 0.05
 THESIS_TO_GLTF = np.array([[0.0, 0.0, 1.0],
                            [0.0, 1.0, 0.0],
                            [-1.0, 0.0, 0.0]])
-
-
-@dataclass(frozen=True)
-class Part:
-    """One node of the fish: a mesh placed at ``translation`` (the pivot for moving fins)."""
-    name: str
-    mesh: Mesh
-    material: str
-    translation: np.ndarray
-    motion: FinMotion | None = None
-
-
-@dataclass(frozen=True)
-class FishAsset:
-    name: str
-    parts: tuple[Part, ...]
-    materials: dict[str, Material]
-    images: dict[str, bytes]
-    fps: float
-    clip_frames: int
-    fin_mode: str
-    species: Species | None = field(default=None, compare=False)
-
-    @property
-    def clip_seconds(self) -> float:
-        return self.clip_frames / self.fps if self.clip_frames else 0.0
-
-    def rest_meshes(self) -> list[tuple[Part, Mesh]]:
-        """Every part's mesh in asset space (rest pose)."""
-        return [(p, Mesh(p.mesh.positions + p.translation, p.mesh.faces, p.mesh.uvs)) for p in self.parts]
-
-    def bounds(self) -> np.ndarray:
-        pts = np.concatenate([m.positions for _, m in self.rest_meshes()])
-        return np.stack([pts.min(axis=0), pts.max(axis=0)])
 
 
 def build_fins(species: Species, rings: np.ndarray) -> list[Fin]:
@@ -78,7 +46,7 @@ def build_fins(species: Species, rings: np.ndarray) -> list[Fin]:
 
 
 def build_fish(species: Species, *, fins: str | None = None, length: float | None = None,
-               fps: float = 30.0) -> FishAsset:
+               fps: float = 30.0) -> Scene:
     """Build the fish of ``species``.
 
     ``fins``: ``blend``, ``mask`` or ``opaque`` (default: ``mask`` when the file
@@ -116,26 +84,53 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
     def place(points: np.ndarray) -> np.ndarray:
         return (points - centre) @ THESIS_TO_GLTF.T * metres
 
-    parts = [Part("body", Mesh(place(body.mesh.positions), body.mesh.faces, body.mesh.uvs), "body",
-                  np.zeros(3))]
-    motions: list[tuple[str, FinMotion]] = []
+    scene = Scene(name=species.name, info={"fin_mode": mode, "kind": "fish"})
+    root = scene.add_node(Node(name=species.name))
+    skin = load_textures(species, mode)
+    texture = scene.add_image(Image("skin", skin["skin"])) if "skin" in skin else None
+    body_material, fin_material = (scene.add_material(m) for m in make_materials(species, mode, texture))
+
+    def add_part(name: str, positions: np.ndarray, faces: np.ndarray, uvs: np.ndarray, material: int,
+                 pivot: np.ndarray) -> int:
+        attributes = {"POSITION": positions.astype(np.float32),
+                      "NORMAL": vertex_normals(positions, faces).astype(np.float32)}
+        if texture is not None:
+            attributes["TEXCOORD_0"] = uvs.astype(np.float32)
+        mesh = scene.add_mesh(Mesh(name, [Primitive(attributes, faces.astype(np.uint32), material)]))
+        return scene.add_node(Node(name=name, mesh=mesh, translation=tuple(float(v) for v in pivot)),
+                              parent=root)
+
+    add_part("body", place(body.mesh.positions), body.mesh.faces, body.mesh.uvs, body_material, np.zeros(3))
+    motions: list[tuple[int, str, FinMotion]] = []
     for fin in fin_list:
         motion = FinMotion.from_fin(fin.movement_angle, fin.step_size,
                                     -1.0 if fin.mirror_of else 1.0) if fin.pivot is not None else None
+        pivot = place(fin.pivot[None, :])[0] if motion is not None and fin.pivot is not None else np.zeros(3)
+        node = add_part(fin.name, place(fin.mesh.positions) - pivot, fin.mesh.faces, fin.mesh.uvs,
+                        fin_material, pivot)
         if motion is not None:
-            pivot = place(fin.pivot[None, :])[0]
-            motions.append((fin.name, motion))
-        else:
-            pivot = np.zeros(3)
-        mesh = Mesh(place(fin.mesh.positions) - pivot, fin.mesh.faces, fin.mesh.uvs)
-        parts.append(Part(fin.name, mesh, "fins", pivot, motion))
+            motions.append((node, fin.name, motion))
 
-    frames = clip_frames([m for _, m in motions])
+    frames = clip_frames([m for _, _, m in motions])
     if frames > MAX_CLIP_FRAMES:
-        slowest, _ = max(motions, key=lambda nm: nm[1].period_frames)
+        _, slowest, _ = max(motions, key=lambda nm: nm[2].period_frames)
         raise FishgenError(f"expected fin cycles that loop within {MAX_CLIP_FRAMES} frames, found "
-                           f"{frames} (periods {sorted({m.period_frames for _, m in motions})}); "
+                           f"{frames} (periods {sorted({m.period_frames for _, _, m in motions})}); "
                            "choose movement angles and step sizes with a small common multiple",
                            species.source, species.line_of(slowest.split("_")[0]))
-    return FishAsset(species.name, tuple(parts), make_materials(species, mode),
-                     load_textures(species, mode), float(fps), frames, mode, species)
+    if motions:
+        channels = []
+        for node, _, motion in motions:
+            keys, angles = motion.keys(frames)
+            channels.append(Channel(node, "rotation", Sampler((keys / fps).astype(np.float32),
+                                                              y_rotation_quaternions(angles).astype(np.float32))))
+        scene.clips.append(Clip("swim", channels))
+    scene.info["fps"] = float(fps)
+    return scene
+
+
+def species_scene(path, *, textures_dir=None, **_) -> Scene:
+    """The fish a species file builds with default options (the registry's species reader)."""
+    from fishgen.species.parser import load_species
+
+    return build_fish(load_species(path, textures_dir=textures_dir))

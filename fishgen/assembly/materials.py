@@ -10,23 +10,13 @@
 from __future__ import annotations
 
 import io
-from dataclasses import dataclass
 
 from fishgen.errors import FishgenError
+from fishgen.scene.model import Material
 from fishgen.species.model import Species
 
-FIN_MODES = ("blend", "mask", "opaque")
+from fishgen.assembly.fin_modes import FIN_MODES
 MASK_CUTOFF = 0.5
-
-
-@dataclass(frozen=True)
-class Material:
-    name: str
-    base_color: tuple[float, float, float, float]
-    texture: str | None = None          # key into FishAsset.images
-    alpha_mode: str = "OPAQUE"
-    alpha_cutoff: float | None = None
-    double_sided: bool = False
 
 
 def fin_alpha(transparency: float) -> float:
@@ -76,10 +66,11 @@ def _png(image) -> bytes:
     return out.getvalue()
 
 
-def make_materials(species: Species, mode: str) -> dict[str, Material]:
-    textured = species.textured and species.colour_texture is not None
+def make_materials(species: Species, mode: str, texture: int | None) -> tuple[Material, Material]:
+    """(body, fins) materials; ``texture`` is the scene image index of the skin, if any."""
+    textured = texture is not None
     colour = (*species.colour, 1.0)
-    tex = "skin" if textured else None
+    tex = texture
     body = Material("body", (1.0, 1.0, 1.0, 1.0) if textured else colour, tex)
     fin_rgb = (1.0, 1.0, 1.0) if textured else species.colour
     if mode == "blend":
@@ -88,4 +79,4 @@ def make_materials(species: Species, mode: str) -> dict[str, Material]:
         fins = Material("fins", (*fin_rgb, 1.0), tex, "MASK", MASK_CUTOFF, True)
     else:
         fins = Material("fins", (*fin_rgb, 1.0), tex, "OPAQUE", None, True)
-    return {"body": body, "fins": fins}
+    return body, fins

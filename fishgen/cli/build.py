@@ -5,18 +5,23 @@ from pathlib import Path
 
 import click
 
-FORMATS = ("glb", "gltf", "obj", "ply")
+from fishgen.assembly.fin_modes import FIN_MODES
+
+from fishgen.exchange.registry import MESHES, extensions, formats
+
+FISH_FORMATS = formats(writable=True, holding=[MESHES])
 
 
 @click.command("build", context_settings={"show_default": True})
 @click.argument("species_files", nargs=-1, required=True,
                 type=click.Path(dir_okay=False, path_type=Path), metavar="SPECIES_FILE...")
 @click.option("-o", "--output", type=click.Path(path_type=Path), default=None,
-              help="Output file for one species (its extension picks the format: .glb, .gltf, .obj, "
-                   ".ply), or a folder for several. [default: out/<species file stem>.<format>]")
-@click.option("--format", "fmt", type=click.Choice(FORMATS), default="glb",
+              help=f"Output file for one species (its extension picks the format: "
+                   f"{', '.join(extensions(FISH_FORMATS))}), or a folder for several. "
+                   "[default: out/<species file stem>.<format>]")
+@click.option("--format", "fmt", type=click.Choice([f.name for f in FISH_FORMATS]), default="glb",
               help="Format when writing into a folder.")
-@click.option("--fins", type=click.Choice(["blend", "mask", "opaque"]), default=None,
+@click.option("--fins", type=click.Choice(FIN_MODES), default=None,
               help="Fin technique (thesis ch. 5): translucent, mask cut-out or opaque. "
                    "[default: mask if the file says masked, else blend]")
 @click.option("--length", type=float, default=None, metavar="METRES",
@@ -38,17 +43,22 @@ def build(species_files: tuple[Path, ...], output: Path | None, fmt: str, fins: 
     """
     from fishgen.assembly.fish import build_fish
     from fishgen.errors import FishgenError
-    from fishgen.exchange import WRITERS, export
+    from fishgen.exchange import export
+    from fishgen.exchange.registry import FORMATS, by_extension, input_format, output_format
     from fishgen.species.parser import load_species
 
-    single_file = (len(species_files) == 1 and output is not None
-                   and output.suffix.lower() in WRITERS)
-    if len(species_files) == 1 and output is not None and output.suffix and not single_file:
-        raise FishgenError(f"expected an output ending in {', '.join(WRITERS)} (or a folder), "
-                           f"found {output.name!r}")
+    species_formats = [f for f in FORMATS.values() if f.command == "build"]
+    for species_file in species_files:
+        input_format(species_file, kinds=species_formats, command="build", default=FORMATS["species"])
+    suffix = output.suffix.lower() if output is not None else ""
+    single_file = len(species_files) == 1 and output is not None and by_extension(output) is not None
+    if single_file:
+        output_format(output, [MESHES])  # type: ignore[arg-type]
+    elif len(species_files) == 1 and suffix:
+        output_format(output, [MESHES], what="output (or a folder)")  # type: ignore[arg-type]
     folder = output if output is not None else Path("out")
     if len(species_files) > 1:
-        if output is not None and output.suffix.lower() in WRITERS:
+        if output is not None and by_extension(output) is not None:
             raise FishgenError(f"expected a folder for {len(species_files)} species files, found "
                                f"{output.name!r} (name a folder and pick the format with --format)")
         seen: dict[str, Path] = {}
@@ -63,17 +73,31 @@ def build(species_files: tuple[Path, ...], output: Path | None, fmt: str, fins: 
     for species_file in species_files:
         target = output if single_file else folder / f"{species_file.stem}.{fmt}"
         try:
-            asset = build_fish(load_species(species_file, textures_dir), fins=fins, length=length, fps=fps)
-            written = export(asset, target)
+            scene = build_fish(load_species(species_file, textures_dir), fins=fins, length=length, fps=fps)
+            written = export(scene, target, require=[MESHES])  # type: ignore[arg-type]
         except FishgenError as err:
             if len(species_files) == 1:
                 raise
             click.echo(str(err), err=True)
             failures += 1
             continue
-        lo, hi = asset.bounds()
-        click.echo(f"{target}: {asset.name}, {sum(len(p.mesh.faces) for p in asset.parts)} triangles, "
-                   f"{hi[2] - lo[2]:.3f} m long, fins {asset.fin_mode}, swim loop {asset.clip_seconds:.2f} s"
-                   + (f" (+{len(written) - 1} files)" if len(written) > 1 else ""), err=True)
+        click.echo(summary(scene, target, written))  # type: ignore[arg-type]
     if failures:
         raise SystemExit(2)
+
+
+def summary(scene, target: Path, written: list[Path]) -> str:
+    """One line: what was built, and what the format could not keep (said once)."""
+    from fishgen.exchange.registry import by_extension, lost
+    from fishgen.scene.pose import bounds
+
+    lo, hi = bounds(scene)
+    fmt = by_extension(target)
+    dropped = lost(fmt, scene) if fmt is not None else []
+    clip = scene.clip("swim")
+    motion = (f"swim loop {clip.duration:.2f} s" if clip is not None and not dropped
+              else "rest pose only" if clip is not None else "no animation")
+    note = f" ({fmt.extensions[0][1:].upper()} holds no {' or '.join(dropped)})" if dropped and fmt else ""
+    return (f"{target}: {scene.name}, {scene.counts()['triangles']} triangles, {hi[2] - lo[2]:.3f} m long, "
+            f"fins {scene.info.get('fin_mode')}, {motion}{note}"
+            + (f" (+{len(written) - 1} files)" if len(written) > 1 else ""))

@@ -1,26 +1,23 @@
-"""Exporters, one module per format behind one entry point chosen by file extension."""
+"""Writers and readers, one module per format, behind one entry point chosen by extension.
+
+Which formats exist and what each can hold is declared in :mod:`fishgen.exchange.registry`.
+"""
 from __future__ import annotations
 
-import importlib
 import os
+from collections.abc import Iterable
 from pathlib import Path
 
-from fishgen.errors import FishgenError
-
-#: extension -> (module, function); each writer takes (asset, path) and writes atomically.
-WRITERS = {
-    ".glb": ("fishgen.exchange.gltf", "write_glb"),
-    ".gltf": ("fishgen.exchange.gltf", "write_gltf"),
-    ".obj": ("fishgen.exchange.obj", "write_obj"),
-    ".ply": ("fishgen.exchange.ply", "write_ply"),
-}
+from fishgen.scene.model import Scene
 
 
-def export(asset, path: str | os.PathLike) -> list[Path]:
-    """Write ``asset`` to ``path`` in the format its extension names; returns the files written."""
+def export(scene: Scene, path: str | os.PathLike, *, require: Iterable[str] = ()) -> list[Path]:
+    """Write ``scene`` to ``path`` in the format its extension names; returns the files written.
+
+    ``require`` names what the format must hold (``"node animation"`` for a
+    school); a format that cannot is refused before anything is written.
+    """
+    from fishgen.exchange.registry import output_format
+
     path = Path(path)
-    ext = path.suffix.lower()
-    if ext not in WRITERS:
-        raise FishgenError(f"expected an output ending in {', '.join(WRITERS)}, found {path.name!r}")
-    module, name = WRITERS[ext]
-    return getattr(importlib.import_module(module), name)(asset, path)
+    return output_format(path, require).write(scene, path)

@@ -1,11 +1,12 @@
-"""glTF 2.0 writer (.glb and .gltf + .bin + .png) built on pygltflib.
+"""glTF 2.0 writer (.glb, or .gltf + .bin + images) of a scene, built on pygltflib.
 
-Nodes: a root named after the species, one child per part; moving fins carry
-their pivot as the node translation and are animated by the ``swim`` clip.
+It only writes: the scene says what the nodes, meshes, materials, skins and
+clips are. pygltflib holds the document and makes the GLB container; this
+module lays the arrays out in one buffer (4-byte aligned views) and checks that
+nothing non-finite or larger than a GLB can hold gets written.
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from urllib.parse import quote
 
@@ -13,149 +14,191 @@ import numpy as np
 import pygltflib as gl
 
 from fishgen import __version__
-from fishgen.assembly.animation import y_rotation_quaternions
-from fishgen.atomic import write_files
+from fishgen.atomic import atomic_open, write_files
+from fishgen.errors import FishgenError
+from fishgen.scene.model import Primitive, Scene
 
-CLAMP, LINEAR, LINEAR_MIPMAP_LINEAR = 33071, 9729, 9987
+GLB_LIMIT = 2**32 - 1
+_COMPONENT = {np.dtype(np.float32): gl.FLOAT, np.dtype(np.uint8): gl.UNSIGNED_BYTE,
+              np.dtype(np.uint16): gl.UNSIGNED_SHORT, np.dtype(np.uint32): gl.UNSIGNED_INT,
+              np.dtype(np.int8): gl.BYTE, np.dtype(np.int16): gl.SHORT}
+_TYPE = {1: gl.SCALAR, 2: gl.VEC2, 3: gl.VEC3, 4: gl.VEC4, 16: gl.MAT4}
+_NORMALIZED = ("COLOR_0", "WEIGHTS_0", "TEXCOORD_0")
+_MODES = {"TRIANGLES": gl.TRIANGLES, "POINTS": gl.POINTS}
 
 
-class _Blob:
-    """Accumulates the binary buffer with 4-byte aligned buffer views."""
+class _Buffer:
+    """The binary buffer as a list of pieces, with 4-byte aligned buffer views and accessors."""
 
-    def __init__(self, gltf: gl.GLTF2):
-        self.gltf = gltf
-        self.data = bytearray()
+    def __init__(self, gltf: gl.GLTF2, where: Path):
+        self.gltf, self.where = gltf, where
+        self.pieces: list[bytes | memoryview] = []
+        self.length = 0
 
-    def view(self, payload: bytes, target: int | None = None) -> int:
-        self.data.extend(b"\0" * (-len(self.data) % 4))
-        self.gltf.bufferViews.append(gl.BufferView(buffer=0, byteOffset=len(self.data),
+    def view(self, payload: bytes | memoryview, target: int | None = None, stride: int | None = None) -> int:
+        pad = -self.length % 4
+        if pad:
+            self.pieces.append(b"\0" * pad)
+            self.length += pad
+        self.gltf.bufferViews.append(gl.BufferView(buffer=0, byteOffset=self.length, byteStride=stride,
                                                    byteLength=len(payload), target=target))
-        self.data.extend(payload)
+        self.pieces.append(payload)
+        self.length += len(payload)
+        if self.length > GLB_LIMIT:
+            raise FishgenError(f"expected at most 4 GiB of binary data for glTF, found more than "
+                               f"{self.length:,} bytes", self.where)
         return len(self.gltf.bufferViews) - 1
 
-    def accessor(self, array: np.ndarray, kind: str, target: int | None = None,
-                 bounds: bool = False) -> int:
+    def accessor(self, array: np.ndarray, *, target: int | None = None, bounds: bool = False,
+                 normalized: bool = False, mat4: bool = False) -> int:
         array = np.ascontiguousarray(array)
-        component = {np.dtype(np.float32): gl.FLOAT, np.dtype(np.uint16): gl.UNSIGNED_SHORT,
-                     np.dtype(np.uint32): gl.UNSIGNED_INT}[array.dtype]
-        view = self.view(array.tobytes(), target)
-        acc = gl.Accessor(bufferView=view, componentType=component, count=len(array), type=kind)
-        if bounds:
-            flat = array.reshape(len(array), -1)
-            acc.min = [float(v) for v in flat.min(axis=0)]
-            acc.max = [float(v) for v in flat.max(axis=0)]
+        if array.dtype == np.float64:
+            array = array.astype(np.float32)
+        if array.dtype.kind == "f" and not np.all(np.isfinite(array)):
+            raise FishgenError("expected finite numbers in every array, found NaN or infinity",
+                               self.where)
+        width = 16 if mat4 else (1 if array.ndim == 1 else int(np.prod(array.shape[1:])))
+        flat = array.reshape(len(array), width)
+        payload, stride = memoryview(flat).cast("B"), None
+        row = flat.dtype.itemsize * width
+        if target == gl.ARRAY_BUFFER and row % 4:  # vertex rows must be 4-byte aligned: pad them
+            stride = row + (-row % 4)
+            padded = np.zeros((len(flat), stride), np.uint8)
+            padded[:, :row] = flat.view(np.uint8).reshape(len(flat), row)
+            payload = memoryview(padded).cast("B")
+        acc = gl.Accessor(bufferView=self.view(payload, target, stride),
+                          componentType=_COMPONENT[array.dtype], count=len(array), type=_TYPE[width],
+                          normalized=True if normalized and array.dtype.kind in "iu" else None)
+        if bounds and len(array):
+            acc.min = [v.item() for v in flat.min(axis=0)]
+            acc.max = [v.item() for v in flat.max(axis=0)]
         self.gltf.accessors.append(acc)
         return len(self.gltf.accessors) - 1
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
-    v = v.astype(np.float32)
-    return v / np.linalg.norm(v, axis=1, keepdims=True)
-
-
-def build_gltf(asset, image_uri=None) -> tuple[gl.GLTF2, bytes, dict[str, bytes]]:
-    """The glTF document, its binary buffer, and the images (for external files)."""
+def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[gl.GLTF2, _Buffer]:
+    """The glTF document and its buffer; ``image_uri(index)`` names external image files."""
     gltf = gl.GLTF2(asset=gl.Asset(version="2.0", generator=f"fishgen {__version__}"))
-    blob = _Blob(gltf)
+    buf = _Buffer(gltf, where)
 
-    image_index: dict[str, int] = {}
-    for key, png in asset.images.items():
+    for k, image in enumerate(scene.images):
         if image_uri is None:
-            gltf.images.append(gl.Image(bufferView=blob.view(png), mimeType="image/png", name=key))
+            gltf.images.append(gl.Image(bufferView=buf.view(image.data), mimeType=image.mime_type,
+                                        name=image.name))
         else:
-            gltf.images.append(gl.Image(uri=image_uri(key), name=key))
-        image_index[key] = len(gltf.images) - 1
-    if asset.images:
-        gltf.samplers.append(gl.Sampler(magFilter=LINEAR, minFilter=LINEAR_MIPMAP_LINEAR,
-                                        wrapS=CLAMP, wrapT=CLAMP))
-    texture_index = {}
-    for key, idx in image_index.items():
-        gltf.textures.append(gl.Texture(sampler=0, source=idx, name=key))
-        texture_index[key] = len(gltf.textures) - 1
-
-    material_index = {}
-    for name, mat in asset.materials.items():
+            gltf.images.append(gl.Image(uri=image_uri(k), name=image.name))
+    textures: dict[int, int] = {}
+    for mat in scene.materials:
+        if mat.texture is not None and mat.texture not in textures:
+            if not gltf.samplers:
+                gltf.samplers.append(gl.Sampler(magFilter=gl.LINEAR, minFilter=gl.LINEAR_MIPMAP_LINEAR,
+                                                wrapS=gl.CLAMP_TO_EDGE, wrapT=gl.CLAMP_TO_EDGE))
+            gltf.textures.append(gl.Texture(sampler=0, source=mat.texture, name=scene.images[mat.texture].name))
+            textures[mat.texture] = len(gltf.textures) - 1
+    for mat in scene.materials:
         pbr = gl.PbrMetallicRoughness(baseColorFactor=[float(c) for c in mat.base_color],
-                                      metallicFactor=0.0, roughnessFactor=0.55)
+                                      metallicFactor=float(mat.metallic), roughnessFactor=float(mat.roughness))
         if mat.texture is not None:
-            pbr.baseColorTexture = gl.TextureInfo(index=texture_index[mat.texture])
-        gltf.materials.append(gl.Material(name=name, pbrMetallicRoughness=pbr, alphaMode=mat.alpha_mode,
-                                          alphaCutoff=mat.alpha_cutoff, doubleSided=mat.double_sided))
-        material_index[name] = len(gltf.materials) - 1
+            pbr.baseColorTexture = gl.TextureInfo(index=textures[mat.texture])
+        out = gl.Material(name=mat.name, pbrMetallicRoughness=pbr, alphaMode=mat.alpha_mode,
+                          doubleSided=mat.double_sided,
+                          alphaCutoff=(0.5 if mat.alpha_cutoff is None else mat.alpha_cutoff)
+                          if mat.alpha_mode == "MASK" else None)
+        if mat.unlit:
+            out.extensions = {"KHR_materials_unlit": {}}
+            if "KHR_materials_unlit" not in gltf.extensionsUsed:
+                gltf.extensionsUsed.append("KHR_materials_unlit")
+        gltf.materials.append(out)
 
-    textured = bool(asset.images)
-    children = []
-    for part in asset.parts:
-        mesh = part.mesh
-        attrs = gl.Attributes(
-            POSITION=blob.accessor(mesh.positions.astype(np.float32), gl.VEC3, gl.ARRAY_BUFFER, True),
-            NORMAL=blob.accessor(_unit(mesh.normals), gl.VEC3, gl.ARRAY_BUFFER))
-        if textured:
-            attrs.TEXCOORD_0 = blob.accessor(mesh.uvs.astype(np.float32), gl.VEC2, gl.ARRAY_BUFFER)
-        index_type = np.uint16 if len(mesh.positions) < 65535 else np.uint32
-        indices = blob.accessor(mesh.faces.reshape(-1).astype(index_type), gl.SCALAR,
-                                gl.ELEMENT_ARRAY_BUFFER, True)
-        gltf.meshes.append(gl.Mesh(name=part.name, primitives=[gl.Primitive(
-            attributes=attrs, indices=indices, material=material_index[part.material])]))
-        node = gl.Node(name=part.name, mesh=len(gltf.meshes) - 1)
-        if np.any(part.translation):
-            node.translation = [float(v) for v in part.translation]
-        gltf.nodes.append(node)
-        children.append(len(gltf.nodes) - 1)
-    gltf.nodes.append(gl.Node(name=asset.name, children=children))
-    gltf.scenes.append(gl.Scene(name=asset.name, nodes=[len(gltf.nodes) - 1]))
+    for mesh in scene.meshes:
+        gltf.meshes.append(gl.Mesh(name=mesh.name, primitives=[_primitive(buf, p) for p in mesh.primitives],
+                                   weights=[float(w) for w in mesh.weights] or None))
+    for node in scene.nodes:
+        out_node = gl.Node(name=node.name or None, mesh=node.mesh, skin=node.skin, children=list(node.children))
+        if node.matrix is not None:
+            out_node.matrix = [float(v) for v in np.asarray(node.matrix, float).T.ravel()]
+        else:
+            if any(node.translation):
+                out_node.translation = [float(v) for v in node.translation]
+            if tuple(node.rotation) != (0.0, 0.0, 0.0, 1.0):
+                out_node.rotation = [float(v) for v in node.rotation]
+            if tuple(node.scale) != (1.0, 1.0, 1.0):
+                out_node.scale = [float(v) for v in node.scale]
+        gltf.nodes.append(out_node)
+    for skin in scene.skins:
+        ibm = np.asarray(skin.inverse_bind_matrices, np.float32).transpose(0, 2, 1)  # column-major
+        gltf.skins.append(gl.Skin(name=skin.name, joints=list(skin.joints), skeleton=skin.skeleton,
+                                  inverseBindMatrices=buf.accessor(ibm.reshape(-1, 16), mat4=True)))
+    gltf.scenes.append(gl.Scene(name=scene.name or None, nodes=list(scene.roots)))
     gltf.scene = 0
 
-    animated = [(i, p) for i, p in enumerate(asset.parts) if p.motion is not None]
-    if animated:
-        anim = gl.Animation(name="swim")
-        for node, part in animated:
-            frames, angles = part.motion.keys(asset.clip_frames)
-            times = blob.accessor((frames / asset.fps).astype(np.float32), gl.SCALAR, bounds=True)
-            rot = blob.accessor(y_rotation_quaternions(angles).astype(np.float32), gl.VEC4)
-            anim.samplers.append(gl.AnimationSampler(input=times, output=rot, interpolation="LINEAR"))
+    for clip in scene.clips:
+        anim = gl.Animation(name=clip.name)
+        for ch in clip.channels:
+            smp = ch.sampler
+            times = buf.accessor(np.asarray(smp.times, np.float32).ravel(), bounds=True)
+            values = np.asarray(smp.values, np.float32)
+            if ch.path == "weights":
+                values = values.ravel()  # glTF: SCALAR, (keys x targets) values
+            anim.samplers.append(gl.AnimationSampler(input=times, output=buf.accessor(values),
+                                                     interpolation=smp.interpolation))
             anim.channels.append(gl.AnimationChannel(sampler=len(anim.samplers) - 1,
-                                                     target=gl.AnimationChannelTarget(node=node,
-                                                                                      path="rotation")))
+                                                     target=gl.AnimationChannelTarget(node=ch.node,
+                                                                                      path=ch.path)))
         gltf.animations.append(anim)
-
-    data = bytes(blob.data) + b"\0" * (-len(blob.data) % 4)
-    gltf.buffers.append(gl.Buffer(byteLength=len(data)))
-    return gltf, data, asset.images
+    gltf.buffers.append(gl.Buffer(byteLength=buf.length + (-buf.length % 4)))
+    return gltf, buf
 
 
-def _json(gltf: gl.GLTF2) -> bytes:
-    # Stable key order and no whitespace: same asset -> same bytes.
-    doc = json.loads(gltf.to_json())
-    return json.dumps(doc, separators=(",", ":"), sort_keys=True).encode("utf-8")
+def _primitive(buf: _Buffer, prim: Primitive) -> gl.Primitive:
+    attrs = gl.Attributes()
+    for name, array in prim.attributes.items():
+        acc = buf.accessor(array, target=gl.ARRAY_BUFFER, bounds=name == "POSITION",
+                           normalized=name in _NORMALIZED)
+        setattr(attrs, name, acc)
+    out = gl.Primitive(attributes=attrs, material=prim.material,
+                       mode=None if prim.mode == "TRIANGLES" else _MODES[prim.mode])
+    if prim.indices is not None:
+        flat = np.asarray(prim.indices).ravel()
+        dtype = np.uint16 if prim.vertex_count < 65535 else np.uint32
+        out.indices = buf.accessor(flat.astype(dtype), target=gl.ELEMENT_ARRAY_BUFFER, bounds=True)
+    if prim.targets:
+        out.targets = [{name: buf.accessor(array, target=gl.ARRAY_BUFFER, bounds=name == "POSITION")
+                        for name, array in target.items()} for target in prim.targets]
+    return out
 
 
-def glb_bytes(asset) -> bytes:
-    """The asset as one binary glTF (.glb) file, in memory."""
-    gltf, data, _ = build_gltf(asset)
-    body = _json(gltf)
-    body += b" " * (-len(body) % 4)
-    total = 12 + 8 + len(body) + 8 + len(data)
-    return b"".join([
-        np.array([0x46546C67, 2, total], dtype="<u4").tobytes(),
-        np.array([len(body), 0x4E4F534A], dtype="<u4").tobytes(), body,
-        np.array([len(data), 0x004E4942], dtype="<u4").tobytes(), data,
-    ])
+def _blob(buf: _Buffer) -> bytes:
+    return b"".join(buf.pieces) + b"\0" * (-buf.length % 4)
 
 
-def write_glb(asset, path: Path) -> list[Path]:
-    write_files({path: glb_bytes(asset)})
+def glb_bytes(scene: Scene, where: Path = Path("<glb>")) -> bytes:
+    """The scene as one binary glTF (.glb) file, in memory."""
+    gltf, buf = build_document(scene, where)
+    gltf.set_binary_blob(_blob(buf))
+    return b"".join(gltf.save_to_bytes())
+
+
+def write_glb(scene: Scene, path: Path) -> list[Path]:
+    gltf, buf = build_document(scene, path)
+    gltf.set_binary_blob(_blob(buf))
+    buf.pieces.clear()
+    with atomic_open(path) as handle:  # pygltflib's container, written piece by piece
+        for piece in gltf.save_to_bytes():
+            handle.write(piece)
     return [path]
 
 
-def write_gltf(asset, path: Path) -> list[Path]:
-    """``.gltf`` JSON with the buffer and textures as files beside it."""
+def write_gltf(scene: Scene, path: Path) -> list[Path]:
+    """``.gltf`` JSON with the buffer and images as files beside it (URIs percent-encoded)."""
     stem = path.stem
-    # URIs are percent-encoded: a file named "a b.bin" is referenced as "a%20b.bin".
-    gltf, data, images = build_gltf(asset, image_uri=lambda key: quote(f"{stem}_{key}.png"))
+    names = [f"{stem}_{image.name}.{'jpg' if image.mime_type == 'image/jpeg' else 'png'}"
+             for image in scene.images]
+    gltf, buf = build_document(scene, path, image_uri=lambda k: quote(names[k]))
     gltf.buffers[0].uri = quote(f"{stem}.bin")
-    files = {path: _json(gltf), path.with_name(f"{stem}.bin"): data}
-    for key, png in images.items():
-        files[path.with_name(f"{stem}_{key}.png")] = png
+    files: dict[Path, bytes] = {path: gltf.gltf_to_json(separators=(",", ":"), indent=None).encode("utf-8"),
+                                path.with_name(f"{stem}.bin"): _blob(buf)}
+    for name, image in zip(names, scene.images):
+        files[path.with_name(name)] = image.data
     write_files(files)
     return list(files)

@@ -1,8 +1,9 @@
-"""Read a glTF 2.0 asset (.glb / .gltf, or GLB bytes) into a preview ``Scene``.
+"""Read a glTF 2.0 asset (.glb / .gltf, or GLB bytes) into the scene model.
 
 Uses pygltflib for the JSON and does the accessor decoding itself, so that
-alpha modes, double-sidedness, POINTS primitives with a ``_RADIUS`` attribute
-and the animation channels all survive (general mesh loaders drop some of them).
+alpha modes, double-sidedness, POINTS primitives with ``_RADIUS``, skins,
+morph targets and every animation channel survive (general mesh loaders drop
+some of them). Side files are read only from the asset's own folder.
 """
 from __future__ import annotations
 
@@ -13,19 +14,18 @@ from pathlib import Path
 import numpy as np
 
 from fishgen.errors import FishgenError, describe
-from fishgen.preview.animation import INTERPOLATIONS, PATHS, Animation, Channel, Node
-from fishgen.preview.scene import (Material, MeshPart, PointPart, Scene, vertex_normals)
-from fishgen.preview.sidefiles import side_file
+from fishgen.exchange.sidefiles import side_file
+from fishgen.scene.model import (INTERPOLATIONS, PATHS, Channel, Clip, Image, Material, Mesh, Node,
+                                 Primitive, Sampler, Scene, Skin)
 
 _DTYPES = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16,
            5125: np.uint32, 5126: np.float32}
 _WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
-POINT_SIZE_FRACTION = 0.004
-"""Radius of particles that carry no ``_RADIUS``, as a fraction of the bounding-box diagonal."""
+_MODES = {0: "POINTS", 4: "TRIANGLES", 5: "TRIANGLES", 6: "TRIANGLES"}
 
 
 def read_gltf(path: str | Path | None = None, *, data: bytes | None = None,
-              label: str | None = None) -> Scene:
+              label: str | None = None, **_) -> Scene:
     """Load a .glb/.gltf file (or GLB ``data``) as a Scene; bad files raise FishgenError."""
     import pygltflib
 
@@ -109,108 +109,77 @@ class _Reader:
         return np.frombuffer(raw, _DTYPES[ctype], count * width,
                              offset + (part.byteOffset or 0)).reshape(count, width)
 
-    def image(self, i: int) -> np.ndarray:
-        from PIL import Image
-
-        if i not in self._images:
-            img = self.g.images[i]
-            if img.bufferView is not None:
-                raw, offset, _ = self.view_bytes(img.bufferView)
-                blob = raw[offset: offset + self.g.bufferViews[img.bufferView].byteLength]
-            else:
-                blob = self._uri(img.uri)
-            self._images[i] = np.asarray(Image.open(io.BytesIO(blob)).convert("RGBA"))
-        return self._images[i]
+    def image_bytes(self, i: int) -> bytes:
+        img = self.g.images[i]
+        if img.bufferView is not None:
+            raw, offset, _ = self.view_bytes(img.bufferView)
+            return bytes(raw[offset: offset + self.g.bufferViews[img.bufferView].byteLength])
+        return self._uri(img.uri)
 
     # -- scene ------------------------------------------------------------------
-    def material(self, i: int | None) -> Material:
-        if i is None:
-            return Material()
-        m = self.g.materials[i]
+    def material(self, k: int) -> Material:
+        m = self.g.materials[k]
         pbr = m.pbrMetallicRoughness
         texture = None
         if pbr is not None and pbr.baseColorTexture is not None:
-            source = self.g.textures[pbr.baseColorTexture.index].source
-            if source is not None:
-                texture = self.image(source)
+            texture = self.g.textures[pbr.baseColorTexture.index].source
         factor = tuple(pbr.baseColorFactor) if pbr is not None and pbr.baseColorFactor else (1, 1, 1, 1)
-        return Material(base_color=tuple(float(v) for v in factor), texture=texture,
-                        alpha_mode=m.alphaMode or "OPAQUE",
-                        alpha_cutoff=0.5 if m.alphaCutoff is None else float(m.alphaCutoff),
+        return Material(name=m.name or f"material{k}", base_color=tuple(float(v) for v in factor),
+                        texture=texture, alpha_mode=m.alphaMode or "OPAQUE",
+                        alpha_cutoff=None if m.alphaCutoff is None else float(m.alphaCutoff),
                         double_sided=bool(m.doubleSided),
                         unlit="KHR_materials_unlit" in (m.extensions or {}))
 
-    def primitive(self, prim, node: int, scene: Scene) -> None:
-        attrs = prim.attributes
+    def primitive(self, prim) -> Primitive | None:
         mode = 4 if prim.mode is None else prim.mode
-        if attrs.POSITION is None or mode not in (0, 4, 5, 6):
-            return  # lines have no surface to preview
-        positions = self.accessor(attrs.POSITION).astype(np.float32)
-        material = self.material(prim.material)
-        colors = None
-        if attrs.COLOR_0 is not None:
-            colors = self.accessor(attrs.COLOR_0).astype(np.float32)
-            if colors.shape[1] == 3:
-                colors = np.hstack([colors, np.ones((len(colors), 1), np.float32)])
-        if mode == 0:
-            extra = {k.upper(): v for k, v in vars(attrs).items() if k.startswith("_") and v is not None}
-            if "_RADIUS" in extra:
-                radii = self.accessor(extra["_RADIUS"]).astype(np.float32).ravel()
-            else:
-                span = positions.max(0) - positions.min(0) if len(positions) else np.ones(3)
-                radii = np.full(len(positions), POINT_SIZE_FRACTION * float(np.linalg.norm(span)), np.float32)
-            rgba = np.ones((len(positions), 4), np.float32) if colors is None else colors
-            rgba = rgba * np.asarray(material.base_color, np.float32)
-            if "_DENSITY" in extra:  # fishgen clouds: thin edge particles are fainter
-                rgba[:, 3] *= np.clip(self.accessor(extra["_DENSITY"]).ravel(), 0, 1)
-            scene.points.append(PointPart(positions, radii, rgba, node))
-            return
-        if prim.indices is not None:
-            flat = self.accessor(prim.indices).ravel().astype(np.uint32)
-        else:
-            flat = np.arange(len(positions), dtype=np.uint32)
-        if len(flat) and int(flat.max()) >= len(positions):  # the GPU would read past the vertices
-            raise FishgenError(f"expected vertex indices below {len(positions)}, found {int(flat.max())}",
-                               self.where)
-        indices = _triangles(flat, mode)
-        normals = self.accessor(attrs.NORMAL).astype(np.float32) if attrs.NORMAL is not None else None
-        uvs = self.accessor(attrs.TEXCOORD_0).astype(np.float32) if attrs.TEXCOORD_0 is not None else None
-        if normals is None:
-            normals = vertex_normals(positions, indices)
-        scene.meshes.append(MeshPart(positions, indices, material, node, normals, uvs, colors))
+        if prim.attributes.POSITION is None or mode not in _MODES:
+            return None  # lines have no surface to preview
+        attributes = {name: self.accessor(index) for name, index in vars(prim.attributes).items()
+                      if index is not None}
+        attributes = {name: (a.ravel() if a.shape[1] == 1 else a) for name, a in attributes.items()}
+        attributes["POSITION"] = attributes["POSITION"].astype(np.float32)
+        n = len(attributes["POSITION"])
+        indices = None
+        if _MODES[mode] == "TRIANGLES":
+            flat = (self.accessor(prim.indices).ravel().astype(np.uint32) if prim.indices is not None
+                    else np.arange(n, dtype=np.uint32))
+            if len(flat) and int(flat.max()) >= n:  # the GPU would read past the vertices
+                raise FishgenError(f"expected vertex indices below {n}, found {int(flat.max())}", self.where)
+            indices = _triangles(flat, mode)
+        targets = [{name: self.accessor(index).astype(np.float32) for name, index in target.items()
+                    if index is not None} for target in (prim.targets or [])]
+        return Primitive(attributes, indices, prim.material, _MODES[mode], targets)
 
     def scene(self, label: str) -> Scene:
         g = self.g
-        scene = Scene(label=label)
-        parents: dict[int, int] = {}
+        scene = Scene(name=label, info={"source": self.where})
+        for k, m in enumerate(g.meshes):
+            prims = [p for p in (self.primitive(prim) for prim in m.primitives) if p is not None]
+            scene.meshes.append(Mesh(m.name or f"mesh{k}", prims, [float(w) for w in (m.weights or [])]))
+        scene.images = [Image(img.name or f"image{k}", self.image_bytes(k), img.mimeType or "image/png")
+                        for k, img in enumerate(g.images)]
+        scene.materials = [self.material(k) for k in range(len(g.materials))]
         for i, n in enumerate(g.nodes):
-            for c in n.children or []:
-                parents[c] = i
-        for i, n in enumerate(g.nodes):
-            node = Node(name=n.name or f"node{i}", parent=parents.get(i))
+            node = Node(name=n.name or f"node{i}", children=list(n.children or []), mesh=n.mesh, skin=n.skin)
             if n.matrix is not None and list(n.matrix) != [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]:
                 node.matrix = np.asarray(n.matrix, float).reshape(4, 4).T  # column-major
             if n.translation is not None:
-                node.translation = np.asarray(n.translation, float)
+                node.translation = tuple(float(v) for v in n.translation)
             if n.rotation is not None:
-                node.rotation = np.asarray(n.rotation, float)
+                node.rotation = tuple(float(v) for v in n.rotation)
             if n.scale is not None:
-                node.scale = np.asarray(n.scale, float)
+                node.scale = tuple(float(v) for v in n.scale)
             scene.nodes.append(node)
+        for k, skin in enumerate(g.skins or []):
+            joints = list(skin.joints or [])
+            if skin.inverseBindMatrices is not None:
+                ibm = self.accessor(skin.inverseBindMatrices).astype(float).reshape(-1, 4, 4).transpose(0, 2, 1)
+            else:
+                ibm = np.repeat(np.eye(4)[None], len(joints), axis=0)
+            scene.skins.append(Skin(skin.name or f"skin{k}", joints, ibm, skin.skeleton))
         # Only nodes reachable from the default scene are drawn, as an engine would.
-        roots = list(range(len(g.nodes)))
-        if g.scenes:
-            roots = g.scenes[g.scene or 0].nodes or []
-        stack, seen = list(roots), set()
-        while stack:
-            i = stack.pop()
-            if i in seen:
-                continue
-            seen.add(i)
-            if g.nodes[i].mesh is not None:
-                for prim in g.meshes[g.nodes[i].mesh].primitives:
-                    self.primitive(prim, i, scene)
-            stack.extend(g.nodes[i].children or [])
+        scene.roots = list(g.scenes[g.scene or 0].nodes or []) if g.scenes else \
+            [i for i in range(len(g.nodes)) if not any(i in (n.children or []) for n in g.nodes)]
         for k, a in enumerate(g.animations or []):
             channels = []
             for ch in a.channels:
@@ -218,10 +187,12 @@ class _Reader:
                 interp = smp.interpolation or "LINEAR"
                 if ch.target.node is None or ch.target.path not in PATHS or interp not in INTERPOLATIONS:
                     continue
-                channels.append(Channel(ch.target.node, ch.target.path,
-                                        self.accessor(smp.input).astype(float).ravel(),
-                                        self.accessor(smp.output).astype(float), interp))
-            scene.animations.append(Animation(a.name or f"clip{k}", channels))
+                times = self.accessor(smp.input).astype(float).ravel()
+                values = self.accessor(smp.output).astype(float)
+                if ch.target.path == "weights":
+                    values = values.reshape(len(times) * (3 if interp == "CUBICSPLINE" else 1), -1)
+                channels.append(Channel(ch.target.node, ch.target.path, Sampler(times, values, interp)))
+            scene.clips.append(Clip(a.name or f"clip{k}", channels))
         return scene
 
 

@@ -1,4 +1,4 @@
-"""Read OBJ (+MTL, textures) and PLY (meshes or particle clouds) into a preview ``Scene``.
+"""Read OBJ (+MTL, textures) and PLY (meshes or particle clouds) into the scene model.
 
 trimesh does the parsing; this module maps what it finds onto preview materials.
 OBJ transparency comes from the MTL itself (``d`` below 1: blended; ``map_d``:
@@ -15,12 +15,13 @@ import numpy as np
 from trimesh.resolvers import Resolver
 
 from fishgen.errors import FishgenError, describe, expected
-from fishgen.preview.gltf_reader import POINT_SIZE_FRACTION, one_line
-from fishgen.preview.scene import Material, MeshPart, PointPart, Scene, srgb_to_linear
-from fishgen.preview.sidefiles import side_file
+from fishgen.exchange.gltf_reader import one_line
+from fishgen.exchange.sidefiles import side_file
+from fishgen.numeric import srgb_to_linear
+from fishgen.scene.model import Image, Material, Mesh, Node, Primitive, Scene
 
 
-def read_mesh_file(path: str | Path) -> Scene:
+def read_mesh_file(path: str | Path, **_) -> Scene:
     """Load an .obj or .ply file as a Scene; unreadable files raise FishgenError.
 
     The whole read is guarded, not only trimesh's parse: a face index past the
@@ -43,13 +44,17 @@ def _read(path: Path) -> Scene:
     alpha = _mtl_alpha(path) if obj else {}  # also refuses side files outside the asset's folder
     loaded = trimesh.load(str(path), process=False, resolver=_FolderResolver(path))
     geoms = loaded.dump(concatenate=False) if isinstance(loaded, trimesh.Scene) else [loaded]
-    scene = Scene(label=path.stem)
-    for geom in geoms:
+    scene = Scene(name=path.stem, info={"source": str(path)})
+    for k, geom in enumerate(geoms):
         if isinstance(geom, trimesh.PointCloud):
-            scene.points.append(_points(geom))
+            prim = _points(geom)
         elif isinstance(geom, trimesh.Trimesh) and len(geom.faces):
-            scene.meshes.append(_mesh(geom, alpha, path))
-    if not scene.meshes and not scene.points:
+            prim = _mesh(geom, alpha, path, scene)
+        else:
+            continue
+        name = str(geom.metadata.get("name") or f"{path.stem}{k}")
+        scene.add_node(Node(name=name, mesh=scene.add_mesh(Mesh(name, [prim]))))
+    if not scene.meshes:
         raise FishgenError("expected triangles or points, found an empty asset", path)
     return scene
 
@@ -120,16 +125,15 @@ _MAP_KEYS = {"map_ka", "map_kd", "map_ks", "map_ke", "map_ns", "map_d", "map_bum
              "decal", "refl", "norm", "map_pr", "map_pm", "map_ps"}
 
 
-def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path) -> MeshPart:
+def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path, scene: Scene) -> Primitive:
     positions = np.asarray(geom.vertices, np.float32)
     faces = np.asarray(geom.faces)
     if faces.min() < 0 or faces.max() >= len(positions):  # checked before anything indexes with them
         bad = int(faces.max()) if faces.max() >= len(positions) else int(faces.min())
         raise expected(f"face vertex indices from 0 to {len(positions) - 1}", str(bad), path)
-    indices = faces.astype(np.uint32)
     # trimesh keeps the file's normals, or computes smooth ones when it has none
-    normals = np.asarray(geom.vertex_normals, np.float32)
-    material, uvs, colors = Material(), None, None
+    attributes = {"POSITION": positions, "NORMAL": np.asarray(geom.vertex_normals, np.float32)}
+    material = None
     visual = geom.visual
     if visual.kind == "texture":
         mat = visual.material
@@ -137,6 +141,7 @@ def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path) -> MeshPart:
         if uv is not None and len(uv) == len(positions):
             uvs = np.asarray(uv, np.float32).copy()
             uvs[:, 1] = 1.0 - uvs[:, 1]  # OBJ's v points up; the image's first row is the top
+            attributes["TEXCOORD_0"] = uvs
         image = getattr(mat, "image", None) or getattr(mat, "baseColorTexture", None)
         diffuse = getattr(mat, "diffuse", None)
         if diffuse is None:
@@ -144,31 +149,35 @@ def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path) -> MeshPart:
         rgba = np.asarray(diffuse if diffuse is not None else [255] * 4, np.float32).ravel()
         rgba = rgba / 255.0 if rgba.max() > 1.0 else rgba
         rgb = srgb_to_linear(rgba[:3])  # MTL Kd is authored as a display (sRGB) colour
-        mode, opacity = alpha.get(getattr(mat, "name", None) or "", ("OPAQUE", 1.0))
-        material = Material(base_color=(*map(float, rgb), float(opacity)),
-                            texture=np.asarray(image.convert("RGBA")) if image is not None and uvs is not None else None,
-                            alpha_mode=mode, double_sided=mode != "OPAQUE")
+        name = getattr(mat, "name", None) or ""
+        mode, opacity = alpha.get(name, ("OPAQUE", 1.0))
+        texture = None
+        if image is not None and "TEXCOORD_0" in attributes:
+            texture = scene.add_image(Image(name or "texture", b"",
+                                            pixels=np.asarray(image.convert("RGBA"))))
+        material = scene.add_material(Material(name or f"material{len(scene.materials)}",
+                                               (*map(float, rgb), float(opacity)), texture, mode,  # type: ignore[arg-type]
+                                               double_sided=mode != "OPAQUE"))
     elif visual.kind == "vertex":
         c = np.asarray(visual.vertex_colors, np.float32) / 255.0
-        colors = np.hstack([srgb_to_linear(c[:, :3]), c[:, 3:4]])
-    return MeshPart(positions, indices, material, None, normals, uvs, colors)
+        attributes["COLOR_0"] = np.hstack([srgb_to_linear(c[:, :3]), c[:, 3:4]])
+    return Primitive(attributes, faces.astype(np.uint32), material)
 
 
-def _points(cloud) -> PointPart:
+def _points(cloud) -> Primitive:
     positions = np.asarray(cloud.vertices, np.float32)
     columns = _ply_columns(cloud.metadata.get("_ply_raw", {}).get("vertex", {}).get("data"))
+    attributes = {"POSITION": positions}
     if "radius" in columns:
-        radii = columns["radius"].astype(np.float32)
-    else:
-        span = positions.max(0) - positions.min(0) if len(positions) else np.ones(3)
-        radii = np.full(len(positions), POINT_SIZE_FRACTION * float(np.linalg.norm(span)), np.float32)
-    rgba = np.ones((len(positions), 4), np.float32)
+        attributes["_RADIUS"] = columns["radius"].astype(np.float32)
     if all(k in columns for k in ("red", "green", "blue")):
         rgb = np.stack([columns[k] for k in ("red", "green", "blue")], 1).astype(np.float32)
+        rgba = np.ones((len(positions), 4), np.float32)
         rgba[:, :3] = srgb_to_linear(rgb / (255.0 if rgb.max() > 1 else 1.0))
+        attributes["COLOR_0"] = rgba
     if "density" in columns:
-        rgba[:, 3] = np.clip(columns["density"].astype(np.float32), 0, 1)
-    return PointPart(positions, radii, rgba)
+        attributes["_DENSITY"] = np.clip(columns["density"].astype(np.float32), 0, 1)
+    return Primitive(attributes, mode="POINTS")
 
 
 def _ply_columns(raw) -> dict[str, np.ndarray]:

@@ -1,4 +1,4 @@
-"""Wavefront OBJ writer: rest pose, one ``o`` group per part, with .mtl and texture PNG."""
+"""Wavefront OBJ writer: the scene's rest pose, one ``o`` group per drawn mesh, with .mtl and images."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -6,6 +6,8 @@ from pathlib import Path
 import numpy as np
 
 from fishgen.atomic import write_files
+from fishgen.exchange.rest import rest_meshes
+from fishgen.scene.model import Scene
 
 
 def _rows(prefix: str, values: np.ndarray, fmt: str = "%.6f") -> str:
@@ -24,24 +26,24 @@ def _face_rows(faces: np.ndarray) -> str:
     return (row * len(faces) % tuple(np.repeat(faces, 3, axis=1).ravel().tolist()))[:-1]
 
 
-def write_obj(asset, path: Path) -> list[Path]:
+def write_obj(scene: Scene, path: Path) -> list[Path]:
     stem = path.stem
     mtl_name = f"{stem}.mtl"
-    textures = {key: f"{stem}_{key}.png" for key in asset.images}
-    lines = [f"# fishgen: {asset.name} (rest pose, metres, +Y up, head towards +Z)", f"mtllib {mtl_name}"]
+    textures = {k: f"{stem}_{image.name}.png" for k, image in enumerate(scene.images)}
+    lines = [f"# fishgen: {scene.name} (rest pose, metres, +Y up, head towards +Z)", f"mtllib {mtl_name}"]
     offset = 0
-    for part, mesh in asset.rest_meshes():
-        n = len(mesh.positions)
-        uv = mesh.uvs.copy()
+    for part in rest_meshes(scene):
+        uv = part.uvs if part.uvs is not None else np.zeros((len(part.positions), 2))
+        uv = uv.astype(np.float64)
         uv[:, 1] = 1.0 - uv[:, 1]          # OBJ's texture origin is bottom-left
-        face_rows = _face_rows(mesh.faces + offset + 1)
-        lines += [f"o {part.name}", _rows("v", mesh.positions), _rows("vt", uv), _rows("vn", mesh.normals),
-                  f"usemtl {part.material}", "s 1", face_rows]
-        offset += n
+        material = scene.materials[part.material].name if part.material is not None else "default"
+        lines += [f"o {part.name}", _rows("v", part.positions), _rows("vt", uv), _rows("vn", part.normals),
+                  f"usemtl {material}", "s 1", _face_rows(part.faces + offset + 1)]
+        offset += len(part.positions)
     mtl = []
-    for name, mat in asset.materials.items():
+    for mat in scene.materials:
         r, g, b, a = mat.base_color
-        mtl += [f"newmtl {name}", f"Kd {r:.6f} {g:.6f} {b:.6f}", "Ka 0 0 0", "Ks 0.04 0.04 0.04",
+        mtl += [f"newmtl {mat.name}", f"Kd {r:.6f} {g:.6f} {b:.6f}", "Ka 0 0 0", "Ks 0.04 0.04 0.04",
                 f"d {a:.6f}", "illum 2"]
         if mat.texture is not None:
             mtl.append(f"map_Kd {textures[mat.texture]}")
@@ -49,7 +51,7 @@ def write_obj(asset, path: Path) -> list[Path]:
                 mtl.append(f"map_d -imfchan m {textures[mat.texture]}")
         mtl.append("")
     files = {path: ("\n".join(lines) + "\n").encode(), path.with_name(mtl_name): "\n".join(mtl).encode()}
-    for key, name in textures.items():
-        files[path.with_name(name)] = asset.images[key]
+    for k, name in textures.items():
+        files[path.with_name(name)] = scene.images[k].data
     write_files(files)
     return list(files)

@@ -1,53 +1,24 @@
-"""Turn any preview input (species, cube file, or asset) into a ``Scene``."""
+"""Turn any preview input (species file, cube file, or asset) into a scene, through the format registry."""
 from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from fishgen.errors import FishgenError
-from fishgen.preview.scene import PointPart, Scene, srgb_to_linear
+from fishgen.exchange.registry import formats, input_format
+from fishgen.scene.model import Scene
 
-ASSETS = (".glb", ".gltf", ".obj", ".ply")
-KINDS = (".txt", ".awn") + ASSETS
+
+def input_formats():
+    """Everything a preview reads: every registered format with a reader."""
+    return formats(readable=True)
 
 
 def load_input(path: str | Path, *, textures_dir: str | Path | None = None, seed: int = 0) -> Scene:
-    """Load a species file (.txt), a cube file (.awn) or an asset (glb, gltf, obj, ply)."""
+    """Load a species file, a cube file or an asset; species and cube files are built in memory."""
     path = Path(path)
-    ext = path.suffix.lower()
-    if ext not in KINDS:
-        raise FishgenError(f"expected an input ending in {', '.join(KINDS)}, found {path.name!r}")
+    fmt = input_format(path, kinds=input_formats(), command="preview")
+    if path.is_dir():
+        raise FishgenError("expected a file, found a directory", path)
     if not path.is_file():
         raise FishgenError("expected an existing file, found none", path)
-    if ext == ".txt":
-        return species_scene(path, textures_dir)
-    if ext == ".awn":
-        return cloud_scene(path, seed)
-    if ext in (".glb", ".gltf"):
-        from fishgen.preview.gltf_reader import read_gltf
-        return read_gltf(path)
-    from fishgen.preview.mesh_reader import read_mesh_file
-    return read_mesh_file(path)
-
-
-def species_scene(path: Path, textures_dir=None) -> Scene:
-    """Build the fish in memory and read its GLB, so the preview shows exactly what `build` writes."""
-    import fishgen
-    from fishgen.exchange.gltf import glb_bytes
-    from fishgen.preview.gltf_reader import read_gltf
-
-    asset = fishgen.build_fish(fishgen.load_species(path, textures_dir=textures_dir))
-    return read_gltf(data=glb_bytes(asset), label=path.stem)
-
-
-def cloud_scene(path: Path, seed: int = 0) -> Scene:
-    """Fill the cube file as `fishgen clouds` does; density fades the thin edges."""
-    from fishgen.clouds import fill_cloud, load_cubes
-
-    cloud = fill_cloud(load_cubes(path), seed=seed)
-    rgba = np.empty((len(cloud), 4), np.float32)
-    rgba[:, :3] = srgb_to_linear(cloud.colors.astype(np.float32) / 255.0)
-    rgba[:, 3] = np.clip(cloud.density, 0.0, 1.0)
-    return Scene(label=path.stem, points=[PointPart(cloud.centers.astype(np.float32),
-                                                    cloud.radii.astype(np.float32), rgba)])
+    return fmt.read(path, textures_dir=textures_dir, seed=seed)

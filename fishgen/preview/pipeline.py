@@ -17,7 +17,7 @@ import numpy as np
 
 from fishgen.errors import FishgenError
 from fishgen.preview.camera import VIEWS, frame, turned
-from fishgen.preview.scene import Scene
+from fishgen.scene.model import Scene
 
 OUTPUTS = (".png", ".webp", ".gif", ".jpg", ".jpeg")
 ANIMATED = (".gif", ".webp")
@@ -125,17 +125,18 @@ def total_pixels(options: PreviewOptions, frames: int, inputs: int = 1) -> int:
 
 def subject_points(scene: Scene, times: Sequence[float | None], clip: str | None) -> np.ndarray:
     """Every vertex (and particle extent) the camera must keep in frame, at each of ``times``."""
+    from fishgen.preview.render import particles
+    from fishgen.scene.pose import deformed, pose
+
     out = []
     for t in times:
-        world = scene.world_matrices(t, clip)
-        for m in scene.meshes:
-            mat = world[m.node] if m.node is not None else np.eye(4)
-            out.append(m.positions @ mat[:3, :3].T + mat[:3, 3])
-        for p in scene.points:
-            mat = world[p.node] if p.node is not None else np.eye(4)
-            c = p.positions @ mat[:3, :3].T + mat[:3, 3]
-            r = p.radii[:, None] * float(np.cbrt(abs(np.linalg.det(mat[:3, :3]))) or 1.0)
-            out += [c - r, c + r]
+        posed = pose(scene, t, clip)
+        for node, prim in scene.drawn():
+            if prim.mode == "POINTS":
+                c, r, _ = particles(scene, node, prim, posed)
+                out += [c - r[:, None], c + r[:, None]]
+            else:
+                out.append(deformed(scene, node, prim, posed)[0])
     return np.concatenate(out) if out else np.zeros((1, 3))
 
 
@@ -160,10 +161,10 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
     from fishgen.preview.render import Renderer
 
     for scene in scenes:
-        if options.clip is not None and scene.animations and scene.clip(options.clip) is None:
-            names = ", ".join(a.name for a in scene.animations)
+        if options.clip is not None and scene.clips and scene.clip(options.clip) is None:
+            names = ", ".join(a.name for a in scene.clips)
             raise FishgenError(f"expected --clip to name one of {names}, found {options.clip!r}",
-                               scene.label)
+                               scene.info.get("source", scene.name))
     renderer = Renderer(options.width, options.height)
     bg = tuple(c / 255.0 for c in options.background)
     out, seconds = [], []

@@ -14,8 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from fishgen.errors import FishgenError
+from fishgen.geometry.mesh import vertex_normals
+from fishgen.numeric import to_linear_float
 from fishgen.preview.camera import Camera
-from fishgen.preview.scene import MeshPart, Scene
+from fishgen.scene.model import Material, Primitive, Scene
+from fishgen.scene.pose import Pose, deformed, pose
 
 SAMPLES = 4
 # World-fixed lights: a sun from above and in front, a weak fill from behind, a
@@ -23,6 +26,9 @@ SAMPLES = 4
 SUN_DIR = np.array([0.35, 1.0, 0.55]) / np.linalg.norm([0.35, 1.0, 0.55])
 FILL_DIR = np.array([-0.6, 0.1, -0.4]) / np.linalg.norm([-0.6, 0.1, -0.4])
 PARTICLE_OPACITY = 0.55
+POINT_SIZE_FRACTION = 0.004
+"""Radius of particles that carry no ``_RADIUS``, as a fraction of the bounding-box diagonal."""
+DEFAULT_MATERIAL = Material("default")
 
 _SRGB = """
 vec3 to_srgb(vec3 c) {
@@ -123,10 +129,14 @@ void main() {
 
 @dataclass
 class _GpuMesh:
-    part: MeshPart
+    node: int
+    prim: Primitive
+    material: Material
+    vbo: object
     vao: object
     texture: object | None
     centroid: np.ndarray
+    deforms: bool            # skinned or morphed: positions re-posed on the CPU every frame
 
 
 class Renderer:
@@ -140,7 +150,7 @@ class Renderer:
         except Exception as err:  # no libEGL / no Mesa driver on this machine
             raise FishgenError(
                 "expected an OpenGL 3.3 context from EGL (Debian: apt-get install libegl1 "
-                f"libgl1-mesa-dri), found none ({err})")
+                f"libgl1-mesa-dri), found none ({err})") from None
         self.width, self.height = width, height
         samples = min(SAMPLES, self.ctx.max_samples)
         self.msaa = self.ctx.framebuffer(
@@ -152,36 +162,65 @@ class Renderer:
         corners = np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32)
         self.corner_buf = self.ctx.buffer(corners.tobytes())
         self._uploaded: dict[int, list[_GpuMesh]] = {}
+        self._textures: dict[tuple[int, int], object] = {}
 
     # -- uploads -------------------------------------------------------------
+    def _texture(self, scene: Scene, index: int):
+        import moderngl
+
+        key = (id(scene), index)
+        if key not in self._textures:
+            try:
+                img = np.ascontiguousarray(scene.images[index].rgba())
+            except Exception as err:  # Pillow raises anything from OSError to SyntaxError
+                raise FishgenError(f"expected a readable texture image, found {scene.images[index].name!r} "
+                                   f"damaged ({type(err).__name__})", scene.info.get("source")) from None
+            tex = self.ctx.texture((img.shape[1], img.shape[0]), 4, img.tobytes())
+            tex.build_mipmaps()
+            tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            tex.anisotropy = 8.0
+            self._textures[key] = tex
+        return self._textures[key]
+
     def _upload(self, scene: Scene) -> list[_GpuMesh]:
         key = id(scene)
         if key in self._uploaded:
             return self._uploaded[key]
-        import moderngl
-
         out = []
-        for part in scene.meshes:
-            n = len(part.positions)
-            if n == 0 or len(part.indices) == 0:
+        for node, prim in scene.drawn():
+            if prim.mode != "TRIANGLES" or prim.indices is None or not prim.vertex_count or not len(prim.indices):
                 continue
-            uvs = part.uvs if part.uvs is not None else np.zeros((n, 2), np.float32)
-            colors = part.colors if part.colors is not None else np.ones((n, 4), np.float32)
-            data = np.hstack([part.positions, part.normals, uvs, colors]).astype(np.float32)
-            vbo = self.ctx.buffer(data.tobytes())
-            ibo = self.ctx.buffer(part.indices.astype(np.uint32).tobytes())
+            material = scene.materials[prim.material] if prim.material is not None else DEFAULT_MATERIAL
+            deforms = bool(prim.targets) or (scene.nodes[node].skin is not None
+                                             and "JOINTS_0" in prim.attributes)
+            data = self._vertex_data(prim, *self._local(prim))
+            vbo = self.ctx.buffer(data.tobytes(), dynamic=deforms)
+            ibo = self.ctx.buffer(np.asarray(prim.indices, np.uint32).tobytes())
             vao = self.ctx.vertex_array(self.mesh_prog, [(vbo, "3f 3f 2f 4f", "in_pos", "in_normal",
                                                           "in_uv", "in_color")], ibo)
-            tex = None
-            if part.material.texture is not None:
-                img = np.ascontiguousarray(part.material.texture)
-                tex = self.ctx.texture((img.shape[1], img.shape[0]), 4, img.tobytes())
-                tex.build_mipmaps()
-                tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-                tex.anisotropy = 8.0
-            out.append(_GpuMesh(part, vao, tex, part.positions.mean(0)))
+            tex = self._texture(scene, material.texture) if material.texture is not None else None
+            out.append(_GpuMesh(node, prim, material, vbo, vao, tex,
+                                np.asarray(prim.positions, float).mean(0), deforms))
         self._uploaded[key] = out
         return out
+
+    @staticmethod
+    def _local(prim: Primitive) -> tuple[np.ndarray, np.ndarray]:
+        pos = np.asarray(prim.positions, np.float32)
+        nrm = prim.attributes.get("NORMAL")
+        if nrm is None:
+            nrm = vertex_normals(pos.astype(np.float64), np.asarray(prim.indices, np.int64))
+        return pos, np.asarray(nrm, np.float32)
+
+    @staticmethod
+    def _vertex_data(prim: Primitive, positions: np.ndarray, normals: np.ndarray) -> np.ndarray:
+        n = prim.vertex_count
+        uvs = prim.attributes.get("TEXCOORD_0")
+        uvs = np.zeros((n, 2), np.float32) if uvs is None else to_linear_float(uvs)[:, :2] \
+            if np.asarray(uvs).dtype.kind in "iu" else np.asarray(uvs, np.float32)
+        colors = prim.attributes.get("COLOR_0")
+        colors = np.ones((n, 4), np.float32) if colors is None else to_linear_float(colors)
+        return np.hstack([positions, normals, uvs, colors]).astype(np.float32)
 
     # -- drawing -------------------------------------------------------------
     def render(self, scene: Scene, camera: Camera, t: float | None,
@@ -190,7 +229,7 @@ class Renderer:
         import moderngl
 
         ctx = self.ctx
-        world = scene.world_matrices(t, clip)
+        posed = pose(scene, t, clip)
         view, proj = camera.view(), camera.projection()
         viewproj = proj @ view
         self.msaa.use()
@@ -205,23 +244,30 @@ class Renderer:
         prog["u_fill"].value = tuple(FILL_DIR)
 
         meshes = self._upload(scene)
-        opaque = [m for m in meshes if m.part.material.alpha_mode != "BLEND"]
-        blended = [m for m in meshes if m.part.material.alpha_mode == "BLEND"]
-
-        def model_of(m: _GpuMesh) -> np.ndarray:
-            return world[m.part.node] if m.part.node is not None else np.eye(4)
+        models = {}
+        for m in meshes:
+            if m.deforms:  # morph targets and skins are posed on the CPU, drawn in world space
+                pos, nrm = deformed(scene, m.node, m.prim, posed)
+                if nrm is None:
+                    nrm = vertex_normals(pos, np.asarray(m.prim.indices, np.int64))
+                m.vbo.write(self._vertex_data(m.prim, pos.astype(np.float32), nrm.astype(np.float32)).tobytes())
+                models[id(m)] = np.eye(4)
+            else:
+                models[id(m)] = posed.matrix(m.node)
+        opaque = [m for m in meshes if m.material.alpha_mode != "BLEND"]
+        blended = [m for m in meshes if m.material.alpha_mode == "BLEND"]
 
         def depth(m: _GpuMesh) -> float:
-            c = view @ model_of(m) @ np.append(m.centroid, 1.0)
+            c = view @ models[id(m)] @ np.append(m.centroid, 1.0)
             return float(c[2])  # more negative = farther
 
         ctx.depth_mask = True
         for m in opaque:
-            self._draw_mesh(m, model_of(m))
+            self._draw_mesh(m, models[id(m)])
         ctx.depth_mask = False  # transparent fins must not hide what lies behind them
         for m in sorted(blended, key=depth):
-            self._draw_mesh(m, model_of(m))
-        self._draw_points(scene, world, camera, view, proj)
+            self._draw_mesh(m, models[id(m)])
+        self._draw_points(scene, posed, view, proj)
         ctx.depth_mask = True
 
         ctx.copy_framebuffer(self.resolved, self.msaa)
@@ -232,13 +278,14 @@ class Renderer:
     def _draw_mesh(self, m: _GpuMesh, model: np.ndarray) -> None:
         import moderngl
 
-        prog, mat = self.mesh_prog, m.part.material
+        prog, mat = self.mesh_prog, m.material
         prog["u_model"].write(model.T.astype("f4").tobytes())
-        normal = np.linalg.inv(model[:3, :3]).T
+        linear = model[:3, :3]
+        normal = np.linalg.inv(linear).T if abs(np.linalg.det(linear)) > 1e-30 else np.eye(3)
         prog["u_normal_matrix"].write(normal.T.astype("f4").tobytes())
         prog["u_base"].value = tuple(mat.base_color)
         prog["u_alpha_mode"].value = {"OPAQUE": 0, "MASK": 1, "BLEND": 2}.get(mat.alpha_mode, 0)
-        prog["u_cutoff"].value = mat.alpha_cutoff
+        prog["u_cutoff"].value = 0.5 if mat.alpha_cutoff is None else mat.alpha_cutoff
         prog["u_unlit"].value = mat.unlit
         prog["u_has_tex"].value = m.texture is not None
         if m.texture is not None:
@@ -251,18 +298,18 @@ class Renderer:
         m.vao.render(moderngl.TRIANGLES)
         self.ctx.disable(moderngl.CULL_FACE)
 
-    def _draw_points(self, scene: Scene, world, camera: Camera, view, proj) -> None:
-        if not scene.points:
-            return
+    def _draw_points(self, scene: Scene, posed: Pose, view, proj) -> None:
         centers, radii, colors = [], [], []
-        for p in scene.points:
-            m = world[p.node] if p.node is not None else np.eye(4)
-            centers.append(p.positions @ m[:3, :3].T + m[:3, 3])
-            radii.append(p.radii * float(np.cbrt(abs(np.linalg.det(m[:3, :3]))) or 1.0))
-            colors.append(p.colors)
-        c = np.concatenate(centers).astype(np.float32)
-        if len(c) == 0:
+        for node, prim in scene.drawn():
+            if prim.mode != "POINTS" or not prim.vertex_count:
+                continue
+            c, r, col = particles(scene, node, prim, posed)
+            centers.append(c)
+            radii.append(r)
+            colors.append(col)
+        if not centers:
             return
+        c = np.concatenate(centers).astype(np.float32)
         r = np.concatenate(radii).astype(np.float32)
         col = np.concatenate(colors).astype(np.float32)
         order = np.argsort((c @ view[2, :3]) + view[2, 3])  # back to front for "over" blending
@@ -283,6 +330,29 @@ class Renderer:
 
     def release(self) -> None:
         self.ctx.release()
+
+
+def particles(scene: Scene, node: int, prim: Primitive, posed: Pose) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """World centres, world radii and linear RGBA of a point set: a soft disc per particle.
+
+    ``_RADIUS`` sizes each particle (else a small fraction of the set's extent);
+    ``_DENSITY`` (fishgen clouds) fades the thin edges.
+    """
+    centers, _ = deformed(scene, node, prim, posed)
+    m = posed.matrix(node)
+    a = prim.attributes
+    if "_RADIUS" in a:
+        radii = np.asarray(a["_RADIUS"], np.float32).ravel()
+    else:
+        span = np.ptp(prim.positions, axis=0) if prim.vertex_count else np.ones(3)
+        radii = np.full(prim.vertex_count, POINT_SIZE_FRACTION * float(np.linalg.norm(span)), np.float32)
+    radii = radii * float(np.cbrt(abs(np.linalg.det(m[:3, :3]))))
+    rgba = np.ones((prim.vertex_count, 4), np.float32) if "COLOR_0" not in a else to_linear_float(a["COLOR_0"])
+    material = scene.materials[prim.material] if prim.material is not None else DEFAULT_MATERIAL
+    rgba = rgba * np.asarray(material.base_color, np.float32)
+    if "_DENSITY" in a:
+        rgba[:, 3] *= np.clip(np.asarray(a["_DENSITY"], np.float32).ravel(), 0, 1)
+    return centers, radii, rgba
 
 
 def unpremultiply(img: np.ndarray) -> np.ndarray:

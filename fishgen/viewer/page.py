@@ -12,7 +12,7 @@ from pathlib import Path
 from urllib.parse import unquote
 
 from fishgen.errors import FishgenError
-from fishgen.preview.sidefiles import side_file
+from fishgen.exchange.sidefiles import side_file
 
 HERE = Path(__file__).resolve().parent
 STATIC = HERE / "static"

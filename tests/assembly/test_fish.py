@@ -18,50 +18,69 @@ def bony():
     return load_species(PARAMS / "bonybream.txt")
 
 
+def parts(scene):
+    """Node name -> (node, its one primitive), for the fish's part nodes."""
+    return {n.name: (n, scene.meshes[n.mesh].primitives[0]) for n in scene.nodes if n.mesh is not None}
+
+
+def swim_channels(scene):
+    """Node name -> its rotation channel in the swim clip."""
+    return {scene.nodes[c.node].name: c for c in scene.clip("swim").channels}
+
+
+def material(scene, name):
+    return next(m for m in scene.materials if m.name == name)
+
+
+def images(scene):
+    return {i.name: i.data for i in scene.images}
+
+
 def test_axes_head_towards_plus_z_and_dorsal_up(bony):
-    asset = build_fish(bony)
-    parts = {p.name: p for p in asset.parts}
-    body = parts["body"].mesh.positions
+    fish = parts(build_fish(bony))
+    body = fish["body"][1].positions
     nose = body[np.argmax(body[:, 2])]
-    assert nose[2] > 0 and abs(nose[0]) < 1e-9 and abs(nose[1]) < 1e-9      # nose on +Z axis
-    assert parts["caudal_fin"].translation[2] < body[:, 2].min() + 0.1 * np.ptp(body[:, 2])
-    dorsal = parts["dorsal_fin"].mesh.positions
+    assert nose[2] > 0 and abs(nose[0]) < 1e-7 and abs(nose[1]) < 1e-7      # nose on +Z axis
+    assert fish["caudal_fin"][0].translation[2] < body[:, 2].min() + 0.1 * np.ptp(body[:, 2])
+    dorsal = fish["dorsal_fin"][1].positions
     assert dorsal[:, 1].max() > body[:, 1].max()                              # dorsal fin is up
-    left = parts["pectoral_fin_left"].translation
+    left = fish["pectoral_fin_left"][0].translation
     assert left[0] > 0                                                        # fish's left is +X
 
 
 def test_length_option_sets_nose_to_tail_metres(bony):
-    asset = build_fish(bony, length=1.25)
-    lo, hi = asset.bounds()
+    from fishgen.scene.pose import bounds
+    lo, hi = bounds(build_fish(bony, length=1.25))
     assert hi[2] - lo[2] == pytest.approx(1.25)
 
 
 def test_default_size_comes_from_world_scale(bony):
-    asset = build_fish(bony)
-    body = asset.parts[0].mesh.positions
+    body = parts(build_fish(bony))["body"][1].positions
     assert np.ptp(body[:, 2]) == pytest.approx(25.5 * 0.26 * 0.05)
 
 
 def test_moving_fins_pivot_and_static_fins_do_not(bony):
-    asset = build_fish(bony)
-    moving = {p.name for p in asset.parts if p.motion is not None}
+    scene = build_fish(bony)
+    moving = set(swim_channels(scene))
     assert moving == {"caudal_fin", "pectoral_fin_left", "pectoral_fin_right", "pelvic_fin_left",
                       "pelvic_fin_right"}
-    for p in asset.parts:
-        if p.motion is None:
-            assert not np.any(p.translation)
+    for name, (node, _) in parts(scene).items():
+        if name not in moving:
+            assert not np.any(node.translation)
 
 
 def test_swim_clip_loops_every_fin_seamlessly(bony):
-    asset = build_fish(bony, fps=30)
+    scene = build_fish(bony, fps=30)
     # caudal 4*10/1 = 40 frames, pelvic 24, pectoral 16 -> lcm 240
-    assert asset.clip_frames == 240 and asset.clip_seconds == pytest.approx(8.0)
-    for p in asset.parts:
-        if p.motion:
-            frames, angles = p.motion.keys(asset.clip_frames)
-            assert frames[-1] == asset.clip_frames and angles[0] == angles[-1] == 0
-            assert np.abs(angles).max() == p.motion.amplitude
+    assert scene.clip("swim").duration == pytest.approx(8.0)
+    amplitudes = {"caudal_fin": 10.0, "pectoral_fin_left": 4.0, "pelvic_fin_left": 6.0}
+    for name, channel in swim_channels(scene).items():
+        times, quats = channel.sampler.times, channel.sampler.values
+        assert times[-1] == pytest.approx(8.0) and np.allclose(quats[0], quats[-1])
+        assert np.allclose(quats[0], [0, 0, 0, 1])            # every fin starts and ends at rest
+        if name in amplitudes:
+            angles = np.degrees(2 * np.arcsin(quats[:, 1]))
+            assert np.abs(angles).max() == pytest.approx(amplitudes[name], abs=1e-4)
 
 
 def test_fin_steps_by_step_size_each_frame():
@@ -73,15 +92,15 @@ def test_fin_steps_by_step_size_each_frame():
 
 
 def test_mirrored_fins_swing_opposite(bony):
-    asset = build_fish(bony)
-    parts = {p.name: p for p in asset.parts}
-    assert parts["pelvic_fin_right"].motion.sign == -parts["pelvic_fin_left"].motion.sign
+    channels = swim_channels(build_fish(bony))
+    left, right = (channels[f"pelvic_fin_{side}"].sampler.values for side in ("left", "right"))
+    assert np.abs(left[:, 1]).max() > 0 and np.allclose(right[:, 1], -left[:, 1])
 
 
 @pytest.mark.parametrize("mode,alpha_mode", [("blend", "BLEND"), ("mask", "MASK"), ("opaque", "OPAQUE")])
 def test_fin_techniques(bony, mode, alpha_mode):
-    asset = build_fish(bony, fins=mode)
-    fins, body = asset.materials["fins"], asset.materials["body"]
+    scene = build_fish(bony, fins=mode)
+    fins, body = material(scene, "fins"), material(scene, "body")
     assert fins.alpha_mode == alpha_mode and fins.double_sided and body.alpha_mode == "OPAQUE"
     if mode == "blend":
         assert fins.base_color[3] == 0.5            # transparency 1.0 -> 0.5 as the thesis did
@@ -93,8 +112,7 @@ def test_mask_texture_carries_the_black_and_white_picture_as_alpha(bony):
     from io import BytesIO
 
     from PIL import Image, ImageOps
-    asset = build_fish(bony, fins="mask")
-    skin = Image.open(BytesIO(asset.images["skin"]))
+    skin = Image.open(BytesIO(images(build_fish(bony, fins="mask"))["skin"]))
     assert skin.mode == "RGBA"
     mask = ImageOps.flip(Image.open(bony.mask_texture).convert("L"))
     assert np.array_equal(np.asarray(skin)[:, :, 3], np.asarray(mask))
@@ -106,8 +124,8 @@ def test_texture_is_turned_upright(bony):
     from io import BytesIO
 
     from PIL import Image
-    asset = build_fish(bony, fins="opaque")
-    skin = np.asarray(Image.open(BytesIO(asset.images["skin"])).convert("RGB")).astype(float)
+    skin = np.asarray(Image.open(BytesIO(images(build_fish(bony, fins="opaque"))["skin"])).convert("RGB"))
+    skin = skin.astype(float)
     tp = np.asarray(bony.texture_points.body).reshape(16, 12, 2)
     h, w = skin.shape[:2]
     back = tp[8, 3] * [w, h]          # circle 3 is the top of the fish (+y)
@@ -118,8 +136,8 @@ def test_texture_is_turned_upright(bony):
 
 def test_untextured_species_uses_its_colour(bony):
     plain = replace(bony, textured=False, texture_points=None, colour_texture=None, mask_texture=None)
-    asset = build_fish(plain)
-    assert asset.images == {} and asset.materials["body"].base_color == (1.0, 1.0, 0.0, 1.0)
+    scene = build_fish(plain)
+    assert scene.images == [] and material(scene, "body").base_color == (1.0, 1.0, 0.0, 1.0)
     with pytest.raises(FishgenError, match="textured species for --fins mask"):
         build_fish(plain, fins="mask")
 

@@ -12,8 +12,21 @@ def test_build_default_species_to_glb(tmp_path):
     out = tmp_path / "bonybream.glb"
     result = run_cli("build", PARAMS / "bonybream.txt", "-o", out)
     assert result.returncode == 0, result.stderr
-    assert "bonybream" in result.stderr and "swim loop 8.00 s" in result.stderr
+    assert result.stderr == "" and result.stdout.count("\n") == 1      # one summary line, on stdout
+    assert "bonybream" in result.stdout and "swim loop 8.00 s" in result.stdout
     assert_valid_gltf(out)
+
+
+def test_obj_summary_says_the_animation_is_not_kept(tmp_path):
+    result = run_cli("build", PARAMS / "bonybream.txt", "-o", tmp_path / "b.obj")
+    assert result.returncode == 0, result.stderr
+    assert "swim loop" not in result.stdout and result.stdout.count("rest pose only (OBJ holds no node animation)") == 1
+
+
+def test_a_cube_file_says_which_command_builds_it(tmp_path):
+    result = run_cli("build", PARAMS / "clouds" / "table_4_3.awn", "-o", tmp_path / "x.glb")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1
+    assert "found a RekAwan cloud cube file; use `fishgen clouds` for it" in result.stderr
 
 
 def test_help_documents_every_option():

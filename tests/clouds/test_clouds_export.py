@@ -12,7 +12,8 @@ import trimesh
 from PIL import Image
 
 from fishgen.clouds import export_cloud, fill_cloud, load_cubes
-from fishgen.clouds.export import gltf, records
+from fishgen.clouds.scene import cloud_scene
+from fishgen.exchange import particles
 from fishgen.errors import FishgenError
 
 from cloud_tables import TABLES
@@ -65,12 +66,16 @@ def test_glb_points(cloud, tmp_path, gltf_validator):
     gltf_validator(path)
     doc, blob = glb_parts(path)
     prim = doc["meshes"][0]["primitives"][0]
-    assert prim["mode"] == 0 and set(prim["attributes"]) == {"POSITION", "COLOR_0", "_RADIUS", "_DENSITY"}
+    assert prim["mode"] == 0 and set(prim["attributes"]) == {"POSITION", "COLOR_0", "_RADIUS", "_DENSITY",
+                                                             "_CUBE"}
     np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["POSITION"], "<f4", 3), cloud.centers)
-    # glTF's COLOR_0 is linear; the cloud's colours are sRGB bytes
-    from fishgen.clouds.export.gltf import SRGB_TO_LINEAR
-    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["COLOR_0"], "u1", 3),
-                                  SRGB_TO_LINEAR[cloud.colors])
+    # glTF's COLOR_0 is linear (16 bits, so each sRGB byte stays distinct); the cloud's are sRGB bytes
+    from fishgen.numeric import linear_to_srgb
+    rgb = accessor_array(doc, blob, prim["attributes"]["COLOR_0"], "<u2", 3)
+    assert doc["accessors"][prim["attributes"]["COLOR_0"]]["normalized"] is True
+    np.testing.assert_array_equal(np.round(linear_to_srgb(rgb / 65535.0) * 255), cloud.colors)
+    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_CUBE"], "<f4", 1)[:, 0],
+                                  cloud.cube_index)
     np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_RADIUS"], "<f4", 1)[:, 0], cloud.radii)
     np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_DENSITY"], "<f4", 1)[:, 0], cloud.density)
     pygltflib = pytest.importorskip("pygltflib")
@@ -169,11 +174,16 @@ def test_csv_text_matches_printf_for_every_kind_of_float32():
     assert format_csv_rows(odd) == _printf_rows(odd)
 
 
+def _records(cloud):
+    (prim,) = cloud_scene(cloud).meshes[0].primitives
+    return next(particles.particle_chunks(prim, particles.particle_columns(prim))).copy()
+
+
 def test_csv_is_not_formatted_row_by_row(cloud, tmp_path, monkeypatch):
     # np.savetxt formats each row in Python: 1M particles took 6.9-7.7 s (PLY: 0.07 s).
     expected = tmp_path / "expected.csv"
     expected.write_bytes(b"x,y,z,radius,density,red,green,blue,cube\n"
-                         + _printf_rows(next(records.record_chunks(cloud, records.PARTICLE_WITH_CUBE))))
+                         + _printf_rows(_records(cloud)))
     def refuse(*args, **kwargs):
         raise AssertionError("per-row formatting")
     monkeypatch.setattr(np, "savetxt", refuse)
@@ -209,7 +219,7 @@ def test_failed_export_leaves_no_file_and_keeps_the_old_one(cloud, tmp_path, mon
         yield from ()
         raise OSError("disk full")
 
-    monkeypatch.setattr("fishgen.clouds.export.ply.record_chunks", broken)
+    monkeypatch.setattr("fishgen.exchange.ply.particle_chunks", broken)
     for target in (old, tmp_path / "new.ply"):
         with pytest.raises(OSError):
             export_cloud(cloud, target)
@@ -222,16 +232,15 @@ def test_failed_export_leaves_no_file_and_keeps_the_old_one(cloud, tmp_path, mon
 def test_streaming_in_small_blocks_gives_the_same_bytes(cloud, tmp_path, monkeypatch, name, billboards):
     whole = tmp_path / "whole" / name
     export_cloud(cloud, whole, billboards=billboards)
-    monkeypatch.setattr(records, "ROWS", 64)   # 615 particles -> 10 blocks
-    monkeypatch.setattr(gltf, "ROWS", 64)
-    monkeypatch.setattr("fishgen.clouds.export.table.CSV_ROWS", 10)  # CSV: 7 pieces per block
+    monkeypatch.setattr(particles, "ROWS", 64)   # 615 particles -> 10 blocks
+    monkeypatch.setattr("fishgen.exchange.table.CSV_ROWS", 10)  # CSV: 7 pieces per block
     blocks = tmp_path / "blocks" / name
     export_cloud(cloud, blocks, billboards=billboards)
     assert whole.read_bytes() == blocks.read_bytes()
 
 
 def test_unknown_extension_and_billboards_outside_gltf(cloud, tmp_path):
-    with pytest.raises(FishgenError, match=r"expected an output ending in .ply, .glb, .gltf, .csv, .npy, found '.obj'"):
+    with pytest.raises(FishgenError, match=r"expected a format that holds points, found .obj .*use .glb or .gltf or .ply or .csv or .npy"):
         export_cloud(cloud, tmp_path / "cloud.obj")
     with pytest.raises(FishgenError, match="with --billboards"):
         export_cloud(cloud, tmp_path / "cloud.ply", billboards=True)

@@ -17,6 +17,10 @@ from tests.conftest import PARAMS, assert_valid_gltf
 SPECIES = sorted(PARAMS.glob("*.txt"))
 
 
+def primitives(scene):
+    return {n.name: scene.meshes[n.mesh].primitives[0] for n in scene.nodes if n.mesh is not None}
+
+
 @pytest.fixture(scope="module")
 def assets():
     return {p.stem: build_fish(load_species(p)) for p in SPECIES}
@@ -39,7 +43,8 @@ def test_glb_round_trips_through_pygltflib(assets, tmp_path):
     export(assets["bonybream"], out)
     doc = pygltflib.GLTF2().load(str(out))
     names = [n.name for n in doc.nodes]
-    assert names[-1] == "bonybream" and "caudal_fin" in names and "pelvic_fin_right" in names
+    assert doc.scenes[0].nodes == [0] and names[0] == "bonybream" and doc.nodes[0].children == list(range(1, 10))
+    assert "caudal_fin" in names and "pelvic_fin_right" in names
     (anim,) = doc.animations
     assert anim.name == "swim" and len(anim.channels) == 5
     assert {m.alphaMode for m in doc.materials} == {"OPAQUE", "MASK"}
@@ -47,23 +52,24 @@ def test_glb_round_trips_through_pygltflib(assets, tmp_path):
 
 
 def test_glb_round_trips_through_trimesh(assets, tmp_path):
+    from fishgen.scene.pose import bounds
     asset = assets["centroberyx"]
     out = tmp_path / "c.glb"
     export(asset, out)
     scene = trimesh.load(out)
-    assert len(scene.geometry) == len(asset.parts)
+    prims = primitives(asset)
+    assert len(scene.geometry) == len(prims)
     body = scene.geometry["body"]
-    assert len(body.vertices) == len(asset.parts[0].mesh.positions)
-    assert body.visual.uv is not None and np.allclose(body.visual.uv[:, 0], asset.parts[0].mesh.uvs[:, 0],
-                                                      atol=1e-6)
-    lo, hi = asset.bounds()
-    assert np.allclose(scene.bounds, [lo, hi], atol=1e-5)
+    assert len(body.vertices) == prims["body"].vertex_count
+    assert body.visual.uv is not None and np.allclose(body.visual.uv[:, 0],
+                                                      prims["body"].attributes["TEXCOORD_0"][:, 0], atol=1e-6)
+    assert np.allclose(scene.bounds, bounds(asset), atol=1e-5)
 
 
 def test_gltf_writes_buffer_and_texture_beside_it(assets, tmp_path):
     files = export(assets["pineapplefish"], tmp_path / "p.gltf")
     assert sorted(f.name for f in files) == ["p.bin", "p.gltf", "p_skin.png"]
-    assert len(trimesh.load(tmp_path / "p.gltf").geometry) == len(assets["pineapplefish"].parts)
+    assert len(trimesh.load(tmp_path / "p.gltf").geometry) == len(primitives(assets["pineapplefish"]))
 
 
 def test_obj_with_mtl_and_texture(assets, tmp_path):
@@ -72,14 +78,14 @@ def test_obj_with_mtl_and_texture(assets, tmp_path):
     assert "map_Kd b_skin.png" in (tmp_path / "b.mtl").read_text()
     scene = trimesh.load(tmp_path / "b.obj")
     total = sum(len(g.faces) for g in scene.geometry.values())
-    assert total == sum(len(p.mesh.faces) for p in assets["bonybream"].parts)
+    assert total == assets["bonybream"].counts()["triangles"]
 
 
 def test_ply_rest_pose_with_normals_and_uvs(assets, tmp_path):
     export(assets["threadfingoldie"], tmp_path / "t.ply")
     mesh = trimesh.load(tmp_path / "t.ply", process=False)
     asset = assets["threadfingoldie"]
-    assert len(mesh.vertices) == sum(len(p.mesh.positions) for p in asset.parts)
+    assert len(mesh.vertices) == asset.counts()["vertices"]
     assert mesh.visual.uv is not None and mesh.visual.uv.shape == (len(mesh.vertices), 2)
     header = (tmp_path / "t.ply").read_bytes().split(b"end_header")[0].decode()
     assert "binary_little_endian" in header and "property float nx" in header and "property float s" in header
@@ -116,5 +122,8 @@ def test_animation_pose_matches_fin_motion(assets):
 
 
 def test_unknown_extension(assets, tmp_path):
-    with pytest.raises(FishgenError, match="expected an output ending in .glb"):
+    with pytest.raises(FishgenError, match="expected an output ending in .glb, .gltf, .obj, .ply, .csv, .npy"):
         export(assets["bonybream"], tmp_path / "fish.fbx")
+    with pytest.raises(FishgenError, match="holds node animation, found .obj .* use .glb or .gltf instead"):
+        export(assets["bonybream"], tmp_path / "fish.obj", require=["node animation"])
+    assert list(tmp_path.iterdir()) == []

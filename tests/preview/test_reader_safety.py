@@ -11,6 +11,7 @@ import pytest
 
 from fishgen.errors import FishgenError
 from fishgen.preview.inputs import load_input
+from tests.preview.test_readers import point_sets
 from tests.conftest import run_cli
 
 SECRET = b"top secret, not part of any asset\n"
@@ -103,18 +104,18 @@ def test_ascii_ply_point_cloud_keeps_radius_and_colour(tmp_path):
                     "property float z\nproperty float radius\nproperty uchar red\nproperty uchar green\n"
                     "property uchar blue\nproperty float density\nend_header\n"
                     "0 0 0 0.1 255 0 0 1\n1 0 0 0.2 0 255 0 0.5\n0 1 0 0.3 0 0 255 0.25\n")
-    (points,) = load_input(path).points
-    assert np.allclose(points.radii, [0.1, 0.2, 0.3])
-    assert np.allclose(points.colors[:, 3], [1, 0.5, 0.25])
-    assert points.colors[0, 0] == pytest.approx(1) and points.colors[0, 1] == pytest.approx(0)
+    ((_, radii, colors),) = point_sets(load_input(path))
+    assert np.allclose(radii, [0.1, 0.2, 0.3])
+    assert np.allclose(colors[:, 3], [1, 0.5, 0.25])
+    assert colors[0, 0] == pytest.approx(1) and colors[0, 1] == pytest.approx(0)
 
 
 def test_ascii_ply_bare_points_render(tmp_path):
     path = tmp_path / "p.ply"
     path.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                     "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n")
-    (points,) = load_input(path).points
-    assert len(points.positions) == 3 and np.all(points.radii > 0)
+    ((centres, radii, _),) = point_sets(load_input(path))
+    assert len(centres) == 3 and np.all(radii > 0)
 
 
 def _bad_face_ply(tmp_path):

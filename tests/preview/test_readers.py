@@ -6,17 +6,30 @@ import pytest
 
 from fishgen.errors import FishgenError
 from fishgen.preview.inputs import load_input
+from fishgen.preview.render import particles
+from fishgen.scene.pose import pose
 from tests.conftest import PARAMS
+
+
+def drawn_meshes(scene):
+    """(node name, primitive, material) for every drawn triangle primitive."""
+    return [(scene.nodes[n].name, p, scene.materials[p.material] if p.material is not None else None)
+            for n, p in scene.drawn() if p.mode == "TRIANGLES"]
+
+
+def point_sets(scene):
+    posed = pose(scene)
+    return [particles(scene, n, p, posed) for n, p in scene.drawn() if p.mode == "POINTS"]
 
 
 def test_species_scene_has_textured_body_fins_and_swim_clip():
     scene = load_input(PARAMS / "bonybream.txt")
-    assert [a.name for a in scene.animations] == ["swim"]
-    body = [m for m in scene.meshes if scene.nodes[m.node].name == "body"]
-    fins = [m for m in scene.meshes if "fin" in scene.nodes[m.node].name]
-    assert body and body[0].material.texture is not None and body[0].uvs is not None
-    assert len(fins) >= 5 and all(f.material.double_sided for f in fins)
-    assert {f.material.alpha_mode for f in fins} <= {"MASK", "BLEND", "OPAQUE"}
+    assert [a.name for a in scene.clips] == ["swim"]
+    body = [(p, m) for name, p, m in drawn_meshes(scene) if name == "body"]
+    fins = [m for name, _, m in drawn_meshes(scene) if "fin" in name]
+    assert body and body[0][1].texture is not None and "TEXCOORD_0" in body[0][0].attributes
+    assert len(fins) >= 5 and all(f.double_sided for f in fins)
+    assert {f.alpha_mode for f in fins} <= {"MASK", "BLEND", "OPAQUE"}
 
 
 def test_posing_moves_the_tail_but_not_the_body():
@@ -24,7 +37,7 @@ def test_posing_moves_the_tail_but_not_the_body():
     tail = next(i for i, n in enumerate(scene.nodes) if n.name == "caudal_fin")
     body = next(i for i, n in enumerate(scene.nodes) if n.name == "body")
     duration = scene.clip().duration
-    a, b = scene.world_matrices(0.0), scene.world_matrices(duration / 8)
+    a, b = pose(scene, 0.0).world, pose(scene, duration / 8).world
     assert not np.allclose(a[tail], b[tail])
     assert np.allclose(a[body], b[body])
 
@@ -35,9 +48,9 @@ def test_fish_in_every_format_keeps_geometry_and_texture(assets, ext):
     reference = load_input(assets["fish.glb"]).counts()
     assert scene.counts()["triangles"] == reference["triangles"]
     if ext != "ply":  # PLY carries no material: texture coordinates at most
-        assert any(m.material.texture is not None for m in scene.meshes)
+        assert any(m is not None and m.texture is not None for _, _, m in drawn_meshes(scene))
     if ext == "obj":  # the MTL's map_d makes the fins a cut-out, as in the glb
-        assert {m.material.alpha_mode for m in scene.meshes} == {"OPAQUE", "MASK"}
+        assert {m.alpha_mode for _, _, m in drawn_meshes(scene)} == {"OPAQUE", "MASK"}
     if ext in ("glb", "gltf"):
         assert scene.clip("swim") is not None
 
@@ -46,10 +59,11 @@ def test_fish_in_every_format_keeps_geometry_and_texture(assets, ext):
 def test_cloud_assets_carry_radius_and_density(assets, ext):
     scene = load_input(assets[f"cloud.{ext}"])
     direct = load_input(PARAMS / "clouds" / "table_4_3.awn")
-    (points,), (expected,) = scene.points, direct.points
-    assert len(points.positions) == assets["cloud_len"] == len(expected.positions)
-    assert np.allclose(np.sort(points.radii), np.sort(expected.radii))
-    assert np.allclose(np.sort(points.colors[:, 3]), np.sort(expected.colors[:, 3]), atol=1e-6)
+    (points,), (expected,) = point_sets(scene), point_sets(direct)
+    assert len(points[0]) == assets["cloud_len"] == len(expected[0])
+    assert np.allclose(np.sort(points[1]), np.sort(expected[1]))
+    assert np.allclose(np.sort(points[2][:, 3]), np.sort(expected[2][:, 3]), atol=1e-6)
+    assert np.allclose(np.sort(points[2][:, 0]), np.sort(expected[2][:, 0]), atol=2e-3)
 
 
 def test_points_without_radius_get_a_visible_default(tmp_path):
@@ -57,8 +71,8 @@ def test_points_without_radius_get_a_visible_default(tmp_path):
 
     path = tmp_path / "bare.ply"
     trimesh.PointCloud(np.random.default_rng(0).random((50, 3))).export(path)
-    (points,) = load_input(path).points
-    assert np.all(points.radii > 0)
+    (points,) = point_sets(load_input(path))
+    assert np.all(points[1] > 0)
 
 
 @pytest.mark.parametrize("name,content,message", [

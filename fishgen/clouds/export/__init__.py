@@ -1,4 +1,4 @@
-"""Export a particle cloud, format chosen by the output's extension."""
+"""Export a particle cloud: build its scene (fishgen.clouds.scene) and write it by extension."""
 from __future__ import annotations
 
 import os
@@ -6,34 +6,29 @@ from pathlib import Path
 
 from fishgen.clouds.model import Cloud
 from fishgen.errors import FishgenError
+from fishgen.exchange.registry import POINTS, extensions, formats, output_format
 
-FORMATS = (".ply", ".glb", ".gltf", ".csv", ".npy")
+FORMATS = extensions(formats(writable=True, holding=[POINTS]))
+BILLBOARD_FORMATS = (".glb", ".gltf")
+"""Billboards need unlit, alpha-blended, vertex-coloured quads: only glTF says all of that."""
 
 
 def check_output(path: str | os.PathLike, billboards: bool = False) -> str:
     """Return the output's format suffix, or raise FishgenError before any work is done."""
+    output_format(path, [POINTS])
     suffix = Path(path).suffix.lower()
-    if suffix not in FORMATS:
-        raise FishgenError(f"expected an output ending in {', '.join(FORMATS)}, "
-                           f"found {suffix or 'no extension'!r}", path)
-    if billboards and suffix not in (".glb", ".gltf"):
+    if billboards and suffix not in BILLBOARD_FORMATS:
         raise FishgenError(f"expected a .glb or .gltf output with --billboards, found {suffix!r}",
                            path)
     return suffix
 
 
-def export_cloud(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = False) -> None:
+def export_cloud(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = False) -> list[Path]:
     """Write ``cloud`` to ``path`` (.ply, .glb, .gltf, .csv or .npy), atomically."""
-    suffix = check_output(path, billboards)
-    if suffix == ".ply":
-        from fishgen.clouds.export.ply import write_ply
-        write_ply(cloud, path)
-    elif suffix in (".glb", ".gltf"):
-        from fishgen.clouds.export.gltf import write_gltf
-        write_gltf(cloud, path, billboards=billboards)
-    elif suffix == ".csv":
-        from fishgen.clouds.export.table import write_csv
-        write_csv(cloud, path)
-    else:
-        from fishgen.clouds.export.table import write_npy
-        write_npy(cloud, path)
+    from fishgen.clouds.scene import cloud_scene
+    from fishgen.exchange import export
+
+    check_output(path, billboards)
+    if len(cloud) == 0:
+        raise FishgenError("expected at least 1 particle to export, found 0", path)
+    return export(cloud_scene(cloud, billboards=billboards), path)
