@@ -8,6 +8,7 @@ from __future__ import annotations
 import io
 import os
 import queue
+import re
 import shutil
 import subprocess
 import sys
@@ -18,7 +19,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from tests.conftest import ROOT
+from tests.conftest import ROOT, run_cli
 
 CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium",
                              shutil.which("chromium")) if p and Path(p).is_file()), None)
@@ -137,6 +138,37 @@ def test_cloud_shows_its_particles(browser, served, viewer_assets):
         state = page.evaluate("window.fishgenViewer")
         assert state["counts"] == {"vertices": 0, "triangles": 0, "particles": viewer_assets["particles"]}
         assert state["clips"] == [] and page.locator("#play").is_disabled()
+        page.wait_for_timeout(200)
+        _assert_not_blank(_canvas(page))
+        assert problems == []
+        _assert_offline(requests)
+    finally:
+        page.close()
+
+
+@pytest.fixture(scope="module")
+def cli_clouds(tmp_path_factory):
+    """Table 4.4 through the real `fishgen clouds`, as points and as billboards, with the count it prints."""
+    folder = tmp_path_factory.mktemp("clouds")
+    made = {}
+    for form, flags in (("points", []), ("billboards", ["--billboards"])):
+        out = folder / f"{form}.glb"
+        result = run_cli("clouds", ROOT / "params" / "clouds" / "table_4_4.awn", "-o", out, *flags)
+        assert result.returncode == 0, result.stderr
+        made[form] = (out, int(re.search(r"(\d+) particles", result.stdout)[1]))
+    return made
+
+
+@pytest.mark.parametrize("form", ["billboards", "points"])
+def test_cloud_from_the_cli_shows_the_particle_count_it_printed(browser, served, cli_clouds, form):
+    # A billboard cloud is a mesh of one textured quad per particle: its quads are the particles.
+    asset, particles = cli_clouds[form]
+    assert particles > 0
+    page, problems, requests = _open(browser, served(asset))
+    try:
+        expected = {"vertices": 0, "triangles": 0, "particles": particles}
+        assert page.evaluate("window.fishgenViewer.counts") == expected
+        assert page.locator("#counts").inner_text() == f"0 vertices · 0 triangles · {particles} particles"
         page.wait_for_timeout(200)
         _assert_not_blank(_canvas(page))
         assert problems == []
