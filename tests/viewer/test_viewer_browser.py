@@ -177,6 +177,35 @@ def test_cloud_from_the_cli_shows_the_particle_count_it_printed(browser, served,
         page.close()
 
 
+def test_a_triangle_with_the_cloud_material_is_still_a_mesh(browser, tmp_path):
+    # The billboard rule needs the shape too (4 vertices and 6 indices per quad), not just the name.
+    import base64
+    import json
+
+    from fishgen.viewer.page import write_page
+
+    data = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32).tobytes() + np.array(
+        [0, 1, 2, 0], np.uint16).tobytes()
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+           "nodes": [{"mesh": 0, "name": "cloud"}],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+           "materials": [{"name": "cloud particle"}],
+           "buffers": [{"byteLength": len(data),
+                        "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+           "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                          "min": [0, 0, 0], "max": [1, 1, 0]},
+                         {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]}
+    asset = tmp_path / "triangle.gltf"
+    asset.write_text(json.dumps(doc))
+    page, problems, _ = _open(browser, write_page(asset).as_uri())
+    try:
+        assert page.evaluate("window.fishgenViewer.counts") == {"vertices": 3, "triangles": 1, "particles": 0}
+        assert problems == []
+    finally:
+        page.close()
+
+
 def test_page_works_from_disk_without_a_server(browser, viewer_assets):
     from fishgen.viewer.page import write_page
 
