@@ -1,15 +1,20 @@
 #!/usr/bin/env python3
-"""Copy the three.js modules the viewer needs from node_modules into the package.
+"""Bundle the viewer (fishgen/viewer/app.js + the parts of three.js it uses) into one minified file.
 
-Run after `npm ci` whenever package.json changes three's version:
+Run after `npm ci` whenever app.js or package.json (three's or esbuild's version) changes:
 
-    python tools/bundle_viewer.py          # writes fishgen/viewer/static/
-    python tools/bundle_viewer.py --check  # exit 1 if the committed copy is stale
+    python tools/bundle_viewer.py                 # writes fishgen/viewer/static/
+    python tools/bundle_viewer.py --check         # exit 1 unless a rebuild gives the committed bytes
+    python tools/bundle_viewer.py --check-hashes  # no node needed: exit 1 if the committed bundle
+                                                  # or app.js differ from what manifest.json records
 
-The copies are committed, so `pip install` needs no node and `fishgen view`
-never fetches anything. Relative imports are rewritten to bare specifiers
-(`three`, `three/addons/...`): the page loads each module from a blob: URL
-through an import map, and blob: URLs have no directory to be relative to.
+esbuild (pinned in package.json) resolves app.js's imports (`three`,
+`three/addons/...`) in node_modules, drops what the viewer never calls, and
+minifies. The result, `static/viewer.min.js`, is committed together with
+`static/manifest.json` (sha256 of the bundle and of every input file esbuild
+read, the tool versions and options) and three's licence, so `pip install`
+needs no node and `fishgen view` never fetches anything. The page inlines the
+bundle as one module script (fishgen/viewer/page.py).
 """
 from __future__ import annotations
 
@@ -17,78 +22,121 @@ import argparse
 import hashlib
 import json
 import re
+import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-THREE = ROOT / "node_modules" / "three"
+NODE_MODULES = ROOT / "node_modules"
 STATIC = ROOT / "fishgen" / "viewer" / "static"
-
-# import-map specifier -> file inside the three package
-MODULES = {
-    "three/core": "build/three.core.js",
-    "three": "build/three.module.js",
-    "three/addons/controls/OrbitControls.js": "examples/jsm/controls/OrbitControls.js",
-    "three/addons/loaders/GLTFLoader.js": "examples/jsm/loaders/GLTFLoader.js",
-    "three/addons/loaders/PLYLoader.js": "examples/jsm/loaders/PLYLoader.js",
-    "three/addons/loaders/OBJLoader.js": "examples/jsm/loaders/OBJLoader.js",
-    "three/addons/loaders/MTLLoader.js": "examples/jsm/loaders/MTLLoader.js",
-    "three/addons/utils/BufferGeometryUtils.js": "examples/jsm/utils/BufferGeometryUtils.js",
-    "three/addons/utils/SkeletonUtils.js": "examples/jsm/utils/SkeletonUtils.js",
-}
-_IMPORT = re.compile(r"""(\bfrom\s*|\bimport\s*\(?\s*)(['"])(\.{1,2}/[^'"]+)\2""")
+ENTRY = "fishgen/viewer/app.js"
+BUNDLE = "viewer.min.js"
+LICENSE = "THREE-LICENSE"
+# Fixed options, so the same inputs and esbuild version give the same bytes.
+OPTIONS = ["--bundle", "--format=esm", "--minify", "--target=es2022", "--charset=ascii",
+           "--legal-comments=eof", "--log-level=warning"]
+# The page inlines the bundle in a <script> element: these would end or confuse it.
+UNSAFE_IN_SCRIPT = re.compile(r"</script|<!--|<script", re.I)
 
 
-def _specifier(importer: str, relative: str) -> str:
-    target = (Path(importer).parent / relative).as_posix()
-    parts: list[str] = []
-    for piece in target.split("/"):
-        if piece == "..":
-            parts.pop()
-        elif piece not in ("", "."):
-            parts.append(piece)
-    target = "/".join(parts)
-    for spec, file in MODULES.items():
-        if file == target:
-            return spec
-    raise SystemExit(f"{importer} imports {relative} ({target}), which is not bundled: add it to MODULES")
+def _sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
 
 
-def bundled() -> dict[str, bytes]:
-    """file name in static/ -> rewritten module text, plus manifest and licence."""
-    version = json.loads((THREE / "package.json").read_text())["version"]
-    out: dict[str, bytes] = {}
-    manifest = {"three": version, "source": "npm package three (node_modules/three)", "modules": {}}
-    for spec, file in MODULES.items():
-        text = (THREE / file).read_text(encoding="utf-8")
-        text = _IMPORT.sub(lambda m: f"{m[1]}{m[2]}{_specifier(file, m[3])}{m[2]}", text)
-        name = Path(file).name
-        out[name] = text.encode("utf-8")
-        manifest["modules"][spec] = {"file": name, "from": file,
-                                     "sha256": hashlib.sha256(out[name]).hexdigest()}
-    out["THREE-LICENSE"] = (THREE / "LICENSE").read_bytes()
-    out["manifest.json"] = (json.dumps(manifest, indent=1) + "\n").encode()
-    return out
+def _version(package: str) -> str:
+    return json.loads((NODE_MODULES / package / "package.json").read_text())["version"]
+
+
+def build() -> dict[str, bytes]:
+    """File name in static/ -> contents: the bundle, three's licence and the manifest."""
+    esbuild = NODE_MODULES / ".bin" / "esbuild"
+    with tempfile.TemporaryDirectory() as tmp:
+        out, meta = Path(tmp) / BUNDLE, Path(tmp) / "meta.json"
+        run = subprocess.run([str(esbuild), ENTRY, *OPTIONS, f"--outfile={out}", f"--metafile={meta}"],
+                             cwd=ROOT, capture_output=True, text=True)
+        if run.returncode != 0:
+            raise SystemExit(f"esbuild failed:\n{run.stderr}")
+        if run.stderr.strip():  # warnings: a viewer bundle should build cleanly
+            raise SystemExit(f"esbuild warned:\n{run.stderr}")
+        bundle = out.read_bytes()
+        inputs = sorted(json.loads(meta.read_text())["inputs"])  # paths relative to ROOT
+    unsafe = UNSAFE_IN_SCRIPT.search(bundle.decode("ascii"))
+    if unsafe:
+        raise SystemExit(f"the bundle contains {unsafe[0]!r}, which cannot sit inside a <script> element")
+    licence = (NODE_MODULES / "three" / "LICENSE").read_bytes()
+    manifest = {
+        "bundle": {"file": BUNDLE, "bytes": len(bundle), "sha256": _sha256(bundle)},
+        "entry": ENTRY,
+        "tools": {"esbuild": _version("esbuild"), "three": _version("three")},
+        "options": OPTIONS,
+        "inputs": {name: _sha256((ROOT / name).read_bytes()) for name in inputs},
+        "license": {"file": LICENSE, "from": "node_modules/three/LICENSE", "sha256": _sha256(licence)},
+    }
+    return {BUNDLE: bundle, LICENSE: licence,
+            "manifest.json": (json.dumps(manifest, indent=1) + "\n").encode()}
+
+
+def check_hashes(static: Path) -> list[str]:
+    """Problems with the committed files that need no node to find (empty: consistent)."""
+    try:
+        manifest = json.loads((static / "manifest.json").read_text())
+    except (OSError, ValueError) as err:
+        return [f"manifest.json unreadable: {err}"]
+    problems = []
+    expected = {manifest["bundle"]["file"], manifest["license"]["file"], "manifest.json"}
+    extra = sorted(p.name for p in static.iterdir() if p.name not in expected)
+    if extra:
+        problems.append(f"files not in the manifest (delete them): {', '.join(extra)}")
+    for entry in (manifest["bundle"], manifest["license"]):
+        path = static / entry["file"]
+        if not path.is_file() or _sha256(path.read_bytes()) != entry["sha256"]:
+            problems.append(f"{entry['file']} differs from its sha256 in manifest.json")
+    for name, digest in manifest["inputs"].items():
+        # Inputs in the repository are always checkable; node_modules ones only after `npm ci`.
+        path = ROOT / name
+        if name.startswith("node_modules/") and not NODE_MODULES.is_dir():
+            continue
+        if not path.is_file() or _sha256(path.read_bytes()) != digest:
+            problems.append(f"{name} changed since the bundle was built: run python tools/bundle_viewer.py")
+    return problems
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--check", action="store_true", help="compare instead of writing")
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument("--check", action="store_true",
+                      help="rebuild in memory and compare with the committed files (needs npm ci)")
+    mode.add_argument("--check-hashes", action="store_true",
+                      help="compare the committed files and app.js with manifest.json (no node needed)")
+    parser.add_argument("--static", type=Path, default=STATIC, help=argparse.SUPPRESS)  # for tests
     args = parser.parse_args()
-    if not THREE.is_dir():
-        print("node_modules/three is missing: run `npm ci` in the project root", file=sys.stderr)
+    if args.check_hashes:
+        problems = check_hashes(args.static)
+        for problem in problems:
+            print(f"stale: {problem}", file=sys.stderr)
+        return 1 if problems else 0
+    if not (NODE_MODULES / ".bin" / "esbuild").exists() or not (NODE_MODULES / "three").is_dir():
+        print("node_modules/esbuild or node_modules/three is missing: run `npm ci` in the project root",
+              file=sys.stderr)
         return 2
-    files = bundled()
+    files = build()
     if args.check:
-        stale = [n for n, data in files.items()
-                 if not (STATIC / n).is_file() or (STATIC / n).read_bytes() != data]
-        for name in stale:
-            print(f"stale: fishgen/viewer/static/{name}", file=sys.stderr)
-        return 1 if stale else 0
-    STATIC.mkdir(parents=True, exist_ok=True)
+        problems = check_hashes(args.static)
+        problems += [f"{name} is not what a rebuild gives" for name, data in files.items()
+                     if not (args.static / name).is_file() or (args.static / name).read_bytes() != data]
+        for problem in problems:
+            print(f"stale: {problem}", file=sys.stderr)
+        return 1 if problems else 0
+    args.static.mkdir(parents=True, exist_ok=True)
+    for old in args.static.iterdir():
+        if old.is_file() and old.name not in files:
+            old.unlink()  # modules of an older layout, say
     for name, data in files.items():
-        (STATIC / name).write_bytes(data)
-    print(f"bundled three {json.loads(files['manifest.json'])['three']} into {STATIC.relative_to(ROOT)}")
+        (args.static / name).write_bytes(data)
+    manifest = json.loads(files["manifest.json"])
+    print(f"bundled {ENTRY} with three {manifest['tools']['three']} (esbuild {manifest['tools']['esbuild']}): "
+          f"{len(files[BUNDLE]):,} bytes in {args.static.relative_to(ROOT) if args.static.is_relative_to(ROOT) else args.static}")
     return 0
 
 

@@ -125,13 +125,28 @@ async function load() {
 	return { root: await loader.loadAsync( url ), clips: [] };
 }
 
+// `fishgen clouds --billboards` writes a cloud as one mesh of camera-facing quads, one per
+// particle (4 vertices, 2 triangles), with the material "cloud particle" and the texture
+// "gaussian sprite". Such a mesh is counted as particles, one per quad, and not as vertices
+// and triangles: the same cloud then reads the same exported as points or as billboards.
+// Anything that does not have exactly that shape is counted as an ordinary mesh.
+const CLOUD_MATERIAL = 'cloud particle', CLOUD_SPRITE = 'gaussian sprite';
+
+function billboardQuads( o, g, n ) {
+	const sprite = [].concat( o.material ).some( ( m ) => m && ( m.name === CLOUD_MATERIAL || ( m.map && m.map.name === CLOUD_SPRITE ) ) );
+	if ( ! sprite || n === 0 || n % 4 !== 0 || ! g.index || g.index.count !== n / 4 * 6 ) return 0;
+	return n / 4;
+}
+
 function count( root ) {
 	const c = { vertices: 0, triangles: 0, particles: 0 };
 	root.traverse( ( o ) => {
 		const g = o.geometry;
 		if ( ! g || ! g.getAttribute( 'position' ) ) return;
 		const n = g.getAttribute( 'position' ).count;
+		const quads = o.isMesh ? billboardQuads( o, g, n ) : 0;
 		if ( o.isPoints ) c.particles += n;
+		else if ( quads ) c.particles += quads;
 		else if ( o.isMesh ) {
 			c.vertices += n;
 			c.triangles += ( g.index ? g.index.count : n ) / 3;

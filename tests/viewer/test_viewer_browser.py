@@ -8,6 +8,7 @@ from __future__ import annotations
 import io
 import os
 import queue
+import re
 import shutil
 import subprocess
 import sys
@@ -18,7 +19,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from tests.conftest import ROOT
+from tests.conftest import ROOT, run_cli
 
 CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium",
                              shutil.which("chromium")) if p and Path(p).is_file()), None)
@@ -141,6 +142,66 @@ def test_cloud_shows_its_particles(browser, served, viewer_assets):
         _assert_not_blank(_canvas(page))
         assert problems == []
         _assert_offline(requests)
+    finally:
+        page.close()
+
+
+@pytest.fixture(scope="module")
+def cli_clouds(tmp_path_factory):
+    """Table 4.4 through the real `fishgen clouds`, as points and as billboards, with the count it prints."""
+    folder = tmp_path_factory.mktemp("clouds")
+    made = {}
+    for form, flags in (("points", []), ("billboards", ["--billboards"])):
+        out = folder / f"{form}.glb"
+        result = run_cli("clouds", ROOT / "params" / "clouds" / "table_4_4.awn", "-o", out, *flags)
+        assert result.returncode == 0, result.stderr
+        made[form] = (out, int(re.search(r"(\d+) particles", result.stdout)[1]))
+    return made
+
+
+@pytest.mark.parametrize("form", ["billboards", "points"])
+def test_cloud_from_the_cli_shows_the_particle_count_it_printed(browser, served, cli_clouds, form):
+    # A billboard cloud is a mesh of one textured quad per particle: its quads are the particles.
+    asset, particles = cli_clouds[form]
+    assert particles > 0
+    page, problems, requests = _open(browser, served(asset))
+    try:
+        expected = {"vertices": 0, "triangles": 0, "particles": particles}
+        assert page.evaluate("window.fishgenViewer.counts") == expected
+        assert page.locator("#counts").inner_text() == f"0 vertices · 0 triangles · {particles} particles"
+        page.wait_for_timeout(200)
+        _assert_not_blank(_canvas(page))
+        assert problems == []
+        _assert_offline(requests)
+    finally:
+        page.close()
+
+
+def test_a_triangle_with_the_cloud_material_is_still_a_mesh(browser, tmp_path):
+    # The billboard rule needs the shape too (4 vertices and 6 indices per quad), not just the name.
+    import base64
+    import json
+
+    from fishgen.viewer.page import write_page
+
+    data = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32).tobytes() + np.array(
+        [0, 1, 2, 0], np.uint16).tobytes()
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+           "nodes": [{"mesh": 0, "name": "cloud"}],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+           "materials": [{"name": "cloud particle"}],
+           "buffers": [{"byteLength": len(data),
+                        "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+           "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                          "min": [0, 0, 0], "max": [1, 1, 0]},
+                         {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]}
+    asset = tmp_path / "triangle.gltf"
+    asset.write_text(json.dumps(doc))
+    page, problems, _ = _open(browser, write_page(asset).as_uri())
+    try:
+        assert page.evaluate("window.fishgenViewer.counts") == {"vertices": 3, "triangles": 1, "particles": 0}
+        assert problems == []
     finally:
         page.close()
 
