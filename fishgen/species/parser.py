@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Callable, NamedTuple, Sequence
 
 from fishgen.errors import FishgenError
+from fishgen.shape_names import SHAPE_NAMES, check_shape_params
 from fishgen.species.model import (Behaviour, CaudalFin, PectoralFin, PelvicFin, Species,
                                    TexturePoints, VerticalFin)
 
@@ -167,11 +168,6 @@ PECTORAL = ("startBodySection", "startCircleSection", "no_of_triangles", "startL
 URGES = ("random", "center", "keepaway", "repelDistance", "speed", "changeRate", "direction")
 
 
-def _shape_classes() -> set[str]:
-    from fishgen.geometry.shapes import SHAPES
-    return set(SHAPES)
-
-
 def _vertical(reader: _Reader, label: str, bodies: int) -> VerticalFin:
     line = reader.record(f"the {label} record `{' '.join(VERTICAL)}`", 6)
     f = _Fields(reader, line, [f"{label} {n}" for n in VERTICAL])
@@ -270,15 +266,13 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     line = reader.record(f"the shape record `{' '.join(SHAPE)}`", at_least=7, key="shape")
     f = _Fields(reader, line, SHAPE + tuple(f"shape parameter {k + 1}" for k in range(len(line.tokens))))
     shape_class = line.tokens[0]
-    known = _shape_classes()
-    if shape_class not in known:
-        raise reader.error(line, "a shape class (one of " + ", ".join(sorted(known)) + ")",
+    if shape_class not in SHAPE_NAMES:
+        raise reader.error(line, "a shape class (one of " + ", ".join(sorted(SHAPE_NAMES)) + ")",
                            f"{shape_class!r}")
     bodies = f.whole(1, 3, MAX_SECTIONS, "BodySections")
     circles = f.whole(2, 3, MAX_SECTIONS, "CircleSections")
     textured, masked, turn, catch = (f.flag(k) for k in range(3, 7))
     shape_params = tuple(f.number(k) for k in range(7, len(line.tokens)))
-    from fishgen.geometry.shapes import check_shape_params
     problem = check_shape_params(shape_class, shape_params)
     if problem:
         raise reader.error(line, problem, f"{len(shape_params)} extra values")
