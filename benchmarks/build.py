@@ -36,7 +36,7 @@ def run(cmd: list[str]) -> tuple[float, float]:
 
 def lod_species(folder: Path, bodies: int, circles: int) -> Path:
     """BonyBream's design at another level of detail, with Fixel-style texture points."""
-    from fishgen.species.fixel import project_texture_points
+    from fishgen.authoring.texture_points import project_texture_points
     from fishgen.species.parser import parse_species
     from fishgen.species.writer import format_species
 

@@ -4,7 +4,7 @@
 
 BonyBream's texture points come from the thesis (Appendix A); the other three
 species are designed here and get Fixel-style texture points from
-``fishgen.species.fixel``. Every texture is painted from its species' texture
+``fishgen.authoring.texture_points``. Every texture is painted from its species' texture
 points, so fins and body land where the geometry expects them. As VRFish did,
 the files are stored upside down (chapter 6); fishgen flips them on load.
 """
@@ -19,7 +19,7 @@ from PIL import Image, ImageDraw, ImageFilter, ImageOps
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from fishgen.species.fixel import project_texture_points  # noqa: E402
+from fishgen.authoring.texture_points import project_texture_points  # noqa: E402
 from fishgen.species.model import (Behaviour, CaudalFin, PectoralFin, PelvicFin, Species,  # noqa: E402
                                    VerticalFin)
 from fishgen.species.parser import parse_species  # noqa: E402
