@@ -73,7 +73,8 @@ def main() -> None:
             shutil.copy(ROOT / "textures" / tex, tmp / tex)
         cases = [("fishgen --help", fishgen + ["--help"])]
         for species in sorted((ROOT / "params").glob("*.txt")):
-            cases.append((f"build {species.stem}", fishgen + ["build", str(species), "-o", str(tmp / "o.glb")]))
+            cases.append((f"build {species.stem}",
+                          fishgen + ["build", str(species), "-o", str(tmp / "o.glb")]))
         for b, c in ((8, 6), (16, 12), (32, 24), (128, 96)):
             path = lod_species(tmp, b, c)
             cases.append((f"build LOD {b}x{c}", fishgen + ["build", str(path), "-o", str(tmp / "o.glb")]))

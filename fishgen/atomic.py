@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Mapping
 
 from fishgen.errors import FishgenError
 
@@ -63,7 +63,7 @@ def write_files(files: Mapping[str | os.PathLike, bytes]) -> None:
         _check_target(target)
     staged: list[tuple[str, Path]] = []
     try:
-        for target, data in zip(targets, files.values()):
+        for target, data in zip(targets, files.values(), strict=True):
             staged.append((_stage(target, data), target))
     except BaseException:
         for tmp, _ in staged:

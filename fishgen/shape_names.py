@@ -20,6 +20,6 @@ def check_shape_params(name: str, params: Sequence[float]) -> str | None:
         return "FishShapeSpline control points `x r` pairs after the flags (at least one pair)"
     xs = params[0::2]
     rs = params[1::2]
-    if not all(a < b for a, b in zip((0.0, *xs), (*xs, 1.0))) or min(rs) <= 0 or max(rs) > 10:
+    if not all(a < b for a, b in zip((0.0, *xs), (*xs, 1.0), strict=True)) or min(rs) <= 0 or max(rs) > 10:
         return "FishShapeSpline control points with 0 < x increasing < 1 and 0 < r <= 10"
     return None

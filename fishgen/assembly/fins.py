@@ -4,8 +4,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from fishgen.geometry.fins import (CaudalParams, Fin, PectoralParams, PelvicParams, VerticalParams,
-                                   caudal_fin, mirrored, pectoral_fin, pelvic_fin, vertical_fin)
+from fishgen.geometry.fins import (
+    CaudalParams,
+    Fin,
+    PectoralParams,
+    PelvicParams,
+    VerticalParams,
+    caudal_fin,
+    mirrored,
+    pectoral_fin,
+    pelvic_fin,
+    vertical_fin,
+)
 from fishgen.species.model import CaudalFin, PectoralFin, PelvicFin, Species, VerticalFin
 
 

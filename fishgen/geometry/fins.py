@@ -171,7 +171,8 @@ def _splay(vector: np.ndarray, side: float) -> np.ndarray:
     return out
 
 
-def pectoral_fin(fin: PectoralParams, rings: np.ndarray, scale: np.ndarray, uv: ArrayLike | None = None) -> Fin:
+def pectoral_fin(fin: PectoralParams, rings: np.ndarray, scale: np.ndarray,
+                 uv: ArrayLike | None = None) -> Fin:
     """Left pectoral fin (Figure 4.14): base on ring startBodySection from startCircleSection
     down through ``triangles`` CircleSections; like a vertical fin whose end line is zero.
 
@@ -185,7 +186,8 @@ def pectoral_fin(fin: PectoralParams, rings: np.ndarray, scale: np.ndarray, uv: 
     side = 1.0 if base[:, 2].mean() >= 0 else -1.0
     a = np.radians(fin.start_angle)
     top = np.empty_like(base)
-    top[0] = base[0] + _splay(_scaled(fin.start_length * np.cos(a), fin.start_length * np.sin(a), scale), side)
+    start = _scaled(fin.start_length * np.cos(a), fin.start_length * np.sin(a), scale)
+    top[0] = base[0] + _splay(start, side)
     for k in range(1, n + 1):
         top[k] = base[k] + fin.proportion * (top[k - 1] - base[k])
     top[n] = base[n]

@@ -16,7 +16,7 @@ class Mesh:
     def normals(self) -> np.ndarray:
         return vertex_normals(self.positions, self.faces)
 
-    def mirrored_z(self) -> "Mesh":
+    def mirrored_z(self) -> Mesh:
         """Mirror in z, reversing the winding so the front stays the front."""
         pos = self.positions * np.array([1.0, 1.0, -1.0])
         return Mesh(pos, self.faces[:, ::-1].copy(), self.uvs)

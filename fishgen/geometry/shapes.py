@@ -5,7 +5,7 @@ before scaling. Classes are selected by the name in the species file.
 """
 from __future__ import annotations
 
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 

@@ -10,13 +10,21 @@ import math
 import os
 import stat
 import unicodedata
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Callable, NamedTuple, Sequence
+from typing import NamedTuple
 
 from fishgen.errors import FishgenError
 from fishgen.shape_names import SHAPE_NAMES, check_shape_params
-from fishgen.species.model import (Behaviour, CaudalFin, PectoralFin, PelvicFin, Species,
-                                   TexturePoints, VerticalFin)
+from fishgen.species.model import (
+    Behaviour,
+    CaudalFin,
+    PectoralFin,
+    PelvicFin,
+    Species,
+    TexturePoints,
+    VerticalFin,
+)
 
 #: Largest level of detail accepted; refused before anything is allocated.
 MAX_SECTIONS = 1024
@@ -324,7 +332,8 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     points = None
     transparency = 1.0
     nxt = reader.peek()
-    has_texture_block = textured or (nxt is not None and len(nxt.tokens) == 2 and not _is_number(nxt.tokens[0]))
+    has_texture_block = textured or (nxt is not None and len(nxt.tokens) == 2
+                                     and not _is_number(nxt.tokens[0]))
     if has_texture_block:
         line = reader.record("the texture record `texture_file black_and_white_file`", 2, key="texture")
         if textured and textures is not None:

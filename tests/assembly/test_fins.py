@@ -14,8 +14,9 @@ SPECIES = [parse_species(p.read_text(), str(p)) for p in sorted(PARAMS.glob("*.t
 
 @pytest.mark.parametrize("sp", SPECIES, ids=lambda s: s.name)
 def test_every_geometry_parameter_comes_from_the_same_named_species_field(sp):
-    for record, params in ((sp.caudal, caudal_params(sp.caudal)), (sp.dorsal, vertical_params(sp.dorsal)),
-                           (sp.adipose, vertical_params(sp.adipose)), (sp.anal, vertical_params(sp.anal)),
-                           (sp.pectoral, pectoral_params(sp.pectoral)), (sp.pelvic, pelvic_params(sp.pelvic))):
+    mapped = [(sp.caudal, caudal_params(sp.caudal)), (sp.dorsal, vertical_params(sp.dorsal)),
+              (sp.adipose, vertical_params(sp.adipose)), (sp.anal, vertical_params(sp.anal)),
+              (sp.pectoral, pectoral_params(sp.pectoral)), (sp.pelvic, pelvic_params(sp.pelvic))]
+    for record, params in mapped:
         for field in dataclasses.fields(params):
             assert getattr(params, field.name) == getattr(record, field.name), field.name

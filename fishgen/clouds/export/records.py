@@ -1,7 +1,7 @@
 """Packed per-particle records shared by the PLY, NPY and CSV writers."""
 from __future__ import annotations
 
-from typing import Iterator
+from collections.abc import Iterator
 
 import numpy as np
 

@@ -60,7 +60,7 @@ def format_csv_rows(rec: np.ndarray) -> bytes:
               for n in names]
     slots = np.zeros((len(rec), sum(widths)), np.uint8)
     at = 0
-    for k, (name, width) in enumerate(zip(names, widths)):
+    for k, (name, width) in enumerate(zip(names, widths, strict=True)):
         part = slots[:, at:at + width]
         (_float_slots if rec.dtype[name].kind == "f" else _int_slots)(rec[name], part)
         part[:, -1] = ord("\n") if k == len(names) - 1 else ord(",")
@@ -164,7 +164,7 @@ def _nine_digits(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     doubt = (np.abs(scaled - np.floor(scaled) - 0.5) < 1e-5) | (mantissa < 1e8) | (mantissa >= 1e9)
     mantissa = mantissa.astype(np.int32)                             # 9 digits fit
     for i in np.flatnonzero(doubt & ~zero):                          # ~1 value in 10^5
-        text = "%.8e" % abs(float(x[i]))
+        text = f"{abs(float(x[i])):.8e}"
         mantissa[i], exp[i] = int(text[0] + text[2:10]), int(text[11:])
     mantissa[zero], exp[zero] = 0, 0
     return mantissa, exp
