@@ -23,6 +23,8 @@ from fishgen.species.model import (
     PelvicFin,
     Species,
     TexturePoints,
+    Vec2,
+    Vec3,
     VerticalFin,
 )
 
@@ -159,6 +161,14 @@ class _Fields:
     def vec(self, i: int, n: int) -> tuple[float, ...]:
         return tuple(self.number(i + k) for k in range(n))
 
+    def vec2(self, i: int) -> Vec2:
+        return self.number(i), self.number(i + 1)
+
+    def vec3(self, i: int, low: float = -MAX_MAGNITUDE, high: float = MAX_MAGNITUDE,
+             open_low: bool = False) -> Vec3:
+        return (self.number(i, low, high, open_low), self.number(i + 1, low, high, open_low),
+                self.number(i + 2, low, high, open_low))
+
 
 # Record names as the thesis' comments give them.
 HEADER = ("name", "world_scale", "urgeFactor", "start x", "start y", "start z", "cube_size")
@@ -264,7 +274,7 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     name = line.tokens[0]
     world_scale = f.number(1, 0, MAX_WORLD_SCALE, open_low=True)
     urge = f.number(2)
-    start = f.vec(3, 3)
+    start = f.vec3(3)
     cube = f.number(6)
 
     line = reader.record("the fish colour record `R G B`", 3)
@@ -287,7 +297,7 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
 
     line = reader.record("the body scale record `scaleX scaleY scaleZ`", 3)
     f = _Fields(reader, line, ("scaleX", "scaleY", "scaleZ"))
-    scale = tuple(f.number(k, 0, MAX_SCALE, open_low=True) for k in range(3))
+    scale = f.vec3(0, 0, MAX_SCALE, open_low=True)
 
     line = reader.record("the caudal fin record", 13, key="caudal")
     f = _Fields(reader, line, [f"caudal {n}" for n in CAUDAL])
@@ -362,11 +372,12 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
             points = None
 
     line = reader.record("the initial velocity record `vx vy vz`", 3)
-    velocity = _Fields(reader, line, ("vx", "vy", "vz")).vec(0, 3)
+    velocity = _Fields(reader, line, ("vx", "vy", "vz")).vec3(0)
     line = reader.record(f"the urge weightings record `{' '.join(URGES)}`", 7)
-    urges = _Fields(reader, line, URGES).vec(0, 7)
+    random, center, keepaway, repel_distance, speed, change_rate, direction = \
+        _Fields(reader, line, URGES).vec(0, 7)
     line = reader.record("the flee record", 2)
-    flee = _Fields(reader, line, ("flee 1", "flee 2")).vec(0, 2)
+    flee = _Fields(reader, line, ("flee 1", "flee 2")).vec2(0)
     extra = reader.peek()
     if extra is not None:
         raise reader.error(extra, "end of file after the flee record", _found_values(extra))
@@ -378,7 +389,8 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
         catchfish_test=catch, scale=scale, caudal=caudal, adipose=adipose, dorsal=dorsal,
         pelvic=pelvic, anal=anal, pectoral=pectoral, transparency=transparency,
         colour_texture=colour_tex, mask_texture=mask_tex, texture_points=points,
-        behaviour=Behaviour(velocity, *urges, flee=flee), source=Path(file),
+        behaviour=Behaviour(velocity, random, center, keepaway, repel_distance, speed, change_rate,
+                            direction, flee), source=Path(file),
         record_lines=dict(reader.record_lines))
 
 

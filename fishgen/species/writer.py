@@ -1,14 +1,14 @@
 """Write a :class:`Species` back to the VRFish file layout (Appendix A order)."""
 from __future__ import annotations
 
-from fishgen.species.model import Species
+from fishgen.species.model import Species, Vec2
 
 
 def _n(value: float) -> str:
     return repr(float(value))
 
 
-def _row(*values) -> str:
+def _row(*values: float | str) -> str:
     return " ".join(v if isinstance(v, str) else _n(v) for v in values)
 
 
@@ -61,13 +61,15 @@ def format_species(sp: Species, colour_name: str = "colour.png", mask_name: str 
         for k, (u, v) in enumerate(tp.body):
             out.append(f"{k // sp.circle_sections} {k % sp.circle_sections} {_n(u)} {_n(v)}")
 
-        def block(label: str, points) -> list[str]:
+        def block(label: str, points: tuple[Vec2, ...]) -> list[str]:
             return [f"//no_of_{label}_texture_points", str(len(points)), "//texture_points_2D"] + \
                 [_row(u, v) for u, v in points]
         out += block("caudal", tp.caudal) + ["//transparency_t", _n(sp.transparency)]
         for label in ("dorsal", "adipose", "anal", "pectoral", "pelvic"):
             out += block(label, getattr(tp, label))
     b = sp.behaviour
+    if b is None:   # the file format requires the movement records
+        raise ValueError(f"species {sp.name!r} has no behaviour to write")
     out += ["//movement of fish", "//initVelocity_vector", _row(*b.initial_velocity),
             "//urge_weightings", "//random center keepaway repelDistance speed changeRate direction",
             _row(b.random, b.center, b.keepaway, b.repel_distance, b.speed, b.change_rate, b.direction),
