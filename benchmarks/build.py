@@ -36,7 +36,7 @@ def run(cmd: list[str]) -> tuple[float, float]:
 
 def lod_species(folder: Path, bodies: int, circles: int) -> Path:
     """BonyBream's design at another level of detail, with Fixel-style texture points."""
-    from fishgen.species.fixel import project_texture_points
+    from fishgen.authoring.texture_points import project_texture_points
     from fishgen.species.parser import parse_species
     from fishgen.species.writer import format_species
 
@@ -73,7 +73,8 @@ def main() -> None:
             shutil.copy(ROOT / "textures" / tex, tmp / tex)
         cases = [("fishgen --help", fishgen + ["--help"])]
         for species in sorted((ROOT / "params").glob("*.txt")):
-            cases.append((f"build {species.stem}", fishgen + ["build", str(species), "-o", str(tmp / "o.glb")]))
+            cases.append((f"build {species.stem}",
+                          fishgen + ["build", str(species), "-o", str(tmp / "o.glb")]))
         for b, c in ((8, 6), (16, 12), (32, 24), (128, 96)):
             path = lod_species(tmp, b, c)
             cases.append((f"build LOD {b}x{c}", fishgen + ["build", str(path), "-o", str(tmp / "o.glb")]))

@@ -9,10 +9,15 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Mapping
+from types import TracebackType
+from typing import BinaryIO, Literal, TypeVar
 
 from fishgen.errors import FishgenError
+
+#: A path type: any one of them per call (a Mapping's key type cannot widen).
+_PathT = TypeVar("_PathT", bound="str | os.PathLike[str]")
 
 
 def _fail(target: Path, err: OSError) -> FishgenError:
@@ -56,14 +61,14 @@ def _discard(tmp: str) -> None:
         pass
 
 
-def write_files(files: Mapping[str | os.PathLike, bytes]) -> None:
+def write_files(files: Mapping[_PathT, bytes]) -> None:
     """Write every ``path -> bytes`` entry atomically: all of them, or none."""
     targets = [Path(p) for p in files]
     for target in targets:
         _check_target(target)
     staged: list[tuple[str, Path]] = []
     try:
-        for target, data in zip(targets, files.values()):
+        for target, data in zip(targets, files.values(), strict=True):
             staged.append((_stage(target, data), target))
     except BaseException:
         for tmp, _ in staged:
@@ -116,9 +121,9 @@ class atomic_open:
     def __init__(self, path: str | os.PathLike):
         self.path = Path(path)
         self._tmp: str | None = None
-        self._handle = None
+        self._handle: BinaryIO | None = None
 
-    def __enter__(self):
+    def __enter__(self) -> BinaryIO:
         _check_target(self.path)
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -129,7 +134,8 @@ class atomic_open:
         self._handle = os.fdopen(fd, "wb")
         return self._handle
 
-    def __exit__(self, exc_type, exc, tb) -> bool:
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> Literal[False]:
         assert self._handle is not None and self._tmp is not None
         try:
             if exc_type is None:

@@ -4,7 +4,7 @@
 
 BonyBream's texture points come from the thesis (Appendix A); the other three
 species are designed here and get Fixel-style texture points from
-``fishgen.species.fixel``. Every texture is painted from its species' texture
+``fishgen.authoring.texture_points``. Every texture is painted from its species' texture
 points, so fins and body land where the geometry expects them. As VRFish did,
 the files are stored upside down (chapter 6); fishgen flips them on load.
 """
@@ -19,9 +19,8 @@ from PIL import Image, ImageDraw, ImageFilter, ImageOps
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from fishgen.species.fixel import project_texture_points  # noqa: E402
-from fishgen.species.model import (Behaviour, CaudalFin, PectoralFin, PelvicFin, Species,  # noqa: E402
-                                   VerticalFin)
+from fishgen.authoring.texture_points import project_texture_points  # noqa: E402
+from fishgen.species.model import Behaviour, CaudalFin, PectoralFin, PelvicFin, Species, VerticalFin  # noqa: E402
 from fishgen.species.parser import parse_species  # noqa: E402
 from fishgen.species.writer import format_species  # noqa: E402
 
@@ -30,7 +29,8 @@ SIZE = (512, 256)
 
 # ---------------------------------------------------------------- species designs
 def _behaviour(speed: float) -> Behaviour:
-    return Behaviour((0.000009, 0.0000075, 0.0000071), 0.04, 0.35, 0.01, 0.15, speed, 50.0, 0.0015, (0.04, 10.0))
+    return Behaviour((0.000009, 0.0000075, 0.0000071), 0.04, 0.35, 0.01, 0.15, speed, 50.0, 0.0015,
+                     (0.04, 10.0))
 
 
 DESIGNS = {
@@ -157,7 +157,8 @@ def paint(sp: Species, palette: dict, seed: int) -> tuple[Image.Image, Image.Ima
     top_v = min(v for _, v in body_poly)
     bottom_v = max(v for _, v in body_poly)
     t = np.clip((np.arange(h) - top_v) / max(bottom_v - top_v, 1), 0, 1) ** 0.8
-    rows = (np.array(palette["back"])[None, :] * (1 - t[:, None]) + np.array(palette["belly"])[None, :] * t[:, None])
+    rows = (np.array(palette["back"])[None, :] * (1 - t[:, None])
+            + np.array(palette["belly"])[None, :] * t[:, None])
     grad_arr = np.repeat(rows[:, None, :], w, axis=1)
     grad_arr += rng.normal(0, 6, grad_arr.shape)           # skin noise
     grad = Image.fromarray(np.clip(grad_arr, 0, 255).astype(np.uint8))
@@ -168,7 +169,8 @@ def paint(sp: Species, palette: dict, seed: int) -> tuple[Image.Image, Image.Ima
 
     pd = ImageDraw.Draw(colour)
     u0, u1 = body_poly[0][0], body_poly[len(top_line) - 1][0]
-    mid = [((a[0] + b[0]) / 2, a[1] + (b[1] - a[1]) * 0.45) for a, b in zip(_px(top_line), _px(bottom_line))]
+    mid = [((a[0] + b[0]) / 2, a[1] + (b[1] - a[1]) * 0.45)
+           for a, b in zip(_px(top_line), _px(bottom_line), strict=True)]
     accent = tuple(palette["accent"])
     layer = Image.new("RGBA", SIZE, (0, 0, 0, 0))
     ld = ImageDraw.Draw(layer)

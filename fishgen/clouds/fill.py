@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from typing import Sequence
 
 import numpy as np
 
@@ -127,7 +127,7 @@ def merge_clouds(clouds: Sequence[Cloud]) -> Cloud:
         radii=np.concatenate([c.radii for c in clouds]),
         density=np.concatenate([c.density for c in clouds]),
         colors=np.concatenate([c.colors for c in clouds]),
-        cube_index=np.concatenate([c.cube_index + np.int32(k) for c, k in zip(clouds, shifts)]),
+        cube_index=np.concatenate([c.cube_index + np.int32(k) for c, k in zip(clouds, shifts, strict=True)]),
         cube_bounds=np.concatenate([c.cube_bounds for c in clouds]))
 
 
@@ -244,7 +244,7 @@ def _phase_shift(s: np.ndarray) -> None:
     for source in (y, x):                            # both before either coordinate moves
         sine = np.multiply(source, _HALF_PI)
         sines.append(np.sin(sine, out=sine))         # eq. 4.5: P = pi/2 sin(0.5 theta_other)
-    for moved, sine in zip((x, y), sines):
+    for moved, sine in zip((x, y), sines, strict=True):
         np.multiply(sine, z_term, out=tmp)           # P * theta_z / 2
         np.sin(tmp, out=tmp)
         tmp *= _F32(k * math.pi)                     # eq. 4.6 (for y: P_y as meant, not P_x)

@@ -44,12 +44,12 @@ class Cloud:
     coordinates (offset applied); ``cube_index`` maps each particle to its cube.
     """
 
-    centers: "np.ndarray"      # (N, 3) float32, world units, y up
-    radii: "np.ndarray"        # (N,) float32, in (0, max radius of its cube]
-    density: "np.ndarray"      # (N,) float32, Gaussian fall-off weight in (0, 1]
-    colors: "np.ndarray"       # (N, 3) uint8 sRGB
-    cube_index: "np.ndarray"   # (N,) int32
-    cube_bounds: "np.ndarray"  # (K, 2, 3) float64
+    centers: np.ndarray      # (N, 3) float32, world units, y up
+    radii: np.ndarray        # (N,) float32, in (0, max radius of its cube]
+    density: np.ndarray      # (N,) float32, Gaussian fall-off weight in (0, 1]
+    colors: np.ndarray       # (N, 3) uint8 sRGB
+    cube_index: np.ndarray   # (N,) int32
+    cube_bounds: np.ndarray  # (K, 2, 3) float64
 
     def __post_init__(self) -> None:
         n = len(self.centers)

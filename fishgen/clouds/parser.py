@@ -14,8 +14,8 @@ import re
 import stat
 import warnings
 
-from fishgen.errors import FishgenError, describe, expected
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, Cube, CubeFile
+from fishgen.errors import FishgenError, describe, expected
 
 # ASCII-only patterns: "１２" (full-width digits) or "1_000" are not numbers in this format.
 _SEPARATOR = re.compile(r"[ \t]*,[ \t]*|[ \t]+")

@@ -1,21 +1,79 @@
 """Fin construction (thesis 4.2) in scaled thesis space, with Fixel's texture-point order.
 
-Each builder returns a :class:`Fin`: its mesh (vertices in exactly the order of
-the species file's texture points, so UVs map one to one) and, for moving fins,
-the pivot the thesis names in 7.1.
+Each builder takes the fin's measurements as a small parameter record of plain
+numbers (:class:`CaudalParams`, :class:`VerticalParams`, :class:`PectoralParams`,
+:class:`PelvicParams`; lengths in thesis units, angles in degrees, section numbers
+as indices into ``rings``), the body's ``rings`` and ``scale`` as arrays, and
+optional texture points. It returns a :class:`Fin`: its mesh (vertices in exactly
+the order of the species file's texture points, so UVs map one to one) and, for
+moving fins, the pivot the thesis names in 7.1. Mapping a species file's records
+onto these parameters is :mod:`fishgen.assembly.fins`' job.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from fishgen.geometry.body import midline_point
 from fishgen.geometry.mesh import Mesh, strip_faces
-from fishgen.species.model import CaudalFin, PectoralFin, PelvicFin, VerticalFin
 
 #: Paired fins stand off the flank by this angle instead of lying in it (decisions.md).
 SPLAY_DEGREES = 20.0
+
+
+@dataclass(frozen=True)
+class CaudalParams:
+    """Tail fin (Figure 4.9): two fans from ``connection`` (unit body space, x y z)."""
+    top_line: float
+    middle_line: float
+    top_angle: float          # degrees between top and middle line
+    top_triangles: int
+    connection: tuple[float, float, float]
+    rotation_angle: float     # degrees, tilts the whole fin about the z-axis
+    bottom_line: float
+    bottom_angle: float       # degrees between bottom and middle line
+    bottom_triangles: int
+    movement_angle: float = 0.0   # degrees, swing amplitude
+    step_size: float = 0.0        # degrees per frame
+
+
+@dataclass(frozen=True)
+class VerticalParams:
+    """Dorsal, adipose or anal fin over ring sections ``start_section..end_section``."""
+    start_section: int
+    end_section: int
+    start_length: float
+    end_length: float
+    start_angle: float        # degrees from the horizontal; the sign is ignored
+    proportion: float
+
+
+@dataclass(frozen=True)
+class PectoralParams:
+    """Pectoral fin (Figure 4.14): based on ring ``start_section`` from point ``start_circle``."""
+    start_section: int
+    start_circle: int
+    triangles: int
+    start_length: float
+    start_angle: float        # degrees from the horizontal
+    proportion: float
+    movement_angle: float = 0.0
+    step_size: float = 0.0
+
+
+@dataclass(frozen=True)
+class PelvicParams:
+    """Pelvic fin (Figure 4.16): based on ring point ``start_circle`` of sections start..end."""
+    start_circle: int
+    start_section: int
+    end_section: int
+    start_length: float
+    end_length: float
+    end_angle: float          # degrees below the horizontal
+    movement_angle: float = 0.0
+    step_size: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -28,19 +86,19 @@ class Fin:
     mirror_of: str | None = None         # set on a right-hand fin
 
 
-def _uv(points, n: int) -> np.ndarray:
+def _uv(points: ArrayLike | None, n: int) -> np.ndarray:
     if points is None:
         return np.zeros((n, 2))
     return np.asarray(points, dtype=np.float64).reshape(n, 2)
 
 
-def _scaled(dx: float, dy: float, scale) -> np.ndarray:
+def _scaled(dx: float, dy: float, scale: np.ndarray) -> np.ndarray:
     """A fin vector in thesis units to scaled space: uniformly by scaleY, the body's depth,
     so the angles the file gives are the angles one sees (docs/decisions.md)."""
     return np.array([dx, dy, 0.0]) * scale[1]
 
 
-def caudal_fin(fin: CaudalFin, scale, uv=None) -> Fin:
+def caudal_fin(fin: CaudalParams, scale: np.ndarray, uv: ArrayLike | None = None) -> Fin:
     """Two fans of triangles from the connection point (Figure 4.9).
 
     Vertex order as Fixel writes it: connection point; the top edge from the top
@@ -70,7 +128,8 @@ def caudal_fin(fin: CaudalFin, scale, uv=None) -> Fin:
     return Fin("caudal_fin", mesh, origin, fin.movement_angle, fin.step_size)
 
 
-def vertical_fin(name: str, fin: VerticalFin, rings: np.ndarray, scale, side: float, uv=None) -> Fin:
+def vertical_fin(name: str, fin: VerticalParams, rings: np.ndarray, scale: np.ndarray, side: float,
+                 uv: ArrayLike | None = None) -> Fin:
     """Dorsal/adipose (side=+1) or anal (side=-1) fin over BodySections start..end.
 
     Base points B_k sit on the body's top (or bottom) line. The tip of the start
@@ -82,7 +141,7 @@ def vertical_fin(name: str, fin: VerticalFin, rings: np.ndarray, scale, side: fl
     """
     sections = np.arange(fin.start_section, fin.end_section + 1)
     n = sections.size
-    base = np.array([midline_point(rings, s, side) for s in sections])
+    base = np.array([midline_point(rings, int(s), side) for s in sections])
     a = np.radians(abs(fin.start_angle))
     top = np.empty_like(base)
     top[0] = base[0] + _scaled(fin.start_length * np.cos(a), side * fin.start_length * np.sin(a), scale)
@@ -92,7 +151,7 @@ def vertical_fin(name: str, fin: VerticalFin, rings: np.ndarray, scale, side: fl
     return _strip_fin(name, base, top, side_up=side > 0, uv=uv)
 
 
-def _strip_fin(name: str, base: np.ndarray, top: np.ndarray, side_up: bool, uv) -> Fin:
+def _strip_fin(name: str, base: np.ndarray, top: np.ndarray, side_up: bool, uv: ArrayLike | None) -> Fin:
     n = len(base)
     middle = np.arange(1, n - 1)
     order = np.concatenate([[n + 0, 0, n - 1, 2 * n - 1], middle, n + middle])  # Fixel order
@@ -112,7 +171,8 @@ def _splay(vector: np.ndarray, side: float) -> np.ndarray:
     return out
 
 
-def pectoral_fin(fin: PectoralFin, rings: np.ndarray, scale, uv=None) -> Fin:
+def pectoral_fin(fin: PectoralParams, rings: np.ndarray, scale: np.ndarray,
+                 uv: ArrayLike | None = None) -> Fin:
     """Left pectoral fin (Figure 4.14): base on ring startBodySection from startCircleSection
     down through ``triangles`` CircleSections; like a vertical fin whose end line is zero.
 
@@ -126,7 +186,8 @@ def pectoral_fin(fin: PectoralFin, rings: np.ndarray, scale, uv=None) -> Fin:
     side = 1.0 if base[:, 2].mean() >= 0 else -1.0
     a = np.radians(fin.start_angle)
     top = np.empty_like(base)
-    top[0] = base[0] + _splay(_scaled(fin.start_length * np.cos(a), fin.start_length * np.sin(a), scale), side)
+    start = _scaled(fin.start_length * np.cos(a), fin.start_length * np.sin(a), scale)
+    top[0] = base[0] + _splay(start, side)
     for k in range(1, n + 1):
         top[k] = base[k] + fin.proportion * (top[k - 1] - base[k])
     top[n] = base[n]
@@ -146,7 +207,7 @@ def pectoral_fin(fin: PectoralFin, rings: np.ndarray, scale, uv=None) -> Fin:
                fin.movement_angle, fin.step_size)
 
 
-def pelvic_fin(fin: PelvicFin, rings: np.ndarray, scale, uv=None) -> Fin:
+def pelvic_fin(fin: PelvicParams, rings: np.ndarray, scale: np.ndarray, uv: ArrayLike | None = None) -> Fin:
     """Left pelvic fin (Figure 4.16): base along CircleSection startCircleSection over
     BodySections start..end; the start line hangs straight down with start_length,
     the end line leaves at end_angle below the horizontal with end_length, and the

@@ -16,14 +16,7 @@ class Mesh:
     def normals(self) -> np.ndarray:
         return vertex_normals(self.positions, self.faces)
 
-    def transformed(self, matrix: np.ndarray, offset: np.ndarray | None = None) -> "Mesh":
-        """Apply ``p -> matrix @ p + offset`` (matrix must be a rotation/scale with det > 0)."""
-        pos = self.positions @ np.asarray(matrix, dtype=np.float64).T
-        if offset is not None:
-            pos = pos + offset
-        return Mesh(pos, self.faces, self.uvs)
-
-    def mirrored_z(self) -> "Mesh":
+    def mirrored_z(self) -> Mesh:
         """Mirror in z, reversing the winding so the front stays the front."""
         pos = self.positions * np.array([1.0, 1.0, -1.0])
         return Mesh(pos, self.faces[:, ::-1].copy(), self.uvs)

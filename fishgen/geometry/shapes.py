@@ -5,9 +5,11 @@ before scaling. Classes are selected by the name in the species file.
 """
 from __future__ import annotations
 
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
+
+from fishgen.shape_names import SHAPE_NAMES
 
 Profile = Callable[[np.ndarray], np.ndarray]
 
@@ -72,19 +74,8 @@ SHAPES: dict[str, Callable[[Sequence[float]], Profile]] = {
     "FishShapeHawk": lambda params: spline_profile(HAWK),
     "FishShapeAngel": lambda params: spline_profile(ANGEL),
 }
-
-
-def check_shape_params(name: str, params: Sequence[float]) -> str | None:
-    """Return what was expected if ``params`` do not suit shape class ``name``."""
-    if name != "FishShapeSpline":
-        return None if not params else f"no values after the flags for {name}"
-    if len(params) < 2 or len(params) % 2:
-        return "FishShapeSpline control points `x r` pairs after the flags (at least one pair)"
-    xs = params[0::2]
-    rs = params[1::2]
-    if not all(a < b for a, b in zip((0.0, *xs), (*xs, 1.0))) or min(rs) <= 0 or max(rs) > 10:
-        return "FishShapeSpline control points with 0 < x increasing < 1 and 0 < r <= 10"
-    return None
+if tuple(SHAPES) != SHAPE_NAMES:  # the parser accepts SHAPE_NAMES: each needs a profile
+    raise ImportError(f"fishgen.geometry.shapes: profiles {tuple(SHAPES)} != shape names {SHAPE_NAMES}")
 
 
 def profile_for(name: str, params: Sequence[float] = ()) -> Profile:

@@ -74,7 +74,7 @@ def frame(points: np.ndarray, view: str, aspect: float, azimuths=(0.0,),
     tan_y = math.tan(FOV_Y / 2) * FILL
     tan_x = tan_y * aspect
     fixed_target = target is not None or len(azimuths) > 1
-    best = None
+    best: tuple[float, np.ndarray] | None = None
     for az in azimuths:
         d, up = view_basis(view, az)
         right = _unit(np.cross(-d, up))
@@ -90,6 +90,8 @@ def frame(points: np.ndarray, view: str, aspect: float, azimuths=(0.0,),
         dist = float(np.max(np.maximum(np.abs(x - cx) / tan_x, np.abs(y - cy) / tan_y) + (z - zc)))
         if best is None or dist > best[0]:
             best = (dist, centre)
+    if best is None:
+        raise ValueError("frame needs at least one azimuth")
     dist, centre = best
     span = float(np.linalg.norm(hi - lo)) or 1.0
     dist = max(dist, 1e-3 * span, 1e-6)

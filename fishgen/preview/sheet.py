@@ -28,7 +28,7 @@ def contact_sheet(tiles: list[Image.Image], labels: list[str], columns: int | No
     # Text colour picked against the background so labels stay readable on any --background.
     r, g, b, a = background
     ink = (20, 24, 28, 255) if a < 128 or (0.299 * r + 0.587 * g + 0.114 * b) > 140 else (245, 245, 245, 255)
-    for k, (tile, label) in enumerate(zip(tiles, labels)):
+    for k, (tile, label) in enumerate(zip(tiles, labels, strict=True)):
         x, y = (k % columns) * w, (k // columns) * (h + strip)
         sheet.paste(tile, (x, y))
         box = draw.textbbox((0, 0), label, font=font)

@@ -10,12 +10,23 @@ import math
 import os
 import stat
 import unicodedata
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Callable, NamedTuple, Sequence
+from typing import NamedTuple
 
 from fishgen.errors import FishgenError
-from fishgen.species.model import (Behaviour, CaudalFin, PectoralFin, PelvicFin, Species,
-                                   TexturePoints, VerticalFin)
+from fishgen.shape_names import SHAPE_NAMES, check_shape_params
+from fishgen.species.model import (
+    Behaviour,
+    CaudalFin,
+    PectoralFin,
+    PelvicFin,
+    Species,
+    TexturePoints,
+    Vec2,
+    Vec3,
+    VerticalFin,
+)
 
 #: Largest level of detail accepted; refused before anything is allocated.
 MAX_SECTIONS = 1024
@@ -150,6 +161,14 @@ class _Fields:
     def vec(self, i: int, n: int) -> tuple[float, ...]:
         return tuple(self.number(i + k) for k in range(n))
 
+    def vec2(self, i: int) -> Vec2:
+        return self.number(i), self.number(i + 1)
+
+    def vec3(self, i: int, low: float = -MAX_MAGNITUDE, high: float = MAX_MAGNITUDE,
+             open_low: bool = False) -> Vec3:
+        return (self.number(i, low, high, open_low), self.number(i + 1, low, high, open_low),
+                self.number(i + 2, low, high, open_low))
+
 
 # Record names as the thesis' comments give them.
 HEADER = ("name", "world_scale", "urgeFactor", "start x", "start y", "start z", "cube_size")
@@ -165,11 +184,6 @@ PELVIC = ("startCircleSection", "startBodySection", "endBodySection", "start_len
 PECTORAL = ("startBodySection", "startCircleSection", "no_of_triangles", "startLength",
             "startAngle", "proportion", "version_t", "movement_angle", "step_size")
 URGES = ("random", "center", "keepaway", "repelDistance", "speed", "changeRate", "direction")
-
-
-def _shape_classes() -> set[str]:
-    from fishgen.geometry.shapes import SHAPES
-    return set(SHAPES)
 
 
 def _vertical(reader: _Reader, label: str, bodies: int) -> VerticalFin:
@@ -260,7 +274,7 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     name = line.tokens[0]
     world_scale = f.number(1, 0, MAX_WORLD_SCALE, open_low=True)
     urge = f.number(2)
-    start = f.vec(3, 3)
+    start = f.vec3(3)
     cube = f.number(6)
 
     line = reader.record("the fish colour record `R G B`", 3)
@@ -270,22 +284,20 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     line = reader.record(f"the shape record `{' '.join(SHAPE)}`", at_least=7, key="shape")
     f = _Fields(reader, line, SHAPE + tuple(f"shape parameter {k + 1}" for k in range(len(line.tokens))))
     shape_class = line.tokens[0]
-    known = _shape_classes()
-    if shape_class not in known:
-        raise reader.error(line, "a shape class (one of " + ", ".join(sorted(known)) + ")",
+    if shape_class not in SHAPE_NAMES:
+        raise reader.error(line, "a shape class (one of " + ", ".join(sorted(SHAPE_NAMES)) + ")",
                            f"{shape_class!r}")
     bodies = f.whole(1, 3, MAX_SECTIONS, "BodySections")
     circles = f.whole(2, 3, MAX_SECTIONS, "CircleSections")
     textured, masked, turn, catch = (f.flag(k) for k in range(3, 7))
     shape_params = tuple(f.number(k) for k in range(7, len(line.tokens)))
-    from fishgen.geometry.shapes import check_shape_params
     problem = check_shape_params(shape_class, shape_params)
     if problem:
         raise reader.error(line, problem, f"{len(shape_params)} extra values")
 
     line = reader.record("the body scale record `scaleX scaleY scaleZ`", 3)
     f = _Fields(reader, line, ("scaleX", "scaleY", "scaleZ"))
-    scale = tuple(f.number(k, 0, MAX_SCALE, open_low=True) for k in range(3))
+    scale = f.vec3(0, 0, MAX_SCALE, open_low=True)
 
     line = reader.record("the caudal fin record", 13, key="caudal")
     f = _Fields(reader, line, [f"caudal {n}" for n in CAUDAL])
@@ -330,7 +342,8 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     points = None
     transparency = 1.0
     nxt = reader.peek()
-    has_texture_block = textured or (nxt is not None and len(nxt.tokens) == 2 and not _is_number(nxt.tokens[0]))
+    has_texture_block = textured or (nxt is not None and len(nxt.tokens) == 2
+                                     and not _is_number(nxt.tokens[0]))
     if has_texture_block:
         line = reader.record("the texture record `texture_file black_and_white_file`", 2, key="texture")
         if textured and textures is not None:
@@ -359,11 +372,12 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
             points = None
 
     line = reader.record("the initial velocity record `vx vy vz`", 3)
-    velocity = _Fields(reader, line, ("vx", "vy", "vz")).vec(0, 3)
+    velocity = _Fields(reader, line, ("vx", "vy", "vz")).vec3(0)
     line = reader.record(f"the urge weightings record `{' '.join(URGES)}`", 7)
-    urges = _Fields(reader, line, URGES).vec(0, 7)
+    random, center, keepaway, repel_distance, speed, change_rate, direction = \
+        _Fields(reader, line, URGES).vec(0, 7)
     line = reader.record("the flee record", 2)
-    flee = _Fields(reader, line, ("flee 1", "flee 2")).vec(0, 2)
+    flee = _Fields(reader, line, ("flee 1", "flee 2")).vec2(0)
     extra = reader.peek()
     if extra is not None:
         raise reader.error(extra, "end of file after the flee record", _found_values(extra))
@@ -375,7 +389,8 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
         catchfish_test=catch, scale=scale, caudal=caudal, adipose=adipose, dorsal=dorsal,
         pelvic=pelvic, anal=anal, pectoral=pectoral, transparency=transparency,
         colour_texture=colour_tex, mask_texture=mask_tex, texture_points=points,
-        behaviour=Behaviour(velocity, *urges, flee=flee), source=Path(file),
+        behaviour=Behaviour(velocity, random, center, keepaway, repel_distance, speed, change_rate,
+                            direction, flee), source=Path(file),
         record_lines=dict(reader.record_lines))
 
 

@@ -1,14 +1,14 @@
 """Write a :class:`Species` back to the VRFish file layout (Appendix A order)."""
 from __future__ import annotations
 
-from fishgen.species.model import Species
+from fishgen.species.model import Species, Vec2
 
 
 def _n(value: float) -> str:
     return repr(float(value))
 
 
-def _row(*values) -> str:
+def _row(*values: float | str) -> str:
     return " ".join(v if isinstance(v, str) else _n(v) for v in values)
 
 
@@ -20,7 +20,8 @@ def format_species(sp: Species, colour_name: str = "colour.png", mask_name: str 
         "//description world_scale urgeFactor start_position_3D_point cubesize_t",
         _row(sp.name, sp.world_scale, sp.urge_factor, *sp.start_position, sp.cube_size),
         "//fish_colours_RGB", _row(*sp.colour),
-        "//fishshape_subclass BodySections CircleSections textured masked turn_T catchfish_T [spline x r pairs]",
+        "//fishshape_subclass BodySections CircleSections textured masked turn_T catchfish_T "
+        "[spline x r pairs]",
         " ".join([sp.shape_class, str(sp.body_sections), str(sp.circle_sections), flag(sp.textured),
                   flag(sp.masked), flag(sp.turn_test), flag(sp.catchfish_test)]
                  + [_n(v) for v in sp.shape_params]),
@@ -31,7 +32,8 @@ def format_species(sp: Species, colour_name: str = "colour.png", mask_name: str 
         _row(c.top_line, c.middle_line, c.top_angle, c.top_triangles, *c.connection, c.rotation_angle,
              c.bottom_line, c.bottom_angle, c.bottom_triangles, c.movement_angle, c.step_size),
     ]
-    vertical_header = "//startBodySection endBodySection startLength endLength startangle_in_degrees proportion"
+    vertical_header = ("//startBodySection endBodySection startLength endLength startangle_in_degrees "
+                       "proportion")
     for label, fin in (("adiposeFin", sp.adipose), ("dorsalFin", sp.dorsal)):
         out += [f"//{label}", vertical_header,
                 _row(fin.start_section, fin.end_section, fin.start_length, fin.end_length, fin.start_angle,
@@ -47,8 +49,8 @@ def format_species(sp: Species, colour_name: str = "colour.png", mask_name: str 
             _row(a.start_section, a.end_section, a.start_length, a.end_length, a.start_angle, a.proportion)]
     q = sp.pectoral
     out += ["//pectoralfin",
-            "//startBodySection startCircleSection no_of_triangles startLength startAngle proportion version_t "
-            "movement_angle step_size",
+            "//startBodySection startCircleSection no_of_triangles startLength startAngle proportion "
+            "version_t movement_angle step_size",
             _row(q.start_section, q.start_circle, q.triangles, q.start_length, q.start_angle, q.proportion,
                  q.version, q.movement_angle, q.step_size)]
     tp = sp.texture_points
@@ -59,13 +61,15 @@ def format_species(sp: Species, colour_name: str = "colour.png", mask_name: str 
         for k, (u, v) in enumerate(tp.body):
             out.append(f"{k // sp.circle_sections} {k % sp.circle_sections} {_n(u)} {_n(v)}")
 
-        def block(label: str, points) -> list[str]:
+        def block(label: str, points: tuple[Vec2, ...]) -> list[str]:
             return [f"//no_of_{label}_texture_points", str(len(points)), "//texture_points_2D"] + \
                 [_row(u, v) for u, v in points]
         out += block("caudal", tp.caudal) + ["//transparency_t", _n(sp.transparency)]
         for label in ("dorsal", "adipose", "anal", "pectoral", "pelvic"):
             out += block(label, getattr(tp, label))
     b = sp.behaviour
+    if b is None:   # the file format requires the movement records
+        raise ValueError(f"species {sp.name!r} has no behaviour to write")
     out += ["//movement of fish", "//initVelocity_vector", _row(*b.initial_velocity),
             "//urge_weightings", "//random center keepaway repelDistance speed changeRate direction",
             _row(b.random, b.center, b.keepaway, b.repel_distance, b.speed, b.change_rate, b.direction),

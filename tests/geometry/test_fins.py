@@ -5,11 +5,10 @@ import numpy as np
 import pytest
 import trimesh
 
-from fishgen.assembly.fish import build_fins
+from fishgen.assembly.fins import build_fins
 from fishgen.geometry.body import build_body
-from fishgen.geometry.fins import caudal_fin, vertical_fin
+from fishgen.geometry.fins import CaudalParams, VerticalParams, caudal_fin, vertical_fin
 from fishgen.geometry.shapes import profile_for
-from fishgen.species.model import CaudalFin, VerticalFin
 from fishgen.species.parser import parse_species
 from tests.conftest import PARAMS
 
@@ -49,7 +48,7 @@ def test_fins_touch_the_body(sp):
 @pytest.mark.parametrize("bodies,circles", [(8, 6), (16, 12), (9, 7)])
 def test_no_gap_under_the_dorsal_fin_at_any_level_of_detail(bodies, circles):
     body = build_body(profile_for("FishShapeSin"), bodies, circles, (0.26, 0.1, 0.04))
-    fin = vertical_fin("dorsal_fin", VerticalFin(2, bodies - 3, 0.6, 0.1, 70, 0.9), body.rings,
+    fin = vertical_fin("dorsal_fin", VerticalParams(2, bodies - 3, 0.6, 0.1, 70, 0.9), body.rings,
                        np.array([0.26, 0.1, 0.04]), 1.0)
     mesh = trimesh.Trimesh(body.mesh.positions, body.mesh.faces, process=False)
     n = bodies - 4
@@ -69,7 +68,7 @@ def test_right_fins_mirror_the_left(sp):
 
 
 def test_caudal_fin_follows_its_lines_and_angles():
-    fin = caudal_fin(CaudalFin(1.0, 0.5, 90.0, 2, (1.0, 0.0, 0.0), 0.0, 1.0, 45.0, 1, 10, 1), np.ones(3))
+    fin = caudal_fin(CaudalParams(1.0, 0.5, 90.0, 2, (1.0, 0.0, 0.0), 0.0, 1.0, 45.0, 1, 10, 1), np.ones(3))
     p = fin.mesh.positions
     assert np.allclose(p[0], [1, 0, 0])                            # connection point
     assert np.allclose(p[1], [1, 1, 0])                            # top tip, 90 degrees up
@@ -80,7 +79,7 @@ def test_caudal_fin_follows_its_lines_and_angles():
 
 def test_vertical_fin_proportion_and_ninety_degree_end():
     rings = build_body(profile_for("FishShapeSin"), 16, 12, (1, 1, 1)).rings
-    fin = vertical_fin("dorsal_fin", VerticalFin(4, 7, 0.5, 0.2, 60.0, 0.5), rings, np.ones(3), 1.0)
+    fin = vertical_fin("dorsal_fin", VerticalParams(4, 7, 0.5, 0.2, 60.0, 0.5), rings, np.ones(3), 1.0)
     p = fin.mesh.positions
     t0, b0, b3, t3, b1, b2, t1, t2 = p
     assert np.allclose(t0 - b0, [0.5 * np.cos(np.radians(60)), 0.5 * np.sin(np.radians(60)), 0])
@@ -91,5 +90,5 @@ def test_vertical_fin_proportion_and_ninety_degree_end():
 def test_anal_fin_hangs_below_whatever_the_angle_sign():
     rings = build_body(profile_for("FishShapeSin"), 16, 12, (1, 1, 1)).rings
     for angle in (-55.0, 55.0):
-        fin = vertical_fin("anal_fin", VerticalFin(11, 14, 0.3, 0.1, angle, 0.9), rings, np.ones(3), -1.0)
+        fin = vertical_fin("anal_fin", VerticalParams(11, 14, 0.3, 0.1, angle, 0.9), rings, np.ones(3), -1.0)
         assert fin.mesh.positions[:, 1].max() <= 1e-12

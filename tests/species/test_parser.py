@@ -121,13 +121,15 @@ def test_body_point_count_must_match_level_of_detail(tmp_path):
 def test_fin_point_count_must_follow_fin_structure(tmp_path):
     text = replace_record(BONY, "//no_of_dorsal_texture_points\n8", "//no_of_dorsal_texture_points\n9")
     err = error_of(tmp_path, text)
-    assert "expected 8 dorsal fin texture points (2 x (endBodySection 10 - startBodySection 7 + 1))" in str(err)
+    assert ("expected 8 dorsal fin texture points (2 x (endBodySection 10 - startBodySection 7 + 1))"
+            in str(err))
 
 
 def test_fin_section_outside_the_body(tmp_path):
-    err = error_of(tmp_path, replace_record(BONY, "7.0 10.0 0.6 0.05 70.0 0.98", "7.0 16.0 0.6 0.05 70.0 0.98"))
-    assert "dorsal fin endBodySection as a BodySection number (from startBodySection 7) in 7..15, found '16.0'" \
-        in str(err)
+    err = error_of(tmp_path, replace_record(BONY, "7.0 10.0 0.6 0.05 70.0 0.98",
+                                            "7.0 16.0 0.6 0.05 70.0 0.98"))
+    assert ("dorsal fin endBodySection as a BodySection number (from startBodySection 7) in 7..15, "
+            "found '16.0'" in str(err))
 
 
 def test_pectoral_triangles_may_not_wrap_the_body(tmp_path):
@@ -210,7 +212,8 @@ def test_step_size_required_for_a_moving_fin(tmp_path):
 def test_texture_that_is_not_an_image(tmp_path):
     path = write(tmp_path, BONY)
     (tmp_path / "bonybream_mask.png").write_text("not a picture")
-    with pytest.raises(FishgenError, match="expected a texture image .* found 'bonybream_mask.png' unreadable"):
+    with pytest.raises(FishgenError,
+                       match="expected a texture image .* found 'bonybream_mask.png' unreadable"):
         load_species(path)
 
 

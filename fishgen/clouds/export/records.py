@@ -1,7 +1,7 @@
 """Packed per-particle records shared by the PLY, NPY and CSV writers."""
 from __future__ import annotations
 
-from typing import Iterator
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -16,6 +16,13 @@ PARTICLE = np.dtype(FIELDS)                       # the PLY vertex, 23 bytes
 PARTICLE_WITH_CUBE = np.dtype(FIELDS + [("cube", "<i4")])  # NPY/CSV keep the source cube
 
 
+def field_names(dtype: np.dtype) -> tuple[str, ...]:
+    """The field names of a structured dtype such as ``PARTICLE`` (numpy types them optional)."""
+    if dtype.names is None:
+        raise TypeError(f"expected a structured dtype, found {dtype}")
+    return dtype.names
+
+
 def record_chunks(cloud: Cloud, dtype: np.dtype = PARTICLE) -> Iterator[np.ndarray]:
     """Yield the cloud as packed structured arrays of at most ``ROWS`` rows."""
     buffer = np.empty(min(ROWS, len(cloud)), dtype)
@@ -28,6 +35,6 @@ def record_chunks(cloud: Cloud, dtype: np.dtype = PARTICLE) -> Iterator[np.ndarr
         rec["density"] = cloud.density[start:stop]
         for channel, name in enumerate(("red", "green", "blue")):
             rec[name] = cloud.colors[start:stop, channel]
-        if "cube" in dtype.names:
+        if "cube" in field_names(dtype):
             rec["cube"] = cloud.cube_index[start:stop]
         yield rec

@@ -31,7 +31,7 @@ def _fit(points_xy: np.ndarray, box, aspect: float, keep=None) -> np.ndarray:
 
 def project_texture_points(species: Species, aspect: float = 2.0) -> Species:
     """Return ``species`` with texture points for a texture ``aspect`` times wider than tall."""
-    from fishgen.assembly.fish import build_fins
+    from fishgen.assembly.fins import build_fins
     from fishgen.geometry.body import ring_positions
     from fishgen.geometry.shapes import profile_for
 
