@@ -28,7 +28,7 @@ import os
 import subprocess
 import sys
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -64,14 +64,18 @@ def shown_from(side: str, species: str) -> list[str]:
 # --- thresholds -------------------------------------------------------------------------------
 
 MIN_AREA = 1e-4
-"""A fin 'shows' when it covers at least this fraction of the frame (the adipose fin: ~2.4e-4)."""
+"""A fin 'shows' when it covers at least this fraction of the frame (the adipose fin: ~2.2e-4)."""
 AREA_TOLERANCE = 0.20
-"""Relative difference allowed from a part's recorded area (rasterizers differ by under 8 %)."""
+"""Relative difference allowed from a part's recorded area (llvmpipe and softpipe differ by up to
+10 %, on the adipose fin's few pixels; 2 % or less elsewhere)."""
 TEXTURE_DETAIL = 0.02
 """Least spread of the body's chromaticity (sum of r, g, b standard deviations); a textured body
 shows 0.039 to 0.16, a flat-coloured one about 0.005 (lighting alone)."""
-TEXTURE_HUE = 0.016
-"""Largest difference of mean chromaticity between the body's pixels and its texture's texels."""
+TEXTURE_HUE = 0.03
+"""Largest difference of mean chromaticity (any channel) between the body's pixels and the texels
+under its vertices: correct bodies are off by at most 0.013, untextured ones by 0.17 to 0.22 -
+except bonybream, whose nearly grey texture is only 0.020 off white, so TEXTURE_DETAIL catches
+its loss."""
 CLOUD_AREA_TOLERANCE = 0.10
 CLOUD_BOX_TOLERANCE = 0.03
 """Fractions of the frame a cloud's covered share and bounding box may move from the record."""
@@ -227,7 +231,7 @@ class Cloud:
     box: tuple[float, float, float, float]      # left, top, right, bottom of alpha > 0.05, fractions
 
     @staticmethod
-    def of(image: np.ndarray) -> "Cloud":
+    def of(image: np.ndarray) -> Cloud:
         alpha = image[..., 3] / 255.0
         ys, xs = np.nonzero(alpha > 0.05)
         h, w = alpha.shape
@@ -255,12 +259,12 @@ def cloud_problems(name: str, cloud: Cloud) -> list[str]:
 
 # --- the shipped species and clouds -----------------------------------------------------------
 
-@lru_cache(maxsize=None)
+@cache
 def species_scene(species: str):
     return partrender.load(PARAMS / f"{species}.txt")
 
 
-@lru_cache(maxsize=None)
+@cache
 def flanks_of(species: str) -> dict[str, Flank]:
     scene = species_scene(species)
     return {side: flank(scene, side) for side in ("left", "right")}
@@ -322,17 +326,20 @@ def test_catches_a_dropped_fin(fin):
 
 
 def test_checks_hold_under_softpipe():
-    """This module again, in a subprocess on Mesa's softpipe (no multisampling) instead of llvmpipe."""
+    """The checks on correct renders again, in a subprocess on Mesa's softpipe (no multisampling).
+
+    The fault tests stay out of the rerun to keep the suite quick: a fault's distance from
+    the thresholds is far larger than anything a rasterizer changes (see the thresholds)."""
     if os.environ.get("GALLIUM_DRIVER") == "softpipe":
         pytest.skip("already running under softpipe")
     env = {**os.environ, "GALLIUM_DRIVER": "softpipe",
            "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
-    probe = subprocess.run([sys.executable, "-c", "import moderngl; c = moderngl.create_context("
-                            "standalone=True, backend='egl'); print(c.info['GL_RENDERER'])"],
-                           env=env, capture_output=True, text=True)
+    probe = subprocess.run([sys.executable, "-c", ("import moderngl; c = moderngl.create_context("
+                            "standalone=True, backend='egl'); print(c.info['GL_RENDERER'])")],
+                           env=env, capture_output=True, text=True, check=False)
     assert "softpipe" in probe.stdout, f"expected Mesa softpipe, found {probe.stdout!r} {probe.stderr}"
     run = subprocess.run([sys.executable, "-m", "pytest", __file__, "-q", "-p", "no:cacheprovider",
-                          "-k", "not softpipe"], cwd=ROOT, env=env, capture_output=True, text=True)
+                          "-k", "not softpipe and not catches"], cwd=ROOT, env=env, capture_output=True, text=True, check=False)
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-2000:]
 
 
