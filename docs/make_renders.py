@@ -6,9 +6,9 @@
 
 One still per shipped species (params/*.txt) and per report cloud
 (params/clouds/*.awn), a side-view contact sheet of the species, and a swim
-loop. tests/preview/test_reference.py renders the stills again and compares
-them with these files, so run this script (and look at the images) whenever a
-change is meant to alter how an asset looks.
+loop. Run it (and look at the images) whenever a change is meant to alter how
+an asset looks. The tests do not diff against these files; they measure each
+part instead (tests/preview/test_reference.py).
 """
 from __future__ import annotations
 

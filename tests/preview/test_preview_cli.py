@@ -6,7 +6,6 @@ import pytest
 from PIL import Image
 
 from tests.conftest import PARAMS, run_cli
-from tests.preview.imagecompare import difference
 
 pytestmark = pytest.mark.usefixtures("gl_available")
 BREAM = PARAMS / "bonybream.txt"
@@ -30,7 +29,7 @@ def test_default_still_is_800x600_with_a_subject(tmp_path):
 
 
 def test_fish_faces_left_in_side_view(tmp_path):
-    # Field-guide convention; upside-down renders are caught by test_reference.py.
+    # Field-guide convention; test_reference.py checks the whole layout of every fin.
     out = tmp_path / "side.png"
     _ok(BREAM, "-o", out, "--view", "side", "--size", "400x300")
     img = np.asarray(Image.open(out).convert("RGB"), np.float32)
@@ -46,8 +45,10 @@ def test_views_time_and_background_change_the_image(tmp_path):
                        "white": ["--view", "side", "--background", "white"]}.items():
         paths[key] = tmp_path / f"{key}.png"
         _ok(BREAM, "-o", paths[key], "--size", "320x240", *extra)
+    side = np.asarray(Image.open(paths["side"]).convert("RGB"), np.float32)
     for other in ("top", "front", "posed", "white"):
-        assert not difference(paths["side"], paths[other]).within_tolerance, other
+        changed = np.abs(side - np.asarray(Image.open(paths[other]).convert("RGB"), np.float32)).max(-1) > 32
+        assert changed.mean() > 0.01, other  # over 1 % of the pixels differ clearly
 
 
 def test_transparent_background_keeps_alpha(tmp_path):
