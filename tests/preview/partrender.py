@@ -40,12 +40,13 @@ def load(path):
     return load_input(Path(path))
 
 
+def _parts(scene):
+    """(node name, primitive) of every drawn triangle primitive."""
+    return [(scene.nodes[n].name, prim) for n, prim in scene.drawn() if prim.mode == "TRIANGLES"]
+
+
 def part_names(scene) -> list[str]:
-    return [_name(scene, m) for m in scene.meshes]
-
-
-def _name(scene, mesh) -> str:
-    return scene.nodes[mesh.node].name if mesh.node is not None else ""
+    return [name for name, _ in _parts(scene)]
 
 
 def part_coverage(scene, view: str, size: tuple[int, int]) -> dict[str, np.ndarray]:
@@ -57,28 +58,27 @@ def part_coverage(scene, view: str, size: tuple[int, int]) -> dict[str, np.ndarr
     but still hide what is behind them, so anti-aliased edges give fractional coverage
     rather than colours to classify.
     """
+    from fishgen.scene.model import Image, Material
+
     names = part_names(scene)
     groups = [names[k:k + 3] for k in range(0, len(names), 3)]
     scenes = []
     for group in groups:
         s = copy.deepcopy(scene)
-        for m in s.meshes:
-            name = _name(s, m)
+        for name, prim in _parts(s):
             rgb = [0.0, 0.0, 0.0]
             if name in group:
                 rgb[group.index(name)] = 1.0
-            mat = m.material
-            mat.base_color = (*rgb, 1.0)
-            mat.unlit = True
-            m.colors = None
-            if mat.texture is not None and mat.alpha_mode != "OPAQUE":
-                white = mat.texture.copy()  # keep only the texture's alpha: it cuts the outline
+            old = s.materials[prim.material] if prim.material is not None else Material("none")
+            flat = Material(f"id {name}", (*rgb, 1.0), unlit=True, double_sided=old.double_sided)
+            prim.attributes.pop("COLOR_0", None)
+            if old.texture is not None and old.alpha_mode != "OPAQUE":
+                white = s.images[old.texture].rgba().copy()  # keep only the texture's alpha: it cuts the outline
                 white[..., :3] = 255
-                mat.texture = white
-                mat.alpha_mode = "MASK"
-            else:
-                mat.texture = None
-                mat.alpha_mode = "OPAQUE"
+                flat.texture = s.add_image(Image("alpha only", b"", pixels=white))
+                flat.alpha_mode = "MASK"
+                flat.alpha_cutoff = old.alpha_cutoff
+            prim.material = s.add_material(flat)
         scenes.append(s)
     out = {}
     for group, image in zip(groups, _render(scenes, view, size, (0, 0, 0, 255))):
@@ -94,36 +94,38 @@ def beauty_render(scene, view: str, size: tuple[int, int], background=None) -> n
 
 def texture_of(scene, part: str):
     """(texture (H, W, 4) uint8 sRGB or None, (N, 2) float texture coordinates of the part's vertices)."""
-    for m in scene.meshes:
-        if _name(scene, m) == part:
-            return m.material.texture, m.uvs
+    for name, prim in _parts(scene):
+        if name == part:
+            mat = scene.materials[prim.material] if prim.material is not None else None
+            image = scene.images[mat.texture].rgba() if mat is not None and mat.texture is not None else None
+            return image, prim.attributes.get("TEXCOORD_0")
     raise KeyError(part)
 
 
 def without_part(scene, name: str):
     s = copy.deepcopy(scene)
-    keep = [m for m in s.meshes if _name(s, m) != name]
-    if len(keep) == len(s.meshes):
-        raise KeyError(f"{scene.label} has no part {name!r}")
-    s.meshes = keep
+    found = [i for i, node in enumerate(s.nodes) if node.name == name and node.mesh is not None]
+    if not found:
+        raise KeyError(f"{scene.name} has no part {name!r}")
+    for node in s.nodes:
+        node.children = [c for c in node.children if c not in found]
+    s.roots = [r for r in s.roots if r not in found]
     return s
 
 
 def upside_down(scene):
-    from fishgen.preview.animation import Node
+    from fishgen.scene.model import Node
 
     s = copy.deepcopy(scene)
-    roots = [i for i, n in enumerate(s.nodes) if n.parent is None]
-    s.nodes.append(Node("flip", rotation=np.array([0.0, 0.0, 1.0, 0.0])))  # 180 degrees about +Z
-    for i in roots:
-        s.nodes[i].parent = len(s.nodes) - 1
+    s.nodes.append(Node("flip", rotation=(0.0, 0.0, 1.0, 0.0), children=list(s.roots)))  # 180 degrees about +Z
+    s.roots = [len(s.nodes) - 1]
     return s
 
 
 def without_texture(scene):
     s = copy.deepcopy(scene)
-    for m in s.meshes:
-        m.material.texture = None
+    for m in s.materials:
+        m.texture = None
     return s
 
 
