@@ -28,8 +28,17 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from fishgen.clouds import Cube, CubeFile, fill_cloud, load_cubes  # noqa: E402
-from fishgen.clouds.export.ply import write_ply  # noqa: E402
-from fishgen.clouds.export.table import write_csv  # noqa: E402
+from fishgen.clouds.scene import cloud_scene  # noqa: E402
+from fishgen.exchange.ply import write_ply as _write_ply  # noqa: E402
+from fishgen.exchange.table import write_csv as _write_csv  # noqa: E402
+
+
+def write_ply(cloud, path):
+    return _write_ply(cloud_scene(cloud), Path(path))
+
+
+def write_csv(cloud, path):
+    return _write_csv(cloud_scene(cloud), Path(path))
 from fishgen.clouds.fill import BASE_COLOUR, CLUMP, TOP_COLOUR  # noqa: E402
 
 TABLE = ROOT / "params" / "clouds" / "table_4_4.awn"

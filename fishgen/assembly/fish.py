@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from fishgen.assembly.fins import build_fins
 from fishgen.assembly.animation import MAX_CLIP_FRAMES, FinMotion, clip_frames, y_rotation_quaternions
 from fishgen.assembly.materials import FIN_MODES, default_fin_mode, load_textures, make_materials
 from fishgen.errors import FishgenError
 from fishgen.geometry.body import build_body
-from fishgen.geometry.fins import Fin, caudal_fin, mirrored, pectoral_fin, pelvic_fin, vertical_fin
 from fishgen.geometry.mesh import vertex_normals
 from fishgen.geometry.shapes import profile_for
 from fishgen.scene.model import Channel, Clip, Image, Mesh, Node, Primitive, Sampler, Scene
@@ -27,22 +27,6 @@ METRES_PER_WORLD_UNIT = 0.05
 THESIS_TO_GLTF = np.array([[0.0, 0.0, 1.0],
                            [0.0, 1.0, 0.0],
                            [-1.0, 0.0, 0.0]])
-
-
-def build_fins(species: Species, rings: np.ndarray) -> list[Fin]:
-    """All fins in scaled thesis space; right-hand paired fins mirror the left ones."""
-    s = np.asarray(species.scale, dtype=np.float64)
-    tp = species.texture_points
-    uv = (lambda name: getattr(tp, name)) if tp is not None else (lambda name: None)
-    fins = [caudal_fin(species.caudal, s, uv("caudal"))]
-    for name, fin, side in (("dorsal", species.dorsal, 1.0), ("adipose", species.adipose, 1.0),
-                            ("anal", species.anal, -1.0)):
-        if fin.present:
-            fins.append(vertical_fin(f"{name}_fin", fin, rings, s, side, uv(name)))
-    for left in (pectoral_fin(species.pectoral, rings, s, uv("pectoral")),
-                 pelvic_fin(species.pelvic, rings, s, uv("pelvic"))):
-        fins += [left, mirrored(left)]
-    return [f for f in fins if len(f.mesh.faces)]
 
 
 def build_fish(species: Species, *, fins: str | None = None, length: float | None = None,

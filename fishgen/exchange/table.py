@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from fishgen.atomic import atomic_open
+from fishgen.exchange.csv_text import format_csv_rows
 from fishgen.exchange.particles import only_points, particle_chunks, particle_columns
 from fishgen.scene.model import Scene
 
@@ -33,8 +34,6 @@ def write_npy(scene: Scene, path: Path) -> list[Path]:
 
 def write_csv(scene: Scene, path: Path) -> list[Path]:
     """Header row, then floats as %.9g (round-trips float32 exactly) and integers (docs/clouds.md)."""
-    from fishgen.clouds.export.table import format_csv_rows
-
     prim = only_points(scene, path)
     columns = particle_columns(prim)
     threads = min(os.cpu_count() or 1, 4)

@@ -149,8 +149,9 @@ def _printf_rows(rec) -> bytes:
 
 
 def test_csv_text_matches_printf_for_every_kind_of_float32():
-    from fishgen.clouds.export.records import PARTICLE_WITH_CUBE
-    from fishgen.clouds.export.table import format_csv_rows
+    from fishgen.exchange.csv_text import format_csv_rows
+    PARTICLE_WITH_CUBE = np.dtype([(n, "<f4") for n in ("x", "y", "z", "radius", "density")]
+                                  + [(n, "u1") for n in ("red", "green", "blue")] + [("cube", "<i4")])
     rng = np.random.default_rng(5)
     n = 50_000
     rec = np.zeros(n, PARTICLE_WITH_CUBE)
