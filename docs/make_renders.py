@@ -34,7 +34,7 @@ def extras() -> list[tuple[str, list[str]]]:
     if species:
         out.append(("species-side.png", [*species, "--view", "side", "--size", "400x300"]))
     if (ROOT / "params" / "bonybream.txt").is_file():
-        out.append(("bonybream-swim.gif", ["params/bonybream.txt", "--frames", "24", "--size", "400x300"]))
+        out.append(("bonybream-swim.gif", ["params/bonybream.txt", "--size", "400x300"]))
     return out
 
 

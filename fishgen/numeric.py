@@ -21,7 +21,7 @@ def linear_to_srgb(c) -> np.ndarray:
     return np.where(c <= 0.0031308, c * 12.92, 1.055 * c ** (1 / 2.4) - 0.055).astype(np.float32)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def srgb8_to_linear16() -> np.ndarray:
     """256-entry table: an sRGB byte to linear light as a normalized uint16.
 
@@ -33,7 +33,7 @@ def srgb8_to_linear16() -> np.ndarray:
     return np.round(lin * 65535.0).astype(np.uint16)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def linear16_to_srgb8() -> np.ndarray:
     """65536-entry table, the inverse of :func:`srgb8_to_linear16` (nearest sRGB byte)."""
     forward = srgb8_to_linear16().astype(np.int64)
@@ -47,7 +47,8 @@ def linear16_to_srgb8() -> np.ndarray:
 def to_linear_float(colors: np.ndarray) -> np.ndarray:
     """A COLOR_0 array (float, or normalized uint8/uint16) as float32 RGBA in [0, 1]."""
     c = np.asarray(colors)
-    out = c.astype(np.float32) / np.iinfo(c.dtype).max if c.dtype.kind in "iu" else c.astype(np.float32)
+    out: np.ndarray = (c.astype(np.float32) / np.iinfo(c.dtype).max if c.dtype.kind in "iu"
+                       else c.astype(np.float32))
     if out.shape[1] == 3:
         out = np.hstack([out, np.ones((len(out), 1), np.float32)])
     return out

@@ -24,4 +24,6 @@ fi
 
 python -m pip install -q --disable-pip-version-check -e ".[test]"
 npm ci --no-audit --no-fund --loglevel=error
+python -m ruff check fishgen
+python -m mypy
 python -m pytest "$@"

@@ -22,7 +22,7 @@ class FinMotion:
     sign: float = 1.0     # -1 for a mirrored (right-hand) fin
 
     @classmethod
-    def from_fin(cls, movement_angle: float, step_size: float, sign: float = 1.0) -> "FinMotion | None":
+    def from_fin(cls, movement_angle: float, step_size: float, sign: float = 1.0) -> FinMotion | None:
         if movement_angle <= 0 or step_size <= 0:
             return None
         return cls(movement_angle, max(4, round(4 * movement_angle / step_size)), sign)

@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from fishgen.assembly.fins import build_fins
 from fishgen.assembly.animation import MAX_CLIP_FRAMES, FinMotion, clip_frames, y_rotation_quaternions
-from fishgen.assembly.materials import FIN_MODES, default_fin_mode, load_textures, make_materials
+from fishgen.assembly.fin_modes import FIN_MODES
+from fishgen.assembly.fins import build_fins
+from fishgen.assembly.materials import default_fin_mode, load_textures, make_materials
 from fishgen.errors import FishgenError
 from fishgen.geometry.body import build_body
 from fishgen.geometry.mesh import vertex_normals
@@ -81,7 +82,8 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
         if texture is not None:
             attributes["TEXCOORD_0"] = uvs.astype(np.float32)
         mesh = scene.add_mesh(Mesh(name, [Primitive(attributes, faces.astype(np.uint32), material)]))
-        return scene.add_node(Node(name=name, mesh=mesh, translation=tuple(float(v) for v in pivot)),
+        x, y, z = (float(v) for v in pivot)
+        return scene.add_node(Node(name=name, mesh=mesh, translation=(x, y, z)),
                               parent=root)
 
     add_part("body", place(body.mesh.positions), body.mesh.faces, body.mesh.uvs, body_material, np.zeros(3))

@@ -15,7 +15,6 @@ from fishgen.errors import FishgenError
 from fishgen.scene.model import Material
 from fishgen.species.model import Species
 
-from fishgen.assembly.fin_modes import FIN_MODES
 MASK_CUTOFF = 0.5
 
 

@@ -14,8 +14,10 @@ import click
 # name -> (module, attribute, one-line help shown by `fishgen --help`)
 COMMANDS = {
     "build": ("fishgen.cli.build", "build", "Build a species file into a textured, fin-animated fish asset."),
-    "clouds": ("fishgen.cli.clouds", "clouds", "Fill cloud cube files (.awn) with particles and export them."),
-    "preview": ("fishgen.cli.preview", "preview", "Render inputs or assets to PNG, contact sheets or swim loops."),
+    "clouds": ("fishgen.cli.clouds", "clouds",
+               "Fill cloud cube files (.awn) with particles and export them."),
+    "preview": ("fishgen.cli.preview", "preview",
+                "Render inputs or assets to PNG, contact sheets or swim loops."),
     "view": ("fishgen.cli.view", "view", "Open an asset in a self-contained three.js viewer page."),
 }
 
@@ -62,8 +64,12 @@ def main(argv: list[str] | None = None) -> None:
         click.echo(f"fishgen: {err}" if err.file is None else str(err), err=True)
         sys.exit(2)
     except click.exceptions.Abort:
-        click.echo("fishgen: interrupted", err=True)
+        click.echo("fishgen: interrupted", err=True)  # the shell's ^C ends the line before ours
         sys.exit(130)
+    except click.UsageError as err:  # one line, like every other error (`--help` shows the usage)
+        command = err.ctx.command_path if err.ctx is not None else "fishgen"
+        click.echo(f"{command}: {err.format_message()}", err=True)
+        sys.exit(err.exit_code)
     except click.ClickException as err:
         err.show()
         sys.exit(err.exit_code)

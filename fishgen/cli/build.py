@@ -6,7 +6,6 @@ from pathlib import Path
 import click
 
 from fishgen.assembly.fin_modes import FIN_MODES
-
 from fishgen.exchange.registry import MESHES, extensions, formats
 
 FISH_FORMATS = formats(writable=True, holding=[MESHES])
@@ -14,7 +13,7 @@ FISH_FORMATS = formats(writable=True, holding=[MESHES])
 
 @click.command("build", context_settings={"show_default": True})
 @click.argument("species_files", nargs=-1, required=True,
-                type=click.Path(dir_okay=False, path_type=Path), metavar="SPECIES_FILE...")
+                type=click.Path(path_type=Path), metavar="SPECIES_FILE...")
 @click.option("-o", "--output", type=click.Path(path_type=Path), default=None,
               help=f"Output file for one species (its extension picks the format: "
                    f"{', '.join(extensions(FISH_FORMATS))}), or a folder for several. "
@@ -24,9 +23,10 @@ FISH_FORMATS = formats(writable=True, holding=[MESHES])
 @click.option("--fins", type=click.Choice(FIN_MODES), default=None,
               help="Fin technique (thesis ch. 5): translucent, mask cut-out or opaque. "
                    "[default: mask if the file says masked, else blend]")
-@click.option("--length", type=float, default=None, metavar="METRES",
+@click.option("--length", type=click.FloatRange(0, 1e4, min_open=True, max_open=True), default=None,
+              metavar="METRES",
               help="Nose-to-tail length in metres. [default: world scale x scaleX x 0.05 m for the body]")
-@click.option("--fps", type=float, default=30.0,
+@click.option("--fps", type=click.FloatRange(0, 1000, min_open=True), default=30.0,
               help="Frames per second; fins move step size degrees per frame.")
 @click.option("--textures", "textures_dir", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder texture names resolve in (and may not leave). "
@@ -42,14 +42,13 @@ def build(species_files: tuple[Path, ...], output: Path | None, fmt: str, fins: 
     own line, and the exit status is non-zero if any failed.
     """
     from fishgen.assembly.fish import build_fish
+    from fishgen.cli.params import check_inputs
     from fishgen.errors import FishgenError
     from fishgen.exchange import export
-    from fishgen.exchange.registry import FORMATS, by_extension, input_format, output_format
+    from fishgen.exchange.registry import FORMATS, by_extension, output_format
     from fishgen.species.parser import load_species
 
-    species_formats = [f for f in FORMATS.values() if f.command == "build"]
-    for species_file in species_files:
-        input_format(species_file, kinds=species_formats, command="build", default=FORMATS["species"])
+    check_inputs(species_files, "build", [FORMATS["species"]], default=FORMATS["species"])
     suffix = output.suffix.lower() if output is not None else ""
     single_file = len(species_files) == 1 and output is not None and by_extension(output) is not None
     if single_file:

@@ -29,7 +29,7 @@ def view(asset, output, port, no_serve, background):
     from fishgen.viewer.page import write_page
 
     rgba = parse_background(background)  # the same colour syntax as `fishgen preview`
-    colour = "#%02x%02x%02x" % rgba[:3]
+    colour = "#{:02x}{:02x}{:02x}".format(*rgba[:3])
     page = write_page(asset, output, colour)
     click.echo(f"wrote {page}")
     if no_serve:

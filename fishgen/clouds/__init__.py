@@ -12,4 +12,5 @@ from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, Cloud, Cube, CubeFile
 from fishgen.clouds.parser import CubeFileWarning, load_cubes, parse_cubes
 
 __all__ = ["Cloud", "Cube", "CubeFile", "CubeFileWarning", "DEFAULT_MAX_PARTICLES", "FORMATS",
-           "METHODS", "check_output", "export_cloud", "fill_cloud", "load_cubes", "merge_clouds", "parse_cubes"]
+           "METHODS", "check_output", "export_cloud", "fill_cloud", "load_cubes", "merge_clouds",
+           "parse_cubes"]

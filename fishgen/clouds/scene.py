@@ -14,8 +14,8 @@ import os
 
 import numpy as np
 
-from fishgen.clouds.sprite import gaussian_sprite_png
 from fishgen.clouds.model import Cloud
+from fishgen.clouds.sprite import gaussian_sprite_png
 from fishgen.numeric import srgb8_to_linear16
 from fishgen.scene.model import Image, Material, Mesh, Node, Primitive, Scene
 

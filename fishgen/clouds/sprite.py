@@ -10,7 +10,7 @@ SIZE = 64
 SIGMA = 0.4  # in units of the quad's half width: alpha is e^-0.5 at 40 % of the radius
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def gaussian_sprite_png(size: int = SIZE, sigma: float = SIGMA) -> bytes:
     """PNG bytes of an RGBA sprite; the Gaussian is shifted and rescaled to hit 0 at r = 1."""
     from PIL import Image

@@ -5,6 +5,7 @@ import io
 
 import numpy as np
 
+
 def format_csv_rows(rec: np.ndarray) -> bytes:
     """CSV lines for a structured array: floats as ``%.9g``, integers as ``%d``.
 

@@ -59,13 +59,13 @@ class _Buffer:
                                self.where)
         width = 16 if mat4 else (1 if array.ndim == 1 else int(np.prod(array.shape[1:])))
         flat = array.reshape(len(array), width)
-        payload, stride = memoryview(flat).cast("B"), None
+        payload, stride = flat.data.cast("B"), None
         row = flat.dtype.itemsize * width
         if target == gl.ARRAY_BUFFER and row % 4:  # vertex rows must be 4-byte aligned: pad them
             stride = row + (-row % 4)
             padded = np.zeros((len(flat), stride), np.uint8)
             padded[:, :row] = flat.view(np.uint8).reshape(len(flat), row)
-            payload = memoryview(padded).cast("B")
+            payload = padded.data.cast("B")
         acc = gl.Accessor(bufferView=self.view(payload, target, stride),
                           componentType=_COMPONENT[array.dtype], count=len(array), type=_TYPE[width],
                           normalized=True if normalized and array.dtype.kind in "iu" else None)
@@ -93,11 +93,13 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[gl.GLTF2,
             if not gltf.samplers:
                 gltf.samplers.append(gl.Sampler(magFilter=gl.LINEAR, minFilter=gl.LINEAR_MIPMAP_LINEAR,
                                                 wrapS=gl.CLAMP_TO_EDGE, wrapT=gl.CLAMP_TO_EDGE))
-            gltf.textures.append(gl.Texture(sampler=0, source=mat.texture, name=scene.images[mat.texture].name))
+            gltf.textures.append(gl.Texture(sampler=0, source=mat.texture,
+                                            name=scene.images[mat.texture].name))
             textures[mat.texture] = len(gltf.textures) - 1
     for mat in scene.materials:
         pbr = gl.PbrMetallicRoughness(baseColorFactor=[float(c) for c in mat.base_color],
-                                      metallicFactor=float(mat.metallic), roughnessFactor=float(mat.roughness))
+                                      metallicFactor=float(mat.metallic),
+                                      roughnessFactor=float(mat.roughness))
         if mat.texture is not None:
             pbr.baseColorTexture = gl.TextureInfo(index=textures[mat.texture])
         out = gl.Material(name=mat.name, pbrMetallicRoughness=pbr, alphaMode=mat.alpha_mode,
@@ -114,7 +116,8 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[gl.GLTF2,
         gltf.meshes.append(gl.Mesh(name=mesh.name, primitives=[_primitive(buf, p) for p in mesh.primitives],
                                    weights=[float(w) for w in mesh.weights] or None))
     for node in scene.nodes:
-        out_node = gl.Node(name=node.name or None, mesh=node.mesh, skin=node.skin, children=list(node.children))
+        out_node = gl.Node(name=node.name or None, mesh=node.mesh, skin=node.skin,
+                           children=list(node.children))
         if node.matrix is not None:
             out_node.matrix = [float(v) for v in np.asarray(node.matrix, float).T.ravel()]
         else:
@@ -198,7 +201,7 @@ def write_gltf(scene: Scene, path: Path) -> list[Path]:
     gltf.buffers[0].uri = quote(f"{stem}.bin")
     files: dict[Path, bytes] = {path: gltf.gltf_to_json(separators=(",", ":"), indent=None).encode("utf-8"),
                                 path.with_name(f"{stem}.bin"): _blob(buf)}
-    for name, image in zip(names, scene.images):
+    for name, image in zip(names, scene.images, strict=True):
         files[path.with_name(name)] = image.data
     write_files(files)
     return list(files)

@@ -8,20 +8,33 @@ some of them). Side files are read only from the asset's own folder.
 from __future__ import annotations
 
 import base64
-import io
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 
 from fishgen.errors import FishgenError, describe
 from fishgen.exchange.sidefiles import side_file
-from fishgen.scene.model import (INTERPOLATIONS, PATHS, Channel, Clip, Image, Material, Mesh, Node,
-                                 Primitive, Sampler, Scene, Skin)
+from fishgen.scene.model import (
+    INTERPOLATIONS,
+    PATHS,
+    Channel,
+    Clip,
+    Image,
+    Material,
+    Mesh,
+    Node,
+    Primitive,
+    PrimitiveMode,
+    Sampler,
+    Scene,
+    Skin,
+)
 
-_DTYPES = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16,
+_DTYPES: dict[int, type[np.number]] = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16,
            5125: np.uint32, 5126: np.float32}
 _WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
-_MODES = {0: "POINTS", 4: "TRIANGLES", 5: "TRIANGLES", 6: "TRIANGLES"}
+_MODES: dict[int, PrimitiveMode] = {0: "POINTS", 4: "TRIANGLES", 5: "TRIANGLES", 6: "TRIANGLES"}
 
 
 def read_gltf(path: str | Path | None = None, *, data: bytes | None = None,
@@ -42,7 +55,8 @@ def read_gltf(path: str | Path | None = None, *, data: bytes | None = None,
     except FishgenError:
         raise
     except Exception as err:  # pygltflib raises anything from KeyError to JSONDecodeError
-        raise FishgenError(f"not a readable glTF asset ({type(err).__name__}: {one_line(err)})", where) from None
+        raise FishgenError(f"not a readable glTF asset ({type(err).__name__}: {one_line(err)})",
+                           where) from None
 
 
 def one_line(err: BaseException, limit: int = 200) -> str:
@@ -62,7 +76,8 @@ class _Reader:
         if uri.strip().startswith("data:"):
             return base64.b64decode(uri.split(",", 1)[1])
         if self.asset is None:  # GLB bytes from memory have no folder to take side files from
-            raise FishgenError(f"expected only embedded data, found a reference to {describe(uri)}", self.where)
+            raise FishgenError(f"expected only embedded data, found a reference to {describe(uri)}",
+                               self.where)
         # Only files in the asset's folder (glTF URIs are percent-encoded: "my%20skin.png").
         target = side_file(self.asset, uri, uri=True)
         if not target.is_file():
@@ -124,7 +139,9 @@ class _Reader:
         if pbr is not None and pbr.baseColorTexture is not None:
             texture = self.g.textures[pbr.baseColorTexture.index].source
         factor = tuple(pbr.baseColorFactor) if pbr is not None and pbr.baseColorFactor else (1, 1, 1, 1)
-        return Material(name=m.name or f"material{k}", base_color=tuple(float(v) for v in factor),
+        # The tuple's length is the file's, as read (the glTF schema fixes it; not checked here).
+        base_color = cast(tuple[float, float, float, float], tuple(float(v) for v in factor))
+        return Material(name=m.name or f"material{k}", base_color=base_color,
                         texture=texture, alpha_mode=m.alphaMode or "OPAQUE",
                         alpha_cutoff=None if m.alphaCutoff is None else float(m.alphaCutoff),
                         double_sided=bool(m.doubleSided),
@@ -163,17 +180,19 @@ class _Reader:
             node = Node(name=n.name or f"node{i}", children=list(n.children or []), mesh=n.mesh, skin=n.skin)
             if n.matrix is not None and list(n.matrix) != [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]:
                 node.matrix = np.asarray(n.matrix, float).reshape(4, 4).T  # column-major
+            # TRS lengths are the file's, as read (the glTF schema fixes them; not checked here).
             if n.translation is not None:
-                node.translation = tuple(float(v) for v in n.translation)
+                node.translation = cast(tuple[float, float, float], tuple(float(v) for v in n.translation))
             if n.rotation is not None:
-                node.rotation = tuple(float(v) for v in n.rotation)
+                node.rotation = cast(tuple[float, float, float, float], tuple(float(v) for v in n.rotation))
             if n.scale is not None:
-                node.scale = tuple(float(v) for v in n.scale)
+                node.scale = cast(tuple[float, float, float], tuple(float(v) for v in n.scale))
             scene.nodes.append(node)
         for k, skin in enumerate(g.skins or []):
             joints = list(skin.joints or [])
             if skin.inverseBindMatrices is not None:
-                ibm = self.accessor(skin.inverseBindMatrices).astype(float).reshape(-1, 4, 4).transpose(0, 2, 1)
+                ibm = (self.accessor(skin.inverseBindMatrices).astype(float)
+                       .reshape(-1, 4, 4).transpose(0, 2, 1))
             else:
                 ibm = np.repeat(np.eye(4)[None], len(joints), axis=0)
             scene.skins.append(Skin(skin.name or f"skin{k}", joints, ibm, skin.skeleton))

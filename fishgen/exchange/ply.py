@@ -14,8 +14,8 @@ import numpy as np
 
 from fishgen.atomic import atomic_open, write_files
 from fishgen.errors import FishgenError
-from fishgen.exchange.rest import rest_meshes
 from fishgen.exchange.particles import only_points, particle_chunks, particle_columns
+from fishgen.exchange.rest import rest_meshes
 from fishgen.scene.model import Scene
 
 VERTEX = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("nx", "<f4"), ("ny", "<f4"),
@@ -52,7 +52,8 @@ def _write_mesh(scene: Scene, path: Path) -> list[Path]:
         vertices["n" + axis] = nrm[:, k]
     vertices["s"] = uv[:, 0]
     vertices["t"] = 1.0 - uv[:, 1]          # PLY readers take t up from the bottom
-    faces_idx = np.concatenate([m.faces + c for m, c in zip(meshes, counts)])
+    # counts holds one offset more than there are meshes (the total)
+    faces_idx = np.concatenate([m.faces + c for m, c in zip(meshes, counts, strict=False)])
     faces = np.empty(len(faces_idx), dtype=FACE)
     faces["n"] = 3
     faces["v"] = faces_idx
@@ -62,7 +63,7 @@ def _write_mesh(scene: Scene, path: Path) -> list[Path]:
               f"comment fishgen {_ascii(scene.name)} rest pose, metres, +Y up"]
     if texture:
         header.append(f"comment TextureFile {texture}")
-    header += [f"element vertex {len(vertices)}"] + [f"property float {n}" for n in VERTEX.names]
+    header += [f"element vertex {len(vertices)}"] + [f"property float {n}" for n in VERTEX.names or ()]
     header += [f"element face {len(faces)}", "property list uchar int vertex_indices", "end_header", ""]
     files = {path: "\n".join(header).encode("ascii") + vertices.tobytes() + faces.tobytes()}
     if texture and image is not None:
@@ -82,5 +83,5 @@ def _write_points(scene: Scene, path: Path) -> list[Path]:
     with atomic_open(path) as handle:
         handle.write(("\n".join(header) + "\n").encode("ascii"))
         for rec in particle_chunks(prim, columns):
-            handle.write(memoryview(rec).cast("B"))
+            handle.write(rec.data.cast("B"))
     return [path]

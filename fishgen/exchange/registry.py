@@ -13,9 +13,10 @@ have a reader that builds the scene and name the command that makes assets from 
 from __future__ import annotations
 
 import importlib
+import os
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterable
 
 from fishgen.errors import FishgenError
 
@@ -36,10 +37,10 @@ class Format:
     command: str | None = None      # for source formats: the command that turns them into assets
 
     def write(self, scene, path: Path) -> list[Path]:
-        return _load(self.writer)(scene, path)  # type: ignore[arg-type]
+        return _load(self.writer)(scene, path)
 
     def read(self, path: Path, **options):
-        return _load(self.reader)(path, **options)  # type: ignore[arg-type]
+        return _load(self.reader)(path, **options)
 
 
 FORMATS: dict[str, Format] = {}
@@ -74,12 +75,12 @@ def extensions(fmts: Iterable[Format]) -> tuple[str, ...]:
     return tuple(ext for f in fmts for ext in f.extensions)
 
 
-def by_extension(path: str | Path) -> Format | None:
+def by_extension(path: str | os.PathLike) -> Format | None:
     ext = Path(path).suffix.lower()
     return next((f for f in FORMATS.values() if ext in f.extensions), None)
 
 
-def output_format(path: str | Path, holding: Iterable[str] = (), what: str = "output") -> Format:
+def output_format(path: str | os.PathLike, holding: Iterable[str] = (), what: str = "output") -> Format:
     """The writable format ``path``'s extension names, able to hold ``holding``; else a one-line error."""
     need = list(holding)
     usable = formats(writable=True, holding=need)
@@ -99,7 +100,7 @@ def output_format(path: str | Path, holding: Iterable[str] = (), what: str = "ou
     return fmt
 
 
-def input_format(path: str | Path, *, kinds: Iterable[Format], command: str,
+def input_format(path: str | os.PathLike, *, kinds: Iterable[Format], command: str,
                  default: Format | None = None) -> Format:
     """The readable format of an input to ``command``; a file meant for another command says which.
 
@@ -109,7 +110,7 @@ def input_format(path: str | Path, *, kinds: Iterable[Format], command: str,
     allowed = list(kinds)
     fmt = by_extension(path)
     if fmt in allowed:
-        return fmt  # type: ignore[return-value]
+        return fmt
     if fmt is not None:
         use = f"; use `fishgen {fmt.command}` for it" if fmt.command and fmt.command != command else ""
         raise FishgenError(f"expected an input of `fishgen {command}` ({', '.join(extensions(allowed))}), "
@@ -127,9 +128,11 @@ def lost(fmt: Format, scene) -> list[str]:
 
 _ALL = frozenset(CONTENT)
 register_format(Format("glb", (".glb",), "binary glTF 2.0", _ALL,
-                       "fishgen.exchange.gltf:write_glb", "fishgen.exchange.gltf_reader:read_gltf", viewer=True))
+                       "fishgen.exchange.gltf:write_glb", "fishgen.exchange.gltf_reader:read_gltf",
+                       viewer=True))
 register_format(Format("gltf", (".gltf",), "glTF 2.0 JSON with .bin and images beside it", _ALL,
-                       "fishgen.exchange.gltf:write_gltf", "fishgen.exchange.gltf_reader:read_gltf", viewer=True))
+                       "fishgen.exchange.gltf:write_gltf", "fishgen.exchange.gltf_reader:read_gltf",
+                       viewer=True))
 register_format(Format("obj", (".obj",), "Wavefront OBJ with .mtl and images (rest pose)",
                        frozenset({MESHES, TEXTURES}),
                        "fishgen.exchange.obj:write_obj", "fishgen.exchange.mesh_reader:read_mesh_file",
@@ -142,7 +145,8 @@ register_format(Format("csv", (".csv",), "CSV table of particles", frozenset({PO
                        "fishgen.exchange.table:write_csv"))
 register_format(Format("npy", (".npy",), "NumPy structured array of particles", frozenset({POINTS}),
                        "fishgen.exchange.table:write_npy"))
-register_format(Format("species", (".txt",), "a VRFish species file", frozenset({MESHES, TEXTURES, NODE_ANIMATION}),
+register_format(Format("species", (".txt",), "a VRFish species file",
+                       frozenset({MESHES, TEXTURES, NODE_ANIMATION}),
                        reader="fishgen.assembly.fish:species_scene", command="build"))
 register_format(Format("cubes", (".awn",), "a RekAwan cloud cube file", frozenset({POINTS}),
                        reader="fishgen.clouds.scene:cube_file_scene", command="clouds"))

@@ -28,7 +28,7 @@ def write_npy(scene: Scene, path: Path) -> list[Path]:
     with atomic_open(path) as handle:
         np.lib.format.write_array_header_1_0(handle, header)
         for rec in particle_chunks(prim, columns):
-            handle.write(memoryview(rec).cast("B"))
+            handle.write(rec.data.cast("B"))
     return [path]
 
 

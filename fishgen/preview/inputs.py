@@ -1,6 +1,7 @@
 """Turn any preview input (species file, cube file, or asset) into a scene, through the format registry."""
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from fishgen.errors import FishgenError
@@ -13,7 +14,8 @@ def input_formats():
     return formats(readable=True)
 
 
-def load_input(path: str | Path, *, textures_dir: str | Path | None = None, seed: int = 0) -> Scene:
+def load_input(path: str | os.PathLike, *, textures_dir: str | os.PathLike | None = None,
+               seed: int = 0) -> Scene:
     """Load a species file, a cube file or an asset; species and cube files are built in memory."""
     path = Path(path)
     fmt = input_format(path, kinds=input_formats(), command="preview")

@@ -9,9 +9,9 @@ import io
 import math
 import os
 import re
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Sequence
 
 import numpy as np
 
@@ -21,9 +21,13 @@ from fishgen.scene.model import Scene
 
 OUTPUTS = (".png", ".webp", ".gif", ".jpg", ".jpeg")
 ANIMATED = (".gif", ".webp")
-DEFAULT_LOOP_FRAMES = 36
-TURNTABLE_SECONDS = 6.0
-"""One turn of a static asset's turntable loop."""
+LOOP_FPS = 12.0
+"""Frames per second of an animated .gif/.webp: fast enough that fins and bodies read as motion."""
+LOOP_SECONDS = 4.0
+"""A loop's default length: the whole clip when shorter, else its first 4 s (fishgen fish loop
+seamlessly within that in practice; --duration picks another); one turn of a static asset's turntable."""
+MAX_LOOP_SECONDS = 600.0
+"""Longest --duration: GIF frames can last at most 655.35 s."""
 MAX_PIXELS = 8192
 """Largest side of one render (--size)."""
 MAX_FRAMES = 1000
@@ -41,7 +45,9 @@ class PreviewOptions:
     height: int = 600
     time: float | None = None          # seconds into the clip; None is the rest pose
     background: tuple[int, int, int, int] = (140, 173, 204, 255)  # sRGB 0-255, a=0 transparent
-    frames: int | None = None
+    frames: int | None = None         # None: duration x fps for a loop, 1 for a still
+    fps: float = LOOP_FPS
+    duration: float | None = None      # None: LOOP_SECONDS, or the clip's length if shorter
     columns: int | None = None
     clip: str | None = None
     seed: int = 0
@@ -67,7 +73,8 @@ def parse_background(text: str) -> tuple[int, int, int, int]:
     except ValueError:
         raise FishgenError(f"expected --background as a colour (#8cadcc, white) or transparent, "
                            f"found {text!r}") from None
-    return tuple(int(v) for v in rgba)
+    r, g, b, a = rgba if isinstance(rgba, tuple) else (rgba, rgba, rgba, 255)
+    return int(r), int(g), int(b), int(a)
 
 
 def check_output(out: Path, options: PreviewOptions, inputs: int = 1) -> int:
@@ -83,8 +90,12 @@ def check_output(out: Path, options: PreviewOptions, inputs: int = 1) -> int:
     frames = options.frames
     if frames is not None and not 1 <= frames <= MAX_FRAMES:
         raise FishgenError(f"expected --frames from 1 to {MAX_FRAMES}, found {frames}")
-    if frames is None:
-        frames = DEFAULT_LOOP_FRAMES if ext == ".gif" else 1
+    if frames is None:  # the most a loop can have: the pixel budget is checked before loading
+        frames = (max(2, math.ceil((options.duration or LOOP_SECONDS) * options.fps))
+                  if ext == ".gif" else 1)
+    if frames > MAX_FRAMES:
+        raise FishgenError(f"expected at most {MAX_FRAMES} frames, found {frames} "
+                           f"(--duration x --fps); use a shorter --duration or a lower --fps")
     if frames > 1 and ext not in ANIMATED:
         raise FishgenError(f"expected a .gif or .webp output for --frames {frames}, found {out.name!r}")
     if options.view not in VIEWS:
@@ -141,16 +152,22 @@ def subject_points(scene: Scene, times: Sequence[float | None], clip: str | None
 
 
 def _frame_plan(scene: Scene, options: PreviewOptions, frames: int):
-    """(times, azimuths, seconds per frame) for one scene."""
+    """(times, azimuths, seconds per frame) for one scene.
+
+    A loop samples ``duration`` seconds of the clip at ``fps`` (or spreads
+    ``--frames`` over it); a static scene turns once in that time.
+    """
     clip = scene.clip(options.clip)
     start = options.time or 0.0
     if frames == 1:
         return [options.time], [0.0], 0.0
-    if clip is not None and clip.duration > 0:
-        step = clip.duration / frames
-        return [(start + k * step) % clip.duration for k in range(frames)], [0.0] * frames, step
-    return ([options.time] * frames, [2 * math.pi * k / frames for k in range(frames)],
-            TURNTABLE_SECONDS / frames)
+    animated = clip is not None and clip.duration > 0
+    duration = options.duration or (min(clip.duration, LOOP_SECONDS) if animated and clip else LOOP_SECONDS)
+    count = options.frames or max(2, round(duration * options.fps))
+    step = duration / count
+    if animated and clip is not None:
+        return [(start + k * step) % clip.duration for k in range(count)], [0.0] * count, step
+    return [options.time] * count, [2 * math.pi * k / count for k in range(count)], step
 
 
 def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
@@ -164,9 +181,10 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
         if options.clip is not None and scene.clips and scene.clip(options.clip) is None:
             names = ", ".join(a.name for a in scene.clips)
             raise FishgenError(f"expected --clip to name one of {names}, found {options.clip!r}",
-                               scene.info.get("source", scene.name))
+                               str(scene.info.get("source", scene.name)))
     renderer = Renderer(options.width, options.height)
-    bg = tuple(c / 255.0 for c in options.background)
+    r, g, b, a = (c / 255.0 for c in options.background)
+    bg = (r, g, b, a)
     out, seconds = [], []
     try:
         for scene in scenes:
@@ -177,7 +195,7 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
             base = frame(points, options.view, options.width / options.height,
                          azimuths=tuple(sorted(set(azimuths))))
             images = []
-            for t, az in zip(times, azimuths):
+            for t, az in zip(times, azimuths, strict=True):
                 cam = turned(base, options.view, az) if az else base
                 images.append(Image.fromarray(renderer.render(scene, cam, t, bg, options.clip)))
                 if progress:
@@ -208,7 +226,7 @@ def encode(images: list, out: Path, seconds_per_frame: float) -> bytes:
     elif ext == ".png":
         images[0].save(buf, "PNG", optimize=False)
     elif ext == ".webp":
-        kwargs = dict(lossless=False, quality=90, method=4)
+        kwargs: dict[str, object] = dict(lossless=False, quality=90, method=4)
         if len(images) > 1:
             kwargs.update(save_all=True, append_images=images[1:], loop=0,
                           duration=max(20, round(seconds_per_frame * 1000)))
@@ -223,7 +241,8 @@ def encode(images: list, out: Path, seconds_per_frame: float) -> bytes:
 
 
 def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options: PreviewOptions,
-            progress: Callable[[int], None] | None = None, on_loaded: Callable[[int], None] | None = None) -> Path:
+            progress: Callable[[int], None] | None = None,
+            on_loaded: Callable[[int], None] | None = None) -> Path:
     """Render ``inputs`` to ``out`` (still, contact sheet, or loop); written atomically."""
     from fishgen.atomic import write_bytes
     from fishgen.preview.inputs import load_input

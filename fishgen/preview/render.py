@@ -10,6 +10,7 @@ The framebuffer holds premultiplied alpha, so a transparent background works.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -127,14 +128,16 @@ void main() {
 """
 
 
+# moderngl objects are typed ``Any``: its bundled stubs lack ``Context.depth_mask`` and type a
+# program's members as a union, of which only ``Uniform`` has the ``value`` / ``write`` used here.
 @dataclass
 class _GpuMesh:
     node: int
     prim: Primitive
     material: Material
-    vbo: object
-    vao: object
-    texture: object | None
+    vbo: Any          # moderngl.Buffer
+    vao: Any          # moderngl.VertexArray
+    texture: Any      # moderngl.Texture or None
     centroid: np.ndarray
     deforms: bool            # skinned or morphed: positions re-posed on the CPU every frame
 
@@ -146,7 +149,8 @@ class Renderer:
         import moderngl
 
         try:
-            self.ctx = moderngl.create_context(standalone=True, backend="egl")
+            # the stubs type ``**settings`` as dicts; the backend is a string
+            self.ctx: Any = moderngl.create_context(standalone=True, backend="egl")  # type: ignore[arg-type]
         except Exception as err:  # no libEGL / no Mesa driver on this machine
             raise FishgenError(
                 "expected an OpenGL 3.3 context from EGL (Debian: apt-get install libegl1 "
@@ -156,16 +160,17 @@ class Renderer:
         self.msaa = self.ctx.framebuffer(
             color_attachments=[self.ctx.renderbuffer((width, height), 4, samples=samples)],
             depth_attachment=self.ctx.depth_renderbuffer((width, height), samples=samples))
-        self.resolved = self.ctx.framebuffer(color_attachments=[self.ctx.renderbuffer((width, height), 4)])
-        self.mesh_prog = self.ctx.program(vertex_shader=MESH_VS, fragment_shader=MESH_FS)
-        self.point_prog = self.ctx.program(vertex_shader=POINT_VS, fragment_shader=POINT_FS)
+        self.resolved = self.ctx.framebuffer(
+            color_attachments=[self.ctx.renderbuffer((width, height), 4)])
+        self.mesh_prog: Any = self.ctx.program(vertex_shader=MESH_VS, fragment_shader=MESH_FS)
+        self.point_prog: Any = self.ctx.program(vertex_shader=POINT_VS, fragment_shader=POINT_FS)
         corners = np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32)
         self.corner_buf = self.ctx.buffer(corners.tobytes())
         self._uploaded: dict[int, list[_GpuMesh]] = {}
-        self._textures: dict[tuple[int, int], object] = {}
+        self._textures: dict[tuple[int, int], Any] = {}
 
     # -- uploads -------------------------------------------------------------
-    def _texture(self, scene: Scene, index: int):
+    def _texture(self, scene: Scene, index: int) -> Any:
         import moderngl
 
         key = (id(scene), index)
@@ -173,8 +178,10 @@ class Renderer:
             try:
                 img = np.ascontiguousarray(scene.images[index].rgba())
             except Exception as err:  # Pillow raises anything from OSError to SyntaxError
+                source = scene.info.get("source")  # a path string when the scene was read from a file
                 raise FishgenError(f"expected a readable texture image, found {scene.images[index].name!r} "
-                                   f"damaged ({type(err).__name__})", scene.info.get("source")) from None
+                                   f"damaged ({type(err).__name__})",
+                                   source if isinstance(source, str) else None) from None
             tex = self.ctx.texture((img.shape[1], img.shape[0]), 4, img.tobytes())
             tex.build_mipmaps()
             tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
@@ -186,9 +193,10 @@ class Renderer:
         key = id(scene)
         if key in self._uploaded:
             return self._uploaded[key]
-        out = []
+        out: list[_GpuMesh] = []
         for node, prim in scene.drawn():
-            if prim.mode != "TRIANGLES" or prim.indices is None or not prim.vertex_count or not len(prim.indices):
+            if (prim.mode != "TRIANGLES" or prim.indices is None or not prim.vertex_count
+                    or not len(prim.indices)):
                 continue
             material = scene.materials[prim.material] if prim.material is not None else DEFAULT_MATERIAL
             deforms = bool(prim.targets) or (scene.nodes[node].skin is not None
@@ -244,13 +252,14 @@ class Renderer:
         prog["u_fill"].value = tuple(FILL_DIR)
 
         meshes = self._upload(scene)
-        models = {}
+        models: dict[int, np.ndarray] = {}
         for m in meshes:
             if m.deforms:  # morph targets and skins are posed on the CPU, drawn in world space
                 pos, nrm = deformed(scene, m.node, m.prim, posed)
                 if nrm is None:
                     nrm = vertex_normals(pos, np.asarray(m.prim.indices, np.int64))
-                m.vbo.write(self._vertex_data(m.prim, pos.astype(np.float32), nrm.astype(np.float32)).tobytes())
+                data = self._vertex_data(m.prim, pos.astype(np.float32), nrm.astype(np.float32))
+                m.vbo.write(data.tobytes())
                 models[id(m)] = np.eye(4)
             else:
                 models[id(m)] = posed.matrix(m.node)
@@ -298,8 +307,10 @@ class Renderer:
         m.vao.render(moderngl.TRIANGLES)
         self.ctx.disable(moderngl.CULL_FACE)
 
-    def _draw_points(self, scene: Scene, posed: Pose, view, proj) -> None:
-        centers, radii, colors = [], [], []
+    def _draw_points(self, scene: Scene, posed: Pose, view: np.ndarray, proj: np.ndarray) -> None:
+        centers: list[np.ndarray] = []
+        radii: list[np.ndarray] = []
+        colors: list[np.ndarray] = []
         for node, prim in scene.drawn():
             if prim.mode != "POINTS" or not prim.vertex_count:
                 continue
@@ -332,7 +343,8 @@ class Renderer:
         self.ctx.release()
 
 
-def particles(scene: Scene, node: int, prim: Primitive, posed: Pose) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def particles(scene: Scene, node: int, prim: Primitive,
+              posed: Pose) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """World centres, world radii and linear RGBA of a point set: a soft disc per particle.
 
     ``_RADIUS`` sizes each particle (else a small fraction of the set's extent);
@@ -347,7 +359,8 @@ def particles(scene: Scene, node: int, prim: Primitive, posed: Pose) -> tuple[np
         span = np.ptp(prim.positions, axis=0) if prim.vertex_count else np.ones(3)
         radii = np.full(prim.vertex_count, POINT_SIZE_FRACTION * float(np.linalg.norm(span)), np.float32)
     radii = radii * float(np.cbrt(abs(np.linalg.det(m[:3, :3]))))
-    rgba = np.ones((prim.vertex_count, 4), np.float32) if "COLOR_0" not in a else to_linear_float(a["COLOR_0"])
+    rgba = (np.ones((prim.vertex_count, 4), np.float32) if "COLOR_0" not in a
+            else to_linear_float(a["COLOR_0"]))
     material = scene.materials[prim.material] if prim.material is not None else DEFAULT_MATERIAL
     rgba = rgba * np.asarray(material.base_color, np.float32)
     if "_DENSITY" in a:

@@ -149,7 +149,7 @@ def deformed(scene: Scene, node: int, prim: Primitive, posed: Pose) -> tuple[np.
     nrm = None if nrm is None else np.asarray(nrm, np.float64)
     w = posed.weights.get(node)
     if prim.targets and w is not None:
-        for weight, target in zip(w, prim.targets):
+        for weight, target in zip(w, prim.targets, strict=False):  # a file may list more or fewer
             if weight == 0:
                 continue
             if "POSITION" in target:

@@ -100,14 +100,16 @@ def test_total_mismatch_is_a_warning_on_stderr(cli, write_awn, tmp_path):
 
 
 @pytest.mark.parametrize("args,message", [
-    (["--offset", "1,2"], "fishgen: expected --offset X,Y,Z with three finite numbers, found '1,2'"),
+    (["--offset", "1,2"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z with three finite "
+                          "numbers within float32 range, found '1,2'"),
     (["--offset", "0,0,0", "--offset", "1,1,1"], "fishgen: expected one --offset per input (1), found 2"),
-    (["--seed", "-4"], "fishgen: expected a --seed of 0 or more"),
-    (["--offset", "1e300,0,0"], "fishgen: expected --offset X,Y,Z within float32 range "
-                                "(-3.4e+38 to 3.4e+38), found '1e300,0,0'"),
-    (["--offset", "0,-1e39,0"], "fishgen: expected --offset X,Y,Z within float32 range"),
-    (["--offset", "0,0,inf"], "fishgen: expected --offset X,Y,Z with three finite numbers, found '0,0,inf'"),
-    (["--offset", "nan,0,0"], "fishgen: expected --offset X,Y,Z with three finite numbers"),
+    (["--seed", "-4"], "fishgen clouds: Invalid value for '--seed': -4 is not in the range x>=0."),
+    (["--offset", "1e300,0,0"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z with three "
+                                "finite numbers within float32 range, found '1e300,0,0'"),
+    (["--offset", "0,-1e39,0"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z"),
+    (["--offset", "0,0,inf"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z with three "
+                              "finite numbers within float32 range, found '0,0,inf'"),
+    (["--offset", "nan,0,0"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z"),
     (["--billboards"], "out.ply: expected a .glb or .gltf output with --billboards"),
 ])
 def test_bad_options_are_one_line_errors(cli, tmp_path, args, message):
@@ -128,9 +130,9 @@ def test_help_documents_every_option_with_its_default(cli):
     assert result.returncode == 0
     text = " ".join(result.stdout.split())
     for option, default in (("--output", "[required]"), ("--offset", "[default: 0,0,0"),
-                            ("--seed", "[default: 0]"), ("--method", "[default: paper]"),
+                            ("--seed", "[default: 0; x>=0]"), ("--method", "[default: paper]"),
                             ("--billboards", "[default: off"),
-                            ("--max-particles", "[default: 50000000]")):
+                            ("--max-particles", "[default: 50000000; x>=1]")):
         assert option in text and default in text, option
 
 

@@ -100,7 +100,7 @@ def test_help_lists_every_option_with_default():
     (["-o", "x.png", "--background", "mauvish"], "expected --background"),
     (["-o", "x.gif", "--background", "transparent"], "expected an opaque --background"),
     (["-o", "x.png", "--clip", "dance"], "expected --clip to name one of swim"),
-    (["-o", "x.png", "--seed", "-1"], "expected a --seed of 0 or more, found -1"),
+    (["-o", "x.png", "--seed", "-1"], "Invalid value for '--seed': -1 is not in the range x>=0."),
     (["-o", "x.gif", "--size", "8192x8192", "--frames", "1000"], "expected at most 1073741824 pixels"),
     (["-o", "x.webp", "--size", "8192x8192", "--frames", "17"], "expected at most 1073741824 pixels"),
 ])
@@ -126,7 +126,7 @@ def test_missing_and_bad_inputs_name_the_file(tmp_path):
 def test_negative_seed_for_a_cube_file_is_a_one_line_error(tmp_path):
     result = run_cli("preview", PARAMS / "clouds" / "table_4_2.awn", "-o", tmp_path / "s.png", "--seed", "-1")
     assert result.returncode == 2 and "Traceback" not in result.stderr
-    assert result.stderr.strip() == "fishgen: expected a --seed of 0 or more, found -1"
+    assert result.stderr.strip() == "fishgen preview: Invalid value for '--seed': -1 is not in the range x>=0."
     assert list(tmp_path.iterdir()) == []
 
 
