@@ -1,0 +1,71 @@
+"""The format registry: one declaration per format drives writers, readers, CLI choices and errors."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from fishgen.errors import FishgenError
+from fishgen.exchange import export, registry
+from fishgen.exchange.registry import (FORMATS, MESHES, NODE_ANIMATION, POINTS, Format, formats,
+                                       lost, output_format, register_format)
+
+
+def test_every_writer_and_reader_entry_point_resolves():
+    for fmt in FORMATS.values():
+        for target in (fmt.writer, fmt.reader):
+            if target is not None:
+                assert callable(registry._load(target)), target
+
+
+def test_cli_choices_come_from_the_registry():
+    from fishgen.cli.build import FISH_FORMATS
+    from fishgen.clouds.export import FORMATS as CLOUD_FORMATS
+    from fishgen.viewer.page import KINDS
+
+    assert [f.name for f in FISH_FORMATS] == ["glb", "gltf", "obj", "ply"]
+    assert CLOUD_FORMATS == (".glb", ".gltf", ".ply", ".csv", ".npy")
+    assert set(KINDS) == {".glb", ".gltf", ".obj", ".ply"}
+
+
+def test_a_format_that_cannot_hold_what_is_asked_says_what_is_lost_and_what_to_use():
+    with pytest.raises(FishgenError) as info:
+        output_format("school.obj", [MESHES, NODE_ANIMATION])
+    assert str(info.value) == ("school.obj: expected a format that holds node animation, found .obj "
+                               "(Wavefront OBJ with .mtl and images (rest pose)), which would lose them; "
+                               "use .glb or .gltf instead")
+    with pytest.raises(FishgenError, match="an input of `fishgen clouds`"):
+        output_format("sky.awn", [POINTS])
+
+
+def test_summary_names_what_a_rest_pose_format_drops(tmp_path):
+    from fishgen.assembly.fish import build_fish
+    from fishgen.species.parser import load_species
+    from tests.conftest import PARAMS
+
+    fish = build_fish(load_species(PARAMS / "bonybream.txt"))
+    assert lost(FORMATS["obj"], fish) == [NODE_ANIMATION]
+    assert lost(FORMATS["glb"], fish) == []
+
+
+def test_adding_a_format_is_one_module_and_one_entry(tmp_path, monkeypatch):
+    """A toy XYZ point writer: declared once, it is reachable through export() by extension."""
+    monkeypatch.setattr(registry, "FORMATS", dict(FORMATS))
+    register_format(Format("xyz", (".xyz",), "plain x y z text", frozenset({POINTS}),
+                           writer="tests.exchange.test_registry:write_xyz"))
+    from fishgen.clouds import fill_cloud, load_cubes
+    from fishgen.clouds.scene import cloud_scene
+    from tests.conftest import PARAMS
+
+    cloud = fill_cloud(load_cubes(PARAMS / "clouds" / "table_4_2.awn"), seed=1)
+    (written,) = export(cloud_scene(cloud), tmp_path / "c.xyz")
+    assert len(written.read_text().splitlines()) == len(cloud)
+    assert "xyz" in [f.name for f in formats(writable=True, holding=[POINTS])]
+    with pytest.raises(ValueError, match="already registered"):
+        register_format(Format("xyz2", (".xyz",), "again"))
+
+
+def write_xyz(scene, path: Path) -> list[Path]:
+    (prim,) = scene.meshes[0].primitives
+    path.write_text("".join(f"{x} {y} {z}\n" for x, y, z in prim.positions.tolist()))
+    return [path]
