@@ -77,6 +77,7 @@ def clouds(inputs: tuple[str, ...], output: str, offsets: tuple[tuple[float, flo
     if total > max_particles:
         raise FishgenError(f"expected at most {max_particles:,} particles in the scene (raise "
                            f"the limit with --max-particles), found {total:,} in {len(files)} files")
+    check_output(output, billboards, particles=total)  # before filling: a glTF buffer holds 4 GiB
 
     cloud = merge_clouds([fill_cloud(f, seed=seed + i, method=method, offset=place)
                           for i, (f, place) in enumerate(zip(files, places, strict=True))])

@@ -13,13 +13,30 @@ BILLBOARD_FORMATS = (".glb", ".gltf")
 """Billboards need unlit, alpha-blended, vertex-coloured quads: only glTF says all of that."""
 
 
-def check_output(path: str | os.PathLike, billboards: bool = False) -> str:
-    """Return the output's format suffix, or raise FishgenError before any work is done."""
+GLTF_HEADROOM = 1 << 20
+"""Bytes kept for the JSON, the chunk headers and the sprite within glTF's 4 GiB buffer."""
+
+
+def check_output(path: str | os.PathLike, billboards: bool = False, particles: int | None = None) -> str:
+    """Return the output's format suffix, or raise FishgenError before any work is done.
+
+    With ``particles``, a glTF output that could not hold that many (its buffer
+    is at most 4 GiB) is refused before the cloud is filled.
+    """
     output_format(path, [POINTS])
     suffix = Path(path).suffix.lower()
     if billboards and suffix not in BILLBOARD_FORMATS:
         raise FishgenError(f"expected a .glb or .gltf output with --billboards, found {suffix!r}",
                            path)
+    if particles is not None and suffix in BILLBOARD_FORMATS:
+        from fishgen.clouds.scene import BILLBOARD_BYTES, POINT_BYTES
+        from fishgen.exchange.gltf import GLB_LIMIT
+
+        most = (GLB_LIMIT - GLTF_HEADROOM) // (BILLBOARD_BYTES if billboards else POINT_BYTES)
+        if particles > most:
+            raise FishgenError(f"expected at most {most:,} particles for {'--billboards ' * billboards}"
+                               f"glTF (4 GiB buffer limit), found {particles:,}; use .ply, .csv or .npy",
+                               path)
     return suffix
 
 

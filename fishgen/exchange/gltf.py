@@ -83,7 +83,7 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[gl.GLTF2,
 
     for k, image in enumerate(scene.images):
         if image_uri is None:
-            gltf.images.append(gl.Image(bufferView=buf.view(image.data), mimeType=image.mime_type,
+            gltf.images.append(gl.Image(bufferView=buf.view(image.encoded()), mimeType=image.mime_type,
                                         name=image.name))
         else:
             gltf.images.append(gl.Image(uri=image_uri(k), name=image.name))
@@ -175,19 +175,23 @@ def _blob(buf: _Buffer) -> bytes:
     return b"".join(buf.pieces) + b"\0" * (-buf.length % 4)
 
 
-def glb_bytes(scene: Scene, where: Path = Path("<glb>")) -> bytes:
-    """The scene as one binary glTF (.glb) file, in memory."""
+def _glb_pieces(scene: Scene, where: Path) -> list[bytes]:
+    """pygltflib's GLB container (header, JSON chunk, BIN chunk) as the pieces it makes."""
     gltf, buf = build_document(scene, where)
     gltf.set_binary_blob(_blob(buf))
-    return b"".join(gltf.save_to_bytes())
+    buf.pieces.clear()  # the joined blob holds the bytes now
+    return gltf.save_to_bytes()
+
+
+def glb_bytes(scene: Scene, where: Path = Path("<glb>")) -> bytes:
+    """The scene as one binary glTF (.glb) file, in memory."""
+    return b"".join(_glb_pieces(scene, where))
 
 
 def write_glb(scene: Scene, path: Path) -> list[Path]:
-    gltf, buf = build_document(scene, path)
-    gltf.set_binary_blob(_blob(buf))
-    buf.pieces.clear()
-    with atomic_open(path) as handle:  # pygltflib's container, written piece by piece
-        for piece in gltf.save_to_bytes():
+    pieces = _glb_pieces(scene, path)  # before the temp file: a refused scene leaves nothing
+    with atomic_open(path) as handle:  # written piece by piece: no second copy of the buffer
+        for piece in pieces:
             handle.write(piece)
     return [path]
 
@@ -202,6 +206,6 @@ def write_gltf(scene: Scene, path: Path) -> list[Path]:
     files: dict[Path, bytes] = {path: gltf.gltf_to_json(separators=(",", ":"), indent=None).encode("utf-8"),
                                 path.with_name(f"{stem}.bin"): _blob(buf)}
     for name, image in zip(names, scene.images, strict=True):
-        files[path.with_name(name)] = image.data
+        files[path.with_name(name)] = image.encoded()
     write_files(files)
     return list(files)

@@ -52,6 +52,6 @@ def write_obj(scene: Scene, path: Path) -> list[Path]:
         mtl.append("")
     files = {path: ("\n".join(lines) + "\n").encode(), path.with_name(mtl_name): "\n".join(mtl).encode()}
     for k, name in textures.items():
-        files[path.with_name(name)] = scene.images[k].data
+        files[path.with_name(name)] = scene.images[k].encoded()
     write_files(files)
     return list(files)

@@ -67,7 +67,7 @@ def _write_mesh(scene: Scene, path: Path) -> list[Path]:
     header += [f"element face {len(faces)}", "property list uchar int vertex_indices", "end_header", ""]
     files = {path: "\n".join(header).encode("ascii") + vertices.tobytes() + faces.tobytes()}
     if texture and image is not None:
-        files[path.with_name(texture)] = image.data
+        files[path.with_name(texture)] = image.encoded()
     write_files(files)
     return list(files)
 

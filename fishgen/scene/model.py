@@ -33,6 +33,19 @@ class Image:
     mime_type: str = "image/png"
     pixels: np.ndarray | None = None    # (H, W, 4) uint8 RGBA, sRGB-encoded
 
+    def encoded(self) -> bytes:
+        """The picture as file bytes: ``data``, or ``pixels`` encoded as PNG when a reader kept only those."""
+        if self.data or self.pixels is None:
+            return self.data
+        import io
+
+        from PIL import Image as PILImage
+
+        out = io.BytesIO()
+        PILImage.fromarray(self.pixels, "RGBA").save(out, format="PNG")
+        self.data, self.mime_type = out.getvalue(), "image/png"
+        return self.data
+
     def rgba(self) -> np.ndarray:
         """The picture as (H, W, 4) uint8 RGBA, decoded once."""
         if self.pixels is None:

@@ -155,3 +155,15 @@ def test_offset_pushing_a_cube_past_float32_is_refused_at_its_line(cli, tmp_path
     assert_one_line_error(result, f"{TABLES['4.2']}:3: expected a cube at least one float32 "
                                   "step wide on each axis")
     assert list(tmp_path.iterdir()) == [path]
+
+
+@pytest.mark.parametrize("billboards,count", [(True, 35_791_379), (False, 140_000_000)])
+def test_glb_too_large_for_4_gib_is_refused_before_filling(cli, tmp_path, billboards, count):
+    # 35,791,379 billboards is under the default cap but 120 bytes each overflow a GLB's 4 GiB.
+    cubes = tmp_path / "big.awn"
+    cubes.write_text(f"{count}\n1\n{count}, 10 10 10, 0 0 0, 1\n")
+    args = ["clouds", cubes, "-o", tmp_path / "big.glb", "--max-particles", str(200_000_000)]
+    result = cli(*args, *(["--billboards"] if billboards else []))
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "4 GiB buffer limit" in result.stderr and f"found {count:,}" in result.stderr
+    assert list(tmp_path.iterdir()) == [cubes]

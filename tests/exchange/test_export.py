@@ -127,3 +127,17 @@ def test_unknown_extension(assets, tmp_path):
     with pytest.raises(FishgenError, match="holds node animation, found .obj .* use .glb or .gltf instead"):
         export(assets["bonybream"], tmp_path / "fish.obj", require=["node animation"])
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_read_obj_exports_to_glb_with_its_texture(assets, tmp_path):
+    """The OBJ reader keeps decoded pixels only; writers encode them rather than write an empty image."""
+    from fishgen.preview.inputs import load_input
+
+    export(assets["bonybream"], tmp_path / "b.obj")
+    scene = load_input(tmp_path / "b.obj")
+    assert scene.images and all(image.data == b"" for image in scene.images)
+    export(scene, tmp_path / "again.glb")
+    assert_valid_gltf(tmp_path / "again.glb")
+    doc = pygltflib.GLTF2().load(str(tmp_path / "again.glb"))
+    view = doc.bufferViews[doc.images[0].bufferView]
+    assert doc.images[0].mimeType == "image/png" and view.byteLength > 1000
