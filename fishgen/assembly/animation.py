@@ -23,9 +23,13 @@ class FinMotion:
 
     @classmethod
     def from_fin(cls, movement_angle: float, step_size: float, sign: float = 1.0) -> FinMotion | None:
+        """The fin's motion, None for a still fin; a cycle over MAX_CLIP_FRAMES raises ValueError."""
         if movement_angle <= 0 or step_size <= 0:
             return None
-        return cls(movement_angle, max(4, round(4 * movement_angle / step_size)), sign)
+        frames = 4 * movement_angle / step_size   # inf for a subnormal step: checked before round()
+        if not frames <= MAX_CLIP_FRAMES:
+            raise ValueError(f"a cycle of {frames:.4g} frames")
+        return cls(movement_angle, max(4, round(frames)), sign)
 
     def keys(self, clip_frames: int) -> tuple[np.ndarray, np.ndarray]:
         """(frames, angles in degrees) at every turning point over the clip."""

@@ -45,10 +45,10 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
     if mode == "mask" and not species.textured:
         raise FishgenError("expected a textured species for --fins mask (the mask is a texture), "
                            "found textured false", species.source, species.line_of("shape"))
-    if not fps > 0 or fps > 1000:
-        raise FishgenError(f"expected --fps in (0, 1000], found {fps}")
-    if length is not None and not (0 < length < 1e4):
-        raise FishgenError(f"expected --length in metres (0 < L < 10000), found {length}")
+    if not 1 <= fps <= 1000:
+        raise FishgenError(f"expected --fps from 1 to 1000, found {fps}")
+    if length is not None and not 0.001 <= length <= 1e4:
+        raise FishgenError(f"expected --length in metres from 0.001 to 10000, found {length}")
 
     tp = species.texture_points
     body_uv = None
@@ -89,8 +89,14 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
     add_part("body", place(body.mesh.positions), body.mesh.faces, body.mesh.uvs, body_material, np.zeros(3))
     motions: list[tuple[int, str, FinMotion]] = []
     for fin in fin_list:
-        motion = FinMotion.from_fin(fin.movement_angle, fin.step_size,
-                                    -1.0 if fin.mirror_of else 1.0) if fin.pivot is not None else None
+        try:
+            motion = FinMotion.from_fin(fin.movement_angle, fin.step_size,
+                                        -1.0 if fin.mirror_of else 1.0) if fin.pivot is not None else None
+        except ValueError as err:  # a subnormal step size would loop for days
+            raise FishgenError(f"expected a fin cycle (4 x movement angle / step size) of at most "
+                               f"{MAX_CLIP_FRAMES} frames, found {err} (movement angle "
+                               f"{fin.movement_angle:g}, step size {fin.step_size:g})", species.source,
+                               species.line_of(fin.name.split("_")[0])) from None
         pivot = place(fin.pivot[None, :])[0] if motion is not None and fin.pivot is not None else np.zeros(3)
         node = add_part(fin.name, place(fin.mesh.positions) - pivot, fin.mesh.faces, fin.mesh.uvs,
                         fin_material, pivot)

@@ -175,12 +175,21 @@ def _blob(buf: _Buffer) -> bytes:
     return b"".join(buf.pieces) + b"\0" * (-buf.length % 4)
 
 
+def _finite_json(make, where: Path):
+    """pygltflib's JSON refuses NaN and infinity (``allow_nan=False``): say so in our words."""
+    try:
+        return make()
+    except ValueError as err:
+        raise FishgenError(f"expected finite numbers in the glTF document, found one that is not ({err})",
+                           where) from None
+
+
 def _glb_pieces(scene: Scene, where: Path) -> list[bytes]:
     """pygltflib's GLB container (header, JSON chunk, BIN chunk) as the pieces it makes."""
     gltf, buf = build_document(scene, where)
     gltf.set_binary_blob(_blob(buf))
     buf.pieces.clear()  # the joined blob holds the bytes now
-    return gltf.save_to_bytes()
+    return _finite_json(gltf.save_to_bytes, where)
 
 
 def glb_bytes(scene: Scene, where: Path = Path("<glb>")) -> bytes:
@@ -203,7 +212,8 @@ def write_gltf(scene: Scene, path: Path) -> list[Path]:
              for image in scene.images]
     gltf, buf = build_document(scene, path, image_uri=lambda k: quote(names[k]))
     gltf.buffers[0].uri = quote(f"{stem}.bin")
-    files: dict[Path, bytes] = {path: gltf.gltf_to_json(separators=(",", ":"), indent=None).encode("utf-8"),
+    text = _finite_json(lambda: gltf.gltf_to_json(separators=(",", ":"), indent=None), path)
+    files: dict[Path, bytes] = {path: text.encode("utf-8"),
                                 path.with_name(f"{stem}.bin"): _blob(buf)}
     for name, image in zip(names, scene.images, strict=True):
         files[path.with_name(name)] = image.encoded()

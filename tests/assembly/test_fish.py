@@ -155,4 +155,4 @@ def test_loop_length_error_points_at_the_fin_record():
     with pytest.raises(FishgenError) as info:
         build_fish(sp)
     caudal_line = next(i for i, l in enumerate(text.splitlines(), 1) if l.endswith("3.0 10.0 0.0001"))
-    assert info.value.line == caudal_line and "loop within 100000 frames" in str(info.value)
+    assert info.value.line == caudal_line and "fin cycle (4 x movement angle / step size) of at most 100000" in str(info.value)
