@@ -8,6 +8,7 @@ fails part-way, the targets already replaced get their old contents back.
 from __future__ import annotations
 
 import os
+import stat
 import tempfile
 from collections.abc import Mapping
 from pathlib import Path
@@ -29,8 +30,17 @@ def _fail(target: Path, err: OSError) -> FishgenError:
 
 
 def _check_target(target: Path) -> None:
+    """Only a missing file or a regular file may be replaced: renaming over a FIFO or a device
+    node (``-o /dev/null`` run as root) would replace the special file itself."""
     if target.is_dir():
         raise FishgenError(f"expected an output file, found a folder at {target}")
+    try:
+        mode = target.stat().st_mode
+    except OSError:
+        return  # nothing there (or a dangling link): the rename creates the file
+    if not stat.S_ISREG(mode):
+        raise FishgenError("expected a regular file or no file as the output, found a device, pipe or "
+                           "other special file", target)
 
 
 def _stage(path: Path, data: bytes) -> str:
