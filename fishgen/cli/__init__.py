@@ -52,12 +52,26 @@ def cli() -> None:
     """
 
 
+class Interrupted(BaseException):
+    """Ctrl-C or SIGTERM. Not a KeyboardInterrupt: click turns that into Abort after printing a
+    blank line of its own, and the message would be two lines. Atomic writers still unwind."""
+
+    def __init__(self, status: int):
+        super().__init__(status)
+        self.status = status
+
+
+def _interrupt(signum: int, _frame: object) -> None:
+    raise Interrupted(128 + signum)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry: bad input becomes a one-line error, never a traceback."""
     from fishgen.errors import FishgenError
 
-    # SIGTERM unwinds like Ctrl-C so atomic writers can remove their temp files.
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    signal.signal(signal.SIGTERM, _interrupt)
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not when a parent ignores it
+        signal.signal(signal.SIGINT, _interrupt)
     try:
         cli.main(args=argv, prog_name="fishgen", standalone_mode=False)
     except FishgenError as err:
@@ -73,9 +87,9 @@ def main(argv: list[str] | None = None) -> None:
     except click.ClickException as err:
         err.show()
         sys.exit(err.exit_code)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, Interrupted) as err:
         click.echo("fishgen: interrupted", err=True)
-        sys.exit(130)
+        sys.exit(err.status if isinstance(err, Interrupted) else 130)
     except OSError as err:
         click.echo(f"fishgen: {err.filename or ''}: {err.strerror or err}", err=True)
         sys.exit(1)

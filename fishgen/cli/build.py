@@ -6,6 +6,7 @@ from pathlib import Path
 import click
 
 from fishgen.assembly.fin_modes import FIN_MODES
+from fishgen.cli.params import FiniteRange
 from fishgen.exchange.registry import MESHES, extensions, formats
 
 FISH_FORMATS = formats(writable=True, holding=[MESHES])
@@ -23,10 +24,10 @@ FISH_FORMATS = formats(writable=True, holding=[MESHES])
 @click.option("--fins", type=click.Choice(FIN_MODES), default=None,
               help="Fin technique (thesis ch. 5): translucent, mask cut-out or opaque. "
                    "[default: mask if the file says masked, else blend]")
-@click.option("--length", type=click.FloatRange(0, 1e4, min_open=True, max_open=True), default=None,
+@click.option("--length", type=FiniteRange(0.001, 1e4), default=None,
               metavar="METRES",
               help="Nose-to-tail length in metres. [default: world scale x scaleX x 0.05 m for the body]")
-@click.option("--fps", type=click.FloatRange(0, 1000, min_open=True), default=30.0,
+@click.option("--fps", type=FiniteRange(1, 1000), default=30.0,
               help="Frames per second; fins move step size degrees per frame.")
 @click.option("--textures", "textures_dir", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder texture names resolve in (and may not leave). "

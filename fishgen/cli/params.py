@@ -27,6 +27,16 @@ class Triple(click.ParamType):
         return numbers
 
 
+class FiniteRange(click.FloatRange):
+    """click's FloatRange, refusing NaN too (it compares false with both bounds, so it passes them)."""
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number.", param, ctx)
+        return number
+
+
 def check_inputs(paths, command: str, kinds, default=None) -> None:
     """Every input exists as a file of a kind ``command`` reads; else the one-line ``FILE: expected ...``.
 

@@ -5,6 +5,8 @@ import sys
 
 import click
 
+from fishgen.cli.params import FiniteRange
+
 VIEW_NAMES = ("side", "top", "front", "three-quarter")
 
 
@@ -17,7 +19,7 @@ VIEW_NAMES = ("side", "top", "front", "three-quarter")
 @click.option("--size", default="800x600", show_default=True, metavar="WxH",
               help="Pixel size of one render (each tile of a contact sheet), 16 to 8192 a side. "
                    "A contact sheet may hold at most 2^28 pixels, all frames and sheets together 2^30.")
-@click.option("--time", "time_", type=click.FloatRange(0, 1e6, max_open=True), default=None,
+@click.option("--time", "time_", type=FiniteRange(0, 1e6, max_open=True), default=None,
               metavar="SECONDS",
               help="Pose the animation at this time  [default: rest pose; a loop's start]")
 @click.option("--clip", default=None, metavar="NAME",
@@ -27,9 +29,9 @@ VIEW_NAMES = ("side", "top", "front", "three-quarter")
 @click.option("--frames", type=click.IntRange(1, 1000), default=None, metavar="N",
               help="Frames of an animated .gif/.webp, spread over --duration; frames x inputs x W x H "
                    "at most 2^30 pixels  [default: duration x fps for .gif, 1 otherwise]")
-@click.option("--fps", "loop_fps", type=click.FloatRange(1, 60), default=12.0, show_default=True,
+@click.option("--fps", "loop_fps", type=FiniteRange(1, 60), default=12.0, show_default=True,
               help="Frames per second of an animated .gif/.webp.")
-@click.option("--duration", type=click.FloatRange(0, 600, min_open=True), default=None, metavar="SECONDS",
+@click.option("--duration", type=FiniteRange(0, 600, min_open=True), default=None, metavar="SECONDS",
               help="Seconds of the clip a loop shows (a turntable turns once in them)  "
                    "[default: the clip, or its first 4 s if longer; 4 s for a turntable]")
 @click.option("--columns", type=click.IntRange(min=1), default=None, metavar="N",
@@ -74,7 +76,7 @@ def preview(inputs, output, view, size, time_, clip, background, frames, loop_fp
 
     try:
         out = run(inputs, output, options, progress=lambda n: bar.update(n) if bar else None,
-                  on_loaded=start)
+                  on_loaded=start, on_note=lambda text: click.echo(text, err=True))
     finally:
         if bar is not None:
             bar.__exit__(None, None, None)
