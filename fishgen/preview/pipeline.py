@@ -242,7 +242,8 @@ def encode(images: list, out: Path, seconds_per_frame: float) -> bytes:
 
 def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options: PreviewOptions,
             progress: Callable[[int], None] | None = None,
-            on_loaded: Callable[[int], None] | None = None) -> Path:
+            on_loaded: Callable[[int], None] | None = None,
+            on_note: Callable[[str], None] | None = None) -> Path:
     """Render ``inputs`` to ``out`` (still, contact sheet, or loop); written atomically."""
     from fishgen.atomic import write_bytes
     from fishgen.preview.inputs import load_input
@@ -252,6 +253,9 @@ def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options
         raise FishgenError("expected at least one input, found none")
     frames = check_output(out, options, len(inputs))
     scenes = [load_input(p, textures_dir=options.textures_dir, seed=options.seed) for p in inputs]
+    for scene in scenes:  # e.g. a cloud previewed with fewer particles than it holds
+        if on_note and "note" in scene.info:
+            on_note(str(scene.info["note"]))
     if on_loaded:
         on_loaded(len(scenes) * frames)
     per_scene, step = render_frames(scenes, options, frames, progress)
