@@ -37,6 +37,8 @@ MAX_MAGNITUDE = 1e6
 MAX_WORLD_SCALE = 1e4
 MAX_SCALE = 100.0
 MAX_FIN_LENGTH = 100.0
+MAX_LINE_CHARS = 65536
+"""Longest record line: a spline of 2,048 control points fits; a 60 MB line is refused unsplit."""
 
 
 class _Line(NamedTuple):
@@ -55,6 +57,7 @@ class _Reader:
         self.file = file
         # Only \n, \r\n and \r end a line: str.splitlines() would also split on form
         # feeds and U+2028 inside comments, and the line numbers would drift.
+        text = text.removeprefix("\ufeff")  # a byte-order mark, as Windows editors write it
         raw_lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
         self.lines = [_Line(n, raw.strip()) for n, raw in enumerate(raw_lines, 1)
                       if raw.strip() and not raw.lstrip().startswith("//")]
@@ -75,6 +78,9 @@ class _Reader:
         if line is None:
             raise self.error(None, what, "end of file (the file is truncated)")
         self.pos += 1
+        if len(line.text) > MAX_LINE_CHARS:  # before splitting it into millions of tokens
+            raise self.error(line, f"{what} on a line of at most {MAX_LINE_CHARS} characters",
+                             f"{len(line.text):,} characters")
         n = len(line.tokens)
         if (count is not None and n != count) or (at_least is not None and n < at_least):
             wanted = f"{count}" if count is not None else f"at least {at_least}"
@@ -402,10 +408,15 @@ def _check_motion(reader: _Reader, line: _Line, f: _Fields, angle: int, step: in
 def texture_roots(species_path: Path, textures_dir: str | os.PathLike | None) -> list[Path]:
     """Folders a species file may read textures from: ``--textures DIR``, or else the
     species file's folder and the ``textures/`` folder beside it."""
-    if textures_dir is not None:
+    if textures_dir is not None:  # named by the user: followed wherever it points
         return [Path(textures_dir).resolve()]
     here = species_path.resolve().parent
-    return [here, (here.parent / "textures").resolve()]
+    textures = here.parent / "textures"
+    # The same rule as an asset's side files: a link may not lead out of the folders fishgen was
+    # given. The implicit textures/ folder is used only if it really lies beside the species folder.
+    if textures.resolve().is_relative_to(here.parent):
+        return [here, textures.resolve()]
+    return [here]
 
 
 def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> Path:
