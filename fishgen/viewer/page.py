@@ -14,7 +14,7 @@ from pathlib import Path
 from urllib.parse import unquote
 
 from fishgen.errors import FishgenError
-from fishgen.exchange.registry import formats
+from fishgen.exchange.registry import FORMATS, formats
 from fishgen.exchange.sidefiles import side_file
 
 HERE = Path(__file__).resolve().parent
@@ -64,13 +64,14 @@ def sidecars(asset: Path) -> tuple[dict[str, Path], str | None]:
                     add(item["uri"], uri=True)
     elif ext == ".obj":
         text = asset.read_text(encoding="utf-8", errors="replace")
-        for lib in re.findall(r"^\s*mtllib\s+(.+?)\s*$", text, re.M):
-            mtl = add(lib)
-            if mtl is None:
-                continue
-            mtl_name = mtl_name or lib.strip()
-            for ref in _MTL_MAPS.findall(mtl.read_text(encoding="utf-8", errors="replace")):
-                add(ref.split()[-1])  # options such as "-imfchan m" come before the file name
+        for line in re.findall(r"^\s*mtllib\s+(.+?)\s*$", text, re.M):
+            for lib in line.split():  # one mtllib statement may name several files
+                mtl = add(lib)
+                if mtl is None:
+                    continue
+                mtl_name = mtl_name or lib
+                for ref in _MTL_MAPS.findall(mtl.read_text(encoding="utf-8", errors="replace")):
+                    add(ref.split()[-1])  # options such as "-imfchan m" come before the file name
     return found, mtl_name
 
 
@@ -80,8 +81,15 @@ def build_page(asset: str | Path, background: str = "#8cadcc") -> str:
     kind = KINDS.get(asset.suffix.lower())
     if kind is None:
         raise FishgenError(f"expected an asset ending in {', '.join(KINDS)}, found {asset.name!r}")
+    if asset.is_dir():
+        raise FishgenError("expected a file, found a directory", asset)
     if not asset.is_file():
         raise FishgenError("expected an existing file, found none", asset)
+    if asset.stat().st_size > MAX_EMBED_BYTES:  # before reading a byte of it
+        raise FishgenError(f"expected at most {MAX_EMBED_BYTES >> 20} MiB to embed in a page, "
+                           f"found {asset.stat().st_size / 2**20:.0f} MiB", asset)
+    # Parse it as `fishgen preview` does: a truncated or garbage asset is refused, not embedded.
+    FORMATS[kind].read(asset)
     extra, mtl = sidecars(asset)
     files = {asset.name: asset, **extra}
     total = sum(p.stat().st_size for p in files.values())
