@@ -24,6 +24,7 @@ fi
 
 python -m pip install -q --disable-pip-version-check -e ".[test]"
 npm ci --no-audit --no-fund --loglevel=error
+bash tools/core_smoke.sh
 python -m ruff check fishgen
 python -m mypy
 python -m pytest "$@"

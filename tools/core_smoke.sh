@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# The core install alone (no test extra) runs every command on every shipped kind of input without a
+# traceback: catches a runtime dependency that only the test extra happened to bring in.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+python -m venv "$work/venv"
+"$work/venv/bin/python" -m pip install -q --disable-pip-version-check "$root"
+fishgen="$work/venv/bin/fishgen"
+cd "$work"
+run() {  # run a command; fail on a non-zero exit or any traceback on stderr
+  if ! "$@" >out.txt 2>err.txt || grep -q Traceback err.txt; then
+    echo "core install: '$*' failed:" >&2; cat err.txt >&2; exit 1
+  fi
+}
+run "$fishgen" build "$root/params/bonybream.txt" -o fish.obj
+run "$fishgen" build "$root/params/bonybream.txt" -o fish.ply
+run "$fishgen" build "$root/params/bonybream.txt" -o fish.glb
+run "$fishgen" clouds "$root/params/clouds/table_4_3.awn" -o cloud.ply
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n# caf\xe9\nf 1 2 3\n' > latin1.obj   # one Latin-1 byte, no normals
+for input in fish.obj fish.ply fish.glb cloud.ply latin1.obj "$root/params/bonybream.txt"; do
+  run "$fishgen" preview "$input" -o preview.png --size 64x48
+done
+run "$fishgen" view fish.glb --no-serve -o page.html
+echo "core install: every command ran without a traceback"
