@@ -5,9 +5,16 @@ OBJ transparency comes from the MTL itself (``d`` below 1: blended; ``map_d``:
 a cut-out mask), since trimesh's materials drop those statements. A PLY of
 bare vertices is a particle cloud: a ``radius`` property gives each particle's
 size, ``density`` its opacity, ``red green blue`` its sRGB colour.
+
+Before trimesh reads anything, sizes are checked by stat against the caps
+below (the asset and each side file), a PLY header's element counts against
+the bytes really there, and an OBJ's vertex statements for three coordinates.
+Every fault is one ``FishgenError`` reading ``expected ..., found ...``.
 """
 from __future__ import annotations
 
+import io
+import math
 import re
 from pathlib import Path
 
@@ -15,10 +22,23 @@ import numpy as np
 from trimesh.resolvers import Resolver
 
 from fishgen.errors import FishgenError, describe, expected
-from fishgen.exchange.gltf_reader import one_line
+from fishgen.exchange.gltf_reader import _check_picture, one_line, size_text
 from fishgen.exchange.sidefiles import side_file
 from fishgen.numeric import srgb_to_linear
 from fishgen.scene.model import Image, Material, Mesh, Node, Primitive, Scene
+
+MAX_TEXT_BYTES = 256 * 2**20
+"""Largest OBJ or ASCII PLY file (trimesh's text parse takes a few times the file in memory)."""
+MAX_BINARY_BYTES = 512 * 2**20
+"""Largest binary PLY file."""
+MAX_SIDE_BYTES = 64 * 2**20
+"""Largest MTL or texture file beside an OBJ or PLY."""
+MAX_PLY_HEADER = 2**20
+"""Longest PLY header: its ``end_header`` must come within this many bytes."""
+
+_PLY_SIZES = {"char": 1, "uchar": 1, "int8": 1, "uint8": 1, "short": 2, "ushort": 2, "int16": 2,
+              "uint16": 2, "int": 4, "uint": 4, "int32": 4, "uint32": 4, "float": 4, "float32": 4,
+              "double": 8, "float64": 8}
 
 
 def read_mesh_file(path: str | Path, **_) -> Scene:
@@ -28,26 +48,55 @@ def read_mesh_file(path: str | Path, **_) -> Scene:
     vertices or a broken MTL statement is bad input like any other.
     """
     path = Path(path)
+    kind = path.suffix[1:].upper()
     try:
         return _read(path)
     except FishgenError:
         raise
+    except MemoryError:
+        raise FishgenError(f"expected a {kind} file that fits in memory, found it does not", path) from None
     except Exception as err:  # trimesh and numpy raise anything from KeyError to IndexError
-        raise FishgenError(f"not a readable {path.suffix[1:].upper()} file "
-                           f"({type(err).__name__}: {one_line(err)})", path) from None
+        raise FishgenError(f"expected a well-formed {kind} file, found {type(err).__name__}: "
+                           f"{one_line(err)}", path) from None
+
+
+def _stat(path: Path, cap: int, what: str, where: Path) -> int:
+    size = path.stat().st_size
+    if size > cap:
+        raise expected(f"{what} of at most {size_text(cap)}", f"{path.name!r} of {size_text(size)}", where)
+    return size
+
+
+def _decode(data: bytes) -> str:
+    """Text of an OBJ or MTL: UTF-8 (a BOM dropped), else Latin-1, which reads any byte."""
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
 
 
 def _read(path: Path) -> Scene:
     import trimesh
 
     obj = path.suffix.lower() == ".obj"
-    alpha = _mtl_alpha(path) if obj else {}  # also refuses side files outside the asset's folder
-    loaded = trimesh.load(str(path), process=False, resolver=_FolderResolver(path))
+    resolver = _FolderResolver(path)
+    if obj:
+        _stat(path, MAX_TEXT_BYTES, "an OBJ file", path)
+        text = _decode(path.read_bytes())
+        _check_obj_vertices(text, path)
+        alpha = _mtl_alpha(path, text)  # also refuses side files outside the asset's folder
+        source = io.BytesIO(text.encode("utf-8"))  # trimesh gets UTF-8 whatever the file's encoding
+        loaded = trimesh.load(file_obj=source, file_type="obj", process=False, resolver=resolver,
+                              metadata={"file_name": path.name})
+    else:
+        alpha = {}
+        _check_ply_header(path)
+        loaded = trimesh.load(str(path), process=False, resolver=resolver)
     geoms = loaded.dump(concatenate=False) if isinstance(loaded, trimesh.Scene) else [loaded]
     scene = Scene(name=path.stem, info={"source": str(path)})
     for k, geom in enumerate(geoms):
         if isinstance(geom, trimesh.PointCloud):
-            prim = _points(geom)
+            prim = _points(geom, path)
         elif isinstance(geom, trimesh.Trimesh) and len(geom.faces):
             prim = _mesh(geom, alpha, path, scene)
         else:
@@ -67,12 +116,26 @@ class _FolderResolver(Resolver):
 
     def get(self, name: str) -> bytes:
         words = name.split()
+        target = side_file(self.asset, name)
+        if target.is_file():
+            return self._read(target)
+        if len(words) > 1 and all(w.lower().endswith(".mtl") for w in words):
+            # "mtllib a.mtl b.mtl" names several libraries: trimesh gets them as one
+            found = [side_file(self.asset, w) for w in words]
+            return b"\n".join(self._read(t) for t in found if t.is_file())
         # MTL map statements may reach us with options first ("-imfchan m skin.png").
-        for candidate in dict.fromkeys([name, words[-1] if words else name]):
-            target = side_file(self.asset, candidate)
+        if words:
+            target = side_file(self.asset, words[-1])
             if target.is_file():
-                return target.read_bytes()
+                return self._read(target)
         raise FileNotFoundError(name)
+
+    def _read(self, target: Path) -> bytes:
+        _stat(target, MAX_SIDE_BYTES, "a side file", self.asset)
+        data = target.read_bytes()
+        if target.suffix.lower() == ".mtl":
+            data = _decode(data).encode("utf-8")
+        return data
 
     def keys(self):
         return iter(())
@@ -84,26 +147,58 @@ class _FolderResolver(Resolver):
         return self
 
 
-def _mtl_alpha(obj: Path) -> dict[str, tuple[str, float]]:
+def _check_obj_vertices(text: str, path: Path) -> None:
+    """Every ``v`` statement has 3 finite coordinates (then optionally w, or r g b)."""
+    for m in re.finditer(r"^[ \t]*v[ \t]+([^\n]*)", text, re.M):
+        words = m.group(1).split("#", 1)[0].split()
+        ok = 3 <= len(words) <= 7
+        if ok:
+            try:
+                ok = all(math.isfinite(float(w)) for w in words)
+            except ValueError:
+                ok = False
+        if not ok:
+            line = text.count("\n", 0, m.start()) + 1
+            raise expected("a vertex of 3 finite coordinates (v x y z)",
+                           describe(m.group(0).strip()), path, line)
+
+
+def _mtl_libraries(obj: Path, text: str) -> list[Path]:
+    """The MTL files an OBJ's ``mtllib`` statements name (several may share one statement)."""
+    out = []
+    for lib in re.findall(r"^[ \t]*mtllib[ \t]+(.+?)[ \t]*\r?$", text, re.M):
+        whole = side_file(obj, lib)
+        names = [lib] if whole.is_file() else lib.split()
+        for name in names:
+            mtl = side_file(obj, name)
+            if mtl.is_file():
+                out.append(mtl)
+    return out
+
+
+def _mtl_alpha(obj: Path, text: str) -> dict[str, tuple[str, float]]:
     """material name -> (alpha mode, opacity) from the OBJ's MTL libraries.
 
-    Every MTL and texture reference is checked to stay in the OBJ's folder; a
-    missing MTL only loses its materials, as in an engine.
+    Every MTL and texture reference is checked to stay in the OBJ's folder, and
+    their sizes against the caps; a missing MTL only loses its materials, as in
+    an engine.
     """
     out: dict[str, tuple[str, float]] = {}
-    libs = re.findall(r"^\s*mtllib\s+(.+?)\s*$", obj.read_text(errors="replace"), re.M)
-    for lib in libs:
-        mtl = side_file(obj, lib)
-        if not mtl.is_file():
-            continue
+    for mtl in _mtl_libraries(obj, text):
+        _stat(mtl, MAX_SIDE_BYTES, "an MTL file", obj)
         name = None
-        for number, line in enumerate(mtl.read_text(errors="replace").splitlines(), 1):
+        for number, line in enumerate(_decode(mtl.read_bytes()).splitlines(), 1):
             words = line.split()
             if not words:
                 continue
             key = words[0].lower()
             if key in _MAP_KEYS and len(words) > 1:
-                side_file(obj, words[-1])  # options such as "-imfchan m" come before the file name
+                # options such as "-imfchan m" come before the file name
+                image = side_file(obj, words[-1])
+                if image.is_file():
+                    _stat(image, MAX_SIDE_BYTES, "a texture file", obj)
+                    if key == "map_kd":  # the one texture decoded: refuse a huge or damaged one now
+                        _check_texture(image, mtl, number)
             if key == "newmtl":
                 name = " ".join(words[1:])
                 out[name] = ("OPAQUE", 1.0)
@@ -125,8 +220,77 @@ _MAP_KEYS = {"map_ka", "map_kd", "map_ks", "map_ke", "map_ns", "map_d", "map_bum
              "decal", "refl", "norm", "map_pr", "map_pm", "map_ps"}
 
 
+def _check_texture(image: Path, where: Path, line: int | None = None) -> None:
+    try:
+        _check_picture(image.read_bytes(), repr(image.name))
+    except FishgenError as err:
+        raise FishgenError(err.message, where, line) from None
+
+
+def _check_ply_header(path: Path) -> None:
+    """Element counts x property sizes must fit in the file, checked before trimesh allocates."""
+    with path.open("rb") as f:
+        head = f.read(MAX_PLY_HEADER)
+    end = re.search(rb"(^|\n)end_header[ \t]*\r?\n", head)
+    if not head.startswith(b"ply") or end is None:
+        found = "no 'ply' first" if not head.startswith(b"ply") else \
+            f"no end_header in its first {size_text(MAX_PLY_HEADER)}"
+        raise expected("a PLY header (ply ... end_header)", found, path)
+    size = _stat(path, MAX_BINARY_BYTES, "a PLY file", path)
+    body = size - end.end()
+    fmt = None
+    elements: list[tuple[str, int, list[tuple[str, int]]]] = []  # name, count, (property, bytes)
+    lines = head[: end.end()].decode("latin-1").splitlines()
+    for number, line in enumerate(lines, 1):
+        words = line.split()
+        if not words or words[0] in ("ply", "comment", "obj_info", "end_header"):
+            continue
+        if words[0] == "format":
+            if len(words) < 2 or words[1] not in ("ascii", "binary_little_endian", "binary_big_endian"):
+                raise expected("format ascii, binary_little_endian or binary_big_endian",
+                               describe(line), path, number)
+            fmt = words[1]
+        elif words[0] == "element":
+            if len(words) != 3 or not words[2].isdigit():
+                raise expected("element NAME COUNT", describe(line), path, number)
+            elements.append((words[1], int(words[2]), []))
+        elif words[0] == "property":
+            if not elements:
+                raise expected("an element before its properties", describe(line), path, number)
+            if len(words) == 5 and words[1] == "list" and words[2] in _PLY_SIZES and words[3] in _PLY_SIZES:
+                elements[-1][2].append((words[4], _PLY_SIZES[words[2]]))  # at least the item count
+            elif len(words) == 3 and words[1] in _PLY_SIZES:
+                elements[-1][2].append((words[2], _PLY_SIZES[words[1]]))
+            else:
+                raise expected("property TYPE NAME or property list TYPE TYPE NAME", describe(line),
+                               path, number)
+        else:
+            raise expected("a PLY header statement", describe(line), path, number)
+    if fmt is None:
+        raise expected("a format line in the PLY header", "none", path)
+    if fmt == "ascii":
+        _stat(path, MAX_TEXT_BYTES, "an ASCII PLY file", path)
+    need = 0
+    for name, count, props in elements:
+        # ASCII: each value takes at least a digit and a separator
+        need += count * (2 * len(props) if fmt == "ascii" else sum(b for _, b in props))
+        if name == "vertex" and count and not {"x", "y", "z"} <= {p for p, _ in props}:
+            raise expected("vertex properties x, y and z", ", ".join(p for p, _ in props) or "none", path)
+    if need > body:
+        counts = ", ".join(f"{count:,} {name}" for name, count, _ in elements)
+        raise expected(f"at least {need:,} bytes of {fmt} data for {counts}",
+                       f"{body:,} bytes after the header", path)
+
+
+def _finite(positions: np.ndarray, path: Path) -> None:
+    if len(positions) and not np.isfinite(positions).all():
+        bad = int(np.argmax(~np.isfinite(positions).all(axis=1)))
+        raise expected("finite vertex coordinates", f"{positions[bad].tolist()} at vertex {bad + 1}", path)
+
+
 def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path, scene: Scene) -> Primitive:
     positions = np.asarray(geom.vertices, np.float32)
+    _finite(positions, path)
     faces = np.asarray(geom.faces)
     if faces.min() < 0 or faces.max() >= len(positions):  # checked before anything indexes with them
         bad = int(faces.max()) if faces.max() >= len(positions) else int(faces.min())
@@ -153,6 +317,7 @@ def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path, scene: Scene) -
         mode, opacity = alpha.get(name, ("OPAQUE", 1.0))
         texture = None
         if image is not None and "TEXCOORD_0" in attributes:
+            _check_size(image, path)
             texture = scene.add_image(Image(name or "texture", b"",
                                             pixels=np.asarray(image.convert("RGBA"))))
         material = scene.add_material(Material(name or f"material{len(scene.materials)}",
@@ -164,8 +329,19 @@ def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path, scene: Scene) -
     return Primitive(attributes, faces.astype(np.uint32), material)
 
 
-def _points(cloud) -> Primitive:
+def _check_size(image, path: Path) -> None:
+    """A texture trimesh opened (lazily) is refused over the glTF reader's caps before decoding."""
+    from fishgen.exchange.gltf_reader import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE
+
+    width, height = image.size
+    if width > MAX_IMAGE_SIDE or height > MAX_IMAGE_SIDE or width * height > MAX_IMAGE_PIXELS:
+        raise expected(f"a texture of at most {MAX_IMAGE_SIDE} px a side and {MAX_IMAGE_PIXELS:,} pixels",
+                       f"{width}x{height}", path)
+
+
+def _points(cloud, path: Path) -> Primitive:
     positions = np.asarray(cloud.vertices, np.float32)
+    _finite(positions, path)
     columns = _ply_columns(cloud.metadata.get("_ply_raw", {}).get("vertex", {}).get("data"))
     attributes = {"POSITION": positions}
     if "radius" in columns:

@@ -76,8 +76,12 @@ def test_points_without_radius_get_a_visible_default(tmp_path):
 
 
 @pytest.mark.parametrize("name,content,message", [
-    ("broken.glb", b"glTF\x02\x00\x00\x00garbage", "not a readable glTF"),
-    ("broken.gltf", b"{not json", "not a readable glTF"),
+    ("broken.glb", b"glTF\x02\x00\x00\x00garbage", r"expected a GLB of [\d,]+ bytes, as its header says, "
+                                                 r"found 15 bytes$"),
+    ("short.glb", b"glTF\x02\x00", r"expected a glTF 2\.0 file \(JSON, or GLB with a 12-byte header\), "
+                                  r"found 6 bytes$"),
+    ("broken.gltf", b"{not json", r"expected a glTF 2\.0 file \(JSON, or GLB with a 12-byte header\), "
+                                  r"found invalid JSON at line 1 column 2"),
     ("notes.md", b"hello", "expected an input ending in"),
 ])
 def test_bad_inputs_are_one_line_errors(tmp_path, name, content, message):
