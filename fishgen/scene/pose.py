@@ -167,16 +167,28 @@ def deformed(scene: Scene, node: int, prim: Primitive, posed: Pose) -> tuple[np.
         blend = np.einsum("nk,nkij->nij", wts, joint_mats[joints])  # (n, 4, 4) per vertex
         out = np.einsum("nij,nj->ni", blend[:, :3, :3], pos) + blend[:, :3, 3]
         if nrm is not None:
-            nrm = np.einsum("nij,nj->ni", np.linalg.inv(blend[:, :3, :3]).transpose(0, 2, 1), nrm)
+            nrm = np.einsum("nij,nj->ni", cofactor(blend[:, :3, :3]), nrm)
     else:
         m = posed.world[node]
         out = pos @ m[:3, :3].T + m[:3, 3]
         if nrm is not None:
-            nrm = nrm @ np.linalg.inv(m[:3, :3]) if abs(np.linalg.det(m[:3, :3])) > 1e-30 else nrm
+            nrm = nrm @ cofactor(m[:3, :3]).T
     if nrm is not None:
         length = np.linalg.norm(nrm, axis=1, keepdims=True)
         nrm = np.where(length > 0, nrm / np.where(length > 0, length, 1), nrm)
     return out, nrm
+
+
+def cofactor(m: np.ndarray) -> np.ndarray:
+    """The normal transform of (..., 3, 3) linear maps: |det M| inv(M)^T, as a signed cofactor matrix.
+
+    Unlike inv(M)^T it is defined (and zero, not an error) for a map that scales a
+    node or joint to nothing; the sign keeps a mirrored map's normals pointing out.
+    """
+    a, b, c = m[..., :, 0], m[..., :, 1], m[..., :, 2]
+    cof = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=-1)
+    det = np.einsum("...i,...i->...", a, np.cross(b, c))
+    return np.where((det < 0)[..., None, None], -cof, cof)
 
 
 def bounds(scene: Scene, t: float | None = None, clip: Clip | str | None = None) -> np.ndarray:

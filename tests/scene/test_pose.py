@@ -114,3 +114,13 @@ def test_skin_follows_its_joints_and_ignores_its_own_node():
     # joint 1 turned 90 degrees about Y: a point 1 past it swings from +Z to +X
     assert np.allclose(bent[0], [0, 0, 0]) and np.allclose(bent[1], [1, 0, 1])
     assert np.allclose(bent[2], [0.5, 0, 1.5])                 # linear blend of the two joints
+
+
+def test_normals_follow_mirrors_and_survive_a_zero_scale():
+    prim = Primitive({"POSITION": np.array([[1, 0, 0]], np.float32), "NORMAL": np.array([[1, 0, 0]], np.float32)},
+                     mode="POINTS")
+    for scale, expected in (((-1.0, 1.0, 1.0), [-1, 0, 0]), ((2.0, 1.0, 1.0), [1, 0, 0]),
+                            ((0.0, 1.0, 1.0), [1, 0, 0])):
+        scene = scene_of(Node("n", mesh=0, scale=scale), meshes=[Mesh("m", [prim])])
+        _, normals = deformed(scene, 0, prim, pose(scene))
+        assert np.all(np.isfinite(normals)) and np.allclose(normals, expected), scale
