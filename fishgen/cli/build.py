@@ -95,9 +95,11 @@ def summary(scene, target: Path, written: list[Path]) -> str:
     fmt = by_extension(target)
     dropped = lost(fmt, scene) if fmt is not None else []
     clip = scene.clip("swim")
-    motion = (f"swim loop {clip.duration:.2f} s" if clip is not None and not dropped
+    animated = clip is not None and "node animation" not in dropped
+    motion = (f"swim loop {clip.duration:.2f} s" if animated and clip is not None
               else "rest pose only" if clip is not None else "no animation")
-    note = f" ({fmt.extensions[0][1:].upper()} holds no {' or '.join(dropped)})" if dropped and fmt else ""
+    listed = ", ".join(dropped[:-1]) + (" or " if len(dropped) > 1 else "") + dropped[-1] if dropped else ""
+    note = f" ({fmt.extensions[0][1:].upper()} holds no {listed})" if dropped and fmt else ""
     return (f"{target}: {scene.name}, {scene.counts()['triangles']} triangles, {hi[2] - lo[2]:.3f} m long, "
             f"fins {scene.info.get('fin_mode')}, {motion}{note}"
             + (f" (+{len(written) - 1} files)" if len(written) > 1 else ""))

@@ -26,6 +26,17 @@ def _face_rows(faces: np.ndarray) -> str:
     return (row * len(faces) % tuple(np.repeat(faces, 3, axis=1).ravel().tolist()))[:-1]
 
 
+def _alpha_png(rgba: np.ndarray) -> bytes:
+    """The alpha channel of an RGBA picture as a greyscale PNG (white = opaque)."""
+    import io
+
+    from PIL import Image
+
+    out = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(rgba[..., 3]), "L").save(out, format="PNG")
+    return out.getvalue()
+
+
 def write_obj(scene: Scene, path: Path) -> list[Path]:
     stem = path.stem
     mtl_name = f"{stem}.mtl"
@@ -40,6 +51,8 @@ def write_obj(scene: Scene, path: Path) -> list[Path]:
         lines += [f"o {part.name}", _rows("v", part.positions), _rows("vt", uv), _rows("vn", part.normals),
                   f"usemtl {material}", "s 1", _face_rows(part.faces + offset + 1)]
         offset += len(part.positions)
+    masks = {mat.texture: f"{stem}_{scene.images[mat.texture].name}_mask.png" for mat in scene.materials
+             if mat.texture is not None and mat.alpha_mode == "MASK"}
     mtl = []
     for mat in scene.materials:
         r, g, b, a = mat.base_color
@@ -48,10 +61,14 @@ def write_obj(scene: Scene, path: Path) -> list[Path]:
         if mat.texture is not None:
             mtl.append(f"map_Kd {textures[mat.texture]}")
             if mat.alpha_mode == "MASK":
-                mtl.append(f"map_d -imfchan m {textures[mat.texture]}")
+                # A separate greyscale picture: three.js's MTLLoader reads no `-imfchan` option (it
+                # asked for a file named "-imfchan m ...") and every reader takes map_d's grey as alpha.
+                mtl.append(f"map_d {masks[mat.texture]}")
         mtl.append("")
     files = {path: ("\n".join(lines) + "\n").encode(), path.with_name(mtl_name): "\n".join(mtl).encode()}
     for k, name in textures.items():
         files[path.with_name(name)] = scene.images[k].encoded()
+    for k, name in masks.items():
+        files[path.with_name(name)] = _alpha_png(scene.images[k].rgba())
     write_files(files)
     return list(files)

@@ -22,7 +22,8 @@ from fishgen.errors import FishgenError
 
 MESHES, POINTS, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS = (
     "meshes", "points", "textures", "node animation", "skins", "morph targets")
-CONTENT = (MESHES, POINTS, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS)
+ALPHA_CUTOFF, DOUBLE_SIDED = "alpha cutoff", "double-sided faces"
+CONTENT = (MESHES, POINTS, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS, ALPHA_CUTOFF, DOUBLE_SIDED)
 
 
 @dataclass(frozen=True)

@@ -239,6 +239,10 @@ class Scene:
                 kinds.add("morph targets")
         if any(m.texture is not None for m in self.materials):
             kinds.add("textures")
+        if any(m.alpha_mode == "MASK" for m in self.materials):
+            kinds.add("alpha cutoff")
+        if any(m.double_sided for m in self.materials):
+            kinds.add("double-sided faces")
         if self.skins:
             kinds.add("skins")
         if any(c.channels for c in self.clips):

@@ -20,7 +20,9 @@ def test_build_default_species_to_glb(tmp_path):
 def test_obj_summary_says_the_animation_is_not_kept(tmp_path):
     result = run_cli("build", PARAMS / "bonybream.txt", "-o", tmp_path / "b.obj")
     assert result.returncode == 0, result.stderr
-    assert "swim loop" not in result.stdout and result.stdout.count("rest pose only (OBJ holds no node animation)") == 1
+    assert "swim loop" not in result.stdout
+    assert result.stdout.count("rest pose only (OBJ holds no node animation, alpha cutoff or double-sided "
+                               "faces)") == 1
 
 
 def test_a_cube_file_says_which_command_builds_it(tmp_path):

@@ -74,8 +74,15 @@ def test_gltf_writes_buffer_and_texture_beside_it(assets, tmp_path):
 
 def test_obj_with_mtl_and_texture(assets, tmp_path):
     files = export(assets["bonybream"], tmp_path / "b.obj")
-    assert sorted(f.name for f in files) == ["b.mtl", "b.obj", "b_skin.png"]
-    assert "map_Kd b_skin.png" in (tmp_path / "b.mtl").read_text()
+    assert sorted(f.name for f in files) == ["b.mtl", "b.obj", "b_skin.png", "b_skin_mask.png"]
+    mtl = (tmp_path / "b.mtl").read_text()
+    assert "map_Kd b_skin.png" in mtl and "map_d b_skin_mask.png" in mtl and "-imfchan" not in mtl
+    from io import BytesIO
+
+    from PIL import Image
+    skin = Image.open(BytesIO((tmp_path / "b_skin.png").read_bytes()))
+    mask = Image.open(BytesIO((tmp_path / "b_skin_mask.png").read_bytes()))
+    assert mask.mode == "L" and np.array_equal(np.asarray(mask), np.asarray(skin)[..., 3])
     scene = trimesh.load(tmp_path / "b.obj")
     total = sum(len(g.faces) for g in scene.geometry.values())
     assert total == assets["bonybream"].counts()["triangles"]
