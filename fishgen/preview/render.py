@@ -157,11 +157,18 @@ class Renderer:
                 f"libgl1-mesa-dri), found none ({err})") from None
         self.width, self.height = width, height
         samples = min(SAMPLES, self.ctx.max_samples)
-        self.msaa = self.ctx.framebuffer(
-            color_attachments=[self.ctx.renderbuffer((width, height), 4, samples=samples)],
-            depth_attachment=self.ctx.depth_renderbuffer((width, height), samples=samples))
-        self.resolved = self.ctx.framebuffer(
-            color_attachments=[self.ctx.renderbuffer((width, height), 4)])
+        try:
+            self.msaa = self.ctx.framebuffer(
+                color_attachments=[self.ctx.renderbuffer((width, height), 4, samples=samples)],
+                depth_attachment=self.ctx.depth_renderbuffer((width, height), samples=samples))
+            self.resolved = self.ctx.framebuffer(
+                color_attachments=[self.ctx.renderbuffer((width, height), 4)])
+        except moderngl.Error as err:  # out of memory: the driver leaves the framebuffer incomplete
+            self.ctx.release()
+            need = width * height * (4 + 4) * samples + width * height * 4
+            raise FishgenError(f"expected memory for a {width}x{height} framebuffer ({need / 2**20:,.0f} MiB "
+                               f"with {samples}x anti-aliasing), found the driver unable to make one "
+                               f"({err}); use a smaller --size") from None
         self.mesh_prog: Any = self.ctx.program(vertex_shader=MESH_VS, fragment_shader=MESH_FS)
         self.point_prog: Any = self.ctx.program(vertex_shader=POINT_VS, fragment_shader=POINT_FS)
         corners = np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32)
