@@ -1,0 +1,140 @@
+"""Make the committed seed corpus (tests/fuzz/corpus/) from the shipped parameter files.
+
+    python -m fishgen.fuzz.corpus [DEST]
+
+Species and cube files are copied from params/; assets are built once with `fishgen build`
+and `fishgen clouds` (8x8 textures and a 60-particle cloud keep the corpus small and the
+readers fast), plus a few hand-written ASCII OBJ/PLY files for the text paths.
+"""
+from __future__ import annotations
+
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+from fishgen.fuzz.cases import DEFAULT_CORPUS, FISHGEN_ROOT
+from fishgen.fuzz.mutate import png_bytes
+
+PARAMS = FISHGEN_ROOT.parent / "params"
+SMALL_CLOUD = b"60\n3\n20, 4.0, 3.0, 2.0, 0.0, 0.0, 0.0, 1.0\n20, 2.0, 2.0, 2.0, 5.0, 1.0, -2.0, 0.8\n" \
+              b"20 3.0, 1.0, 1.0, -4.0, 0.5, 1.0, 0.5\n"
+ASCII_PLY_CLOUD = """ply
+format ascii 1.0
+comment particles: position, radius, density, sRGB colour
+element vertex 4
+property float x
+property float y
+property float z
+property float radius
+property float density
+property uchar red
+property uchar green
+property uchar blue
+end_header
+0 0 0 0.5 1 255 255 255
+1 0 0 0.25 0.5 200 210 220
+0 1 0 1.0 0.1 10 20 30
+0 0 1 0.1 0.9 0 0 0
+"""
+ASCII_PLY_MESH = """ply
+format ascii 1.0
+element vertex 4
+property float x
+property float y
+property float z
+property uchar red
+property uchar green
+property uchar blue
+property uchar alpha
+element face 2
+property list uchar int vertex_indices
+end_header
+0 0 0 255 0 0 255
+1 0 0 0 255 0 255
+1 1 0 0 0 255 128
+0 1 0 255 255 255 0
+3 0 1 2
+3 0 2 3
+"""
+QUAD_OBJ = """mtllib quad.mtl
+o quad
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+vn 0 0 1
+usemtl skin
+f 1/1/1 2/2/1 3/3/1
+f 1/1/1 3/3/1 4/4/1
+usemtl glass
+f 4/4/1 3/3/1 2/2/1
+"""
+QUAD_MTL = """newmtl skin
+Kd 0.8 0.7 0.6
+map_Kd skin.png
+map_d -imfchan m skin.png
+newmtl glass
+Kd 1 1 1
+d 0.4
+"""
+
+
+def make_corpus(dest: Path = DEFAULT_CORPUS) -> None:
+    from fishgen.cli import main
+
+    if dest.exists():
+        shutil.rmtree(dest)
+    for sub in ("species", "cubes"):
+        (dest / sub).mkdir(parents=True)
+    for p in sorted(PARAMS.glob("*.txt")):
+        shutil.copy(p, dest / "species" / p.name)
+    for p in sorted((PARAMS / "clouds").glob("*.awn")):
+        shutil.copy(p, dest / "cubes" / p.name)
+    (dest / "cubes" / "small.awn").write_bytes(SMALL_CLOUD)
+
+    with tempfile.TemporaryDirectory() as tmp:
+        textures = Path(tmp) / "textures"
+        textures.mkdir()
+        for name in ("pineapplefish", "threadfingoldie"):
+            for suffix in ("", "_mask"):
+                (textures / f"{name}{suffix}.png").write_bytes(png_bytes(8, 8))
+        cloud = Path(tmp) / "small.awn"
+        cloud.write_bytes(SMALL_CLOUD)
+
+        def run(*argv: str) -> None:
+            try:
+                main(list(argv))
+            except SystemExit as stop:
+                if stop.code:
+                    raise RuntimeError(f"fishgen {' '.join(argv)} failed") from None
+
+        fish = str(PARAMS / "pineapplefish.txt")
+        for target, out in (("gltf", "pineapplefish_glb/pineapplefish.glb"),
+                            ("gltf", "pineapplefish_gltf/pineapplefish.gltf"),
+                            ("obj", "pineapplefish/pineapplefish.obj"),
+                            ("ply", "pineapplefish/pineapplefish.ply")):
+            path = dest / target / out
+            path.parent.mkdir(parents=True, exist_ok=True)
+            run("build", fish, "-o", str(path), "--textures", str(textures))
+        for target, out, extra in (("gltf", "cloud_points/cloud.glb", ()),
+                                   ("gltf", "cloud_billboards/cloud.glb", ("--billboards",)),
+                                   ("ply", "cloud/cloud.ply", ())):
+            path = dest / target / out
+            path.parent.mkdir(parents=True, exist_ok=True)
+            run("clouds", str(cloud), "-o", str(path), *extra)
+    for folder, files in (("ply/ascii_cloud", {"cloud.ply": ASCII_PLY_CLOUD}),
+                          ("ply/ascii_mesh", {"mesh.ply": ASCII_PLY_MESH}),
+                          ("obj/quad", {"quad.obj": QUAD_OBJ, "quad.mtl": QUAD_MTL})):
+        (dest / folder).mkdir(parents=True)
+        for name, text in files.items():
+            (dest / folder / name).write_text(text)
+    (dest / "obj/quad/skin.png").write_bytes(png_bytes(4, 4))
+
+
+if __name__ == "__main__":
+    make_corpus(Path(sys.argv[1]) if len(sys.argv) > 1 else DEFAULT_CORPUS)

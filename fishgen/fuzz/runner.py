@@ -1,0 +1,312 @@
+"""Run fuzz cases in persistent worker processes under a memory and time budget.
+
+Each worker is forked once, imports everything, loads the seed corpus, then lowers its own
+address-space limit (``RLIMIT_AS``) and serves batches of case indices: it regenerates each
+case from ``(seed, target, index)``, runs it in-process with a per-case timer, and sends back
+counts and findings. The parent is a watchdog: a worker that stops making progress (a hang
+in C code the timer cannot interrupt) is killed and restarted, and a worker that dies (the
+kernel's OOM killer, a crash under the memory limit) is a finding as well.
+"""
+from __future__ import annotations
+
+import logging
+import multiprocessing as mp
+import os
+import re
+import resource
+import shutil
+import signal
+import tempfile
+import time
+import warnings
+from collections import deque
+from dataclasses import dataclass, field
+from multiprocessing.connection import wait
+from pathlib import Path
+
+from fishgen.fuzz.cases import DEFAULT_CORPUS, CaseTimeout, Outcome, load_seeds, make_case, run_case
+
+#: Address space a worker may use. Imports take ~360 MB of address space, an EGL preview
+#: context another ~650 MB (measured with /proc/self/status VmPeak), so a correct CLI preview
+#: peaks near 1.0 GB; everything a correct run needs fits well inside 1.5 GB.
+DEFAULT_BUDGET_MB = 1536
+#: Seconds one case may take (parsers are ~1 ms, readers ~10 ms, CLI previews ~0.3 s).
+TIME_LIMITS = {"species": 2.0, "cubes": 2.0, "gltf": 5.0, "obj": 5.0, "ply": 5.0, "cli": 20.0}
+#: Extra seconds the parent waits past a case's limit before killing a worker stuck in C code.
+GRACE = 10.0
+BATCH = {"species": 100, "cubes": 200, "gltf": 20, "obj": 10, "ply": 20, "cli": 2}
+
+
+@dataclass
+class Finding:
+    key: str
+    target: str
+    seed: int
+    index: int
+    detail: str
+    count: int = 1
+    folder: Path | None = None
+
+
+@dataclass
+class Stats:
+    inputs: int = 0
+    ok: int = 0
+    errors: int = 0
+    findings: int = 0
+    busy: float = 0.0  # worker-seconds spent on this target
+
+    @property
+    def rate(self) -> float:
+        return self.inputs / self.busy if self.busy else 0.0
+
+
+@dataclass
+class Report:
+    stats: dict[str, Stats] = field(default_factory=dict)
+    findings: dict[str, Finding] = field(default_factory=dict)
+    wall: float = 0.0
+
+    @property
+    def total(self) -> int:
+        return sum(s.inputs for s in self.stats.values())
+
+
+def _worker(conn, progress, corpus: str, budget: int, workdir: str, quiet: bool = True) -> None:
+    # Import everything a case may need before the memory limit, as a long-lived tool would.
+    import fishgen.assembly.fish  # noqa: F401
+    import fishgen.cli.build  # noqa: F401
+    import fishgen.cli.clouds  # noqa: F401
+    import fishgen.cli.preview  # noqa: F401
+    import fishgen.clouds.fill  # noqa: F401
+    import fishgen.exchange.gltf_reader  # noqa: F401
+    import fishgen.exchange.mesh_reader  # noqa: F401
+    import fishgen.preview.inputs  # noqa: F401
+    import fishgen.scene.pose  # noqa: F401
+    import fishgen.species.parser  # noqa: F401
+
+    seeds = load_seeds(Path(corpus))
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles ^C
+    # Libraries log and warn about the broken inputs they are fed (trimesh prints tracebacks of
+    # errors it recovers from); none of that is a finding, and it would drown the report.
+    logging.disable(logging.CRITICAL)
+    warnings.simplefilter("ignore")
+    if quiet:
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 1)
+        os.dup2(null, 2)
+
+    def alarm(*_):
+        raise CaseTimeout("per-case time limit")
+
+    signal.signal(signal.SIGALRM, alarm)
+    if budget:
+        resource.setrlimit(resource.RLIMIT_AS, (budget, budget))
+    work = Path(workdir)
+    while True:
+        msg = conn.recv()
+        if msg is None:
+            break
+        target, seed, indices, limit = msg
+        counts = {"ok": 0, "error": 0}
+        found: list[tuple[int, str, str]] = []
+        start = time.monotonic()
+        for index in indices:
+            progress[0], progress[1] = index, time.monotonic()
+            try:
+                signal.setitimer(signal.ITIMER_REAL, limit)
+                try:
+                    case = make_case(seeds, target, seed, index)
+                except Exception as err:  # a bug in the fuzzer itself: shown, never hidden
+                    outcome = Outcome("finding", f"fuzz harness error: {err!r}", "")
+                else:
+                    outcome = run_case(case, work)
+            except CaseTimeout:
+                outcome = Outcome("finding", f"budget overrun (time) in {target}", "")
+            except MemoryError:
+                outcome = Outcome("finding", f"budget overrun (memory) in {target} (outside fishgen)", "")
+            finally:
+                signal.setitimer(signal.ITIMER_REAL, 0)
+            if outcome.status == "finding":
+                found.append((index, outcome.key, outcome.detail))
+            else:
+                counts[outcome.status] += 1
+        conn.send((counts, found, time.monotonic() - start))
+
+
+class _Worker:
+    def __init__(self, ctx, corpus: Path, budget: int, root: Path, number: int):
+        self.ctx, self.corpus, self.budget, self.number = ctx, corpus, budget, number
+        self.workdir = root / f"w{number}"
+        self.batch: tuple[str, int, list[int]] | None = None
+        self.sent = 0.0
+        self.start()
+
+    def start(self) -> None:
+        self.workdir.mkdir(parents=True, exist_ok=True)
+        self.conn, child = self.ctx.Pipe()
+        self.progress = self.ctx.RawArray("d", [-1.0, 0.0])
+        self.proc = self.ctx.Process(target=_worker, daemon=True,
+                                     args=(child, self.progress, str(self.corpus), self.budget,
+                                           str(self.workdir)))
+        self.proc.start()
+        child.close()
+
+    def send(self, target: str, seed: int, indices: list[int]) -> None:
+        self.batch = (target, seed, indices)
+        self.progress[0], self.progress[1] = -1.0, time.monotonic()
+        self.sent = time.monotonic()
+        self.conn.send((target, seed, indices, TIME_LIMITS[target]))
+
+    def kill(self) -> None:
+        if self.proc.is_alive():
+            os.kill(self.proc.pid, signal.SIGKILL)
+        self.proc.join()
+        self.conn.close()
+
+    def stop(self) -> None:
+        try:
+            self.conn.send(None)
+        except (BrokenPipeError, OSError):
+            pass
+        self.proc.join(5)
+        if self.proc.is_alive():
+            self.kill()
+
+
+def _slug(key: str) -> str:
+    return re.sub(r"[^A-Za-z0-9]+", "-", key).strip("-")[:90]
+
+
+def run(targets: list[str], *, seed: int = 0, minutes: float | None = None,
+        counts: dict[str, int] | None = None, jobs: int = 1, corpus: Path = DEFAULT_CORPUS,
+        findings_dir: Path | None = None, budget_mb: int = DEFAULT_BUDGET_MB,
+        on_finding=None) -> Report:
+    """Fuzz ``targets`` for ``minutes`` (round-robin by time) or ``counts[target]`` inputs each.
+
+    Case indices start at 0, so every run first replays the whole seed corpus verbatim.
+    """
+    seeds = load_seeds(corpus)
+    report = Report({t: Stats() for t in targets})
+    next_index = {t: 0 for t in targets}
+    requeued: dict[str, deque[int]] = {t: deque() for t in targets}
+    deadline = time.monotonic() + minutes * 60 if minutes is not None else None
+    ctx = mp.get_context("fork")
+    root = Path(tempfile.mkdtemp(prefix="fishgen-fuzz-"))
+    workers = [_Worker(ctx, corpus, budget_mb << 20, root, j) for j in range(max(1, jobs))]
+    started = time.monotonic()
+
+    def record(target: str, index: int, key: str, detail: str) -> None:
+        report.stats[target].findings += 1
+        if key in report.findings:
+            report.findings[key].count += 1
+            return
+        f = Finding(key, target, seed, index, detail)
+        report.findings[key] = f
+        if findings_dir is not None:
+            f.folder = findings_dir / f"{len(report.findings):03d}-{_slug(key)}"
+            try:
+                make_case(seeds, target, seed, index).save(f.folder)
+            except Exception as err:  # a case that cannot even be regenerated is still reported
+                f.detail += f"\n(could not save the input: {err!r})"
+            f.folder.mkdir(parents=True, exist_ok=True)
+            (f.folder / "finding.txt").write_text(
+                f"{key}\n\ntarget {target}, seed {seed}, index {index}\n"
+                f"replay: python -m fishgen.fuzz --replay {target}:{seed}:{index}\n\n{detail}\n")
+        if on_finding is not None:
+            on_finding(f)
+
+    def pick() -> tuple[str, list[int]] | None:
+        if deadline is not None:
+            if time.monotonic() >= deadline:
+                return None
+            live = targets
+        else:
+            assert counts is not None
+            live = [t for t in targets if requeued[t] or next_index[t] < counts.get(t, 0)]
+            if not live:
+                return None
+        # the target with the least worker time so far (plus what is in flight) goes next
+        in_flight = {t: 0.0 for t in targets}
+        for w in workers:
+            if w.batch is not None:
+                in_flight[w.batch[0]] += time.monotonic() - w.sent + 0.01
+        target = min(live, key=lambda t: report.stats[t].busy + in_flight[t])
+        if requeued[target]:
+            batch = [requeued[target].popleft() for _ in range(min(len(requeued[target]), BATCH[target]))]
+            return target, batch
+        stop = next_index[target] + BATCH[target]
+        if counts is not None:
+            stop = min(stop, counts.get(target, 0))
+        # the seed corpus goes one case per batch position so a broken seed cannot hide others
+        batch = list(range(next_index[target], stop))
+        next_index[target] = stop
+        return target, batch
+
+    try:
+        while True:
+            for w in workers:
+                if w.batch is None:
+                    job = pick()
+                    if job is not None:
+                        w.send(job[0], seed, job[1])
+            busy = [w for w in workers if w.batch is not None]
+            if not busy:
+                break
+            ready = wait([w.conn for w in busy], timeout=0.25)
+            now = time.monotonic()
+            for w in busy:
+                assert w.batch is not None
+                target, _, indices = w.batch
+                if w.conn in ready:
+                    try:
+                        done, found, elapsed = w.conn.recv()
+                    except (EOFError, OSError):
+                        done = None
+                    if done is not None:
+                        st = report.stats[target]
+                        st.inputs += len(indices)
+                        st.ok += done["ok"]
+                        st.errors += done["error"]
+                        st.busy += elapsed
+                        for index, key, detail in found:
+                            record(target, index, key, detail)
+                        w.batch = None
+                        continue
+                current = int(w.progress[0])
+                stuck = now - w.progress[1] > TIME_LIMITS[target] + GRACE
+                if w.proc.is_alive() and not stuck:
+                    continue
+                # died or hung: the current case is a finding; the rest of the batch is run again
+                code = w.proc.exitcode
+                w.kill()
+                if current < 0:
+                    current = indices[0]
+                if stuck:
+                    hung = TIME_LIMITS[target] + GRACE
+                    key = f"budget overrun (time: hung in C code past {hung:.0f} s) in {target}"
+                else:
+                    key = f"worker died ({_death(code)}) in {target}"
+                done_before = indices.index(current) if current in indices else 0
+                st = report.stats[target]
+                st.inputs += done_before + 1
+                st.busy += now - w.sent
+                record(target, current, key, f"exit code {code}")
+                requeued[target].extend(indices[done_before + 1:])
+                w.batch = None
+                w.start()
+    finally:
+        for w in workers:
+            w.stop()
+        shutil.rmtree(root, ignore_errors=True)
+    report.wall = time.monotonic() - started
+    return report
+
+
+def _death(code: int | None) -> str:
+    if code is not None and code < 0:
+        try:
+            return f"signal {signal.Signals(-code).name}"
+        except ValueError:
+            return f"signal {-code}"
+    return f"exit code {code}"

@@ -1,0 +1,121 @@
+"""The CI fuzz run: the whole seed corpus plus a fixed-seed budget of generated inputs per target.
+
+Every input must succeed (finite outputs) or raise FishgenError (the CLI: exit 2, one stderr
+line, no traceback), within the worker's memory and time budget (docs/fuzzing.md). These
+tests fail while any finding exists; each failure names the finding and its saved input
+(out/fuzz-findings-ci/) and the command that replays it. The nightly runs the same harness
+for longer: `python -m fishgen.fuzz --minutes 30`.
+"""
+from __future__ import annotations
+
+import os
+import random
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from fishgen.errors import FishgenError
+from fishgen.fuzz import TARGETS, load_seeds, make_case, run
+from fishgen.fuzz.cases import DEFAULT_CORPUS, Case, classify, run_case
+from fishgen.fuzz.mutate import NUMBERS, pack_glb, unpack_glb
+
+ROOT = Path(__file__).resolve().parents[2]
+CI_SEED = 20240601
+#: Inputs per target (the seed corpus comes first). About 30 s on 2 cores; rates in docs/fuzzing.md.
+CI_COUNTS = {"species": 4000, "cubes": 10000, "gltf": 3000, "obj": 2000, "ply": 3000, "cli": 600}
+FINDINGS_DIR = ROOT / "out" / "fuzz-findings-ci"
+
+
+@pytest.fixture(scope="module")
+def ci_report():
+    return run(list(TARGETS), seed=CI_SEED, counts=CI_COUNTS, jobs=min(2, os.cpu_count() or 1),
+               findings_dir=FINDINGS_DIR)
+
+
+@pytest.mark.parametrize("target", TARGETS)
+def test_no_findings(ci_report, target):
+    stats = ci_report.stats[target]
+    assert stats.inputs == CI_COUNTS[target]
+    found = [f for f in ci_report.findings.values() if f.target == target]
+    assert not found, f"{len(found)} distinct finding(s) fuzzing {target}:\n" + "\n".join(
+        f"  {f.key} (x{f.count}); input in {f.folder}; "
+        f"replay: python -m fishgen.fuzz --replay {f.target}:{f.seed}:{f.index}" for f in found)
+
+
+def test_seed_corpus_is_small_and_complete():
+    seeds = load_seeds()
+    assert len(seeds.species) >= 4 and len(seeds.cubes) >= 3
+    assert all(len(v) >= 2 for v in seeds.assets.values())
+    size = sum(p.stat().st_size for p in DEFAULT_CORPUS.rglob("*") if p.is_file())
+    assert size < 2 << 20
+
+
+def test_cases_are_reproducible():
+    seeds = load_seeds()
+    for target in TARGETS:
+        for index in (0, 57, 1234):
+            a, b = make_case(seeds, target, 7, index), make_case(seeds, target, 7, index)
+            assert (a.text, a.data, a.files, a.argv) == (b.text, b.data, b.files, b.argv)
+
+
+def test_seed_cases_are_the_corpus_verbatim():
+    seeds = load_seeds()
+    assert make_case(seeds, "species", 1, 0).text == seeds.species[0]
+    main, files = seeds.assets["gltf"][0]
+    assert make_case(seeds, "gltf", 1, 0).files == files
+
+
+def test_glb_round_trip():
+    main, files = next((m, f) for m, f in load_seeds().assets["gltf"] if m.endswith(".glb"))
+    doc, blob = unpack_glb(files[main])  # type: ignore[arg-type]
+    again = unpack_glb(pack_glb(doc, blob))
+    assert again[0] == doc and again[1][: len(blob)] == blob
+
+
+def test_the_judge_flags_what_it_should():
+    """The harness itself: FishgenError passes, anything else (or a hidden MemoryError) is a finding."""
+    assert classify(FishgenError("expected x, found y", "f", 1)).status == "error"
+    try:
+        [][1]
+    except IndexError as err:
+        assert classify(err).status == "finding"
+    try:
+        try:
+            raise MemoryError
+        except MemoryError:
+            raise FishgenError("not a readable glTF asset (MemoryError: )") from None
+    except FishgenError as err:
+        assert classify(err).key.startswith("budget overrun (memory)")
+    bad_cli = Case("cli", 0, argv=["build", "missing.txt", "--fps", "nan"])
+    assert run_case(bad_cli, ROOT / "out" / "fuzz-selftest").status == "error"
+
+
+# Property-based generation (hypothesis) over the two text parsers, in-process: records of
+# interesting tokens in the layout of the real files.
+_token = st.one_of(st.sampled_from(NUMBERS), st.text(max_size=6),
+                   st.floats(allow_nan=True, allow_infinity=True).map(repr))
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
+@given(st.data())
+def test_species_parser_hypothesis(data):
+    seeds = load_seeds()
+    lines = random.Random(0).choice(seeds.species).split("\n")
+    k = data.draw(st.integers(0, len(lines) - 1))
+    tokens = lines[k].split() or [""]
+    i = data.draw(st.integers(0, len(tokens) - 1))
+    tokens[i] = data.draw(_token)
+    lines[k] = " ".join(tokens)
+    outcome = run_case(Case("species", 0, text="\n".join(lines)), ROOT / "out" / "fuzz-selftest")
+    assert outcome.status != "finding", outcome.detail
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
+@given(st.lists(st.lists(_token, min_size=1, max_size=9), min_size=0, max_size=6),
+       st.sampled_from([", ", " ", ","]))
+def test_cubes_parser_hypothesis(rows, sep):
+    text = "\n".join(sep.join(r) for r in rows)
+    outcome = run_case(Case("cubes", 0, data=text.encode("utf-8", "surrogatepass")), ROOT / "out")
+    assert outcome.status != "finding", outcome.detail
