@@ -1,0 +1,620 @@
+"""The client matrix: every fishgen output format, loaded by every client that can run here.
+
+Shared by the pytest cells (tests/clients/test_clients.py) and the command-line
+report (tools/check_clients.py). Assets are made by the real `fishgen` command
+line, one folder each, and each cell checks: it loads, nothing failed (console
+errors, failed or 4xx/5xx requests), every texture the file names arrives, the
+counts match the summary line fishgen printed, and the `swim` clip is there
+where the format and the client hold animation.
+
+A few cells fail because of what a client cannot do; those are listed in
+KNOWN_LIMITS with the reason, reported as "✗ known: …" and xfail (strict) in
+pytest: if a client starts to manage it, the cell fails until the entry goes.
+"""
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from functools import partial
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+HERE = Path(__file__).resolve().parent
+PARAMS = ROOT / "params"
+FISH_SOURCE = PARAMS / "bonybream.txt"
+CLOUD_SOURCE = PARAMS / "clouds" / "table_4_4.awn"
+SWIM_TRACKS = 5
+CLOUD_COLUMNS = ("x", "y", "z", "radius", "density", "red", "green", "blue")
+
+
+@dataclass(frozen=True)
+class Format:
+    label: str          # row of the table
+    kind: str           # "fish" or "cloud"
+    filename: str
+    flags: tuple[str, ...] = ()
+
+    @property
+    def ext(self) -> str:
+        return self.filename.rsplit(".", 1)[1]
+
+    @property
+    def slug(self) -> str:
+        return self.label.replace(" ", "-")
+
+
+FORMATS = (
+    Format("fish glb", "fish", "fish.glb"),
+    Format("fish gltf", "fish", "fish.gltf"),
+    Format("fish obj", "fish", "fish.obj"),
+    Format("fish ply", "fish", "fish.ply"),
+    Format("cloud ply", "cloud", "cloud.ply"),
+    Format("cloud glb points", "cloud", "points.glb"),
+    Format("cloud glb billboards", "cloud", "billboards.glb", ("--billboards",)),
+    Format("cloud csv", "cloud", "cloud.csv"),
+    Format("cloud npy", "cloud", "cloud.npy"),
+)
+CLIENTS = ("three.js", "trimesh", "pygltflib", "plyfile", "numpy")
+APPLIES = {
+    "glb": ("three.js", "trimesh", "pygltflib"),
+    "gltf": ("three.js", "trimesh", "pygltflib"),
+    "obj": ("three.js", "trimesh"),
+    "ply": ("three.js", "trimesh", "plyfile"),
+    "csv": ("numpy",),
+    "npy": ("numpy",),
+}
+
+# (format label, client) -> (substring of the failure it must show, short reason for the table)
+KNOWN_LIMITS: dict[tuple[str, str], tuple[str, str]] = {
+    ("fish ply", "three.js"): ("never requested", "PLYLoader ignores `comment TextureFile`: no texture"),
+    ("fish obj", "trimesh"): ("map_d", "trimesh ignores map_d (fins keep the skin png's alpha)"),
+}
+
+
+def cells() -> list[tuple[str, str]]:
+    return [(f.label, c) for f in FORMATS for c in CLIENTS if c in APPLIES[f.ext]]
+
+
+# --------------------------------------------------------------------------- assets
+
+@dataclass
+class Asset:
+    fmt: Format
+    path: Path
+    files: list[str]            # every file fishgen wrote for it (the main file first)
+    summary: str                # the one line fishgen printed
+    reported: dict[str, int]    # counts from that line
+    expected: dict[str, int]    # vertices / triangles / particles a loader must find
+
+    @property
+    def label(self) -> str:
+        return self.fmt.label
+
+    @property
+    def side_files(self) -> list[str]:
+        return self.files[1:]
+
+
+def _summary_counts(line: str) -> dict[str, int]:
+    return {k: int(m[1]) for k in ("triangles", "particles") if (m := re.search(rf"(\d+) {k}\b", line))}
+
+
+def _scene_counts(kind: str) -> dict[str, dict[str, int]]:
+    """Counts of the scene fishgen builds in-process (the summary line has no vertex count)."""
+    import fishgen
+    from fishgen.clouds import fill_cloud, load_cubes
+
+    if kind == "fish":
+        return {"fish": fishgen.build_fish(fishgen.load_species(FISH_SOURCE)).counts()}
+    return {"points": {"particles": len(fill_cloud(load_cubes(CLOUD_SOURCE), seed=0))}}
+
+
+def make_assets(folder: Path) -> dict[str, Asset]:
+    """Run the real CLI once per format (in parallel), each into its own folder."""
+    folder.mkdir(parents=True, exist_ok=True)
+
+    def build(fmt: Format) -> Asset:
+        out_dir = folder / fmt.slug
+        if out_dir.exists():
+            shutil.rmtree(out_dir)
+        out_dir.mkdir()
+        out = out_dir / fmt.filename
+        command = "build" if fmt.kind == "fish" else "clouds"
+        source = FISH_SOURCE if fmt.kind == "fish" else CLOUD_SOURCE
+        result = subprocess.run([sys.executable, "-m", "fishgen", command, str(source), "-o", str(out), *fmt.flags],
+                                cwd=ROOT, capture_output=True, text=True)
+        if result.returncode != 0:
+            raise RuntimeError(f"fishgen {command} -o {fmt.filename} failed: {result.stderr.strip()}")
+        lines = result.stdout.strip().splitlines()
+        if len(lines) != 1:
+            raise RuntimeError(f"fishgen printed {len(lines)} lines, expected one summary line: {result.stdout!r}")
+        files = [fmt.filename] + sorted(p.name for p in out_dir.iterdir() if p.name != fmt.filename)
+        return Asset(fmt, out, files, lines[0], _summary_counts(lines[0]), {})
+
+    with ThreadPoolExecutor(4) as pool:
+        assets = {a.label: a for a in pool.map(build, FORMATS)}
+    fish = _scene_counts("fish")["fish"]
+    points = _scene_counts("cloud")["points"]
+    for a in assets.values():
+        if a.fmt.kind == "fish":
+            if a.reported.get("triangles") != fish["triangles"]:
+                raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, the scene has {fish['triangles']} triangles")
+            a.expected = {"vertices": fish["vertices"], "triangles": a.reported["triangles"], "particles": 0}
+        else:
+            n = a.reported["particles"]
+            if n != points["particles"]:
+                raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, fill_cloud made {points['particles']}")
+            if "--billboards" in a.fmt.flags:  # one quad (4 vertices, 2 triangles) per particle
+                a.expected = {"vertices": 4 * n, "triangles": 2 * n, "particles": 0, "quads": n}
+            else:
+                a.expected = {"vertices": 0, "triangles": 0, "particles": n}
+    return assets
+
+
+# --------------------------------------------------------------------------- cells
+
+class CellFailure(AssertionError):
+    pass
+
+
+@dataclass
+class Cell:
+    label: str
+    client: str
+    status: str                 # pass, fail, known, skip
+    reason: str = ""
+    details: dict = field(default_factory=dict)
+    seconds: float = 0.0
+
+    @property
+    def mark(self) -> str:
+        return {"pass": "✓", "fail": "✗", "known": "✗", "skip": "–"}[self.status]
+
+    @property
+    def text(self) -> str:
+        if self.status == "known":
+            return f"✗ known: {self.reason}"
+        return f"{self.mark} {self.reason}".strip()
+
+
+def expect(condition: bool, message: str) -> None:
+    if not condition:
+        raise CellFailure(message)
+
+
+def expect_counts(found: dict[str, int], expected: dict[str, int], what: str = "") -> None:
+    for key, value in found.items():
+        if key in expected and value != expected[key]:
+            raise CellFailure(f"{what}{key}: found {value}, fishgen made {expected[key]}")
+
+
+# ---- Python clients
+
+def _image_ok(img) -> bool:
+    return img is not None and getattr(img, "size", (0, 0))[0] > 0
+
+
+def check_trimesh(asset: Asset) -> str:
+    import numpy as np
+    import trimesh
+
+    loaded = trimesh.load(asset.path)               # what people call: default processing
+    raw = trimesh.load(asset.path, process=False)   # the file's own vertices
+    notes = []
+
+    def instances(scene_or_geom):
+        if isinstance(scene_or_geom, trimesh.Scene):
+            return [scene_or_geom.geometry[g] for _, g in
+                    (scene_or_geom.graph[n] for n in scene_or_geom.graph.nodes_geometry)]
+        return [scene_or_geom]
+
+    geoms, raw_geoms = instances(loaded), instances(raw)
+    meshes = [g for g in geoms if isinstance(g, trimesh.Trimesh)]
+    clouds = [g for g in geoms if isinstance(g, trimesh.PointCloud)]
+    counts = {"triangles": sum(len(g.faces) for g in meshes),
+              "particles": sum(len(g.vertices) for g in clouds),
+              "vertices": sum(len(g.vertices) for g in raw_geoms if isinstance(g, trimesh.Trimesh))}
+    expect_counts(counts, asset.expected)
+    merged = counts["vertices"] - sum(len(g.vertices) for g in meshes)
+    if merged:
+        notes.append(f"default load merges {merged} duplicate vertex{'es' if merged > 1 else ''}")
+
+    if asset.fmt.kind == "fish" or "--billboards" in asset.fmt.flags:
+        for g in meshes:
+            mat = getattr(g.visual, "material", None)
+            expect(mat is not None, f"{g.metadata.get('name', 'mesh')}: no material")
+            img = getattr(mat, "image", None) or getattr(mat, "baseColorTexture", None)
+            expect(_image_ok(img), f"{g.metadata.get('name', 'mesh')}: texture did not arrive")
+        if asset.fmt.ext == "obj":
+            masked = [g for g in loaded.geometry.values() if "map_d" in getattr(g.visual.material, "kwargs", {})]
+            expect(not masked, "map_d mask png named in the .mtl is not loaded (only kept as text)")
+    if "--billboards" in asset.fmt.flags:
+        expect(counts["triangles"] == 2 * asset.expected["quads"], "quads != particles")
+    if clouds:
+        for g in clouds:
+            expect(g.colors is not None and len(g.colors) == len(g.vertices), "particle colours missing")
+        if asset.fmt.ext == "ply":
+            raw_ply = loaded.metadata.get("_ply_raw", {}).get("vertex", {}).get("data")
+            names = raw_ply.dtype.names if raw_ply is not None else ()
+            expect({"radius", "density"} <= set(names or ()), "radius/density not kept")
+            notes.append("radius/density only in metadata['_ply_raw']")
+        else:
+            attrs = set()
+            for g in clouds:
+                attrs |= set(getattr(g, "vertex_attributes", {}) or {})
+            if not attrs & {"_RADIUS", "_radius"}:
+                notes.append("drops _RADIUS/_DENSITY/_CUBE")
+    if asset.fmt.ext in ("glb", "gltf") and asset.fmt.kind == "fish":
+        notes.append("no animation support")
+    _ = np
+    return "; ".join(notes)
+
+
+def check_pygltflib(asset: Asset) -> str:
+    import io
+
+    import pygltflib
+    from PIL import Image
+
+    g = pygltflib.GLTF2().load(str(asset.path))
+    blob = g.binary_blob() if asset.fmt.ext == "glb" else None
+    counts = {"vertices": 0, "triangles": 0, "particles": 0}
+    attrs_seen: set[str] = set()
+
+    def walk(i):
+        node = g.nodes[i]
+        if node.mesh is not None:
+            for prim in g.meshes[node.mesh].primitives:
+                mode = 4 if prim.mode is None else prim.mode
+                pos = g.accessors[prim.attributes.POSITION].count
+                attrs_seen.update(k for k, v in prim.attributes.__dict__.items() if v is not None)
+                attrs_seen.update(getattr(prim.attributes, "__pydantic_extra__", None) or {})
+                if mode == 0:
+                    counts["particles"] += pos
+                elif mode == 4:
+                    counts["vertices"] += pos
+                    n = g.accessors[prim.indices].count if prim.indices is not None else pos
+                    counts["triangles"] += n // 3
+        for c in node.children or []:
+            walk(c)
+
+    for root in g.scenes[g.scene or 0].nodes:
+        walk(root)
+    expect_counts(counts, asset.expected)
+    if asset.fmt.kind == "cloud" and "--billboards" not in asset.fmt.flags:
+        raw = json.loads(g.to_json())
+        prim_attrs = raw["meshes"][0]["primitives"][0]["attributes"]
+        missing = {"POSITION", "COLOR_0", "_RADIUS", "_DENSITY", "_CUBE"} - set(prim_attrs)
+        expect(not missing, f"attributes missing: {sorted(missing)}")
+        bad = [k for k, v in prim_attrs.items() if g.accessors[v].count != asset.expected["particles"]]
+        expect(not bad, f"attribute counts differ: {bad}")
+
+    for i, image in enumerate(g.images or []):
+        if image.uri:
+            p = asset.path.parent / image.uri
+            expect(p.is_file(), f"image {image.uri} missing")
+            data = p.read_bytes()
+        else:
+            bv = g.bufferViews[image.bufferView]
+            expect(blob is not None, f"image {i}: bufferView image outside a glb")
+            data = blob[(bv.byteOffset or 0):(bv.byteOffset or 0) + bv.byteLength]
+        expect(Image.open(io.BytesIO(data)).size[0] > 0, f"image {i} does not decode")
+    for buf in g.buffers:
+        if buf.uri and not buf.uri.startswith("data:"):
+            expect((asset.path.parent / buf.uri).is_file(), f"buffer {buf.uri} missing")
+    if asset.fmt.kind == "fish":
+        expect(bool(g.images), "no images")
+        _check_clip([(a.name, len(a.channels)) for a in g.animations or []])
+    return ""
+
+
+def _check_clip(clips: list[tuple[str, int]]) -> None:
+    swim = [n for name, n in clips if name == "swim"]
+    expect(bool(swim), f"no clip named swim (found {[c for c, _ in clips]})")
+    expect(swim[0] == SWIM_TRACKS, f"swim has {swim[0]} tracks, expected {SWIM_TRACKS}")
+
+
+def check_plyfile(asset: Asset) -> str:
+    from PIL import Image
+    from plyfile import PlyData
+
+    ply = PlyData.read(str(asset.path))
+    vertex = ply["vertex"]
+    if asset.fmt.kind == "fish":
+        faces = ply["face"].data["vertex_indices"]
+        expect(all(len(f) == 3 for f in faces), "faces that are not triangles")
+        expect_counts({"vertices": vertex.count, "triangles": ply["face"].count}, asset.expected)
+        names = [c.split(None, 1)[1] for c in ply.comments if c.startswith("TextureFile")]
+        expect(bool(names), "no `comment TextureFile`")
+        for name in names:
+            p = asset.path.parent / name
+            expect(p.is_file(), f"TextureFile {name} missing")
+            expect(Image.open(p).size[0] > 0, f"TextureFile {name} does not decode")
+        expect({"s", "t"} <= {p.name for p in vertex.properties}, "no s/t texture coordinates")
+    else:
+        expect_counts({"particles": vertex.count}, asset.expected)
+        props = tuple(p.name for p in vertex.properties)
+        expect(props == CLOUD_COLUMNS, f"vertex properties {props}")
+    return ""
+
+
+def check_numpy(asset: Asset) -> str:
+    import numpy as np
+
+    if asset.fmt.ext == "npy":
+        data = np.load(asset.path, allow_pickle=False)
+    else:
+        data = np.genfromtxt(asset.path, delimiter=",", names=True, dtype=None, encoding="utf-8")
+    expect(data.dtype.names is not None, "not a table with named columns")
+    expect(set(CLOUD_COLUMNS) <= set(data.dtype.names), f"columns {data.dtype.names}")
+    expect_counts({"particles": len(data)}, asset.expected)
+    expect(bool(np.isfinite(data["radius"]).all() and (data["radius"] > 0).all()), "radius not positive finite")
+    return ""
+
+
+PY_CHECKS: dict[str, Callable[[Asset], str]] = {
+    "trimesh": check_trimesh, "pygltflib": check_pygltflib, "plyfile": check_plyfile, "numpy": check_numpy}
+
+
+# ---- three.js in headless Chromium
+
+CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium", shutil.which("chromium"))
+                 if p and Path(p).is_file()), None)
+CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                 "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+THREE_DIR = ROOT / "node_modules" / "three"
+
+
+def three_unavailable() -> str | None:
+    if CHROMIUM is None:
+        return "no chromium (apt-get install chromium)"
+    if not (THREE_DIR / "build" / "three.module.js").is_file():
+        return "three.js not installed (npm ci)"
+    try:
+        import playwright  # noqa: F401
+    except ImportError:
+        return "playwright not installed"
+    return None
+
+
+class _Handler(SimpleHTTPRequestHandler):
+    """/three/ -> node_modules/three, /harness/ -> tests/clients, /assets/ -> the asset folder."""
+
+    mounts: dict[str, Path] = {}
+    log: list[tuple[str, int]] = []
+
+    def translate_path(self, path: str) -> str:
+        path = path.split("?", 1)[0].split("#", 1)[0]
+        from urllib.parse import unquote
+
+        path = unquote(path)
+        for prefix, base in self.mounts.items():
+            if path.startswith(prefix):
+                target = (base / path[len(prefix):]).resolve()
+                if target == base or base in target.parents:
+                    return str(target)
+        return str(Path("/nonexistent") / path.lstrip("/"))
+
+    def end_headers(self) -> None:
+        self.send_header("Cache-Control", "no-store")
+        super().end_headers()
+
+    def log_request(self, code="-", size="-") -> None:  # noqa: ARG002
+        self.log.append((self.path, int(code) if str(code).isdigit() else 0))
+
+    def log_message(self, format, *args) -> None:  # noqa: A002
+        pass
+
+
+class ThreeClient:
+    """One local HTTP server, one Chromium, one harness page for all the three.js cells."""
+
+    def __init__(self, asset_dir: Path):
+        from playwright.sync_api import sync_playwright
+
+        handler = type("Handler", (_Handler,), {"mounts": {"/three/": THREE_DIR.resolve(),
+                                                          "/harness/": HERE,
+                                                          "/assets/": asset_dir.resolve()},
+                                                "log": []})
+        handler.extensions_map = {**SimpleHTTPRequestHandler.extensions_map, ".js": "text/javascript"}
+        self.handler = handler
+        self.server = ThreadingHTTPServer(("127.0.0.1", 0), handler)
+        self.base = f"http://127.0.0.1:{self.server.server_address[1]}"
+        threading.Thread(target=self.server.serve_forever, daemon=True).start()
+        self._pw = sync_playwright().start()
+        self.browser = self._pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        self.page = self.browser.new_page()
+        self.console: list[str] = []
+        self.requests: list[tuple[str, int | str]] = []
+        self.outside: list[str] = []
+        self.page.on("console", lambda m: self.console.append(f"{m.type}: {m.text}") if m.type == "error" else None)
+        self.page.on("pageerror", lambda e: self.console.append(f"pageerror: {e}"))
+        self.page.on("response", lambda r: self.requests.append((r.url, r.status)))
+        self.page.on("requestfailed", lambda r: self.requests.append((r.url, f"failed {r.failure}")))
+        self.page.route("**/*", self._route)
+        self.page.goto(f"{self.base}/harness/harness.html")
+        self.page.wait_for_function("window.harnessReady === true", timeout=30_000)
+        problems = self._problems()
+        if problems:
+            raise RuntimeError(f"the harness page did not load cleanly: {problems}")
+
+    def _route(self, route) -> None:
+        url = route.request.url
+        if url.startswith(self.base) or url.startswith(("blob:", "data:")):
+            route.continue_()
+        else:  # never the internet
+            self.outside.append(url)
+            route.abort()
+
+    def _problems(self) -> list[str]:
+        out = list(self.console)
+        # FileLoader re-streams a body for progress events; Chromium then often reports the
+        # original request as net::ERR_ABORTED after its complete 200 response: not a failure.
+        answered = {u for u, s in self.requests if s == 200}
+        out += [f"{u} -> {s}" for u, s in self.requests if not (isinstance(s, int) and s < 400)
+                and not (s == "failed net::ERR_ABORTED" and u in answered)]
+        out += [f"outside request {u}" for u in self.outside]
+        return out
+
+    def close(self) -> None:
+        try:
+            self.browser.close()
+            self._pw.stop()
+        finally:
+            self.server.shutdown()
+            self.server.server_close()
+
+    def check(self, asset: Asset) -> str:
+        self.console.clear()
+        self.requests.clear()
+        self.outside.clear()
+        loader = {"glb": "gltf", "gltf": "gltf", "obj": "obj", "ply": "ply"}[asset.fmt.ext]
+        url = f"{self.base}/assets/{asset.fmt.slug}/{asset.fmt.filename}"
+        options = {}
+        if loader == "ply" and asset.fmt.kind == "cloud":  # what an app must ask for to keep them
+            options = {"customProperties": {"radius": ["radius"], "density": ["density"]}}
+        result = self.page.evaluate("([l, u, o]) => window.inspectAsset(l, u, o)", [loader, url, options])
+        self.page.wait_for_timeout(50)  # let late console messages and responses land
+        expect("error" not in result, f"loader error: {result.get('error')}")
+        problems = self._problems()
+        expect(not problems, "; ".join(problems[:3]))
+        return self._judge(asset, result)
+
+    def _judge(self, asset: Asset, r: dict) -> str:
+        notes = []
+        objects = r["objects"]
+        meshes = [o for o in objects if o["type"] == "Mesh"]
+        points = [o for o in objects if o["type"] == "Points"]
+        expect(bool(objects), "nothing loaded")
+        indexed = all(o["indexed"] for o in meshes)
+        counts = {"triangles": int(sum(o["triangles"] for o in meshes)),
+                  "particles": sum(o["positions"] for o in points)}
+        if indexed:
+            counts["vertices"] = sum(o["positions"] for o in meshes)
+        else:  # OBJLoader de-indexes: three positions per triangle, the file's sharing is gone
+            positions = sum(o["positions"] for o in meshes)
+            expect(positions == 3 * counts["triangles"], f"{positions} positions for {counts['triangles']} triangles")
+            notes.append(f"non-indexed ({positions} positions)")
+        expect_counts(counts, asset.expected)
+        if "--billboards" in asset.fmt.flags:
+            expect(counts["triangles"] / 2 == asset.expected["quads"], "quads != particles")
+        # every file fishgen wrote is fetched, once or more, and every texture arrives
+        fetched = {u.rsplit("/", 1)[1] for u, s in self.requests if s == 200}
+        never = [f for f in asset.files if f not in fetched]
+        expect(not never, f"{', '.join(never)} never requested")
+        for o in meshes:
+            for m in o["materials"]:
+                expect(m["map"] is not None, f"{o['name'] or 'mesh'}: material has no map")
+                for key in ("map", "alphaMap"):
+                    if m[key] is not None:
+                        expect(m[key]["arrived"], f"{o['name']}: {key} did not arrive")
+        if asset.fmt.ext == "obj":
+            fins = [m for o in meshes for m in o["materials"] if m["name"] == "fins"]
+            expect(bool(fins) and all(m["alphaMap"] and m["alphaMap"]["arrived"] for m in fins),
+                   "fins material has no alphaMap")
+        if asset.fmt.kind == "fish" and asset.fmt.ext in ("glb", "gltf"):
+            clips = r["clips"]
+            _check_clip([(c["name"], len(c["tracks"])) for c in clips])
+            unbound = [t["name"] for c in clips for t in c["tracks"] if not t["bound"]]
+            expect(not unbound, f"tracks target no node: {unbound}")
+            fins = [m for o in meshes for m in o["materials"] if m["name"] == "fins"]
+            expect(all(m["alphaTest"] == 0.5 and m["side"] == 2 for m in fins), "fins lost MASK/double-sided")
+        if points:
+            want = {"color", "_radius", "_density", "_cube"} if asset.fmt.ext == "glb" else {"color", "radius", "density"}
+            have = set().union(*(o["attributes"] for o in points))
+            expect(want <= have, f"attributes missing: {sorted(want - have)}")
+            if asset.fmt.ext == "ply":
+                notes.append("radius/density need setCustomPropertyNameMapping")
+        return "; ".join(notes)
+
+
+# --------------------------------------------------------------------------- running
+
+class Matrix:
+    def __init__(self, asset_dir: Path):
+        self.asset_dir = asset_dir
+        self.assets = make_assets(asset_dir)
+        self.results: dict[tuple[str, str], Cell] = {}
+        self._three: ThreeClient | None = None
+        self._three_error: str | None = None
+
+    def three(self) -> ThreeClient | None:
+        if self._three is None and self._three_error is None:
+            self._three_error = three_unavailable()
+            if self._three_error is None:
+                self._three = ThreeClient(self.asset_dir)
+        return self._three
+
+    def run(self, label: str, client: str) -> Cell:
+        if (label, client) in self.results:
+            return self.results[(label, client)]
+        asset = self.assets[label]
+        start = time.perf_counter()
+        if client == "three.js":
+            three = self.three()
+            check = three.check if three is not None else None
+        else:
+            check = PY_CHECKS[client]
+        if check is None:
+            cell = Cell(label, client, "skip", self._three_error or "unavailable")
+        else:
+            cell = _judge_known(label, client, partial(check, asset))
+        cell.seconds = time.perf_counter() - start
+        self.results[(label, client)] = cell
+        return cell
+
+    def run_all(self) -> list[Cell]:
+        return [self.run(label, client) for label, client in cells()]
+
+    def close(self) -> None:
+        if self._three is not None:
+            self._three.close()
+            self._three = None
+
+
+def _judge_known(label: str, client: str, check: Callable[[], str]) -> Cell:
+    known = KNOWN_LIMITS.get((label, client))
+    try:
+        note = check()
+    except Exception as e:  # noqa: BLE001 - every failure is a cell's reason
+        reason = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        if not isinstance(e, CellFailure):
+            reason = f"{type(e).__name__}: {reason}"
+        if known and known[0] in reason:
+            return Cell(label, client, "known", known[1], {"error": reason})
+        return Cell(label, client, "fail", reason[:160])
+    if known:
+        return Cell(label, client, "fail", f"listed as known ({known[1]}) but passes: update KNOWN_LIMITS")
+    return Cell(label, client, "pass", note)
+
+
+def table(results: dict[tuple[str, str], Cell], clients: tuple[str, ...] = CLIENTS) -> str:
+    """Markdown: one row per format, one column per client; '' where a client does not read it."""
+    lines = ["| format | " + " | ".join(clients) + " |", "|---|" + "---|" * len(clients)]
+    for fmt in FORMATS:
+        row = []
+        for c in clients:
+            cell = results.get((fmt.label, c))
+            row.append(cell.text.replace("|", "\\|") if cell else "")
+        lines.append(f"| {fmt.label} | " + " | ".join(row) + " |")
+    return "\n".join(lines)
+
+
+def write_report(results: dict[tuple[str, str], Cell], path: Path, seconds: float | None = None) -> str:
+    text = "# fishgen client matrix\n\n" + table(results) + "\n"
+    if seconds is not None:
+        text += f"\n{len(results)} cells in {seconds:.1f} s.\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")
+    return text
