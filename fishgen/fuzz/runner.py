@@ -1,7 +1,7 @@
 """Run fuzz cases in persistent worker processes under a memory and time budget.
 
-Each worker is forked once, imports everything, loads the seed corpus, then lowers its own
-address-space limit (``RLIMIT_AS``) and serves batches of case indices: it regenerates each
+Each worker is started once (from a fork server), imports everything, loads the seed corpus,
+then lowers its own address-space limit (``RLIMIT_AS``) and serves batches of case indices: it regenerates each
 case from ``(seed, target, index)``, runs it in-process with a per-case timer, and sends back
 counts and findings. The parent is a watchdog: a worker that stops making progress (a hang
 in C code the timer cannot interrupt) is killed and restarted, and a worker that dies (the
@@ -191,7 +191,10 @@ def run(targets: list[str], *, seed: int = 0, minutes: float | None = None,
     next_index = {t: 0 for t in targets}
     requeued: dict[str, deque[int]] = {t: deque() for t in targets}
     deadline = time.monotonic() + minutes * 60 if minutes is not None else None
-    ctx = mp.get_context("fork")
+    # A fork server, not fork: the caller may hold threads (pytest with playwright's browser), and a
+    # child forked from a threaded process can deadlock on a lock another thread held.
+    ctx = mp.get_context("forkserver")
+    ctx.set_forkserver_preload(["fishgen.fuzz.runner"])
     root = Path(tempfile.mkdtemp(prefix="fishgen-fuzz-"))
     workers = [_Worker(ctx, corpus, budget_mb << 20, root, j) for j in range(max(1, jobs))]
     started = time.monotonic()

@@ -16,7 +16,7 @@ from tests.clients.matrix import ROOT, Matrix, write_report
 _STATE: dict = {}
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")  # closed before other packages' browser tests start their own playwright
 def matrix(tmp_path_factory):
     start = time.perf_counter()
     m = Matrix(tmp_path_factory.mktemp("clients"))
