@@ -1,8 +1,8 @@
 """Run fuzz cases in persistent worker processes under a memory and time budget.
 
 Each worker is started once (from a fork server), imports everything, loads the seed corpus,
-then lowers its own address-space limit (``RLIMIT_AS``) and serves batches of case indices: it regenerates each
-case from ``(seed, target, index)``, runs it in-process with a per-case timer, and sends back
+then lowers its own address-space limit (``RLIMIT_AS``) and serves batches of case indices: it
+regenerates each case from ``(seed, target, index)``, runs it in-process with a per-case timer, and sends back
 counts and findings. The parent is a watchdog: a worker that stops making progress (a hang
 in C code the timer cannot interrupt) is killed and restarted, and a worker that dies (the
 kernel's OOM killer, a crash under the memory limit) is a finding as well.
