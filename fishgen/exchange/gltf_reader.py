@@ -368,21 +368,30 @@ class _Reader:
             if not length <= len(self.blob) <= length + 3:
                 raise _fail(f"a GLB BIN chunk of {length:,} bytes for {where}", f"{len(self.blob):,} bytes")
             return
+        found = self._sized_uri(uri, where, "a buffer")
+        if found is None:
+            return
+        target, size = found
+        if size != length:
+            raise _fail(f"{length:,} bytes in {describe(uri)} ({where}.byteLength)", f"{size:,} bytes")
+        self._files[k] = target
+
+    def _sized_uri(self, uri: Any, where: str, what: str) -> tuple[Path, int] | None:
+        """Check a buffer's or image's URI against the caps by its length or its file's stat size,
+        before anything is read: (side file, size), or None for an inline data: URI."""
         if not isinstance(uri, str):
             raise _fail(f"a URI string at {where}.uri", _show(uri))
         if uri.strip().startswith("data:"):
             if len(uri) > MAX_DATA_URI_CHARS:
                 raise _fail(f"a data URI of at most {size_text(MAX_DATA_URI_CHARS)} at {where}",
                             size_text(len(uri)))
-            return
+            return None
         target = self._side(uri)
         size = target.stat().st_size
         if size > MAX_FILE_BYTES:
-            raise _fail(f"a buffer file of at most {size_text(MAX_FILE_BYTES)} at {where}",
+            raise _fail(f"{what} file of at most {size_text(MAX_FILE_BYTES)} at {where}",
                         f"{describe(uri)} of {size_text(size)}")
-        if size != length:
-            raise _fail(f"{length:,} bytes in {describe(uri)} ({where}.byteLength)", f"{size:,} bytes")
-        self._files[k] = target
+        return target, size
 
     def _side(self, uri: str) -> Path:
         if self.asset is None:  # GLB bytes from memory have no folder to take side files from
@@ -460,17 +469,7 @@ class _Reader:
         if (uri is None) == (view is None):
             raise _fail(f"either a uri or a bufferView at {where}", "both" if view is not None else "neither")
         if uri is not None:
-            if not isinstance(uri, str):
-                raise _fail(f"a URI string at {where}.uri", _show(uri))
-            if uri.strip().startswith("data:"):
-                if len(uri) > MAX_DATA_URI_CHARS:
-                    raise _fail(f"a data URI of at most {size_text(MAX_DATA_URI_CHARS)} at {where}",
-                                size_text(len(uri)))
-            else:
-                size = self._side(uri).stat().st_size
-                if size > MAX_FILE_BYTES:
-                    raise _fail(f"an image file of at most {size_text(MAX_FILE_BYTES)} at {where}",
-                                f"{describe(uri)} of {size_text(size)}")
+            self._sized_uri(uri, where, "an image")
 
     def _texture_ref(self, info: Any, where: str) -> int | None:
         if info is None:
