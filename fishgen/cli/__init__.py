@@ -19,6 +19,8 @@ COMMANDS = {
     "preview": ("fishgen.cli.preview", "preview",
                 "Render inputs or assets to PNG, contact sheets or swim loops."),
     "view": ("fishgen.cli.view", "view", "Open an asset in a self-contained three.js viewer page."),
+    "school": ("fishgen.cli.school", "school",
+               "Simulate a fish school and bake it into an animated glb, tracks and measures."),
 }
 
 

@@ -19,6 +19,8 @@ from fishgen.errors import FishgenError
 from fishgen.scene.model import Primitive, Scene
 
 GLB_LIMIT = 2**32 - 1
+SHARED_ARRAY_BYTES = 1 << 16
+"""Arrays up to this size are looked up before they are stored, so identical ones are stored once."""
 _COMPONENT = {np.dtype(np.float32): gl.FLOAT, np.dtype(np.uint8): gl.UNSIGNED_BYTE,
               np.dtype(np.uint16): gl.UNSIGNED_SHORT, np.dtype(np.uint32): gl.UNSIGNED_INT,
               np.dtype(np.int8): gl.BYTE, np.dtype(np.int16): gl.SHORT}
@@ -34,6 +36,8 @@ class _Buffer:
         self.gltf, self.where = gltf, where
         self.pieces: list[bytes | memoryview] = []
         self.length = 0
+        # Identical arrays are stored once: a school's fish share fin keys and key times.
+        self._known: dict[tuple, int] = {}
 
     def view(self, payload: bytes | memoryview, target: int | None = None, stride: int | None = None) -> int:
         pad = -self.length % 4
@@ -54,6 +58,11 @@ class _Buffer:
         array = np.ascontiguousarray(array)
         if array.dtype == np.float64:
             array = array.astype(np.float32)
+        identity: tuple | None = None
+        if array.nbytes <= SHARED_ARRAY_BYTES:  # big arrays are never repeated; don't copy them to look
+            identity = (array.dtype.str, array.shape, target, bounds, normalized, mat4, array.tobytes())
+            if identity in self._known:
+                return self._known[identity]
         if array.dtype.kind == "f" and not np.all(np.isfinite(array)):
             raise FishgenError("expected finite numbers in every array, found NaN or infinity",
                                self.where)
@@ -73,6 +82,8 @@ class _Buffer:
             acc.min = [v.item() for v in flat.min(axis=0)]
             acc.max = [v.item() for v in flat.max(axis=0)]
         self.gltf.accessors.append(acc)
+        if identity is not None:
+            self._known[identity] = len(self.gltf.accessors) - 1
         return len(self.gltf.accessors) - 1
 
 
@@ -137,15 +148,18 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[gl.GLTF2,
 
     for clip in scene.clips:
         anim = gl.Animation(name=clip.name)
+        samplers: dict[tuple[int, int, str], int] = {}
         for ch in clip.channels:
             smp = ch.sampler
             times = buf.accessor(np.asarray(smp.times, np.float32).ravel(), bounds=True)
             values = np.asarray(smp.values, np.float32)
             if ch.path == "weights":
                 values = values.ravel()  # glTF: SCALAR, (keys x targets) values
-            anim.samplers.append(gl.AnimationSampler(input=times, output=buf.accessor(values),
-                                                     interpolation=smp.interpolation))
-            anim.channels.append(gl.AnimationChannel(sampler=len(anim.samplers) - 1,
+            key = (times, buf.accessor(values), smp.interpolation)
+            if key not in samplers:  # channels with the same keys share one sampler
+                anim.samplers.append(gl.AnimationSampler(input=key[0], output=key[1], interpolation=key[2]))
+                samplers[key] = len(anim.samplers) - 1
+            anim.channels.append(gl.AnimationChannel(sampler=samplers[key],
                                                      target=gl.AnimationChannelTarget(node=ch.node,
                                                                                       path=ch.path)))
         gltf.animations.append(anim)

@@ -149,5 +149,7 @@ register_format(Format("npy", (".npy",), "NumPy structured array of particles", 
 register_format(Format("species", (".txt",), "a VRFish species file",
                        frozenset({MESHES, TEXTURES, NODE_ANIMATION}),
                        reader="fishgen.assembly.fish:species_scene", command="build"))
+register_format(Format("school scene", (".toml",), "a school scene file", frozenset({MESHES, NODE_ANIMATION}),
+                       command="school"))
 register_format(Format("cubes", (".awn",), "a RekAwan cloud cube file", frozenset({POINTS}),
                        reader="fishgen.clouds.scene:cube_file_scene", command="clouds"))

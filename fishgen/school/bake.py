@@ -1,0 +1,126 @@
+"""Bake simulated tracks into one animated scene: shared meshes, one node per fish, one clip.
+
+Each species is built once by the same code as `fishgen build`; its meshes, materials
+and texture are shared by all its fish. A fish is a node (translation and rotation
+keys for the whole run, its size as a constant scale) whose children are the species'
+parts; its moving fins swing for the whole run, phase-shifted per fish, keyed at
+their turning points so a fin costs a few keys per cycle. Position and rotation keys
+are thinned per fish to the longest step whose linear interpolation stays within
+``tolerance`` (metres, and the matching angle at one body length) of every frame.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from fishgen.scene.model import Channel, Clip, Node, Sampler, Scene
+from fishgen.scene.pose import sample
+from fishgen.school.model import Tracks
+
+STEPS = (2, 3, 4, 6, 8, 12, 16, 24, 30)
+"""Key spacings tried, in frames; the longest is a one-second horizon at 30 fps."""
+FIN_PHASES = 16
+"""Distinct fin phases per species: fish sharing one share its fin keys in the file, and 16 phases
+already keep neighbours from beating in step."""
+
+
+def merge_species(school: Scene, fish: Scene) -> list[tuple[Node, int | None]]:
+    """Add one built fish's meshes, materials and images to ``school``; return its part nodes
+    (as templates with re-indexed meshes) and the index of each part's swim channel."""
+    image_base, material_base, mesh_base = len(school.images), len(school.materials), len(school.meshes)
+    school.images += fish.images
+    for material in fish.materials:
+        texture = None if material.texture is None else material.texture + image_base
+        school.materials.append(replace(material, texture=texture))
+    for mesh in fish.meshes:
+        prims = [replace(p, material=None if p.material is None else p.material + material_base)
+                 for p in mesh.primitives]
+        school.meshes.append(replace(mesh, primitives=prims))
+    (root,) = fish.roots
+    swim = fish.clip("swim")
+    channel_of = {c.node: k for k, c in enumerate(swim.channels)} if swim is not None else {}
+    parts = []
+    for child in fish.nodes[root].children:
+        node = fish.nodes[child]
+        parts.append((replace(node, children=[], mesh=None if node.mesh is None else node.mesh + mesh_base),
+                      channel_of.get(child)))
+    return parts
+
+
+def reduce_keys(values: np.ndarray, tolerance: float) -> list[np.ndarray]:
+    """Per fish, the frame indices to keep: the longest uniform step of STEPS whose linear
+    interpolation reproduces every frame of ``values`` (F, N, W) within ``tolerance``."""
+    frames, count = values.shape[:2]
+    best = np.ones(count, np.int64)
+    values = values.astype(np.float32)
+    for step in [s for s in STEPS if s < frames]:
+        keys = np.unique(np.append(np.arange(0, frames, step), frames - 1))
+        t = np.arange(frames)
+        k1 = np.clip(np.searchsorted(keys, t, side="right"), 1, len(keys) - 1)
+        a, b = keys[k1 - 1], keys[k1]
+        w = ((t - a) / np.maximum(b - a, 1))[:, None, None]
+        approx = values[a] * (1 - w) + values[b] * w
+        error = np.square(approx - values).sum(axis=2).max(axis=0)
+        best = np.where(error <= tolerance * tolerance, step, best)
+    return [np.unique(np.append(np.arange(0, frames, s), frames - 1)) for s in best]
+
+
+def _fin_keys(channel: Channel, phase: float, duration: float) -> tuple[np.ndarray, np.ndarray]:
+    """A fin's swing keys (the turning points of its cycle) shifted by ``phase`` seconds and
+    repeated to cover [0, duration], with the exact pose at both ends."""
+    times = np.asarray(channel.sampler.times, np.float64)
+    values = np.asarray(channel.sampler.values, np.float64)
+    period = float(times[-1])
+    if period <= 0 or len(times) < 2:
+        return np.array([0.0]), values[:1]
+    laps = int(np.ceil((duration + phase) / period)) + 1
+    all_t = (times[None, :-1] + period * np.arange(laps)[:, None]).ravel() - phase
+    all_v = np.tile(values[:-1], (laps, 1))
+    inside = (all_t > 0) & (all_t < duration)
+    ends = [sample(channel, (edge + phase) % period) for edge in (0.0, duration)]
+    return (np.concatenate([[0.0], all_t[inside], [duration]]),
+            np.concatenate([ends[0][None], all_v[inside], ends[1][None]]))
+
+
+def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, seed: int = 0,
+         body_lengths: np.ndarray | None = None) -> Scene:
+    """One scene of every fish of ``tracks``; ``fish_scenes[g]`` is the built fish of group ``g``."""
+    school = Scene(name="school", info={"kind": "school", "fish": int(len(tracks.group))})
+    templates = [merge_species(school, fish) for fish in fish_scenes]
+    swims = [fish.clip("swim") for fish in fish_scenes]
+    times = np.asarray(tracks.times, np.float64)
+    duration = float(times[-1]) if len(times) else 0.0
+    rng = np.random.default_rng(seed)
+    # A rotation error of e radians moves a point one body length away by about e body lengths.
+    reach = np.ones(len(tracks.group)) if body_lengths is None else np.asarray(body_lengths, np.float64)
+    position_keys = reduce_keys(tracks.positions, tolerance)
+    rotation_keys = reduce_keys(tracks.headings * reach[None, :, None], tolerance)
+    channels: list[Channel] = []
+    fin_samplers: dict[tuple[int, int, int], Sampler] = {}
+    for i, group in enumerate(np.asarray(tracks.group)):
+        size = float(tracks.scale[i])
+        x, y, z = (float(v) for v in tracks.positions[0, i])
+        qx, qy, qz, qw = (float(v) for v in tracks.headings[0, i])
+        node = school.add_node(Node(name=f"{fish_scenes[group].name}_{i:05d}", scale=(size, size, size),
+                                    translation=(x, y, z), rotation=(qx, qy, qz, qw)))
+        keys = position_keys[i]
+        channels.append(Channel(node, "translation", Sampler(times[keys].astype(np.float32),
+                                                             tracks.positions[keys, i].astype(np.float32))))
+        keys = rotation_keys[i]
+        channels.append(Channel(node, "rotation", Sampler(times[keys].astype(np.float32),
+                                                          tracks.headings[keys, i].astype(np.float32))))
+        swim = swims[group]
+        phase = int(rng.integers(FIN_PHASES))
+        for template, channel_index in templates[group]:
+            part = school.add_node(replace(template, children=[]), parent=node)
+            if channel_index is not None and swim is not None and duration > 0:
+                key = (int(group), channel_index, phase)
+                if key not in fin_samplers:
+                    shift = swim.duration * phase / FIN_PHASES
+                    t, v = _fin_keys(swim.channels[channel_index], shift, duration)
+                    fin_samplers[key] = Sampler(t.astype(np.float32), v.astype(np.float32))
+                channels.append(Channel(part, "rotation", fin_samplers[key]))
+    if duration > 0:
+        school.clips.append(Clip("school", channels))
+    return school

@@ -1,0 +1,261 @@
+"""School scene files (TOML): species and counts, model parameters, bounds, target, predator, layout.
+
+    model = "boids"            # or "pso"
+    frames = 300
+    fps = 30
+    seed = 1
+    bounds = [[-4, -1.5, -4], [4, 1.5, 4]]
+    layout = "sphere"          # sphere | box | line
+
+    [[species]]
+    file = "bonybream.txt"     # relative to this file
+    count = 60
+    speed = 1.0                # cruising speed, body lengths per second
+
+    [target]                   # the pso school's target
+    path = "circle"            # circle | figure8 | spline | a CSV of t,x,y,z
+    radius = 3.0
+    period = 20.0
+
+    [predator]                 # optional: fish flee it (flee_info of their species file)
+    path = "figure8"
+
+    [pso]                      # the particle swarm's weights (2017 report, Figure 2.2)
+    inertia = 0.7
+
+Every mistake is one ``FILE:LINE: expected ..., found ...`` line; absurd sizes are refused
+before anything is allocated.
+"""
+from __future__ import annotations
+
+import math
+import os
+import re
+import sys
+from dataclasses import dataclass, fields, replace
+from pathlib import Path
+from typing import Any
+
+from fishgen.errors import FishgenError, describe
+from fishgen.school.model import MODELS, PsoParams, TargetPath
+
+MAX_FISH = 100_000
+MAX_FRAMES = 100_000
+MAX_FISH_FRAMES = 2 * 10**8
+"""Fish x frames: 10,000 fish x 1,000 frames is 10^7 (about 1 GB of tracks at 2 x 10^8)."""
+MAX_SCENE_BYTES = 1 << 20
+LAYOUTS = ("sphere", "box", "line")
+PATHS = ("circle", "figure8", "spline", "none")
+
+
+@dataclass(frozen=True)
+class SpeciesEntry:
+    file: Path
+    count: int
+    speed: float = 1.0
+
+
+@dataclass(frozen=True)
+class SceneFile:
+    """What a scene file (or the command line alone) asks for; the CLI's flags override it."""
+
+    species: tuple[SpeciesEntry, ...] = ()
+    model: str = "boids"
+    frames: int = 300
+    fps: float = 30.0
+    seed: int = 0
+    bounds: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
+    layout: str = "sphere"
+    target: TargetPath = TargetPath()
+    predator: TargetPath | None = None
+    pso: PsoParams = PsoParams()
+
+
+class _Where:
+    """Line numbers of keys in the TOML text, for messages (tomllib keeps none)."""
+
+    def __init__(self, text: str, file: str):
+        self.lines = text.splitlines()
+        self.file = file
+
+    def line(self, key: str, table: str | None = None, nth: int = 0) -> int | None:
+        section, count = None, -1
+        for number, raw in enumerate(self.lines, 1):
+            stripped = raw.strip()
+            header = re.match(r"^\[\[?\s*([A-Za-z_.]+)\s*\]\]?", stripped)
+            if header:
+                section = header[1]
+                if section == table:
+                    count += 1
+                continue
+            if section == table and (table is None or count == nth) and re.match(
+                    rf"^{re.escape(key)}\s*=", stripped):
+                return number
+        return None
+
+    def fail(self, what: str, found: Any, key: str, table: str | None = None, nth: int = 0) -> FishgenError:
+        plain = isinstance(found, str) and found.startswith(("a ", "an ", "no "))
+        shown = found if plain else describe(str(found))
+        return FishgenError(f"expected {what}, found {shown}", self.file, self.line(key, table, nth))
+
+
+def _number(where: _Where, value: Any, key: str, low: float, high: float, table: str | None = None,
+            nth: int = 0, whole: bool = False) -> Any:
+    kind = "a whole number" if whole else "a number"
+    ok = isinstance(value, int) if whole else isinstance(value, (int, float))
+    if isinstance(value, bool) or not ok or not math.isfinite(value) or not low <= value <= high:
+        raise where.fail(f"{key} as {kind} from {low:g} to {high:g}", value, key, table, nth)
+    return value
+
+
+def _triple(where: _Where, value: Any, key: str, table: str | None = None) -> tuple[float, float, float]:
+    if not (isinstance(value, list) and len(value) == 3):
+        raise where.fail(f"{key} as [x, y, z]", value, key, table)
+    return tuple(float(_number(where, v, key, -1e4, 1e4, table)) for v in value)  # type: ignore[return-value]
+
+
+def _path(where: _Where, data: Any, table: str, folder: Path) -> TargetPath:
+    if not isinstance(data, dict):
+        raise where.fail(f"a [{table}] table", data, table)
+    kind = data.get("path", "circle")
+    known = {"path", "centre", "radius", "period", "seed"}
+    for key in data:
+        if key not in known:
+            raise where.fail(f"one of {', '.join(sorted(known))} in [{table}]", key, key, table)
+    path = TargetPath()
+    if not isinstance(kind, str):
+        raise where.fail(f"path as one of {', '.join(PATHS)} or a CSV file", kind, "path", table)
+    if kind not in PATHS:
+        path = replace(path, kind="points", points=_csv_points(where, folder / kind, table))
+    else:
+        path = replace(path, kind=kind)  # type: ignore[arg-type]
+    if "centre" in data:
+        path = replace(path, centre=_triple(where, data["centre"], "centre", table))
+    if "radius" in data:
+        path = replace(path, radius=float(_number(where, data["radius"], "radius", 0.01, 1e4, table)))
+    if "period" in data:
+        path = replace(path, period=float(_number(where, data["period"], "period", 0.1, 1e6, table)))
+    if "seed" in data:
+        path = replace(path, seed=int(_number(where, data["seed"], "seed", 0, 2**32 - 1, table, whole=True)))
+    return path
+
+
+def _csv_points(where: _Where, path: Path, table: str) -> tuple[tuple[float, float, float, float], ...]:
+    """A path as CSV rows ``t,x,y,z`` (a header row is allowed), times increasing."""
+    if not path.is_file():
+        raise where.fail(f"path as one of {', '.join(PATHS)} or an existing CSV file", path.name, "path",
+                         table)
+    if path.stat().st_size > MAX_SCENE_BYTES * 16:
+        raise FishgenError(f"expected a path CSV of at most {MAX_SCENE_BYTES * 16:,} bytes, "
+                           "found a larger file", path)
+    rows: list[tuple[float, ...]] = []
+    for number, line in enumerate(path.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
+        cells = [c.strip() for c in line.split(",")]
+        if not line.strip():
+            continue
+        try:
+            values = tuple(float(c) for c in cells)
+        except ValueError:
+            if number == 1:
+                continue  # a header row
+            raise FishgenError(f"expected t,x,y,z numbers, found {describe(line)}", path, number) from None
+        if len(values) != 4 or not all(math.isfinite(v) for v in values):
+            raise FishgenError(f"expected 4 finite numbers t,x,y,z, found {describe(line)}", path, number)
+        if rows and values[0] <= rows[-1][0]:
+            raise FishgenError(f"expected increasing times, found {values[0]:g} after {rows[-1][0]:g}", path,
+                               number)
+        rows.append(values)
+    if len(rows) < 2:
+        raise FishgenError(f"expected at least 2 rows t,x,y,z, found {len(rows)}", path)
+    return tuple((r[0], r[1], r[2], r[3]) for r in rows)
+
+
+def load_scene_file(path: str | os.PathLike) -> SceneFile:
+    """Read and check a school scene file."""
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # Python 3.10: the same parser as a package
+        import tomli as tomllib
+
+    path = Path(path)
+    file = os.fspath(path)
+    if path.is_dir():
+        raise FishgenError("expected a scene file, found a directory", path)
+    if not path.is_file():
+        raise FishgenError("expected an existing scene file, found none", path)
+    if path.stat().st_size > MAX_SCENE_BYTES:
+        raise FishgenError(f"expected a scene file of at most {MAX_SCENE_BYTES:,} bytes, found a larger file",
+                           path)
+    text = path.read_bytes().decode("utf-8", errors="replace").removeprefix("\ufeff")
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        match = re.search(r"\(at line (\d+), column \d+\)", str(err))
+        message = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(err)) or "valid TOML"
+        raise FishgenError(f"expected TOML, found {message[0].lower() + message[1:]}", file,
+                           int(match[1]) if match else None) from None
+    where = _Where(text, file)
+    known = {"model", "frames", "fps", "seed", "bounds", "layout", "species", "target", "predator", "pso"}
+    for key in data:
+        if key not in known:
+            raise where.fail(f"one of {', '.join(sorted(known))}", key, key)
+    scene = SceneFile()
+    if "model" in data:
+        if data["model"] not in MODELS:
+            raise where.fail(f"model as one of {', '.join(MODELS)}", data["model"], "model")
+        scene = replace(scene, model=data["model"])
+    if "frames" in data:
+        frames = _number(where, data["frames"], "frames", 2, MAX_FRAMES, whole=True)
+        scene = replace(scene, frames=int(frames))
+    if "fps" in data:
+        scene = replace(scene, fps=float(_number(where, data["fps"], "fps", 1, 1000)))
+    if "seed" in data:
+        scene = replace(scene, seed=int(_number(where, data["seed"], "seed", 0, 2**32 - 1, whole=True)))
+    if "layout" in data:
+        if data["layout"] not in LAYOUTS:
+            raise where.fail(f"layout as one of {', '.join(LAYOUTS)}", data["layout"], "layout")
+        scene = replace(scene, layout=data["layout"])
+    if "bounds" in data:
+        b = data["bounds"]
+        if not (isinstance(b, list) and len(b) == 2):
+            raise where.fail("bounds as [[x0, y0, z0], [x1, y1, z1]]", b, "bounds")
+        lo, hi = _triple(where, b[0], "bounds"), _triple(where, b[1], "bounds")
+        if not all(top - bottom >= 0.1 for bottom, top in zip(lo, hi, strict=True)):
+            raise where.fail("bounds whose max corner exceeds the min by 0.1 m or more", b, "bounds")
+        scene = replace(scene, bounds=(lo, hi))
+    entries = data.get("species", [])
+    if not isinstance(entries, list) or not entries or not all(isinstance(e, dict) for e in entries):
+        raise where.fail("one or more [[species]] tables", "none" if not entries else entries, "species")
+    species = []
+    for k, entry in enumerate(entries):
+        for key in entry:
+            if key not in ("file", "count", "speed"):
+                raise where.fail("file, count or speed in [[species]]", key, key, "species", k)
+        name = entry.get("file")
+        if not isinstance(name, str):
+            raise where.fail("file as a species file name", "no file" if name is None else name, "file",
+                             "species", k)
+        count = int(_number(where, entry.get("count", 50), "count", 1, MAX_FISH, "species", k, whole=True))
+        speed = float(_number(where, entry.get("speed", 1.0), "speed", 0.05, 20, "species", k))
+        species.append(SpeciesEntry(path.parent / name, count, speed))
+    scene = replace(scene, species=tuple(species))
+    if "target" in data:
+        scene = replace(scene, target=_path(where, data["target"], "target", path.parent))
+    if "predator" in data:
+        scene = replace(scene, predator=_path(where, data["predator"], "predator", path.parent))
+    if "pso" in data:
+        pso = data["pso"]
+        if not isinstance(pso, dict):
+            raise where.fail("a [pso] table", pso, "pso")
+        names = {f.name for f in fields(PsoParams)}
+        values = {}
+        for key, value in pso.items():
+            if key not in names:
+                raise where.fail(f"one of {', '.join(sorted(names))} in [pso]", key, key, "pso")
+            values[key] = float(_number(where, value, key, 0, 1e3, "pso"))
+        scene = replace(scene, pso=replace(PsoParams(), **values))
+    total = sum(e.count for e in scene.species)
+    if total > MAX_FISH or total * scene.frames > MAX_FISH_FRAMES:
+        raise where.fail(f"at most {MAX_FISH:,} fish and {MAX_FISH_FRAMES:,} fish x frames",
+                         f"{total:,} fish x {scene.frames:,} frames", "count", "species")
+    return scene

@@ -1,0 +1,462 @@
+"""Simulate a school: VRFish's boids "brain" (Lobb 2002, ch. 7.2) or the 2017 particle swarm.
+
+`simulate(config, progress=None) -> Tracks`. Vectorised numpy over all fish; neighbours from
+scipy's cKDTree, refreshed every few frames (the k nearest change slowly) while all distances are
+recomputed from the current positions every frame, so cost grows about linearly with fish count.
+
+Common kinematics for both models: each model proposes a new velocity; the fish's heading turns
+towards it by at most `config.max_turn * dt` radians, the speed is clamped, the fish moves, a hard
+separation pushes apart any pair closer than `HARD_SEPARATION` mean body lengths (VRFish's fish swim
+through each other, ch. 7.3; ours do not), and positions are kept inside `config.bounds`. The
+velocity always points along the heading, so a fish faces where it swims.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from scipy.spatial import cKDTree  # type: ignore[import-untyped]
+
+from fishgen.school.model import Brain, SchoolConfig, Tracks
+from fishgen.school.paths import path_positions
+
+Progress = Callable[[int], None]
+
+# VRFish Appendix A `urge_weightings` (random center keepaway - speed - direction) and flee weight.
+# The thesis' weights multiply vectors of unrelated magnitudes in its own scene units, so fishgen
+# reads each weight relative to these values: gain = BASE_GAIN * weight / APPENDIX_WEIGHT.
+APPENDIX = Brain()
+APPENDIX_WEIGHTS = dict(random=0.04, center=0.35, keepaway=0.01, speed=0.7, direction=0.0015,
+                        flee=0.04)
+# Base gains (1/s) that make the Appendix A brain school (tuned by the tests' measures).
+GAIN_RANDOM = 0.5
+GAIN_CENTER = 1.0
+GAIN_KEEPAWAY = 8.0
+GAIN_SPEED = 1.0
+GAIN_DIRECTION = 6.0
+GAIN_FLEE = 8.0
+GAIN_BOUNDS = 6.0
+GAIN_OTHER_SPECIES = 6.0
+
+HARD_SEPARATION = 0.6      # mean body lengths: centres never closer (metrics flag < 0.5)
+CONTACT_DISTANCE = 0.8     # mean body lengths: bodies push apart inside this, whatever the brain
+GAIN_CONTACT = 10.0
+OTHER_SPECIES_DISTANCE = 4.0  # body lengths: keep away from other species inside this
+FLEE_SPEEDUP = 1.5         # speed up to (1 + this) x cruise next to a predator
+MIN_SPEED = 0.3            # x cruise (boids) / x max_speed (pso)
+WANDER_VERTICAL = 0.3      # wander points are flattened: fish wander mostly horizontally
+LAYOUT_SPACING = 1.5       # body lengths between start positions
+BOUNDS_MARGIN = 3.0        # body lengths inside the walls where they start to steer fish back
+PSO_REFERENCE_DT = 0.05    # Figure 2.2's time step; inertia is re-timed from it
+PSO_MIN_TURN = 0.25        # x max_turn: the least turn rate a pso fish has next to the target
+SEPARATION_PASSES = 2
+# k-nearest lists are rebuilt every this many frames: (fewer than this many fish, frames)
+NEIGHBOUR_REFRESH = ((500, 1), (5000, 4), (None, 6))
+JITTERED = ("random", "center", "keepaway", "speed", "direction", "flee")
+
+
+def simulate(config: SchoolConfig, progress: Progress | None = None) -> Tracks:
+    """Run `config.frames` frames at `config.fps`; frame 0 is the start layout.
+
+    `progress(frames_done)` is called after each frame when given (frames_done = 1 .. frames).
+    """
+    sim = _Simulation(config)
+    frames = int(config.frames)
+    n = sim.n
+    positions = np.empty((frames, n, 3))
+    velocities = np.empty((frames, n, 3))
+    headings = np.empty((frames, n, 4))
+    times = np.arange(frames, dtype=np.float64) / config.fps
+    target = path_positions(config.target, times) if config.model == "pso" else None
+    predator = path_positions(config.predator, times) if config.predator is not None else None
+    for f in range(frames):
+        if f > 0:
+            sim.step(f, None if target is None else target[f],
+                     None if predator is None else predator[f])
+        positions[f] = sim.pos
+        velocities[f] = sim.vel
+        q = headings_from_velocities(sim.vel)
+        if f > 0:  # keep quaternion signs continuous (q and -q are one rotation)
+            q *= np.where(np.einsum("nk,nk->n", q, headings[f - 1]) < 0, -1.0, 1.0)[:, None]
+        headings[f] = q
+        if progress is not None:
+            progress(f + 1)
+    return Tracks(times=times, positions=positions, velocities=velocities,
+                  headings=headings, group=sim.group.copy(),
+                  scale=sim.scale.copy(), target=target, predator=predator)
+
+
+def headings_from_velocities(velocities: np.ndarray) -> np.ndarray:
+    """Quaternions (x, y, z, w) turning +Z to each velocity with no roll (+Y stays as up as it can).
+
+    q = yaw about +Y then pitch about +X; signs are made continuous frame to frame (q and -q are
+    one rotation, but a sign flip breaks linear key interpolation).
+    """
+    v = np.asarray(velocities, dtype=np.float64)
+    horiz = np.hypot(v[..., 0], v[..., 2])
+    yaw = np.arctan2(v[..., 0], v[..., 2])
+    pitch = np.arctan2(-v[..., 1], horiz)
+    a, b = np.sin(yaw / 2), np.cos(yaw / 2)
+    c, e = np.sin(pitch / 2), np.cos(pitch / 2)
+    q = np.stack([b * c, e * a, -a * c, b * e], axis=-1)
+    if q.ndim == 3 and q.shape[0] > 1:
+        dots = np.einsum("fnk,fnk->fn", q[1:], q[:-1])
+        flips = np.cumprod(np.where(dots < 0, -1.0, 1.0), axis=0)
+        q[1:] *= flips[..., None]
+    return q
+
+
+class _Simulation:
+    def __init__(self, config: SchoolConfig) -> None:
+        _check(config)
+        self.cfg = config
+        self.dt = 1.0 / config.fps
+        rng = self.rng = np.random.default_rng(config.seed)
+        groups = config.groups
+        counts = np.array([g.count for g in groups], dtype=np.int64)
+        self.group = np.repeat(np.arange(len(groups)), counts)
+        self.n = n = int(counts.sum())
+        self.n_groups = len(groups)
+        j = float(config.jitter)
+        self.scale = np.clip(1.0 + j * rng.standard_normal(n), 1.0 - 3 * j, 1.0 + 3 * j)
+        base_len = np.array([g.body_length for g in groups], dtype=np.float64)
+        self.length = base_len[self.group] * self.scale
+        self.cruise = np.array([g.cruise_speed for g in groups])[self.group] * self.length
+        # per-fish brain: weights relative to Appendix A, each jittered
+        w = {}
+        for name in JITTERED:
+            if name == "flee":
+                raw = np.array([g.brain.flee[0] for g in groups])
+            else:
+                raw = np.array([getattr(g.brain, name) for g in groups])
+            factor = np.clip(1.0 + j * rng.standard_normal(n), 0.0, None)
+            w[name] = raw[self.group] / APPENDIX_WEIGHTS[name] * factor
+        self.w = w
+        self.repel = np.array([g.brain.repel_distance for g in groups])[self.group] * self.length
+        self.flee_dist = np.array([g.brain.flee[1] for g in groups])[self.group] * self.length
+        cr = np.array([g.brain.change_rate for g in groups])[self.group]
+        self.change_rate = np.maximum(1.0, cr * np.clip(1.0 + j * rng.standard_normal(n), 0.5, 1.5))
+        self.lo = np.asarray(config.bounds[0], dtype=np.float64)
+        self.hi = np.asarray(config.bounds[1], dtype=np.float64)
+        self.pos = self._layout(rng)
+        d = _random_units(rng, n, vertical=WANDER_VERTICAL)
+        if config.model == "pso":
+            speed = 0.1 * config.pso.max_speed * self.length   # Figure 2.2: InitialSpeed 0.1 of 0-1
+        else:
+            speed = self.cruise.copy()
+        self.dir = d
+        self.vel = d * speed[:, None]
+        # wander spline state: previous and next random point (as directions), phase in frames
+        self.w_prev = d.copy()
+        self.w_next = _random_units(rng, n, vertical=WANDER_VERTICAL)
+        self.w_phase = rng.uniform(0.0, 1.0, n) * self.change_rate
+        self.fallback = _random_units(rng, n, vertical=1.0)  # push-apart direction for coincident fish
+        self.refresh = next(r for limit, r in NEIGHBOUR_REFRESH if limit is None or n < limit)
+        self.k = max(1, min(int(config.neighbours), n - 1)) if n > 1 else 0
+        self._neighbours()
+        for _ in range(4):
+            self._separate()
+        self._clamp()
+
+    # ----------------------------------------------------------------- start layout
+    def _layout(self, rng: np.random.Generator) -> np.ndarray:
+        cfg, n = self.cfg, self.n
+        lo, hi = self.lo, self.hi
+        extent = hi - lo
+        centre = (lo + hi) / 2
+        pos = np.empty((n, 3))
+        for g, group in enumerate(cfg.groups):
+            sel = self.group == g
+            m = int(sel.sum())
+            if m == 0:
+                continue
+            spacing = LAYOUT_SPACING * group.body_length
+            gc = centre.copy()
+            if self.n_groups > 1:  # each species starts in its own place along X
+                gc[0] = lo[0] + (g + 0.5) * extent[0] / self.n_groups
+            room = extent / (2 * max(1, self.n_groups) if cfg.layout != "box" else 2)
+            if cfg.layout == "sphere":
+                r = spacing * np.cbrt(3.0 * m / (4.0 * np.pi))
+                r = min(r, 0.45 * float(np.min(extent)), 0.9 * float(room[0]))
+                u = _random_units(rng, m, vertical=1.0)
+                pos[sel] = gc + u * (r * np.cbrt(rng.uniform(0.0, 1.0, m)))[:, None]
+            elif cfg.layout == "box":
+                inset = np.minimum(group.body_length, 0.25 * extent)
+                sub_lo, sub_hi = lo + inset, hi - inset
+                if self.n_groups > 1:
+                    sub_lo = sub_lo.copy()
+                    sub_hi = sub_hi.copy()
+                    sub_lo[0] = lo[0] + g * extent[0] / self.n_groups + inset[0]
+                    sub_hi[0] = lo[0] + (g + 1) * extent[0] / self.n_groups - inset[0]
+                pos[sel] = rng.uniform(sub_lo, sub_hi, (m, 3))
+            else:  # line along X (or along Z per species when there are several)
+                axis = 0 if self.n_groups == 1 else 2
+                width = min(m * spacing, 0.9 * float(extent[axis]))
+                p = np.tile(gc, (m, 1))
+                p[:, axis] += np.linspace(-width / 2, width / 2, m)
+                p += rng.normal(0.0, 0.05 * spacing, (m, 3))
+                pos[sel] = p
+        return np.clip(pos, lo, hi)
+
+    # ----------------------------------------------------------------- neighbours
+    def _neighbours(self) -> None:
+        """k nearest same-species (`nb`), 4 nearest of any species (`near`), nearest other species."""
+        n, pos = self.n, self.pos
+        self.nb = np.zeros((n, max(self.k, 1)), dtype=np.int64)
+        self.nb_ok = np.zeros((n, max(self.k, 1)), dtype=bool)
+        self.other = None
+        if n < 2:
+            self.near = np.zeros((n, 1), dtype=np.int64)
+            self.near_ok = np.zeros((n, 1), dtype=bool)
+            self.near_need = np.zeros((n, 1))
+            return
+        m = min(4, n - 1)
+        tree = cKDTree(pos)
+        k_all = max(self.k, m) if self.n_groups == 1 else m
+        _, idx = tree.query(pos, k=k_all + 1, workers=-1)
+        idx = idx[:, 1:]  # drop self (nearest; coincident fish are separated beforehand)
+        self.near = np.ascontiguousarray(idx[:, :m])
+        self.near_ok = idx[:, :m] != np.arange(n)[:, None]
+        self.near_need = HARD_SEPARATION * 0.5 * (self.length[:, None] + self.length[self.near])
+        if self.n_groups == 1:
+            self.nb = np.ascontiguousarray(idx[:, : self.k])
+            self.nb_ok = self.nb != np.arange(n)[:, None]
+            return
+        other = np.full(n, -1, dtype=np.int64)
+        other_d = np.full(n, np.inf)
+        for g in range(self.n_groups):
+            members = np.flatnonzero(self.group == g)
+            if members.size == 0:
+                continue
+            t = cKDTree(pos[members])
+            kk = min(self.k + 1, members.size)
+            _, li = t.query(pos[members], k=kk, workers=-1)
+            li = li.reshape(members.size, kk)[:, 1:]
+            got = li.shape[1]
+            self.nb[members, :got] = members[li]
+            self.nb_ok[members, :got] = members[li] != members[:, None]
+            outsiders = np.flatnonzero(self.group != g)
+            if outsiders.size:
+                dd, oi = t.query(pos[outsiders], k=1, workers=-1)
+                better = dd < other_d[outsiders]
+                other[outsiders[better]] = members[oi[better]]
+                other_d[outsiders[better]] = dd[better]
+        self.other = other
+
+    # ----------------------------------------------------------------- one step
+    def step(self, frame: int, target: np.ndarray | None, predator: np.ndarray | None) -> None:
+        if self.n == 0:
+            return
+        if frame % self.refresh == 0:
+            self._neighbours()
+        # from each of the few nearest fish (any species) to me, and how far: shared by the urges
+        self.near_off = self.pos[:, None, :] - np.take(self.pos, self.near, axis=0)
+        self.near_dist = np.sqrt(np.einsum("nkc,nkc->nk", self.near_off, self.near_off))
+        max_turn: np.ndarray | float
+        if self.cfg.model == "pso":
+            new_vel, max_turn, v_min, v_max = self._pso(target)
+        else:
+            new_vel, max_turn, v_min, v_max = self._boids()
+        acc = self._bounds_accel() + self._other_species_accel() + self._contact_accel()
+        flee_boost = np.zeros(self.n)
+        if predator is not None:
+            fa, flee_boost = self._flee_accel(predator)
+            acc += fa
+        new_vel += acc * self.dt
+        v_max = v_max * (1.0 + FLEE_SPEEDUP * flee_boost)
+        self.dir = _turn_towards(self.dir, new_vel, max_turn * self.dt)
+        speed = np.clip(np.linalg.norm(new_vel, axis=1), v_min, v_max)
+        if predator is not None:  # fleeing fish speed up
+            fast = np.minimum(v_max, self.cruise * (1.0 + FLEE_SPEEDUP * flee_boost))
+            speed = np.where(flee_boost > 0, np.maximum(speed, fast), speed)
+        self.vel = self.dir * speed[:, None]
+        self.pos = self.pos + self.vel * self.dt
+        for _ in range(SEPARATION_PASSES):
+            self._separate()
+        self._clamp()
+
+    def _boids(self) -> tuple[np.ndarray, np.ndarray | float, np.ndarray, np.ndarray]:
+        pos, d, v, w, L = self.pos, self.dir, self.vel, self.w, self.length
+        cruise = self.cruise
+        perception = self.cfg.perception * L
+        acc = np.zeros_like(pos)
+        if self.n > 1:
+            off = np.take(pos, self.nb, axis=0)                       # (N, k, 3)
+            off -= pos[:, None, :]
+            dist = np.sqrt(np.einsum("nkc,nkc->nk", off, off))
+            seen = self.nb_ok & (dist < perception[:, None])
+            cnt = seen.sum(axis=1)
+            has = cnt > 0
+            inv = (has / np.maximum(cnt, 1))[:, None]
+            seenf = seen.astype(np.float64)
+            # cohesion: towards the centre of the perceived school-mates, in body lengths, capped
+            coh = np.einsum("nk,nkc->nc", seenf, off) * (inv / L[:, None])
+            cn = np.sqrt(np.einsum("nc,nc->n", coh, coh))
+            acc += ((GAIN_CENTER * w["center"] * cruise) / np.maximum(cn, 1.0))[:, None] * coh
+            # alignment: towards their mean heading
+            mean_dir = np.einsum("nk,nkc->nc", seenf, np.take(d, self.nb, axis=0)) * inv
+            acc += (GAIN_DIRECTION * w["direction"] * cruise)[:, None] * (mean_dir - d * has[:, None])
+            # keepaway: inside the repel distance, away, stronger the closer (any species)
+            acc += (GAIN_KEEPAWAY * w["keepaway"] * cruise)[:, None] * self._keepaway(self.repel)
+        # keep own velocity: relax towards cruising speed along the heading
+        acc += (GAIN_SPEED * w["speed"])[:, None] * (d * cruise[:, None] - v)
+        # wander spline
+        acc += (GAIN_RANDOM * w["random"] * cruise)[:, None] * (self._wander() - d)
+        new_vel = v + acc * self.dt
+        return new_vel, self.cfg.max_turn, MIN_SPEED * cruise, cruise * 2.0
+
+    def _keepaway(self, radius: np.ndarray) -> np.ndarray:
+        off, dist = self.near_off, self.near_dist
+        strength = np.clip(1.0 - dist / radius[:, None], 0.0, None) * self.near_ok
+        return np.einsum("nk,nkc->nc", strength / np.maximum(dist, 1e-12), off)
+
+    def _wander(self) -> np.ndarray:
+        """A point on each fish's wander spline (as a direction); new random point every change_rate."""
+        self.w_phase += 1.0
+        due = self.w_phase >= self.change_rate
+        if due.any():
+            idx = np.flatnonzero(due)
+            self.w_phase[idx] -= self.change_rate[idx]
+            self.w_prev[idx] = self.w_next[idx]
+            self.w_next[idx] = _random_units(self.rng, idx.size, vertical=WANDER_VERTICAL)
+        h = np.clip(self.w_phase / self.change_rate, 0.0, 1.0)
+        h = (h * h * (3.0 - 2.0 * h))[:, None]
+        u = (1.0 - h) * self.w_prev + h * self.w_next
+        return u / np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-9)
+
+    def _pso(self, target: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        p = self.cfg.pso
+        pos, v, L, rng = self.pos, self.vel, self.length, self.rng
+        n = self.n
+        assert target is not None
+        to_t = pos - target
+        dist_t = np.linalg.norm(to_t, axis=1)
+        # global best per species: the fish nearest the target; the leader itself seeks the target
+        best = np.empty((n, 3))
+        for g in range(self.n_groups):
+            members = np.flatnonzero(self.group == g)
+            if members.size == 0:
+                continue
+            lead = members[np.argmin(dist_t[members])]
+            best[members] = pos[lead]
+            best[lead] = target
+        r = rng.uniform(0.0, 1.0, (n, 3))
+        force = np.zeros((n, 3))
+        if n > 1:
+            x1 = pos[self.near[:, 0]]
+            away = pos - x1
+            d1 = np.linalg.norm(away, axis=1)
+            inside = (d1 < p.repulsion_radius * L) & self.near_ok[:, 0]
+            slow = np.where(inside, p.slowdown, 1.0)
+            unit = away / np.maximum(d1, 1e-12)[:, None]
+            force += (inside * p.repulsion * r[:, 1] * L)[:, None] * unit
+            second = self.nb[:, 1] if self.nb.shape[1] > 1 else self.nb[:, 0]
+            ok2 = self.nb_ok[:, 1] if self.nb.shape[1] > 1 else self.nb_ok[:, 0]
+            force += (slow * p.attraction * r[:, 2] * ok2)[:, None] * (pos[second] - pos)
+        else:
+            slow = np.ones(n)
+        force += (slow * p.global_weight * r[:, 0])[:, None] * (best - pos)
+        w_eff = p.inertia ** (self.dt / PSO_REFERENCE_DT)
+        gain = (1.0 - w_eff) / (1.0 - p.inertia) if p.inertia < 1.0 else self.dt / PSO_REFERENCE_DT
+        new_vel = w_eff * v + gain * force
+        max_turn = np.clip(p.turn_rate * dist_t, PSO_MIN_TURN * self.cfg.max_turn, self.cfg.max_turn)
+        v_max = p.max_speed * L
+        return new_vel, max_turn, MIN_SPEED * 0.5 * v_max, v_max
+
+    # ----------------------------------------------------------------- shared urges
+    def _bounds_accel(self) -> np.ndarray:
+        margin = np.minimum(BOUNDS_MARGIN * self.length[:, None], 0.25 * (self.hi - self.lo))
+        below = np.clip((self.lo + margin - self.pos) / margin, 0.0, 1.0)
+        above = np.clip((self.pos - (self.hi - margin)) / margin, 0.0, 1.0)
+        return (GAIN_BOUNDS * self.cruise)[:, None] * (below - above) * 2.0
+
+    def _other_species_accel(self) -> np.ndarray:
+        if self.other is None:
+            return np.zeros_like(self.pos)
+        ok = self.other >= 0
+        off = self.pos - self.pos[np.where(ok, self.other, 0)]
+        dist = np.linalg.norm(off, axis=1)
+        radius = OTHER_SPECIES_DISTANCE * self.length
+        strength = np.clip(1.0 - dist / radius, 0.0, None) * ok * self.w["keepaway"]
+        unit = off / np.maximum(dist, 1e-12)[:, None]
+        return (GAIN_OTHER_SPECIES * self.cruise * strength)[:, None] * unit
+
+    def _contact_accel(self) -> np.ndarray:
+        """Bodies that nearly touch push apart (any species, any brain): the swim-through fix."""
+        if self.n < 2:
+            return np.zeros_like(self.pos)
+        off, dist = self.near_off, self.near_dist
+        reach = self.near_need * (CONTACT_DISTANCE / HARD_SEPARATION)
+        strength = np.clip(1.0 - dist / reach, 0.0, None) * self.near_ok / np.maximum(dist, 1e-12)
+        return (GAIN_CONTACT * self.cruise)[:, None] * np.einsum("nk,nkc->nc", strength, off)
+
+    def _flee_accel(self, predator: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        off = self.pos - predator
+        dist = np.linalg.norm(off, axis=1)
+        near = np.clip(1.0 - dist / np.maximum(self.flee_dist, 1e-12), 0.0, 1.0)
+        near = near * (self.w["flee"] > 0)
+        unit = off / np.maximum(dist, 1e-12)[:, None]
+        acc = (GAIN_FLEE * self.w["flee"] * self.cruise * near)[:, None] * unit
+        return acc, np.sqrt(near)
+
+    # ----------------------------------------------------------------- constraints
+    def _separate(self) -> None:
+        """Push apart pairs closer than HARD_SEPARATION mean body lengths (each side moves half)."""
+        if self.n < 2:
+            return
+        pos = self.pos
+        off = pos[:, None, :] - np.take(pos, self.near, axis=0)     # from neighbour to me
+        dist = np.sqrt(np.einsum("nkc,nkc->nk", off, off))
+        short = np.clip(self.near_need - dist, 0.0, None) * self.near_ok
+        if not short.any():
+            return
+        tiny = dist < 1e-9
+        scale = short / np.maximum(dist, 1e-12)
+        push = np.einsum("nk,nkc->nc", scale, off)
+        if tiny.any():  # coincident fish: each goes its own fixed random way
+            push += np.einsum("nk,nc->nc", short * tiny, self.fallback)
+        self.pos = pos + 0.5 * push
+
+    def _clamp(self) -> None:
+        np.clip(self.pos, self.lo, self.hi, out=self.pos)
+
+
+def _turn_towards(d: np.ndarray, want: np.ndarray, max_angle: np.ndarray | float) -> np.ndarray:
+    """Unit directions `d` rotated towards `want` by at most `max_angle` radians."""
+    wn = np.linalg.norm(want, axis=1, keepdims=True)
+    t = np.where(wn > 1e-12, want / np.maximum(wn, 1e-12), d)
+    c = np.clip(np.einsum("nc,nc->n", d, t), -1.0, 1.0)
+    theta = np.arccos(c)
+    perp = t - c[:, None] * d
+    pn = np.linalg.norm(perp, axis=1)
+    flat = pn < 1e-9
+    if flat.any():  # exactly behind (or ahead): turn about the vertical, or about X if vertical
+        alt = np.cross(d[flat], np.array([0.0, 1.0, 0.0]))
+        bad = np.linalg.norm(alt, axis=1) < 1e-6
+        alt[bad] = np.cross(d[flat][bad], np.array([1.0, 0.0, 0.0]))
+        perp[flat] = alt
+        pn[flat] = np.linalg.norm(alt, axis=1)
+    perp /= pn[:, None]
+    a = np.minimum(theta, max_angle)
+    out = np.cos(a)[:, None] * d + np.sin(a)[:, None] * perp
+    return out / np.linalg.norm(out, axis=1, keepdims=True)
+
+
+def _random_units(rng: np.random.Generator, n: int, vertical: float) -> np.ndarray:
+    u = rng.standard_normal((n, 3))
+    u[:, 1] *= vertical
+    norm = np.linalg.norm(u, axis=1, keepdims=True)
+    return u / np.maximum(norm, 1e-12)
+
+
+def _check(config: SchoolConfig) -> None:
+    if not config.fps > 0 or not np.isfinite(config.fps):
+        raise ValueError(f"fps must be > 0, found {config.fps}")
+    if config.frames < 1:
+        raise ValueError(f"frames must be >= 1, found {config.frames}")
+    lo, hi = np.asarray(config.bounds[0], float), np.asarray(config.bounds[1], float)
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
+        raise ValueError(f"bounds must be finite with min < max, found {config.bounds}")
+    for g in config.groups:
+        if g.count < 0 or not g.body_length > 0:
+            raise ValueError(f"group {g.name!r}: count >= 0 and body_length > 0 needed")

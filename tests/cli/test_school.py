@@ -1,0 +1,67 @@
+"""`fishgen school` from the command line: the issue's exact form, outputs, determinism, errors."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pygltflib
+
+from tests.conftest import PARAMS, assert_valid_gltf, run_cli
+
+
+def test_the_exact_form_writes_a_valid_animated_school(tmp_path):
+    out = tmp_path / "school.glb"
+    result = run_cli("school", PARAMS / "bonybream.txt", "-o", out, "--count", "30", "--frames", "120",
+                     "--seed", "5")
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == "" and result.stdout.count("\n") == 1 and "30 bonybream; 120 frames" in result.stdout
+    assert_valid_gltf(out)
+    doc = pygltflib.GLTF2().load(str(out))
+    assert len(doc.scenes[0].nodes) == 30 and [a.name for a in doc.animations] == ["school"]
+    assert len(doc.meshes) == 9                                           # one mesh per part, shared
+    again = tmp_path / "again.glb"
+    run_cli("school", PARAMS / "bonybream.txt", "-o", again, "--count", "30", "--frames", "120", "--seed", "5")
+    assert again.read_bytes() == out.read_bytes()
+
+
+def test_scene_file_with_tracks_metrics_and_plot(tmp_path):
+    out = tmp_path / "reef.glb"
+    result = run_cli("school", PARAMS / "reef.toml", "-o", out, "--frames", "60", "--count", "8",
+                     "--tracks", tmp_path / "t.npz", "--metrics", tmp_path / "m.json", "--plot", tmp_path / "p.png")
+    assert result.returncode == 0, result.stderr
+    assert_valid_gltf(out)
+    tracks = np.load(tmp_path / "t.npz")
+    assert len(tracks["frame"]) == 60 * 16 and list(tracks["species_names"]) == ["bonybream", "threadfingoldie"]
+    assert np.isfinite(tracks["x"]).all() and set(np.unique(tracks["species"])) == {0, 1}
+    metrics = json.loads((tmp_path / "m.json").read_text())
+    assert len(metrics["per_frame"]["polarization"]) == 60 and "predator_distance" in metrics["per_frame"]
+    assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_csv_tracks_have_the_documented_columns(tmp_path):
+    result = run_cli("school", PARAMS / "pineapplefish.txt", "-o", tmp_path / "s.glb", "--count", "5",
+                     "--frames", "10", "--tracks", tmp_path / "t.csv")
+    assert result.returncode == 0, result.stderr
+    lines = (tmp_path / "t.csv").read_text().splitlines()
+    assert lines[0] == "frame,time,fish,species,x,y,z,qx,qy,qz,qw,vx,vy,vz" and len(lines) == 1 + 50
+
+
+def test_formats_that_cannot_hold_a_school_say_what_to_use(tmp_path):
+    result = run_cli("school", PARAMS / "bonybream.txt", "-o", tmp_path / "s.obj")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1
+    assert "holds node animation, found .obj" in result.stderr and "use .glb or .gltf instead" in result.stderr
+
+
+def test_absurd_sizes_are_refused_before_anything_is_built(tmp_path):
+    result = run_cli("school", PARAMS / "bonybream.txt", "-o", tmp_path / "s.glb", "--count", "100000",
+                     "--frames", "100000")
+    assert result.returncode == 2 and "at most 100,000 fish and 200,000,000 fish x frames" in result.stderr
+    for option in (["--count", "1000000000"], ["--frames", "1000000000"]):
+        result = run_cli("school", PARAMS / "bonybream.txt", "-o", tmp_path / "s.glb", *option)
+        assert result.returncode == 2 and "Invalid value" in result.stderr and result.stderr.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_scene_file_given_to_build_names_the_school_command(tmp_path):
+    result = run_cli("build", PARAMS / "reef.toml", "-o", tmp_path / "x.glb")
+    assert result.returncode == 2 and "use `fishgen school` for it" in result.stderr
