@@ -38,12 +38,20 @@ def extras() -> list[tuple[str, list[str]]]:
     return out
 
 
+SCHOOL = ["school", "params/reef.toml", "-o", "out/reef.glb", "--plot", "docs/images/reef-measures.png"]
+"""The README's school: the shipped reef scene, baked first, then previewed as a loop."""
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--list", action="store_true", help="print the renders and exit")
     args = parser.parse_args()
-    jobs = stills() + extras()
+    jobs = stills() + extras() + [("reef.gif", ["out/reef.glb", "--size", "480x360", "--view", "top",
+                                                "--duration", "10", "--fps", "8"])]
     IMAGES.mkdir(parents=True, exist_ok=True)
+    print(" ".join(["fishgen", *SCHOOL]))
+    if not args.list:
+        subprocess.run([sys.executable, "-m", "fishgen", *SCHOOL], cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
     for name, argv in jobs:
         command = [sys.executable, "-m", "fishgen", "preview", *argv, "-o", str(IMAGES / name)]
         print(" ".join(["fishgen", "preview", *argv, "-o", f"docs/images/{name}"]))

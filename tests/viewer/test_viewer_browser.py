@@ -218,3 +218,30 @@ def test_page_works_from_disk_without_a_server(browser, viewer_assets):
         assert all(u.startswith(("file:", "blob:", "data:")) for u in requests), requests
     finally:
         page.close()
+
+
+def test_a_school_plays_and_its_fish_move_in_three_js(browser, served, tmp_path):
+    from fishgen.preview.inputs import load_input
+
+    school = tmp_path / "school.glb"
+    made = run_cli("school", ROOT / "params" / "bonybream.txt", "-o", school, "--count", "12", "--frames", "150",
+                   "--seed", "2")
+    assert made.returncode == 0, made.stderr
+    page, problems, requests = _open(browser, served(school))
+    try:
+        state = page.evaluate("window.fishgenViewer")
+        assert state["clips"] == ["school"] and state["counts"] == load_input(school).counts()
+        page.click("#play")                       # pause, then pose two moments of the clip
+        frames = []
+        for t in ("0.5", "4.5"):
+            page.fill("#time", t)
+            page.dispatch_event("#time", "input")
+            page.wait_for_timeout(200)
+            frames.append(_canvas(page))
+        _assert_not_blank(frames[0])
+        moved = np.abs(frames[1] - frames[0]).max(-1) > 30
+        assert moved.mean() > 0.01, "the fish should be elsewhere four seconds later"
+        assert problems == []
+        _assert_offline(requests)
+    finally:
+        page.close()
