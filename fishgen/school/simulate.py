@@ -52,6 +52,7 @@ PSO_MIN_TURN = 0.25        # x max_turn: the least turn rate a pso fish has next
 SEPARATION_PASSES = 2
 # k-nearest lists are rebuilt every this many frames: (fewer than this many fish, frames)
 NEIGHBOUR_REFRESH = ((500, 1), (5000, 4), (None, 6))
+PARALLEL_QUERY_FISH = 5000
 JITTERED = ("random", "center", "keepaway", "speed", "direction", "flee")
 
 
@@ -152,6 +153,8 @@ class _Simulation:
         self.w_phase = rng.uniform(0.0, 1.0, n) * self.change_rate
         self.fallback = _random_units(rng, n, vertical=1.0)  # push-apart direction for coincident fish
         self.refresh = next(r for limit, r in NEIGHBOUR_REFRESH if limit is None or n < limit)
+        # Threads pay off only for big trees: below that the locks cost more than the queries.
+        self.workers = -1 if n >= PARALLEL_QUERY_FISH else 1
         self.k = max(1, min(int(config.neighbours), n - 1)) if n > 1 else 0
         self._neighbours()
         for _ in range(4):
@@ -213,7 +216,7 @@ class _Simulation:
         m = min(4, n - 1)
         tree = cKDTree(pos)
         k_all = max(self.k, m) if self.n_groups == 1 else m
-        _, idx = tree.query(pos, k=k_all + 1, workers=-1)
+        _, idx = tree.query(pos, k=k_all + 1, workers=self.workers)
         idx = idx[:, 1:]  # drop self (nearest; coincident fish are separated beforehand)
         self.near = np.ascontiguousarray(idx[:, :m])
         self.near_ok = idx[:, :m] != np.arange(n)[:, None]
@@ -230,14 +233,14 @@ class _Simulation:
                 continue
             t = cKDTree(pos[members])
             kk = min(self.k + 1, members.size)
-            _, li = t.query(pos[members], k=kk, workers=-1)
+            _, li = t.query(pos[members], k=kk, workers=self.workers)
             li = li.reshape(members.size, kk)[:, 1:]
             got = li.shape[1]
             self.nb[members, :got] = members[li]
             self.nb_ok[members, :got] = members[li] != members[:, None]
             outsiders = np.flatnonzero(self.group != g)
             if outsiders.size:
-                dd, oi = t.query(pos[outsiders], k=1, workers=-1)
+                dd, oi = t.query(pos[outsiders], k=1, workers=self.workers)
                 better = dd < other_d[outsiders]
                 other[outsiders[better]] = members[oi[better]]
                 other_d[outsiders[better]] = dd[better]
