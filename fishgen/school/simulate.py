@@ -49,10 +49,11 @@ LAYOUT_SPACING = 1.5       # body lengths between start positions
 BOUNDS_MARGIN = 3.0        # body lengths inside the walls where they start to steer fish back
 PSO_REFERENCE_DT = 0.05    # Figure 2.2's time step; inertia is re-timed from it
 PSO_MIN_TURN = 0.25        # x max_turn: the least turn rate a pso fish has next to the target
-SEPARATION_PASSES = 2
+SEPARATION_PASSES = 1
 # k-nearest lists are rebuilt every this many frames: (fewer than this many fish, frames)
-NEIGHBOUR_REFRESH = ((500, 1), (5000, 4), (None, 6))
+NEIGHBOUR_REFRESH = ((300, 1), (5000, 8), (None, 8))
 PARALLEL_QUERY_FISH = 5000
+HEADING_CHUNK = 64         # frames per vectorised heading pass
 JITTERED = ("random", "center", "keepaway", "speed", "direction", "flee")
 
 
@@ -76,12 +77,17 @@ def simulate(config: SchoolConfig, progress: Progress | None = None) -> Tracks:
                      None if predator is None else predator[f])
         positions[f] = sim.pos
         velocities[f] = sim.vel
-        q = headings_from_velocities(sim.vel)
-        if f > 0:  # keep quaternion signs continuous (q and -q are one rotation)
-            q *= np.where(np.einsum("nk,nk->n", q, headings[f - 1]) < 0, -1.0, 1.0)[:, None]
-        headings[f] = q
         if progress is not None:
             progress(f + 1)
+    # headings for all frames at once, in chunks that bound the temporaries' memory; each chunk
+    # starts from the previous one's last frame so signs stay continuous (q and -q are one rotation)
+    for start in range(0, frames, HEADING_CHUNK):
+        first = max(start - 1, 0)
+        q = headings_from_velocities(velocities[first:start + HEADING_CHUNK])
+        if start > 0:
+            q *= np.where(np.einsum("nk,nk->n", q[0], headings[start - 1]) < 0, -1.0, 1.0)[:, None]
+            q = q[1:]
+        headings[start:start + HEADING_CHUNK] = q
     return Tracks(times=times, positions=positions, velocities=velocities,
                   headings=headings, group=sim.group.copy(),
                   scale=sim.scale.copy(), target=target, predator=predator)
@@ -156,6 +162,18 @@ class _Simulation:
         # Threads pay off only for big trees: below that the locks cost more than the queries.
         self.workers = -1 if n >= PARALLEL_QUERY_FISH else 1
         self.k = max(1, min(int(config.neighbours), n - 1)) if n > 1 else 0
+        # per-fish constants of the urges, as columns (hot path: no per-step recomputation)
+        cruise = self.cruise
+        self.g_center = (GAIN_CENTER * w["center"] * cruise)[:, None]
+        self.g_direction = (GAIN_DIRECTION * w["direction"] * cruise)[:, None]
+        self.g_keepaway = (GAIN_KEEPAWAY * w["keepaway"] * cruise)[:, None]
+        self.g_contact = (GAIN_CONTACT * cruise)[:, None]
+        self.g_speed = (GAIN_SPEED * w["speed"])[:, None]
+        self.g_random = (GAIN_RANDOM * w["random"] * cruise)[:, None]
+        self.g_bounds = (2.0 * GAIN_BOUNDS * cruise)[:, None]
+        self.perception = (config.perception * self.length)[:, None]
+        self.inv_length = (1.0 / self.length)[:, None]
+        self.margin = np.minimum(BOUNDS_MARGIN * self.length[:, None], 0.25 * (self.hi - self.lo))
         self._neighbours()
         for _ in range(4):
             self._separate()
@@ -212,6 +230,8 @@ class _Simulation:
             self.near = np.zeros((n, 1), dtype=np.int64)
             self.near_ok = np.zeros((n, 1), dtype=bool)
             self.near_need = np.zeros((n, 1))
+            self.near_reach = np.zeros((n, 1))
+            self.near_is_nb = False
             return
         m = min(4, n - 1)
         tree = cKDTree(pos)
@@ -221,6 +241,8 @@ class _Simulation:
         self.near = np.ascontiguousarray(idx[:, :m])
         self.near_ok = idx[:, :m] != np.arange(n)[:, None]
         self.near_need = HARD_SEPARATION * 0.5 * (self.length[:, None] + self.length[self.near])
+        self.near_reach = self.near_need * (CONTACT_DISTANCE / HARD_SEPARATION)
+        self.near_is_nb = self.n_groups == 1 and self.k >= m  # then `near` = first m of `nb`
         if self.n_groups == 1:
             self.nb = np.ascontiguousarray(idx[:, : self.k])
             self.nb_ok = self.nb != np.arange(n)[:, None]
@@ -252,15 +274,21 @@ class _Simulation:
             return
         if frame % self.refresh == 0:
             self._neighbours()
-        # from each of the few nearest fish (any species) to me, and how far: shared by the urges
-        self.near_off = self.pos[:, None, :] - np.take(self.pos, self.near, axis=0)
-        self.near_dist = np.sqrt(np.einsum("nkc,nkc->nk", self.near_off, self.near_off))
+        boids = self.cfg.model != "pso"
+        if not (boids and self.near_is_nb):
+            # from each of the few nearest fish (any species) to me, and how far: shared by the urges
+            self.near_to = np.take(self.pos, self.near, axis=0) - self.pos[:, None, :]
+            self.near_dist = np.sqrt(np.einsum("nkc,nkc->nk", self.near_to, self.near_to))
         max_turn: np.ndarray | float
-        if self.cfg.model == "pso":
-            new_vel, max_turn, v_min, v_max = self._pso(target)
-        else:
+        if boids:
             new_vel, max_turn, v_min, v_max = self._boids()
-        acc = self._bounds_accel() + self._other_species_accel() + self._contact_accel()
+        else:
+            new_vel, max_turn, v_min, v_max = self._pso(target)
+            if self.n > 1:
+                new_vel += self._push(self._contact_strength()) * self.dt
+        acc = self._bounds_accel()
+        if self.other is not None:
+            acc += self._other_species_accel()
         flee_boost = np.zeros(self.n)
         if predator is not None:
             fa, flee_boost = self._flee_accel(predator)
@@ -268,50 +296,69 @@ class _Simulation:
         new_vel += acc * self.dt
         v_max = v_max * (1.0 + FLEE_SPEEDUP * flee_boost)
         self.dir = _turn_towards(self.dir, new_vel, max_turn * self.dt)
-        speed = np.clip(np.linalg.norm(new_vel, axis=1), v_min, v_max)
+        speed = np.minimum(np.maximum(np.sqrt(np.einsum("nc,nc->n", new_vel, new_vel)), v_min), v_max)
         if predator is not None:  # fleeing fish speed up
             fast = np.minimum(v_max, self.cruise * (1.0 + FLEE_SPEEDUP * flee_boost))
             speed = np.where(flee_boost > 0, np.maximum(speed, fast), speed)
         self.vel = self.dir * speed[:, None]
         self.pos = self.pos + self.vel * self.dt
-        for _ in range(SEPARATION_PASSES):
-            self._separate()
+        if self.n > 1:
+            # only fish that were within one step's closing distance of a too-near neighbour can be
+            # too near now (pairs close by at most both speeds x dt; the pushes add a little more)
+            closing = 2.5 * float(np.max(v_max)) * self.dt
+            rows = np.flatnonzero(np.any((self.near_dist - self.near_need) < closing, axis=1))
+            for _ in range(SEPARATION_PASSES):
+                self._separate(rows)
         self._clamp()
 
     def _boids(self) -> tuple[np.ndarray, np.ndarray | float, np.ndarray, np.ndarray]:
-        pos, d, v, w, L = self.pos, self.dir, self.vel, self.w, self.length
+        pos, d, v = self.pos, self.dir, self.vel
         cruise = self.cruise
-        perception = self.cfg.perception * L
-        acc = np.zeros_like(pos)
+        # keep own velocity (relax towards cruising speed along the heading) and the wander spline
+        acc = self.g_speed * (d * cruise[:, None] - v) + self.g_random * (self._wander() - d)
         if self.n > 1:
-            off = np.take(pos, self.nb, axis=0)                       # (N, k, 3)
-            off -= pos[:, None, :]
+            # one gather of the school-mates' positions and headings: (N, k, 6)
+            mates = np.take(np.concatenate([pos, d], axis=1), self.nb, axis=0)
+            mates -= np.concatenate([pos, np.zeros_like(pos)], axis=1)[:, None, :]  # me to them
+            off = mates[..., :3]
             dist = np.sqrt(np.einsum("nkc,nkc->nk", off, off))
-            seen = self.nb_ok & (dist < perception[:, None])
-            cnt = seen.sum(axis=1)
-            has = cnt > 0
-            inv = (has / np.maximum(cnt, 1))[:, None]
-            seenf = seen.astype(np.float64)
+            seen = self.nb_ok & (dist < self.perception)
+            cnt = np.count_nonzero(seen, axis=1)
+            has = (cnt > 0)[:, None]
+            sums = np.einsum("nk,nkc->nc", seen.astype(np.float64), mates)
+            sums *= has / np.maximum(cnt, 1)[:, None]
             # cohesion: towards the centre of the perceived school-mates, in body lengths, capped
-            coh = np.einsum("nk,nkc->nc", seenf, off) * (inv / L[:, None])
-            cn = np.sqrt(np.einsum("nc,nc->n", coh, coh))
-            acc += ((GAIN_CENTER * w["center"] * cruise) / np.maximum(cn, 1.0))[:, None] * coh
+            coh = sums[:, :3] * self.inv_length
+            cn = np.sqrt(np.einsum("nc,nc->n", coh, coh))[:, None]
+            acc += self.g_center / np.maximum(cn, 1.0) * coh
             # alignment: towards their mean heading
-            mean_dir = np.einsum("nk,nkc->nc", seenf, np.take(d, self.nb, axis=0)) * inv
-            acc += (GAIN_DIRECTION * w["direction"] * cruise)[:, None] * (mean_dir - d * has[:, None])
-            # keepaway: inside the repel distance, away, stronger the closer (any species)
-            acc += (GAIN_KEEPAWAY * w["keepaway"] * cruise)[:, None] * self._keepaway(self.repel)
-        # keep own velocity: relax towards cruising speed along the heading
-        acc += (GAIN_SPEED * w["speed"])[:, None] * (d * cruise[:, None] - v)
-        # wander spline
-        acc += (GAIN_RANDOM * w["random"] * cruise)[:, None] * (self._wander() - d)
+            acc += self.g_direction * (sums[:, 3:] - d * has)
+            if self.near_is_nb:
+                m = self.near.shape[1]
+                self.near_to = off[:, :m]
+                self.near_dist = dist[:, :m]
+            # keepaway inside the repel distance (any species), and bodies that nearly touch push
+            # apart whatever the brain (the swim-through fix): one weighted sum over the nearest
+            strength = self._contact_strength() * self.g_contact
+            strength += self._keepaway_strength(self.repel) * self.g_keepaway
+            acc += self._push(strength)
         new_vel = v + acc * self.dt
         return new_vel, self.cfg.max_turn, MIN_SPEED * cruise, cruise * 2.0
 
-    def _keepaway(self, radius: np.ndarray) -> np.ndarray:
-        off, dist = self.near_off, self.near_dist
-        strength = np.clip(1.0 - dist / radius[:, None], 0.0, None) * self.near_ok
-        return np.einsum("nk,nkc->nc", strength / np.maximum(dist, 1e-12), off)
+    def _keepaway_strength(self, radius: np.ndarray) -> np.ndarray:
+        """Per nearest fish: 1 at contact falling to 0 at `radius`, over the distance (for `_push`)."""
+        dist = self.near_dist
+        reach = np.maximum(1.0 - dist / radius[:, None], 0.0) * self.near_ok
+        return reach / np.maximum(dist, 1e-12)
+
+    def _contact_strength(self) -> np.ndarray:
+        dist = self.near_dist
+        reach = np.maximum(1.0 - dist / self.near_reach, 0.0) * self.near_ok
+        return reach / np.maximum(dist, 1e-12)
+
+    def _push(self, strength: np.ndarray) -> np.ndarray:
+        """Sum over the nearest fish of strength x offset away from them."""
+        return -np.einsum("nk,nkc->nc", strength, self.near_to)
 
     def _wander(self) -> np.ndarray:
         """A point on each fish's wander spline (as a direction); new random point every change_rate."""
@@ -325,7 +372,7 @@ class _Simulation:
         h = np.clip(self.w_phase / self.change_rate, 0.0, 1.0)
         h = (h * h * (3.0 - 2.0 * h))[:, None]
         u = (1.0 - h) * self.w_prev + h * self.w_next
-        return u / np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-9)
+        return u / np.maximum(np.sqrt(np.einsum("nc,nc->n", u, u)), 1e-9)[:, None]
 
     def _pso(self, target: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         p = self.cfg.pso
@@ -368,10 +415,10 @@ class _Simulation:
 
     # ----------------------------------------------------------------- shared urges
     def _bounds_accel(self) -> np.ndarray:
-        margin = np.minimum(BOUNDS_MARGIN * self.length[:, None], 0.25 * (self.hi - self.lo))
-        below = np.clip((self.lo + margin - self.pos) / margin, 0.0, 1.0)
-        above = np.clip((self.pos - (self.hi - margin)) / margin, 0.0, 1.0)
-        return (GAIN_BOUNDS * self.cruise)[:, None] * (below - above) * 2.0
+        margin = self.margin
+        below = np.minimum(np.maximum((self.lo + margin - self.pos) / margin, 0.0), 1.0)
+        above = np.minimum(np.maximum((self.pos - (self.hi - margin)) / margin, 0.0), 1.0)
+        return self.g_bounds * (below - above)
 
     def _other_species_accel(self) -> np.ndarray:
         if self.other is None:
@@ -384,15 +431,6 @@ class _Simulation:
         unit = off / np.maximum(dist, 1e-12)[:, None]
         return (GAIN_OTHER_SPECIES * self.cruise * strength)[:, None] * unit
 
-    def _contact_accel(self) -> np.ndarray:
-        """Bodies that nearly touch push apart (any species, any brain): the swim-through fix."""
-        if self.n < 2:
-            return np.zeros_like(self.pos)
-        off, dist = self.near_off, self.near_dist
-        reach = self.near_need * (CONTACT_DISTANCE / HARD_SEPARATION)
-        strength = np.clip(1.0 - dist / reach, 0.0, None) * self.near_ok / np.maximum(dist, 1e-12)
-        return (GAIN_CONTACT * self.cruise)[:, None] * np.einsum("nk,nkc->nc", strength, off)
-
     def _flee_accel(self, predator: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         off = self.pos - predator
         dist = np.linalg.norm(off, axis=1)
@@ -403,22 +441,34 @@ class _Simulation:
         return acc, np.sqrt(near)
 
     # ----------------------------------------------------------------- constraints
-    def _separate(self) -> None:
-        """Push apart pairs closer than HARD_SEPARATION mean body lengths (each side moves half)."""
+    def _separate(self, rows: np.ndarray | None = None) -> None:
+        """Push apart pairs closer than HARD_SEPARATION mean body lengths (each side moves half).
+
+        `rows`: only these fish (the others are known to be clear of their nearest this step)."""
         if self.n < 2:
             return
         pos = self.pos
-        off = pos[:, None, :] - np.take(pos, self.near, axis=0)     # from neighbour to me
+        near, need, ok = self.near, self.near_need, self.near_ok
+        if rows is not None:
+            if rows.size == 0:
+                return
+            near, need, ok = near[rows], need[rows], ok[rows]
+        mine = pos if rows is None else pos[rows]
+        off = mine[:, None, :] - np.take(pos, near, axis=0)     # from neighbour to me
         dist = np.sqrt(np.einsum("nkc,nkc->nk", off, off))
-        short = np.clip(self.near_need - dist, 0.0, None) * self.near_ok
+        short = np.maximum(need - dist, 0.0) * ok
         if not short.any():
             return
         tiny = dist < 1e-9
         scale = short / np.maximum(dist, 1e-12)
         push = np.einsum("nk,nkc->nc", scale, off)
         if tiny.any():  # coincident fish: each goes its own fixed random way
-            push += np.einsum("nk,nc->nc", short * tiny, self.fallback)
-        self.pos = pos + 0.5 * push
+            fallback = self.fallback if rows is None else self.fallback[rows]
+            push += np.einsum("nk,nc->nc", short * tiny, fallback)
+        if rows is None:
+            self.pos = pos + 0.5 * push
+        else:
+            self.pos[rows] += 0.5 * push
 
     def _clamp(self) -> None:
         np.clip(self.pos, self.lo, self.hi, out=self.pos)
@@ -426,12 +476,11 @@ class _Simulation:
 
 def _turn_towards(d: np.ndarray, want: np.ndarray, max_angle: np.ndarray | float) -> np.ndarray:
     """Unit directions `d` rotated towards `want` by at most `max_angle` radians."""
-    wn = np.linalg.norm(want, axis=1, keepdims=True)
+    wn = np.sqrt(np.einsum("nc,nc->n", want, want))[:, None]
     t = np.where(wn > 1e-12, want / np.maximum(wn, 1e-12), d)
-    c = np.clip(np.einsum("nc,nc->n", d, t), -1.0, 1.0)
-    theta = np.arccos(c)
+    c = np.minimum(np.maximum(np.einsum("nc,nc->n", d, t), -1.0), 1.0)
     perp = t - c[:, None] * d
-    pn = np.linalg.norm(perp, axis=1)
+    pn = np.sqrt(np.einsum("nc,nc->n", perp, perp))
     flat = pn < 1e-9
     if flat.any():  # exactly behind (or ahead): turn about the vertical, or about X if vertical
         alt = np.cross(d[flat], np.array([0.0, 1.0, 0.0]))
@@ -439,10 +488,9 @@ def _turn_towards(d: np.ndarray, want: np.ndarray, max_angle: np.ndarray | float
         alt[bad] = np.cross(d[flat][bad], np.array([1.0, 0.0, 0.0]))
         perp[flat] = alt
         pn[flat] = np.linalg.norm(alt, axis=1)
-    perp /= pn[:, None]
-    a = np.minimum(theta, max_angle)
-    out = np.cos(a)[:, None] * d + np.sin(a)[:, None] * perp
-    return out / np.linalg.norm(out, axis=1, keepdims=True)
+    a = np.minimum(np.arccos(c), max_angle)
+    out = np.cos(a)[:, None] * d + (np.sin(a) / pn)[:, None] * perp
+    return out / np.sqrt(np.einsum("nc,nc->n", out, out))[:, None]
 
 
 def _random_units(rng: np.random.Generator, n: int, vertical: float) -> np.ndarray:
