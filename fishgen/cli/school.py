@@ -90,7 +90,7 @@ def school(inputs, output, count, frames, fps, seed, model, tolerance, tracks, m
                                f"{extra.suffix or 'no extension'!r}", extra)
 
     from fishgen.school import run_school
-    from fishgen.school.metrics import measures, summary
+    from fishgen.school.metrics import format_table, measures, summary, summary_table
 
     bar = None
     if sys.stderr.isatty():  # a person watching gets a bar; logs and CI get none
@@ -117,22 +117,9 @@ def school(inputs, output, count, frames, fps, seed, model, tolerance, tracks, m
     size = sum(p.stat().st_size for p in written)
     kinds = ", ".join(f"{e.count} {Path(e.file).stem}" for e in scene.species)
     click.echo(f"{output}: {kinds}; {scene.frames} frames ({scene.frames / scene.fps:.1f} s), {scene.model}, "
-               f"{size / 1e6:.2f} MB; " + _one_line(numbers))
-
-
-def _one_line(numbers: dict) -> str:
-    import numpy as np
-
-    parts = []
-    for key, label, fmt in (("polarization", "polarization", "{:.2f}"),
-                            ("nearest_neighbour", "nearest neighbour", "{:.2f} BL"),
-                            ("overlaps", "overlapping pairs", "{:.0f}"), ("groups", "groups", "{:.1f}"),
-                            ("target_distance", "to target", "{:.2f} BL")):
-        if key in numbers and numbers[key] is not None:
-            value = numbers[key]
-            value = float(np.mean(value)) if isinstance(value, list) else float(value)  # per species: mean
-            parts.append(f"{label} {fmt.format(value)}")
-    return ", ".join(parts) + " (after warm-up)"
+               f"{size / 1e6:.2f} MB")
+    rows = summary_table(per_frame, warmup, run.species_names)
+    click.echo(format_table(rows, f"after {warmup / scene.fps:.1f} s warm-up"))
 
 
 def _write_metrics(path: Path, run, per_frame: dict, numbers: dict, warmup: int) -> None:

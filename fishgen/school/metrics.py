@@ -143,3 +143,47 @@ def summary(measures: dict[str, np.ndarray], warmup_frames: int) -> dict[str, fl
             peak = tail.max(axis=0)
             out[name + "_peak"] = [float(x) for x in peak] if tail.ndim == 2 else float(peak)
     return out
+
+
+# (measure, label, unit scale, format, which way is worse); per-species measures get one row each
+_TABLE = (
+    ("polarization", "polarization (1 = parallel)", 1.0, "{:.2f}", "min"),
+    ("groups", "separate groups", 1.0, "{:.0f}", "max"),
+    ("nearest_neighbour", "nearest neighbour (body lengths)", 1.0, "{:.2f}", "min"),
+    ("overlaps", "overlapping pairs", 1.0, "{:.0f}", "max"),
+    ("mixed_groups", "groups mixing species", 1.0, "{:.0f}", "max"),
+    ("heading_angle", "heading vs velocity (deg)", np.degrees(1.0), "{:.1f}", "max"),
+    ("turn", "largest turn per frame (deg)", np.degrees(1.0), "{:.1f}", "max"),
+    ("target_distance", "distance to target (body lengths)", 1.0, "{:.2f}", "max"),
+    ("predator_distance", "distance to predator (body lengths)", 1.0, "{:.2f}", "min"),
+)
+
+
+def summary_table(per_frame: dict[str, np.ndarray], warmup_frames: int,
+                  species: Sequence[str]) -> list[tuple[str, str, str]]:
+    """Rows (measure, mean, worst) over the frames after the warm-up, worst being the minimum or
+    maximum, whichever is bad for that measure; per-species measures get a row per species."""
+    rows = []
+    for key, label, scale, fmt, worse in _TABLE:
+        if key not in per_frame:
+            continue
+        tail = np.asarray(per_frame[key], dtype=np.float64)
+        tail = tail[warmup_frames:] if tail.shape[0] > warmup_frames else tail[-1:]
+        columns = tail.T if tail.ndim == 2 else tail[None]
+        for g, column in enumerate(columns):
+            column = column[np.isfinite(column)] * scale
+            name = f"{label}, {species[g]}" if tail.ndim == 2 and len(species) > 1 else label
+            if column.size == 0:
+                rows.append((name, "-", "-"))
+                continue
+            worst = column.min() if worse == "min" else column.max()
+            rows.append((name, fmt.format(column.mean()), fmt.format(worst)))
+    return rows
+
+
+def format_table(rows: Sequence[tuple[str, str, str]], title: str) -> str:
+    """The rows as aligned text under a header line."""
+    width = max(len(title), *(len(r[0]) for r in rows)) if rows else len(title)
+    lines = [f"{title:<{width}}  {'mean':>7}  {'worst':>7}"]
+    lines += [f"{name:<{width}}  {mean:>7}  {worst:>7}" for name, mean, worst in rows]
+    return "\n".join(lines)

@@ -14,7 +14,11 @@ def test_the_exact_form_writes_a_valid_animated_school(tmp_path):
     result = run_cli("school", PARAMS / "bonybream.txt", "-o", out, "--count", "30", "--frames", "120",
                      "--seed", "5")
     assert result.returncode == 0, result.stderr
-    assert result.stderr == "" and result.stdout.count("\n") == 1 and "30 bonybream; 120 frames" in result.stdout
+    assert result.stderr == "" and "30 bonybream; 120 frames" in result.stdout.splitlines()[0]
+    table = result.stdout.splitlines()[1:]       # the one-screen summary: measure, mean, worst
+    assert 6 <= len(table) <= 24 and table[0].split()[-2:] == ["mean", "worst"]
+    overlaps = next(line for line in table if line.startswith("overlapping pairs"))
+    assert overlaps.split()[-2:] == ["0", "0"]
     assert_valid_gltf(out)
     doc = pygltflib.GLTF2().load(str(out))
     assert len(doc.scenes[0].nodes) == 30 and [a.name for a in doc.animations] == ["school"]

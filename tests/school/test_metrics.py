@@ -92,3 +92,17 @@ def test_two_species_keep_apart():
     ab = np.linalg.norm(a[:, :, None] - b[:, None], axis=3)
     aa = np.linalg.norm(a[:, :, None] - a[:, None], axis=3) + np.eye(a.shape[1]) * 1e9
     assert ab.min(axis=2).mean() > 2 * aa.min(axis=2).mean()
+
+
+def test_summary_table_has_mean_and_the_bad_extreme_per_species():
+    from fishgen.school.metrics import format_table, summary_table
+
+    per_frame = {"polarization": np.array([[0.1, 0.2], [0.9, 0.5], [0.7, 0.7]]),
+                 "overlaps": np.array([9, 0, 2]), "heading_angle": np.array([0.0, np.pi / 2, 0.0])}
+    rows = summary_table(per_frame, 1, ["a", "b"])
+    assert rows == [("polarization (1 = parallel), a", "0.80", "0.70"),
+                    ("polarization (1 = parallel), b", "0.60", "0.50"),
+                    ("overlapping pairs", "1", "2"),
+                    ("heading vs velocity (deg)", "45.0", "90.0")]
+    text = format_table(rows, "after warm-up").splitlines()
+    assert len(text) == 5 and len({len(line) for line in text}) == 1
