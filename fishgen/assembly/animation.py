@@ -56,10 +56,11 @@ def clip_frames(motions: list[FinMotion]) -> int:
     return frames
 
 
-def y_rotation_quaternions(angles_deg: np.ndarray) -> np.ndarray:
-    """Unit quaternions (x, y, z, w) for rotations about +Y."""
-    half = np.radians(angles_deg) / 2.0
-    q = np.zeros((len(half), 4))
-    q[:, 1] = np.sin(half)
+def axis_rotation_quaternions(angles_deg: np.ndarray, axis: np.ndarray | None = None) -> np.ndarray:
+    """Unit quaternions (x, y, z, w) for rotations about the unit ``axis`` (default +Y)."""
+    unit = np.array([0.0, 1.0, 0.0]) if axis is None else np.asarray(axis, dtype=np.float64)
+    half = np.radians(np.asarray(angles_deg, dtype=np.float64)) / 2.0
+    q = np.empty((len(half), 4))
+    q[:, :3] = np.sin(half)[:, None] * unit
     q[:, 3] = np.cos(half)
     return q

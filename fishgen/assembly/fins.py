@@ -2,6 +2,8 @@
 onto :mod:`fishgen.geometry.fins`' plain parameters and builds them."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from fishgen.geometry.fins import (
@@ -57,13 +59,42 @@ def build_fins(species: Species, rings: np.ndarray) -> list[Fin]:
         """The texture points the file gives fin ``name``, in the geometry's vertex order."""
         return getattr(tp, name) if tp is not None else None
 
-    fins = [caudal_fin(caudal_params(species.caudal), s, uv("caudal"))]
+    caudal = caudal_fin(caudal_params(species.caudal), s, uv("caudal"), tail_x=float(rings[-1, :, 0].max()))
+    fins = [caudal]
+    # The caudal fin and the vertical fins lie in one plane: where they overlap, renderers flicker
+    # and path tracers show black. A vertical fin ends on the last section that keeps it in front
+    # of the caudal fin (docs/decisions.md); the species file's own numbers are left as they are.
+    tail_front = float(caudal.mesh.positions[:, 0].min()) if len(caudal.mesh.faces) else np.inf
     for name, fin, side in (("dorsal", species.dorsal, 1.0), ("adipose", species.adipose, 1.0),
                             ("anal", species.anal, -1.0)):
         if fin.present:
-            fins.append(vertical_fin(f"{name}_fin", vertical_params(fin), rings, s, side, uv(name)))
+            params = vertical_params(fin)
+            built = vertical_fin(f"{name}_fin", params, rings, s, side, uv(name))
+            while (built.mesh.positions[:, 0].max() > tail_front + 1e-9
+                   and params.end_section > params.start_section):
+                params = replace(params, end_section=params.end_section - 1)
+                built = vertical_fin(f"{name}_fin", params, rings, s, side, _first(uv(name), params))
+            if built.mesh.positions[:, 0].max() <= tail_front + 1e-9:
+                fins.append(built)
     for left in (pectoral_fin(pectoral_params(species.pectoral), rings, s, uv("pectoral")),
                  pelvic_fin(pelvic_params(species.pelvic), rings, s, uv("pelvic"))):
         fins += [left, mirrored(left)]
     return [f for f in fins if len(f.mesh.faces)]
 
+
+
+def _first(points: tuple[tuple[float, float], ...] | None, params: VerticalParams):
+    """The texture points of a vertical fin shortened to ``params``' sections: Fixel's order is
+    T_0, B_0, B_n, T_n, B_1..B_{n-1}, T_1..T_{n-1} (n + 1 sections), so the new end takes the
+    points of the section it now ends on."""
+    if points is None:
+        return None
+    old = len(points) // 2
+    new = params.end_section - params.start_section + 1
+    base_mid = points[4:4 + old - 2]
+    top_mid = points[4 + old - 2:]
+    if new < 2:
+        return None
+    t0, b0 = points[0], points[1]
+    bn, tn = base_mid[new - 2], top_mid[new - 2]
+    return (t0, b0, bn, tn, *base_mid[:new - 2], *top_mid[:new - 2])

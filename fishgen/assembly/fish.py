@@ -3,18 +3,22 @@ materials, textures and the looping ``swim`` clip.
 
 The scene has one root node named after the species and one child node per
 part, each with its own mesh; moving fins carry their pivot as the node
-translation and swing about +Y in the ``swim`` clip.
+translation and swing about their hinge in the ``swim`` clip. With the body
+wave (the default), every mesh also carries four morph targets and the clip
+drives their weights (:mod:`fishgen.assembly.body_wave`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from fishgen.assembly.animation import MAX_CLIP_FRAMES, FinMotion, clip_frames, y_rotation_quaternions
+from fishgen.assembly.animation import MAX_CLIP_FRAMES, FinMotion, axis_rotation_quaternions, clip_frames
 from fishgen.assembly.fin_modes import FIN_MODES
 from fishgen.assembly.fins import build_fins
 from fishgen.assembly.materials import default_fin_mode, load_textures, make_materials
+from fishgen.assembly.swim_modes import DEFAULT_SPEED, SWIM_MODES
 from fishgen.errors import FishgenError
 from fishgen.geometry.body import build_body
+from fishgen.geometry.body_wave import BodyWave, check_wave
 from fishgen.geometry.mesh import vertex_normals
 from fishgen.geometry.shapes import profile_for
 from fishgen.scene.model import Channel, Clip, Image, Mesh, Node, Primitive, Sampler, Scene
@@ -30,14 +34,19 @@ THESIS_TO_GLTF = np.array([[0.0, 0.0, 1.0],
                            [-1.0, 0.0, 0.0]])
 
 
+
+
 def build_fish(species: Species, *, fins: str | None = None, length: float | None = None,
-               fps: float = 30.0) -> Scene:
+               fps: float = 30.0, swim: str = "body", speed: float = DEFAULT_SPEED,
+               wave: BodyWave | None = None) -> Scene:
     """Build the fish of ``species``.
 
     ``fins``: ``blend``, ``mask`` or ``opaque`` (default: ``mask`` when the file
     says masked and the fish is textured, else ``blend``). ``length``: nose-to-tail
     length in metres (default: world scale x scaleX x 0.05 m per world unit for the
-    body). ``fps``: frame rate the fins' step sizes are counted in.
+    body). ``fps``: frame rate the fins' step sizes are counted in. ``swim``: one
+    of SWIM_MODES. ``speed``: body lengths per second, which sets the tail-beat
+    frequency of the body wave (``wave``, default :class:`BodyWave`).
     """
     mode = fins or default_fin_mode(species)
     if mode not in FIN_MODES:
@@ -49,6 +58,15 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
         raise FishgenError(f"expected --fps from 1 to 1000, found {fps}")
     if length is not None and not 0.001 <= length <= 1e4:
         raise FishgenError(f"expected --length in metres from 0.001 to 10000, found {length}")
+    if swim not in SWIM_MODES:
+        raise FishgenError(f"expected a swim mode ({', '.join(SWIM_MODES)}), found {swim!r}")
+    if not 0.01 <= speed <= 100:
+        raise FishgenError(f"expected --speed in body lengths per second from 0.01 to 100, found {speed}")
+    wave = wave or BodyWave()
+    try:
+        check_wave(wave)
+    except ValueError as err:
+        raise FishgenError(str(err)) from None
 
     tp = species.texture_points
     body_uv = None
@@ -87,7 +105,7 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
                               parent=root)
 
     add_part("body", place(body.mesh.positions), body.mesh.faces, body.mesh.uvs, body_material, np.zeros(3))
-    motions: list[tuple[int, str, FinMotion]] = []
+    motions: list[tuple[int, str, FinMotion, np.ndarray | None]] = []
     for fin in fin_list:
         try:
             motion = FinMotion.from_fin(fin.movement_angle, fin.step_size,
@@ -97,28 +115,61 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
                                f"{MAX_CLIP_FRAMES} frames, found {err} (movement angle "
                                f"{fin.movement_angle:g}, step size {fin.step_size:g})", species.source,
                                species.line_of(fin.name.split("_")[0])) from None
+        if swim == "body" and fin.name == "caudal_fin":
+            # The wave sweeps the tail fin with the tail's displacement and slope (about 38 degrees of
+            # yaw at the tip, against the thesis' 10-degree swing); a swing on top would turn the
+            # fin's share of the wave with it and tear the fin off the tail (docs/decisions.md).
+            motion = None
         pivot = place(fin.pivot[None, :])[0] if motion is not None and fin.pivot is not None else np.zeros(3)
         node = add_part(fin.name, place(fin.mesh.positions) - pivot, fin.mesh.faces, fin.mesh.uvs,
                         fin_material, pivot)
         if motion is not None:
-            motions.append((node, fin.name, motion))
+            axis = None if fin.axis is None else THESIS_TO_GLTF @ fin.axis
+            motions.append((node, fin.name, motion, axis))
 
-    frames = clip_frames([m for _, _, m in motions])
+    frames = clip_frames([m for _, _, m, _ in motions])
     if frames > MAX_CLIP_FRAMES:
-        _, slowest, _ = max(motions, key=lambda nm: nm[2].period_frames)
+        _, slowest, _, _ = max(motions, key=lambda nm: nm[2].period_frames)
         raise FishgenError(f"expected fin cycles that loop within {MAX_CLIP_FRAMES} frames, found "
-                           f"{frames} (periods {sorted({m.period_frames for _, _, m in motions})}); "
+                           f"{frames} (periods {sorted({m.period_frames for _, _, m, _ in motions})}); "
                            "choose movement angles and step sizes with a small common multiple",
                            species.source, species.line_of(slowest.split("_")[0]))
-    if motions:
-        channels = []
-        for node, _, motion in motions:
-            keys, angles = motion.keys(frames)
-            channels.append(Channel(node, "rotation", Sampler((keys / fps).astype(np.float32),
-                                                              y_rotation_quaternions(angles).astype(np.float32))))
+    if swim == "body" and frames:
+        from fishgen.assembly.body_wave import loop_laps
+
+        frames *= loop_laps(wave, speed, frames / fps, MAX_CLIP_FRAMES // frames)
+    channels = []
+    for node, _, motion, axis in motions:
+        keys, angles = motion.keys(frames)
+        quaternions = axis_rotation_quaternions(angles, axis).astype(np.float32)
+        channels.append(Channel(node, "rotation", Sampler((keys / fps).astype(np.float32), quaternions)))
+    if swim == "body":
+        channels += _body_wave(scene, wave, speed, frames / fps if frames else None)
+    if channels:
         scene.clips.append(Clip("swim", channels))
     scene.info["fps"] = float(fps)
+    scene.info["swim"] = swim
     return scene
+
+
+def _body_wave(scene: Scene, wave: BodyWave, speed: float, clip_seconds: float | None) -> list[Channel]:
+    """Wave targets on every part and the weights channels of a seamless loop: a whole number of
+    beats in the fins' loop, or one beat when no fin moves."""
+    from fishgen.assembly.body_wave import (
+        add_wave_targets,
+        loop_beats,
+        loop_keys,
+        wave_channels,
+        weight_sampler,
+    )
+
+    if not add_wave_targets(scene, wave):
+        return []
+    seconds = clip_seconds if clip_seconds else 1.0 / float(wave.frequency(speed))
+    beats, frequency = loop_beats(wave, speed, seconds)
+    scene.info["tail_beat_hz"] = frequency
+    scene.info["swim_speed"] = speed
+    return wave_channels(scene, weight_sampler(*loop_keys(beats, frequency)))
 
 
 def species_scene(path, *, textures_dir=None, **_) -> Scene:

@@ -6,6 +6,7 @@ from pathlib import Path
 import click
 
 from fishgen.assembly.fin_modes import FIN_MODES
+from fishgen.assembly.swim_modes import DEFAULT_SPEED, SWIM_MODES
 from fishgen.cli.params import FiniteRange
 from fishgen.exchange.registry import MESHES, extensions, formats
 
@@ -29,11 +30,17 @@ FISH_FORMATS = formats(writable=True, holding=[MESHES])
               help="Nose-to-tail length in metres. [default: world scale x scaleX x 0.05 m for the body]")
 @click.option("--fps", type=FiniteRange(1, 1000), default=30.0,
               help="Frames per second; fins move step size degrees per frame.")
+@click.option("--swim", type=click.Choice(SWIM_MODES), default="body",
+              help="body: a travelling body wave (carangiform, tail-beat frequency from --speed) under "
+                   "the fin swings; fins: a rigid body, only the fins move (VRFish's fish).")
+@click.option("--speed", type=FiniteRange(0.01, 100), default=DEFAULT_SPEED, metavar="BL/S",
+              help="Cruising speed of the swim loop in body lengths per second; the tail beats at "
+                   "Strouhal number 0.3, rounded to a whole number of beats in the loop.")
 @click.option("--textures", "textures_dir", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder texture names resolve in (and may not leave). "
                    "[default: the species file's folder, then the textures/ folder beside it]")
 def build(species_files: tuple[Path, ...], output: Path | None, fmt: str, fins: str | None,
-          length: float | None, fps: float, textures_dir: Path | None) -> None:
+          length: float | None, fps: float, swim: str, speed: float, textures_dir: Path | None) -> None:
     """Build SPECIES_FILE (VRFish parameter files) into game-ready fish.
 
     glTF outputs carry the node hierarchy, materials, textures and a looping
@@ -73,7 +80,8 @@ def build(species_files: tuple[Path, ...], output: Path | None, fmt: str, fins: 
     for species_file in species_files:
         target = output if single_file else folder / f"{species_file.stem}.{fmt}"
         try:
-            scene = build_fish(load_species(species_file, textures_dir), fins=fins, length=length, fps=fps)
+            scene = build_fish(load_species(species_file, textures_dir), fins=fins, length=length, fps=fps,
+                               swim=swim, speed=speed)
             written = export(scene, target, require=[MESHES])  # type: ignore[arg-type]
         except FishgenError as err:
             if len(species_files) == 1:
@@ -98,6 +106,8 @@ def summary(scene, target: Path, written: list[Path]) -> str:
     animated = clip is not None and "node animation" not in dropped
     motion = (f"swim loop {clip.duration:.2f} s" if animated and clip is not None
               else "rest pose only" if clip is not None else "no animation")
+    if animated and "tail_beat_hz" in scene.info:
+        motion += f", body wave {scene.info['tail_beat_hz']:.2f} Hz"
     listed = ", ".join(dropped[:-1]) + (" or " if len(dropped) > 1 else "") + dropped[-1] if dropped else ""
     note = f" ({fmt.extensions[0][1:].upper()} holds no {listed})" if dropped and fmt else ""
     return (f"{target}: {scene.name}, {scene.counts()['triangles']} triangles, {hi[2] - lo[2]:.3f} m long, "

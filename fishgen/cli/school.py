@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from fishgen.assembly.fin_modes import FIN_MODES
+from fishgen.assembly.swim_modes import SWIM_MODES
 from fishgen.cli.params import FiniteRange
 
 MODELS = ("boids", "pso")  # mirrors fishgen.school.model without importing numpy
@@ -41,14 +42,18 @@ MODELS = ("boids", "pso")  # mirrors fishgen.school.model without importing nump
                    "matplotlib, `pip install fishgen[plot]`).")
 @click.option("--fins", type=click.Choice(FIN_MODES), default=None,
               help="Fin technique, as `fishgen build` has it  [default: from each species file]")
+@click.option("--swim", type=click.Choice(SWIM_MODES), default="body", show_default=True,
+              help="body: every fish's body waves, its tail beating faster the faster it swims; "
+                   "fins: rigid bodies, only the fins move.")
 @click.option("--textures", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder texture names resolve in  [default: as `fishgen build` resolves them]")
 def school(inputs, output, count, frames, fps, seed, model, tolerance, tracks, metrics, plot, fins,
-           textures) -> None:
+           swim, textures) -> None:
     """Simulate a school of SPECIES files (or a SCENE.toml) and bake it into an animated glb.
 
     Every fish of a species shares its meshes; each fish is a node with translation and
-    rotation keys for the whole run, and its fins beat phase-shifted in the same clip.
+    rotation keys for the whole run, its body wave follows its own speed, and its fins beat
+    phase-shifted in the same clip.
     A scene file holds species and counts, model parameters, bounds, the target path,
     a predator and the start layout; the options here override it.
 
@@ -97,7 +102,7 @@ def school(inputs, output, count, frames, fps, seed, model, tolerance, tracks, m
         bar = click.progressbar(length=scene.frames, label="simulating", file=sys.stderr)
         bar.__enter__()
     try:
-        run = run_school(scene, fins=fins, tolerance=tolerance, textures_dir=textures,
+        run = run_school(scene, fins=fins, swim=swim, tolerance=tolerance, textures_dir=textures,
                          progress=(lambda n: bar.update(n)) if bar is not None else None)
     finally:
         if bar is not None:

@@ -84,6 +84,7 @@ class Fin:
     movement_angle: float = 0.0          # degrees
     step_size: float = 0.0               # degrees per frame
     mirror_of: str | None = None         # set on a right-hand fin
+    axis: np.ndarray | None = None       # unit hinge axis through the pivot; None: the y-axis
 
 
 def _uv(points: ArrayLike | None, n: int) -> np.ndarray:
@@ -98,11 +99,15 @@ def _scaled(dx: float, dy: float, scale: np.ndarray) -> np.ndarray:
     return np.array([dx, dy, 0.0]) * scale[1]
 
 
-def caudal_fin(fin: CaudalParams, scale: np.ndarray, uv: ArrayLike | None = None) -> Fin:
+def caudal_fin(fin: CaudalParams, scale: np.ndarray, uv: ArrayLike | None = None,
+               tail_x: float | None = None) -> Fin:
     """Two fans of triangles from the connection point (Figure 4.9).
 
     Vertex order as Fixel writes it: connection point; the top edge from the top
     tip to the middle line's end; the bottom edge from the bottom tip to it.
+    The thesis swings the fin about its connection point (7.1), which lies inside the
+    body; given the body's tail end ``tail_x``, it hinges where its middle line leaves
+    the body instead, so the part of the fin that meets the body stays on it.
     """
     origin = np.asarray(fin.connection, dtype=np.float64) * scale
     ta, ba = np.radians(fin.top_angle), np.radians(fin.bottom_angle)
@@ -125,7 +130,12 @@ def caudal_fin(fin: CaudalParams, scale: np.ndarray, uv: ArrayLike | None = None
         np.stack([np.zeros(len(bot_idx) - 1, int), bot_idx[:-1], bot_idx[1:]], axis=1),
     ])
     mesh = Mesh(origin + offsets, faces.astype(np.int64), _uv(uv, len(offsets)))
-    return Fin("caudal_fin", mesh, origin, fin.movement_angle, fin.step_size)
+    pivot = origin
+    middle_end = origin + offsets[n_top]
+    if tail_x is not None and middle_end[0] > origin[0]:
+        s = np.clip((tail_x - origin[0]) / (middle_end[0] - origin[0]), 0.0, 1.0)
+        pivot = origin + s * (middle_end - origin)
+    return Fin("caudal_fin", mesh, pivot, fin.movement_angle, fin.step_size)
 
 
 def vertical_fin(name: str, fin: VerticalParams, rings: np.ndarray, scale: np.ndarray, side: float,
@@ -176,8 +186,9 @@ def pectoral_fin(fin: PectoralParams, rings: np.ndarray, scale: np.ndarray,
     """Left pectoral fin (Figure 4.14): base on ring startBodySection from startCircleSection
     down through ``triangles`` CircleSections; like a vertical fin whose end line is zero.
 
-    Fixel order: T_0, B_0, B_n, B_1..B_{n-1}, T_1..T_{n-1}. Pivot: the base point
-    furthest out along z (thesis 7.1).
+    Fixel order: T_0, B_0, B_n, B_1..B_{n-1}, T_1..T_{n-1}. The fin hinges along its base line,
+    B_0 to B_n (the thesis pivots it on one point, 7.1, which lifts the rest of the base off the
+    body; docs/decisions.md).
     """
     circles = rings.shape[1]
     n = fin.triangles
@@ -202,9 +213,9 @@ def pectoral_fin(fin: PectoralParams, rings: np.ndarray, scale: np.ndarray,
     faces = strip_faces(where[: n + 1], top_idx)
     faces = faces[_nondegenerate(positions, faces)]
     faces = _face_outward(positions, faces, side)
-    pivot = base[np.argmax(base[:, 2] * side)]
+    pivot, axis = _hinge(base)
     return Fin("pectoral_fin_left", Mesh(positions, faces, _uv(uv, 2 * n + 1)), pivot,
-               fin.movement_angle, fin.step_size)
+               fin.movement_angle, fin.step_size, axis=axis)
 
 
 def pelvic_fin(fin: PelvicParams, rings: np.ndarray, scale: np.ndarray, uv: ArrayLike | None = None) -> Fin:
@@ -213,8 +224,9 @@ def pelvic_fin(fin: PelvicParams, rings: np.ndarray, scale: np.ndarray, uv: Arra
     the end line leaves at end_angle below the horizontal with end_length, and the
     outer edge runs straight between their tips.
 
-    Fixel order: B_0, B_n, O_0, O_n, B_1..B_{n-1}, O_1..O_{n-1}. Pivot: the
-    attaching point furthest up the y-axis (thesis 7.1).
+    Fixel order: B_0, B_n, O_0, O_n, B_1..B_{n-1}, O_1..O_{n-1}. The fin hinges along its base
+    line, B_0 to B_n (the thesis pivots it on its highest base point, 7.1, which swings the rear of
+    the base up to 2 % of the body length off the body; docs/decisions.md).
     """
     sections = np.arange(fin.start_section, fin.end_section + 1)
     n = sections.size
@@ -233,9 +245,19 @@ def pelvic_fin(fin: PelvicParams, rings: np.ndarray, scale: np.ndarray, uv: Arra
     faces = strip_faces(where[:n], where[n:])
     faces = faces[_nondegenerate(positions, faces)]
     faces = _face_outward(positions, faces, side)
-    pivot = base[np.argmax(base[:, 1])]
+    pivot, axis = _hinge(base)
     return Fin("pelvic_fin_left", Mesh(positions, faces, _uv(uv, 2 * n)), pivot,
-               fin.movement_angle, fin.step_size)
+               fin.movement_angle, fin.step_size, axis=axis)
+
+
+def _hinge(base: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """Pivot and unit axis of a fin hinged along its base line (first to last base point);
+    a base of one point (or none long enough) swings about the y-axis through it."""
+    line = base[-1] - base[0]
+    length = float(np.linalg.norm(line))
+    if length <= 1e-9 * max(1.0, float(np.abs(base).max())):
+        return base[0].copy(), None
+    return base[0].copy(), line / length
 
 
 def _nondegenerate(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -255,6 +277,8 @@ def _face_outward(positions: np.ndarray, faces: np.ndarray, side: float) -> np.n
 
 def mirrored(fin: Fin) -> Fin:
     """The right-hand twin of a left paired fin: a mirror image in z."""
-    pivot = None if fin.pivot is None else fin.pivot * np.array([1.0, 1.0, -1.0])
+    flip = np.array([1.0, 1.0, -1.0])
+    pivot = None if fin.pivot is None else fin.pivot * flip
+    axis = None if fin.axis is None else fin.axis * flip
     return Fin(fin.name.replace("_left", "_right"), fin.mesh.mirrored_z(), pivot,
-               fin.movement_angle, fin.step_size, mirror_of=fin.name)
+               fin.movement_angle, fin.step_size, mirror_of=fin.name, axis=axis)

@@ -51,7 +51,8 @@ def brain_of(species, body_length_units: float) -> Brain:
                  flee=(b.flee[0], max(1.0, b.flee[1] / body_length_units)))
 
 
-def run_school(scene_file: SceneFile, *, fins: str | None = None, tolerance: float = 0.002,
+def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "body",
+               tolerance: float = 0.002,
                textures_dir: str | os.PathLike | None = None,
                progress: Callable[[int], None] | None = None) -> SchoolRun:
     """Build each species once, simulate the school, and bake it into one scene."""
@@ -64,7 +65,7 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, tolerance: flo
     fishes, groups = [], []
     for entry in scene_file.species:
         species = load_species(entry.file, textures_dir)
-        fish = build_fish(species, fins=fins, fps=scene_file.fps)
+        fish = build_fish(species, fins=fins, fps=scene_file.fps, swim=swim, speed=entry.speed)
         lo, hi = bounds(fish)
         length = float(hi[2] - lo[2])
         units = species.world_scale * species.scale[0]

@@ -7,6 +7,11 @@ parts; its moving fins swing for the whole run, phase-shifted per fish, keyed at
 their turning points so a fin costs a few keys per cycle. Position and rotation keys
 are thinned per fish to the longest step whose linear interpolation stays within
 ``tolerance`` (metres, and the matching angle at one body length) of every frame.
+
+A species built with the body wave (`fishgen build`'s default) shares its four wave targets too;
+each fish gets one weights key array for all its parts, keyed every frame, whose tail-beat
+frequency follows the fish's own speed (Strouhal number) with the phase integrated over time, so a
+fish that speeds up beats faster without a jump.
 """
 from __future__ import annotations
 
@@ -14,6 +19,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from fishgen.assembly.body_wave import wave_nodes, weight_sampler
+from fishgen.geometry.body_wave import BodyWave, integrate_phase
 from fishgen.scene.model import Channel, Clip, Node, Sampler, Scene
 from fishgen.scene.pose import sample
 from fishgen.school.model import Tracks
@@ -25,9 +32,10 @@ FIN_PHASES = 16
 already keep neighbours from beating in step."""
 
 
-def merge_species(school: Scene, fish: Scene) -> list[tuple[Node, int | None]]:
+def merge_species(school: Scene, fish: Scene) -> list[tuple[Node, int | None, bool]]:
     """Add one built fish's meshes, materials and images to ``school``; return its part nodes
-    (as templates with re-indexed meshes) and the index of each part's swim channel."""
+    (as templates with re-indexed meshes), the index of each part's fin swing channel in the swim
+    clip, and whether the part carries the body-wave targets."""
     image_base, material_base, mesh_base = len(school.images), len(school.materials), len(school.meshes)
     school.images += fish.images
     for material in fish.materials:
@@ -39,12 +47,14 @@ def merge_species(school: Scene, fish: Scene) -> list[tuple[Node, int | None]]:
         school.meshes.append(replace(mesh, primitives=prims))
     (root,) = fish.roots
     swim = fish.clip("swim")
-    channel_of = {c.node: k for k, c in enumerate(swim.channels)} if swim is not None else {}
+    channel_of = ({c.node: k for k, c in enumerate(swim.channels) if c.path == "rotation"}
+                  if swim is not None else {})
     parts = []
+    waving = set(wave_nodes(fish))
     for child in fish.nodes[root].children:
         node = fish.nodes[child]
         parts.append((replace(node, children=[], mesh=None if node.mesh is None else node.mesh + mesh_base),
-                      channel_of.get(child)))
+                      channel_of.get(child), child in waving))
     return parts
 
 
@@ -84,8 +94,11 @@ def _fin_keys(channel: Channel, phase: float, duration: float) -> tuple[np.ndarr
 
 
 def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, seed: int = 0,
-         body_lengths: np.ndarray | None = None) -> Scene:
-    """One scene of every fish of ``tracks``; ``fish_scenes[g]`` is the built fish of group ``g``."""
+         body_lengths: np.ndarray | None = None, wave: BodyWave | None = None) -> Scene:
+    """One scene of every fish of ``tracks``; ``fish_scenes[g]`` is the built fish of group ``g``.
+
+    ``wave``: the body wave the species were built with (default :class:`BodyWave`); it drives
+    the species whose meshes carry the wave targets."""
     school = Scene(name="school", info={"kind": "school", "fish": int(len(tracks.group))})
     templates = [merge_species(school, fish) for fish in fish_scenes]
     swims = [fish.clip("swim") for fish in fish_scenes]
@@ -96,6 +109,7 @@ def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, 
     reach = np.ones(len(tracks.group)) if body_lengths is None else np.asarray(body_lengths, np.float64)
     position_keys = reduce_keys(tracks.positions, tolerance)
     rotation_keys = reduce_keys(tracks.headings * reach[None, :, None], tolerance)
+    phases = _wave_phases(fish_scenes, tracks, reach, rng, wave or BodyWave())
     channels: list[Channel] = []
     fin_samplers: dict[tuple[int, int, int], Sampler] = {}
     for i, group in enumerate(np.asarray(tracks.group)):
@@ -112,8 +126,11 @@ def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, 
                                                           tracks.headings[keys, i].astype(np.float32))))
         swim = swims[group]
         phase = int(rng.integers(FIN_PHASES))
-        for template, channel_index in templates[group]:
+        weights = None if phases is None or duration <= 0 else weight_sampler(times, phases[:, i])
+        for template, channel_index, waving in templates[group]:
             part = school.add_node(replace(template, children=[]), parent=node)
+            if waving and weights is not None:
+                channels.append(Channel(part, "weights", weights))
             if channel_index is not None and swim is not None and duration > 0:
                 key = (int(group), channel_index, phase)
                 if key not in fin_samplers:
@@ -124,3 +141,22 @@ def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, 
     if duration > 0:
         school.clips.append(Clip("school", channels))
     return school
+
+
+def _wave_phases(fish_scenes: list[Scene], tracks: Tracks, lengths: np.ndarray,
+                 rng: np.random.Generator, wave: BodyWave) -> np.ndarray | None:
+    """Per frame and fish (F, N), the body wave's phase: a seeded start, then 2 pi times the
+    integral of the tail-beat frequency at the fish's own speed in body lengths per second."""
+    waving = [bool(wave_nodes(fish)) for fish in fish_scenes]
+    start = rng.uniform(0.0, 2.0 * np.pi, len(tracks.group))  # drawn always: seeds stay in step
+    if not any(waving):
+        return None
+    times = np.asarray(tracks.times, np.float64)
+    dt = float(times[1] - times[0]) if len(times) > 1 else 0.0
+    speed = np.linalg.norm(np.asarray(tracks.velocities, np.float64), axis=2) / lengths[None, :]
+    frequency = np.zeros_like(speed)
+    for g, waves in enumerate(waving):
+        if waves:
+            members = np.asarray(tracks.group) == g
+            frequency[:, members] = wave.frequency(speed[:, members])
+    return integrate_phase(frequency, dt, start)

@@ -24,8 +24,8 @@ def parts(scene):
 
 
 def swim_channels(scene):
-    """Node name -> its rotation channel in the swim clip."""
-    return {scene.nodes[c.node].name: c for c in scene.clip("swim").channels}
+    """Node name -> its rotation channel in the swim clip (the fins' swings)."""
+    return {scene.nodes[c.node].name: c for c in scene.clip("swim").channels if c.path == "rotation"}
 
 
 def material(scene, name):
@@ -37,7 +37,7 @@ def images(scene):
 
 
 def test_axes_head_towards_plus_z_and_dorsal_up(bony):
-    fish = parts(build_fish(bony))
+    fish = parts(build_fish(bony, swim="fins"))   # the tail fin swings (carries a pivot) on a rigid body
     body = fish["body"][1].positions
     nose = body[np.argmax(body[:, 2])]
     assert nose[2] > 0 and abs(nose[0]) < 1e-7 and abs(nose[1]) < 1e-7      # nose on +Z axis
@@ -60,7 +60,7 @@ def test_default_size_comes_from_world_scale(bony):
 
 
 def test_moving_fins_pivot_and_static_fins_do_not(bony):
-    scene = build_fish(bony)
+    scene = build_fish(bony, swim="fins")
     moving = set(swim_channels(scene))
     assert moving == {"caudal_fin", "pectoral_fin_left", "pectoral_fin_right", "pelvic_fin_left",
                       "pelvic_fin_right"}
@@ -70,7 +70,7 @@ def test_moving_fins_pivot_and_static_fins_do_not(bony):
 
 
 def test_swim_clip_loops_every_fin_seamlessly(bony):
-    scene = build_fish(bony, fps=30)
+    scene = build_fish(bony, fps=30, swim="fins")
     # caudal 4*10/1 = 40 frames, pelvic 24, pectoral 16 -> lcm 240
     assert scene.clip("swim").duration == pytest.approx(8.0)
     amplitudes = {"caudal_fin": 10.0, "pectoral_fin_left": 4.0, "pelvic_fin_left": 6.0}
@@ -79,7 +79,7 @@ def test_swim_clip_loops_every_fin_seamlessly(bony):
         assert times[-1] == pytest.approx(8.0) and np.allclose(quats[0], quats[-1])
         assert np.allclose(quats[0], [0, 0, 0, 1])            # every fin starts and ends at rest
         if name in amplitudes:
-            angles = np.degrees(2 * np.arcsin(quats[:, 1]))
+            angles = np.degrees(2 * np.arcsin(np.linalg.norm(quats[:, :3], axis=1)))
             assert np.abs(angles).max() == pytest.approx(amplitudes[name], abs=1e-4)
 
 
@@ -156,3 +156,16 @@ def test_loop_length_error_points_at_the_fin_record():
         build_fish(sp)
     caudal_line = next(i for i, l in enumerate(text.splitlines(), 1) if l.endswith("3.0 10.0 0.0001"))
     assert info.value.line == caudal_line and "fin cycle (4 x movement angle / step size) of at most 100000" in str(info.value)
+
+
+def test_with_the_body_wave_the_tail_fin_rides_the_wave_and_the_loop_closes(bony):
+    scene = build_fish(bony, fps=30)
+    assert "caudal_fin" not in swim_channels(scene)          # its swing is the wave's (decisions.md)
+    clip = scene.clip("swim")
+    beats = clip.duration * scene.info["tail_beat_hz"]
+    laps = clip.duration / 1.6                                # fin loop: pelvic 24, pectoral 16 frames
+    assert beats == pytest.approx(round(beats), abs=1e-5) and laps == pytest.approx(round(laps), abs=1e-5)
+    assert scene.info["tail_beat_hz"] == pytest.approx(1.5, rel=0.05)   # St 0.3 at 1 body length/s
+    for channel in clip.channels:
+        assert np.allclose(channel.sampler.values[0], channel.sampler.values[-1], atol=1e-6)
+        assert channel.sampler.times[-1] == pytest.approx(clip.duration)

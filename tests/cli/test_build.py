@@ -13,7 +13,7 @@ def test_build_default_species_to_glb(tmp_path):
     result = run_cli("build", PARAMS / "bonybream.txt", "-o", out)
     assert result.returncode == 0, result.stderr
     assert result.stderr == "" and result.stdout.count("\n") == 1      # one summary line, on stdout
-    assert "bonybream" in result.stdout and "swim loop 8.00 s" in result.stdout
+    assert "bonybream" in result.stdout and "swim loop 3.20 s, body wave 1.56 Hz" in result.stdout
     assert_valid_gltf(out)
 
 
@@ -21,8 +21,8 @@ def test_obj_summary_says_the_animation_is_not_kept(tmp_path):
     result = run_cli("build", PARAMS / "bonybream.txt", "-o", tmp_path / "b.obj")
     assert result.returncode == 0, result.stderr
     assert "swim loop" not in result.stdout
-    assert result.stdout.count("rest pose only (OBJ holds no node animation, alpha cutoff or double-sided "
-                               "faces)") == 1
+    assert result.stdout.count("rest pose only (OBJ holds no node animation, morph targets, alpha cutoff "
+                               "or double-sided faces)") == 1
 
 
 def test_a_cube_file_says_which_command_builds_it(tmp_path):

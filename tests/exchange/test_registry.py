@@ -44,7 +44,7 @@ def test_summary_names_what_a_rest_pose_format_drops(tmp_path):
     from tests.conftest import PARAMS
 
     fish = build_fish(load_species(PARAMS / "bonybream.txt"))
-    assert lost(FORMATS["obj"], fish) == [NODE_ANIMATION, "alpha cutoff", "double-sided faces"]
+    assert lost(FORMATS["obj"], fish) == [NODE_ANIMATION, "morph targets", "alpha cutoff", "double-sided faces"]
     assert lost(FORMATS["glb"], fish) == []
 
 

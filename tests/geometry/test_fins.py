@@ -27,6 +27,11 @@ def test_fin_vertices_match_texture_point_counts(sp):
     tp = sp.texture_points
     for name, points in (("caudal_fin", tp.caudal), ("dorsal_fin", tp.dorsal), ("anal_fin", tp.anal),
                          ("pectoral_fin_left", tp.pectoral), ("pelvic_fin_left", tp.pelvic)):
+        if name == "anal_fin" and len(fins[name].mesh.positions) < len(points):
+            # ended in front of the caudal fin (decisions.md): Fixel's first points, end moved up
+            n = len(fins[name].mesh.positions) // 2
+            assert 2 <= n < len(points) // 2 and np.allclose(fins[name].mesh.uvs[:2], points[:2])
+            continue
         assert len(fins[name].mesh.positions) == len(points)
         assert np.allclose(fins[name].mesh.uvs, points)
 
