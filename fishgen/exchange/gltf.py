@@ -152,19 +152,22 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[gl.GLTF2,
     for clip in scene.clips:
         anim = gl.Animation(name=clip.name)
         samplers: dict[tuple[int, int, str], int] = {}
+        stored: dict[int, int] = {}  # id of a scene Sampler (alive all along) -> its glTF sampler
         for ch in clip.channels:
             smp = ch.sampler
-            times = buf.accessor(np.asarray(smp.times, np.float32).ravel(), bounds=True)
-            values = np.asarray(smp.values, np.float32)
-            if ch.path == "weights":
-                values = values.ravel()  # glTF: SCALAR, (keys x targets) values
-            key = (times, buf.accessor(values), smp.interpolation)
-            if key not in samplers:  # channels with the same keys share one sampler
-                anim.samplers.append(gl.AnimationSampler(input=key[0], output=key[1], interpolation=key[2]))
-                samplers[key] = len(anim.samplers) - 1
-            anim.channels.append(gl.AnimationChannel(sampler=samplers[key],
-                                                     target=gl.AnimationChannelTarget(node=ch.node,
-                                                                                      path=ch.path)))
+            if id(smp) not in stored:  # a fish's parts share one weights Sampler: look it up once
+                times = buf.accessor(np.asarray(smp.times, np.float32).ravel(), bounds=True)
+                values = np.asarray(smp.values, np.float32)
+                if ch.path == "weights":
+                    values = values.ravel()  # glTF: SCALAR, (keys x targets) values
+                key = (times, buf.accessor(values), smp.interpolation)
+                if key not in samplers:  # channels with the same keys share one sampler
+                    anim.samplers.append(gl.AnimationSampler(input=key[0], output=key[1],
+                                                             interpolation=key[2]))
+                    samplers[key] = len(anim.samplers) - 1
+                stored[id(smp)] = samplers[key]
+            # plain JSON rather than pygltflib's dataclasses: a school has tens of thousands
+            anim.channels.append(_Json(sampler=stored[id(smp)], target=_Json(node=ch.node, path=ch.path)))
         gltf.animations.append(anim)
     gltf.buffers.append(gl.Buffer(byteLength=buf.length + (-buf.length % 4)))
     return gltf, buf
@@ -207,25 +210,45 @@ def document_json(gltf: gl.GLTF2, where: Path) -> bytes:
                            where) from None
 
 
+_LEAVES = (int, float, str, bool)
+
+
+class _Json(dict):
+    """A document member written as plain JSON already (no empty members): stored as it is."""
+
+
 def _plain(obj: Any, keep_empty: bool = False) -> Any:
-    """Dataclasses to dicts without their empty members; inside ``extensions`` everything is kept."""
-    if isinstance(obj, (int, float, str)) or obj is None:
+    """Dataclasses to dicts without their empty members; inside ``extensions`` everything is kept.
+
+    Written for speed (a school has tens of thousands of channels): leaves are copied inline."""
+    kind = type(obj)
+    if kind in _LEAVES or obj is None or kind is _Json:
         return obj
-    if isinstance(obj, (list, tuple)):
-        return [_plain(item, keep_empty) for item in obj]
+    if kind is list or kind is tuple:
+        return [item if type(item) in _LEAVES else _plain(item, keep_empty) for item in obj]
     items: Any
-    if isinstance(obj, dict):
+    if kind is dict:
         items = obj.items()
     else:  # a pygltflib dataclass, or its Attributes (a plain object with custom members)
         items = vars(obj).items()
-        if not isinstance(obj, gl.Attributes):  # leave out pygltflib's private state (a blob, a path)
+        if kind is gl.GLTF2:  # leave out pygltflib's private state (a loaded blob, a path)
             items = [(key, value) for key, value in items if not key.startswith("_")]
         keep_empty = False
     out = {}
     for key, value in items:
-        if not keep_empty and (value is None or (hasattr(value, "__len__") and len(value) == 0)):
+        if value is None:
+            if keep_empty:
+                out[key] = None
             continue
-        out[key] = _plain(value, keep_empty or key == "extensions")
+        kind = type(value)
+        if kind is int or kind is float or kind is bool:
+            out[key] = value
+        elif not keep_empty and kind in (str, list, dict, tuple) and not value:
+            continue
+        elif kind is str:
+            out[key] = value
+        else:
+            out[key] = _plain(value, keep_empty or key == "extensions")
     return out
 
 
