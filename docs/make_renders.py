@@ -34,12 +34,16 @@ def extras() -> list[tuple[str, list[str]]]:
     if species:
         out.append(("species-side.png", [*species, "--view", "side", "--size", "400x300"]))
     if (ROOT / "params" / "bonybream.txt").is_file():
-        out.append(("bonybream-swim.gif", ["params/bonybream.txt", "--size", "400x300"]))
+        # from above: the body wave is a sideways motion
+        out.append(("bonybream-swim.gif", ["params/bonybream.txt", "--size", "400x300", "--view", "top"]))
     return out
 
 
 SCHOOL = ["school", "params/reef.toml", "-o", "out/reef.glb", "--plot", "docs/images/reef-measures.png"]
 """The README's school: the shipped reef scene, baked first, then previewed as a loop."""
+SMALL_SCHOOL = ["school", "params/bonybream.txt", "--count", "10", "--frames", "150", "--seed", "3",
+                "-o", "out/school-swim.glb"]
+"""A small school seen close enough to watch the bodies swim."""
 
 
 def main() -> int:
@@ -47,11 +51,15 @@ def main() -> int:
     parser.add_argument("--list", action="store_true", help="print the renders and exit")
     args = parser.parse_args()
     jobs = stills() + extras() + [("reef.gif", ["out/reef.glb", "--size", "480x360", "--view", "top",
-                                                "--duration", "10", "--fps", "8"])]
+                                                "--duration", "10", "--fps", "8"]),
+                                  ("school-swim.gif", ["out/school-swim.glb", "--size", "560x380", "--time",
+                                                       "2.5", "--duration", "2.5", "--fps", "12"])]
     IMAGES.mkdir(parents=True, exist_ok=True)
-    print(" ".join(["fishgen", *SCHOOL]))
-    if not args.list:
-        subprocess.run([sys.executable, "-m", "fishgen", *SCHOOL], cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+    for school in (SCHOOL, SMALL_SCHOOL):
+        print(" ".join(["fishgen", *school]))
+        if not args.list:
+            subprocess.run([sys.executable, "-m", "fishgen", *school], cwd=ROOT, check=True,
+                           stdout=subprocess.DEVNULL)
     for name, argv in jobs:
         command = [sys.executable, "-m", "fishgen", "preview", *argv, "-o", str(IMAGES / name)]
         print(" ".join(["fishgen", "preview", *argv, "-o", f"docs/images/{name}"]))

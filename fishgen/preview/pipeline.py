@@ -232,9 +232,13 @@ def encode(images: list, out: Path, seconds_per_frame: float) -> bytes:
                           duration=max(20, round(seconds_per_frame * 1000)))
         images[0].save(buf, "WEBP", **kwargs)
     else:  # gif: one shared palette keeps the loop from flickering between frames
+        from PIL import Image
+
         rgb = [im.convert("RGB") for im in images]
         palette = rgb[0].quantize(colors=255, method=2)
-        frames = [im.quantize(palette=palette, dither=1) for im in rgb]
+        # no error diffusion: it spreads from the moving fish into the flat background and leaves
+        # faint dotted trails that differ frame to frame
+        frames = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in rgb]
         frames[0].save(buf, "GIF", save_all=True, append_images=frames[1:], loop=0,
                        duration=max(20, round(seconds_per_frame * 1000)), disposal=1)
     return buf.getvalue()

@@ -120,4 +120,38 @@ window.inspectAsset = async (loader, url, options = {}) => {
     return { error: String(e && e.message ? e.message : e) };
   }
 };
+// The tail tip's world position as three.js plays the first clip: the vertex furthest towards -Z
+// at rest, moved by three.js's own morph and skin code (Mesh.getVertexPosition) and node matrices.
+window.tailTrack = async (url, times) => {
+  try {
+    const gltf = await new GLTFLoader().loadAsync(url);
+    const root = gltf.scene;
+    const mixer = new THREE.AnimationMixer(root);
+    mixer.clipAction(gltf.animations[0]).play();
+    const v = new THREE.Vector3();
+    const where = (mesh, i) => mesh.getVertexPosition(i, v).applyMatrix4(mesh.matrixWorld);
+    root.updateMatrixWorld(true);
+    let tip = null;
+    let nose = -Infinity;
+    root.traverse((o) => {
+      if (!o.isMesh) return;
+      for (let i = 0; i < o.geometry.attributes.position.count; i++) {
+        const p = where(o, i);
+        nose = Math.max(nose, p.z);
+        if (!tip || p.z < tip.z) tip = { mesh: o, index: i, z: p.z };
+      }
+    });
+    const track = [];
+    for (const t of times) {
+      mixer.setTime(t);
+      root.updateMatrixWorld(true);
+      const p = where(tip.mesh, tip.index);
+      track.push([p.x, p.y, p.z]);
+    }
+    const influences = tip.mesh.morphTargetInfluences ? tip.mesh.morphTargetInfluences.length : 0;
+    return { track, length: nose - tip.z, mesh: tip.mesh.name, influences };
+  } catch (e) {
+    return { error: String(e && e.message ? e.message : e) };
+  }
+};
 window.harnessReady = true;

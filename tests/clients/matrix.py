@@ -491,6 +491,14 @@ class ThreeClient:
         expect(not problems, "; ".join(problems[:3]))
         return self._judge(asset, result)
 
+    def tail_track(self, relative: str, times: list[float]) -> dict:
+        """The tail tip as three.js plays the file at /assets/RELATIVE (harness.js tailTrack)."""
+        self.console.clear()
+        result = self.page.evaluate("([u, t]) => window.tailTrack(u, t)", [f"{self.base}/assets/{relative}", times])
+        expect("error" not in result, f"three.js: {result.get('error')}")
+        expect(not self._problems(), "; ".join(self._problems()[:3]))
+        return result
+
     def _judge(self, asset: Asset, r: dict) -> str:
         notes = []
         objects = r["objects"]

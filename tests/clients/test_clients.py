@@ -9,7 +9,7 @@ import shutil
 
 import pytest
 
-from tests.clients.matrix import KNOWN_LIMITS, Asset, Format, cells
+from tests.clients.matrix import KNOWN_LIMITS, ROOT, Asset, Format, cells
 
 
 @pytest.mark.parametrize(("label", "client"), cells(), ids=[f"{c}-{fmt.replace(' ', '_')}" for fmt, c in cells()])
@@ -73,3 +73,26 @@ def test_three_fails_on_a_count_fishgen_did_not_report(matrix, three):
     asset.expected["particles"] += 1
     with pytest.raises(AssertionError, match="particles"):
         three.check(asset)
+
+
+def test_three_js_plays_the_body_wave_at_full_amplitude(matrix, three):
+    """three.js's own morph code moves BonyBream's tail tip as the wave says (issue 10, within 10 %)."""
+    import numpy as np
+
+    from fishgen.assembly.fish import build_fish
+    from fishgen.exchange import export
+    from fishgen.geometry.body_wave import BodyWave
+    from fishgen.species.parser import load_species
+
+    scene = build_fish(load_species(ROOT / "params" / "bonybream.txt"))
+    export(scene, matrix.asset_dir / "wave" / "bonybream.glb")
+    duration = scene.clip("swim").duration
+    times = np.linspace(0.0, duration, 600, endpoint=False)
+    result = three.tail_track("wave/bonybream.glb", times.tolist())
+    lateral = np.array(result["track"])[:, 0]
+    wave = BodyWave()
+    print(f"three.js tail tip: peak-to-peak {np.ptp(lateral) / result['length']:.3f} body lengths")
+    assert result["influences"] == 4
+    assert np.ptp(lateral) == pytest.approx(wave.tail_peak_to_peak * result["length"], rel=0.10)
+    upward = np.count_nonzero((lateral[:-1] < lateral.mean()) & (lateral[1:] >= lateral.mean()))
+    assert upward / duration == pytest.approx(scene.info["tail_beat_hz"], rel=0.10)

@@ -32,14 +32,19 @@ def test_species_scene_has_textured_body_fins_and_swim_clip():
     assert {f.alpha_mode for f in fins} <= {"MASK", "BLEND", "OPAQUE"}
 
 
-def test_posing_moves_the_tail_but_not_the_body():
+def test_posing_swings_the_fins_and_bends_the_body():
+    from fishgen.scene.pose import deformed
+
     scene = load_input(PARAMS / "bonybream.txt")
-    tail = next(i for i, n in enumerate(scene.nodes) if n.name == "caudal_fin")
+    fin = next(i for i, n in enumerate(scene.nodes) if n.name == "pelvic_fin_left")
     body = next(i for i, n in enumerate(scene.nodes) if n.name == "body")
     duration = scene.clip().duration
-    a, b = pose(scene, 0.0).world, pose(scene, duration / 8).world
-    assert not np.allclose(a[tail], b[tail])
-    assert np.allclose(a[body], b[body])
+    a, b = pose(scene, 0.0), pose(scene, duration / 16)             # a quarter of the pelvic cycle
+    assert not np.allclose(a.world[fin], b.world[fin])                # the fin swings on its hinge
+    assert np.allclose(a.world[body], b.world[body])                  # the body node stays put...
+    prim = scene.meshes[scene.nodes[body].mesh].primitives[0]
+    bend = deformed(scene, body, prim, b)[0] - deformed(scene, body, prim, a)[0]
+    assert np.abs(bend[:, 0]).max() > 0.02 and np.abs(bend[:, 1:]).max() == 0  # ...and its mesh bends sideways
 
 
 @pytest.mark.parametrize("ext", ["glb", "gltf", "obj", "ply"])
