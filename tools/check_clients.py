@@ -85,8 +85,12 @@ def _judge_blender(asset: Asset, r: dict) -> str:
         swim = [a for a in r["actions"] if a["name"].startswith("swim")]
         expect(bool(swim), f"no swim action (actions: {[a['name'] for a in r['actions']]})")
         animated = [o["name"] for o in r["objects"] if (o.get("action") or "").startswith("swim")]
-        expect(len(animated) == 5, f"swim drives {len(animated)} objects, expected 5")
-        notes.append(f"action swim: {swim[0]['channels']} F-curves on {len(animated)} fins")
+        expect(len(animated) == 4, f"swim drives {len(animated)} objects, expected the 4 paired fins")
+        waving = [o["name"] for o in r["objects"] if o.get("shape_keys") == 4
+                  and (o.get("shape_key_action") or "").startswith("swim")]
+        expect(len(waving) == 9, f"the body wave drives the shape keys of {len(waving)} meshes, expected 9")
+        notes.append(f"action swim: {swim[0]['channels']} F-curves on {len(animated)} fins; "
+                     f"4 shape keys animated on {len(waving)} meshes")
     return "; ".join(notes)
 
 

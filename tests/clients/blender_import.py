@@ -82,6 +82,11 @@ def inspect(path: Path) -> dict:
             info.update(points=len(ob.data.points), attributes=sorted(a.name for a in ob.data.attributes))
         if ob.animation_data and ob.animation_data.action:
             info["action"] = ob.animation_data.action.name
+        keys = getattr(ob.data, "shape_keys", None) if ob.type == "MESH" else None
+        if keys is not None:  # morph targets: shape keys, animated through the key's own action
+            info["shape_keys"] = len(keys.key_blocks) - 1
+            if keys.animation_data and keys.animation_data.action:
+                info["shape_key_action"] = keys.animation_data.action.name
         objects.append(info)
     actions = [{"name": a.name, "channels": _channels(a), "users": a.users} for a in bpy.data.actions]
     return {"file": path.name, "blender": bpy.app.version_string, "objects": objects, "actions": actions,

@@ -33,7 +33,7 @@ HERE = Path(__file__).resolve().parent
 PARAMS = ROOT / "params"
 FISH_SOURCE = PARAMS / "bonybream.txt"
 CLOUD_SOURCE = PARAMS / "clouds" / "table_4_4.awn"
-SWIM_TRACKS = 5
+SWIM_TRACKS = 13  # 4 fin swings (pectoral, pelvic) + the body wave's weights on the body and 8 fins
 CLOUD_COLUMNS = ("x", "y", "z", "radius", "density", "red", "green", "blue")
 
 
