@@ -146,19 +146,69 @@ def _clouds(job: Job, reads: list[Path]) -> list[Path]:
 RUNNERS = {"build": _build, "school": _school, "clouds": _clouds}
 
 
-def init_worker() -> None:
-    """A local pool's worker: one thread of numpy each (the pool is the parallelism), SIGTERM
-    unwinds like the CLI's (atomic writers remove their temp files), and Ctrl-C is the parent's
-    to handle: it stops the workers itself."""
+_busy = False    # a local pool worker is running a job (its SIGTERM must unwind the atomic writer)
+_orphan = False  # the batch that started this worker is gone (killed with SIGKILL)
+
+
+class Stopped(BaseException):
+    """SIGTERM in a pool worker: unwinds the job (atomic writers remove their temp files)."""
+
+
+def _stop(signum: int, _frame: object) -> None:
+    if _busy:
+        raise Stopped(128 + signum)
+    os._exit(128 + signum)  # idle: nothing to clean up, and no traceback from the pool's loop
+
+
+def init_worker(batch_pid: int) -> None:
+    """A local pool's worker: SIGTERM stops it cleanly; Ctrl-C is the parent's to handle (it stops
+    the workers itself, so the terminal's SIGINT to the whole group is ignored here); and when
+    the batch itself is killed, the worker finishes the file it is writing and exits."""
     import signal
+    import threading
 
-    from fishgen.cli import Interrupted
-
-    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(var, "1")
-
-    def stop(signum: int, _frame: object) -> None:
-        raise Interrupted(128 + signum)
-
-    signal.signal(signal.SIGTERM, stop)
+    signal.signal(signal.SIGTERM, _stop)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_watch, args=(batch_pid,), daemon=True).start()
+
+
+def _watch(batch_pid: int) -> None:
+    """A forkserver's worker is not the batch's child, so no pipe or signal tells it the batch died."""
+    global _orphan
+    while _alive(batch_pid):
+        time.sleep(0.2)
+    _orphan = True
+    if not _busy:
+        os._exit(1)
+
+
+def _alive(pid: int) -> bool:
+    """Whether the process runs. A killed batch stays a zombie until its own parent reaps it (and a
+    parent reading its output first never does), so on Linux its state is read, not signalled."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as handle:
+            return handle.read().rpartition(b")")[2].split()[0] not in (b"Z", b"X")
+    except FileNotFoundError:
+        return False
+    except OSError:  # no /proc: a signal 0 tells a live (or zombie) process from none
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        except PermissionError:  # the pid was reused by another user's process
+            return False
+        return True
+
+
+def run_in_worker(job: Job) -> Result:
+    """:func:`run_job` in a local pool worker, which exits once a SIGTERM has unwound the job."""
+    global _busy
+    _busy = True
+    try:
+        return run_job(job)
+    except Stopped as stop:
+        os._exit(stop.args[0])
+    finally:
+        _busy = False
+        if _orphan:  # nobody is waiting for the result; the output is whole either way
+            os._exit(1)

@@ -149,8 +149,9 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None)
     data = loads(text, file)
     where = Where(text, file)
     for key in data:
-        if key not in ("out", *KINDS):
-            raise where.fail(f"one of out, {', '.join(f'[[{k}]]' for k in KINDS)}", key, key)
+        if key not in ("out", *KINDS):  # a misspelt key, or a misspelt [[table]] (its header line)
+            raise FishgenError(f"expected one of out, {', '.join(f'[[{k}]]' for k in KINDS)}, found {key!r}",
+                               file, where.line(key) or where.line("", key))
     folder = path.resolve().parent
     if out is None and "out" in data:
         if not isinstance(data["out"], str) or not data["out"]:

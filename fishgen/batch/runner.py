@@ -12,7 +12,8 @@ import sys
 from collections import deque
 from collections.abc import Callable, Sequence
 
-from fishgen.batch.jobs import Result, init_worker, run_job  # light: the jobs import the library lazily
+# light: the jobs import the library only when one runs
+from fishgen.batch.jobs import Result, init_worker, run_in_worker, run_job
 from fishgen.batch.manifest import Job
 from fishgen.errors import FishgenError
 
@@ -72,7 +73,7 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int) -> None:
     stop = False
     while pending and not stop:
         pool = ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
-                                   initializer=init_worker)
+                                   initializer=init_worker, initargs=(os.getpid(),))
         running: dict[Future, Job] = {}
         broken = clean = False
         try:
@@ -80,7 +81,7 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int) -> None:
                 while pending and len(running) < workers and not (stop or broken):
                     job = pending.popleft()
                     try:
-                        running[pool.submit(run_job, job)] = job
+                        running[pool.submit(run_in_worker, job)] = job
                     except BrokenProcessPool:
                         pending.appendleft(job)
                         broken = True
@@ -136,7 +137,7 @@ def _dask(jobs: Sequence[Job], done: Done, address: str) -> None:
             # pure=False: two runs of the same job are two builds (the outputs may have been removed)
             futures[client.submit(run_job, job, pure=False, key=f"fishgen-batch-{index}-{os.getpid()}-"
                                   f"{job.name}")] = job
-        for future in as_completed(list(futures)):
+        for future in as_completed(list(futures), loop=client.loop):
             job = futures[future]
             try:
                 result = future.result()
