@@ -82,7 +82,11 @@ def run_batch(manifest: Manifest, *, workers: int = 1, force: bool = False, fail
                          result.notes))
             return fail_fast and result.status == "failed"
 
-        run_jobs([job for job, _ in todo], done, workers=workers, scheduler=scheduler)
+        try:
+            run_jobs([job for job, _ in todo], done, workers=workers, scheduler=scheduler)
+        finally:
+            if todo and not record.damaged:
+                record.save()  # once, durably, however the run ended
     return [outcomes.get(job.name) or Outcome(job, "not run", reasons.get(job.name)) for job in manifest.jobs]
 
 

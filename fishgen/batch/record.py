@@ -136,9 +136,22 @@ class Record:
         """Set a job's entry and write the record atomically. A failed job keeps its old entry:
         its old output is still there, whole, and its changed inputs make it run again."""
         self.jobs[name] = entry
-        self.save()
+        self.save(durable=False)
 
-    def save(self) -> None:
+    def save(self, durable: bool = True) -> None:
+        """Replace the record file atomically. ``durable=False`` skips the fsync: the rename alone
+        is atomic against a killed process, and after a power cut an older or unreadable record
+        only means more jobs run (an fsync per job cost 1 s over 100 builds here)."""
         doc = {"format": FORMAT, "version": FORMAT_VERSION, "jobs": dict(sorted(self.jobs.items()))}
-        write_bytes(self.path, (json.dumps(doc, indent=1, sort_keys=True) + "\n").encode("utf-8"))
+        data = (json.dumps(doc, indent=1, sort_keys=True) + "\n").encode("utf-8")
+        if durable:
+            write_bytes(self.path, data)
+        else:
+            temporary = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
+            try:
+                temporary.write_bytes(data)
+                os.replace(temporary, self.path)
+            except BaseException:
+                temporary.unlink(missing_ok=True)
+                raise
         self.damaged = False
