@@ -3,11 +3,13 @@ leaves whole files and a consistent record, and the next run finishes only what 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -102,6 +104,53 @@ def test_a_batch_killed_midway_leaves_whole_files_and_the_next_run_finishes_it(s
     assert {n for n, s in found.items() if s == "skipped"} == set(done)
     assert set(found) == {f"fish{i:03d}.glb" for i in range(120)}
     assert set(hashes(out).values()) == {whole}
+
+
+def descendants(pid: int) -> list[int]:
+    """Every process below ``pid`` (the forkserver's workers are the batch's grandchildren)."""
+    parents = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            parents[int(stat.parent.name)] = int(stat.read_bytes().rpartition(b")")[2].split()[1])
+        except (OSError, ValueError, IndexError):
+            continue
+    found, frontier = [], [pid]
+    while frontier:
+        children = [child for child, parent in parents.items() if parent in frontier]
+        found += children
+        frontier = children
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers through /proc")
+def test_a_killed_worker_fails_only_its_job_and_the_batch_goes_on(shipped):
+    manifest, out = many_builds(shipped, 120)
+    proc = subprocess.Popen([sys.executable, "-m", "fishgen", "batch", str(manifest), "-j", "2"], cwd=ROOT,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and proc.poll() is None:
+        try:
+            if len(record(out)) >= 5:
+                break
+        except (OSError, ValueError):
+            pass
+        time.sleep(0.01)
+    workers = [pid for pid in descendants(proc.pid)
+               if b"forkserver" in Path(f"/proc/{pid}/cmdline").read_bytes()
+               and Path(f"/proc/{pid}/stat").read_bytes().rpartition(b")")[2].split()[1] != str(proc.pid).encode()]
+    assert workers, "no worker found"
+    os.kill(workers[0], signal.SIGKILL)
+    stdout, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 1 and "a worker process died while building it" in stderr
+    assert "Traceback" not in stderr
+    outputs = hashes(out)
+    assert 118 <= len(outputs) <= 120 and len(set(outputs.values())) == 1  # the rest built, every file whole
+    done = set(record(out))
+    assert done <= set(outputs) and len(done) >= 118
+    again = batch(manifest, "-j", "2")
+    assert again.returncode == 0 and len(hashes(out)) == 120
+    everything = {f"fish{i:03d}.glb" for i in range(120)}
+    assert {n for n, s in statuses(again.stdout).items() if s == "built"} == everything - done
 
 
 def test_a_dask_cluster_builds_the_same_bytes_as_the_local_pool(shipped):
