@@ -135,9 +135,10 @@ def test_a_killed_worker_fails_only_its_job_and_the_batch_goes_on(shipped):
         except (OSError, ValueError):
             pass
         time.sleep(0.01)
-    workers = [pid for pid in descendants(proc.pid)
-               if b"forkserver" in Path(f"/proc/{pid}/cmdline").read_bytes()
-               and Path(f"/proc/{pid}/stat").read_bytes().rpartition(b")")[2].split()[1] != str(proc.pid).encode()]
+    # Breadth first: the forkserver (the batch's child) comes before its workers (grandchildren).
+    forked = [pid for pid in descendants(proc.pid)
+              if b"forkserver" in Path(f"/proc/{pid}/cmdline").read_bytes()]
+    workers = forked[1:]
     assert workers, "no worker found"
     os.kill(workers[0], signal.SIGKILL)
     stdout, stderr = proc.communicate(timeout=120)
