@@ -61,8 +61,9 @@ def _context():
 
 
 def _pool(jobs: Sequence[Job], done: Done, workers: int) -> None:
-    """A local process pool, at most ``workers`` jobs in flight; a pool a dead worker broke is
-    replaced, and only the jobs that were in flight fail."""
+    """A local process pool with two jobs queued per worker (a worker never waits for this process
+    to hand it the next one). A pool a dead worker broke is replaced and the jobs it held are
+    tried once more; a job that breaks a second pool fails."""
     from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
     from concurrent.futures.process import BrokenProcessPool
 
@@ -71,6 +72,7 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int) -> None:
     pending = deque(jobs)
     context = _context()
     stop = False
+    lost: set[str] = set()  # jobs a dead worker took down once
     while pending and not stop:
         pool = ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
                                    initializer=init_worker, initargs=(os.getpid(),))
@@ -78,7 +80,7 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int) -> None:
         broken = clean = False
         try:
             while pending or running:
-                while pending and len(running) < workers and not (stop or broken):
+                while pending and len(running) < 2 * workers and not (stop or broken):
                     job = pending.popleft()
                     try:
                         running[pool.submit(run_in_worker, job)] = job
@@ -94,8 +96,12 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int) -> None:
                         result = future.result()
                     except BrokenProcessPool:
                         broken = True
-                        result = _failed(job, "a worker process died while building it (killed, or out of "
-                                              "memory); run the batch again to retry")
+                        if job.name not in lost:  # perhaps only queued behind the job that died
+                            lost.add(job.name)
+                            pending.appendleft(job)
+                            continue
+                        result = _failed(job, "a worker process died twice while building it (killed, or "
+                                              "out of memory)")
                     stop = done(job, result) or stop
             clean = True
         finally:
