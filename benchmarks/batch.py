@@ -49,6 +49,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--jobs", type=int, default=100)
     args = parser.parse_args()
+    load = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         path = manifest(Path(tmp), args.jobs)
         run(str(path), "-j", "2")  # warm the file cache and the record
@@ -58,7 +59,8 @@ def main() -> None:
                 times[f"-j {workers}"].append(run(str(path), "-j", workers, "--force"))
         unchanged = [run(str(path)) for _ in range(max(5, args.repeat))]
     print(f"fishgen batch: {args.jobs} builds of the 4 shipped species, {os.cpu_count()} cores, "
-          f"Python {sys.version.split()[0]}, median of {args.repeat} (min, max)")
+          f"Python {sys.version.split()[0]}, median of {args.repeat} (min, max); load average before "
+          f"{load[0]:.1f}, after {os.getloadavg()[0]:.1f} (other processes' share of the cores)")
     for label, runs in times.items():
         print(f"  {label}   {statistics.median(runs):7.2f} s   ({min(runs):.2f}, {max(runs):.2f})   "
               f"{args.jobs / statistics.median(runs):6.1f} jobs/s")

@@ -2,10 +2,13 @@
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 
 from PIL import Image
 
 from tests.batch.conftest import batch, hashes, record, statuses
+from tests.conftest import ROOT
 
 FISH = {"fish/bonybream.glb", "fish/centroberyx.glb", "fish/pineapplefish.glb", "fish/threadfingoldie.glb"}
 CLOUDS = {"clouds/table_4_2.glb", "clouds/table_4_3.glb", "clouds/table_4_4.glb"}
@@ -34,6 +37,17 @@ def test_the_example_builds_everything_valid_and_a_second_run_skips_everything(s
             "../../textures/threadfingoldie_mask.png"} <= school_inputs
     assert rebuilt(batch(manifest)) == set()
     assert hashes(out) == first
+
+
+def test_deciding_that_nothing_changed_imports_no_numpy(shipped):
+    """What keeps a no-change rerun of 100 jobs well under a second: no library is loaded."""
+    manifest = shipped / "params" / "assets.toml"
+    batch(manifest, "-j", "2")
+    run = subprocess.run([sys.executable, "-X", "importtime", "-m", "fishgen", "batch", str(manifest)],
+                         cwd=ROOT, capture_output=True, text=True)
+    assert run.returncode == 0 and set(statuses(run.stdout).values()) == {"skipped"}
+    imported = {line.split("|")[-1].strip() for line in run.stderr.splitlines() if "|" in line}
+    assert not imported & {"numpy", "trimesh", "pygltflib", "PIL", "scipy"}
 
 
 def test_editing_a_species_file_rebuilds_exactly_the_jobs_that_read_it(shipped):
