@@ -61,10 +61,12 @@ def batch(source: Path, out: Path | None, workers: int | None, force: bool, fail
         manifest = load_manifest(source, out)
     workers = workers or os.cpu_count() or 1
     level = verbosity()
-    show = _Progress(level, quiet=level <= QUIET, verbose=level >= VERBOSE)
-    outcomes = run_batch(manifest, workers=workers, force=force, fail_fast=fail_fast, scheduler=scheduler,
-                         started=show.start, finished=show.job)
-    show.close()
+    show = _Progress(quiet=level <= QUIET, verbose=level >= VERBOSE)
+    try:
+        outcomes = run_batch(manifest, workers=workers, force=force, fail_fast=fail_fast, scheduler=scheduler,
+                             started=show.start, finished=show.job)
+    finally:
+        show.close()  # the terminal gets its cursor back, even when interrupted
     seconds = time.perf_counter() - start
     if report is not None:
         from fishgen.batch.report import report as make_report
@@ -84,7 +86,7 @@ def batch(source: Path, out: Path | None, workers: int | None, force: bool, fail
 class _Progress:
     """A bar on a terminal; one plain line per job otherwise (CI logs). Failures always, on stderr."""
 
-    def __init__(self, level: int, *, quiet: bool, verbose: bool):
+    def __init__(self, *, quiet: bool, verbose: bool):
         self.quiet, self.verbose = quiet, verbose
         self.bar: Any = None
         self.tty = sys.stderr.isatty() and not quiet
@@ -126,6 +128,7 @@ class _Progress:
     def close(self) -> None:
         if self.bar is not None:
             self.bar.__exit__(None, None, None)
+            self.bar = None
 
 
 def _shown(path: Path) -> str:
