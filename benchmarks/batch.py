@@ -65,7 +65,8 @@ def main() -> None:
         print(f"  {label}   {statistics.median(runs):7.2f} s   ({min(runs):.2f}, {max(runs):.2f})   "
               f"{args.jobs / statistics.median(runs):6.1f} jobs/s")
     ratio = statistics.median(times["-j 1"]) / statistics.median(times["-j 2"])
-    print(f"  -j 2 is {ratio:.2f}x -j 1 (target: at least 1.8x)")
+    best = min(times["-j 1"]) / min(times["-j 2"])
+    print(f"  -j 2 is {ratio:.2f}x -j 1 by medians, {best:.2f}x by the fastest runs (target: at least 1.8x)")
     print(f"  rerun with nothing changed, {args.jobs} jobs: {statistics.median(unchanged):.3f} s median of "
           f"{len(unchanged)} (target: under 1 s)")
 
