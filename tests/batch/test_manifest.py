@@ -1,6 +1,7 @@
 """Manifests: typed jobs, every option as the commands take it, one-line FILE:LINE errors."""
 from __future__ import annotations
 
+import click
 import pytest
 
 from fishgen.batch.manifest import (
@@ -116,3 +117,21 @@ def test_the_mirrored_constants_agree_with_the_library():
 
     assert FIN_MODES == LIBRARY_FIN_MODES and tuple(SCHOOL_MODELS) == tuple(MODELS)
     assert tuple(CLOUD_METHODS) == tuple(METHODS) and DEFAULT_MAX_PARTICLES == LIBRARY_MAX
+
+
+# Options a manifest job spells differently or leaves to the command: the output is `output`, a
+# build job's format is its output's extension, and a school's side outputs are `fishgen school`'s.
+NOT_IN_MANIFESTS = {"output", "format", "tracks", "metrics", "plot"}
+
+
+@pytest.mark.parametrize("kind", ["build", "school", "clouds"])
+def test_a_job_takes_every_option_of_its_command(kind):
+    """When a command gains an option, a batch job must take it too (and jobs.py pass it on)."""
+    from fishgen.batch.manifest import OPTIONS
+    from fishgen.cli import cli
+
+    command = cli.get_command(None, kind)  # type: ignore[arg-type]
+    names = {opt.lstrip("-") for p in command.params if isinstance(p, click.Option) for opt in p.opts
+             if opt.startswith("--")}
+    names -= {"quiet", "verbose", "json", "help"} | NOT_IN_MANIFESTS
+    assert names == set(OPTIONS[kind])
