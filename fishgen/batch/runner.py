@@ -20,9 +20,11 @@ from fishgen.errors import FishgenError
 Done = Callable[[Job, Result], bool]
 """Called with each finished job; returns True to stop starting new jobs (--fail-fast)."""
 
-# Imported by the forkserver once, so each worker starts with the library already loaded.
-PRELOAD = ["fishgen.batch.jobs", "fishgen.assembly.fish", "fishgen.exchange.gltf", "fishgen.clouds",
-           "fishgen.school"]
+# Imported by the forkserver once, so each worker starts with what its jobs need already loaded.
+PRELOAD = {"build": ["fishgen.assembly.fish", "fishgen.species.parser", "fishgen.exchange.gltf"],
+           "school": ["fishgen.school", "fishgen.school.simulate", "fishgen.school.bake",
+                      "fishgen.exchange.gltf"],
+           "clouds": ["fishgen.clouds", "fishgen.clouds.scene", "fishgen.exchange.gltf"]}
 
 
 def run_jobs(jobs: Sequence[Job], done: Done, *, workers: int = 1, scheduler: str | None = None) -> None:
@@ -48,14 +50,15 @@ def _failed(job: Job, message: str, kind: str = "worker") -> Result:
     return Result(job.name, "failed", error={"message": message, "file": None, "line": None, "kind": kind})
 
 
-def _context():
+def _context(kinds: set[str]):
     import multiprocessing
 
     # forkserver: workers fork from a clean single-threaded server that has the library imported;
     # fork from this process could copy a held lock, and spawn would import numpy once per worker.
     if sys.platform.startswith("linux"):
         context = multiprocessing.get_context("forkserver")
-        context.set_forkserver_preload(PRELOAD)
+        modules = ["fishgen.batch.jobs"] + [m for kind in sorted(kinds) for m in PRELOAD[kind]]
+        context.set_forkserver_preload(list(dict.fromkeys(modules)))
         return context
     return multiprocessing.get_context("spawn")
 
@@ -70,7 +73,7 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int) -> None:
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")  # before the forkserver imports numpy: the pool is the parallelism
     pending = deque(jobs)
-    context = _context()
+    context = _context({job.kind for job in jobs})
     stop = False
     lost: set[str] = set()  # jobs a dead worker took down once
     while pending and not stop:
