@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
 from collections import deque
 from collections.abc import Callable, Sequence
 
@@ -53,8 +54,11 @@ def _failed(job: Job, message: str, kind: str = "worker") -> Result:
 def _context(kinds: set[str]):
     import multiprocessing
 
-    # forkserver: workers fork from a clean single-threaded server that has the library imported;
-    # fork from this process could copy a held lock, and spawn would import numpy once per worker.
+    # fork while this process has one thread (the command: nothing is imported yet that a worker
+    # would not import anyway, and no lock can be held by another thread); else a forkserver, a
+    # clean single-threaded server with the library imported. Both start a worker in milliseconds.
+    if sys.platform.startswith("linux") and threading.active_count() == 1:
+        return multiprocessing.get_context("fork")
     if sys.platform.startswith("linux"):
         context = multiprocessing.get_context("forkserver")
         modules = ["fishgen.batch.jobs"] + [m for kind in sorted(kinds) for m in PRELOAD[kind]]
@@ -112,7 +116,8 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int) -> None:
 
 
 def _close(pool, clean: bool) -> None:
-    """Shut the pool down; when interrupted, stop its workers first and wait for them to unwind."""
+    """Shut the pool down; when interrupted, stop its workers first and wait for them to unwind.
+    (A forked worker inherits the command's SIGTERM handler until its initializer replaces it.)"""
     if clean:
         pool.shutdown(wait=True)
         return
