@@ -7,6 +7,7 @@ fails part-way, the targets already replaced get their old contents back.
 """
 from __future__ import annotations
 
+import logging
 import os
 import stat
 import tempfile
@@ -19,6 +20,7 @@ from fishgen.errors import FishgenError
 
 #: A path type: any one of them per call (a Mapping's key type cannot widen).
 _PathT = TypeVar("_PathT", bound="str | os.PathLike[str]")
+_log = logging.getLogger("fishgen")  # `--verbose` shows each file written; silent otherwise
 
 
 def _fail(target: Path, err: OSError) -> FishgenError:
@@ -114,6 +116,8 @@ def _commit(staged: list[tuple[str, Path]]) -> None:
     for backup, _ in backups:
         if backup is not None:
             _discard(backup)
+    for _, target in staged:
+        _log.info("wrote %s", target)
 
 
 def write_bytes(path: str | os.PathLike, data: bytes) -> None:
@@ -155,6 +159,7 @@ class atomic_open:
             if exc_type is None:
                 os.chmod(self._tmp, 0o644)
                 os.replace(self._tmp, self.path)
+                _log.info("wrote %s", self.path)
                 return False
         except OSError as err:
             _discard(self._tmp)

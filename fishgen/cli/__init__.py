@@ -11,6 +11,8 @@ import sys
 
 import click
 
+from fishgen.cli.common import add_common_options, error_line, json_errors, reset
+
 # name -> (module, attribute, one-line help shown by `fishgen --help`)
 COMMANDS = {
     "build": ("fishgen.cli.build", "build", "Build a species file into a textured, fin-animated fish asset."),
@@ -21,6 +23,8 @@ COMMANDS = {
     "view": ("fishgen.cli.view", "view", "Open an asset in a self-contained three.js viewer page."),
     "school": ("fishgen.cli.school", "school",
                "Simulate a fish school and bake it into an animated glb, tracks and measures."),
+    "batch": ("fishgen.cli.batch", "batch",
+              "Regenerate an asset set from a manifest or folder, incrementally and in parallel."),
 }
 
 
@@ -33,11 +37,12 @@ class LazyGroup(click.Group):
             return None
         module, attr, _ = COMMANDS[name]
         try:
-            return getattr(importlib.import_module(module), attr)
+            command = getattr(importlib.import_module(module), attr)
         except ModuleNotFoundError as err:
             if err.name == module:
                 return None
             raise
+        return add_common_options(command)  # --quiet, --verbose, --json: every command, declared once
 
     def format_commands(self, ctx, formatter):
         rows = [(name, COMMANDS[name][2]) for name in self.list_commands(ctx)]
@@ -54,6 +59,9 @@ def cli() -> None:
     """
 
 
+add_common_options(cli, wrap=False)  # `fishgen --json build ...` as well as `fishgen build ... --json`
+
+
 class Interrupted(BaseException):
     """Ctrl-C or SIGTERM. Not a KeyboardInterrupt: click turns that into Abort after printing a
     blank line of its own, and the message would be two lines. Atomic writers still unwind."""
@@ -68,30 +76,42 @@ def _interrupt(signum: int, _frame: object) -> None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Console-script entry: bad input becomes a one-line error, never a traceback."""
+    """Console-script entry: bad input becomes a one-line error, never a traceback.
+
+    Exit status: 0 done, 1 a file could not be read or written (or, in a batch, a job failed for
+    another reason than its input), 2 bad input or usage, 130 Ctrl-C, 143 SIGTERM.
+    """
     from fishgen.errors import FishgenError
 
+    args = sys.argv[1:] if argv is None else list(argv)
+    # Known before parsing, so that even an unknown option's error comes out as JSON.
+    reset(json_errors="--json" in (args[: args.index("--")] if "--" in args else args))
     signal.signal(signal.SIGTERM, _interrupt)
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not when a parent ignores it
         signal.signal(signal.SIGINT, _interrupt)
     try:
-        cli.main(args=argv, prog_name="fishgen", standalone_mode=False)
+        cli.main(args=args, prog_name="fishgen", standalone_mode=False)
     except FishgenError as err:
-        click.echo(f"fishgen: {err}" if err.file is None else str(err), err=True)
-        sys.exit(2)
+        status = getattr(err, "status", 2)
+        _fail(f"fishgen: {err}" if err.file is None else str(err), status, err.file, err.line,
+              getattr(err, "kind", "input"))
     except click.exceptions.Abort:
-        click.echo("fishgen: interrupted", err=True)  # the shell's ^C ends the line before ours
-        sys.exit(130)
+        _fail("fishgen: interrupted", 130, kind="interrupted")  # the shell's ^C ends the line before ours
     except click.UsageError as err:  # one line, like every other error (`--help` shows the usage)
         command = err.ctx.command_path if err.ctx is not None else "fishgen"
-        click.echo(f"{command}: {err.format_message()}", err=True)
-        sys.exit(err.exit_code)
+        _fail(f"{command}: {err.format_message()}", err.exit_code, kind="usage")
     except click.ClickException as err:
-        err.show()
-        sys.exit(err.exit_code)
+        if not json_errors():
+            err.show()
+            sys.exit(err.exit_code)
+        _fail(err.format_message(), err.exit_code, kind="usage")
     except (KeyboardInterrupt, Interrupted) as err:
-        click.echo("fishgen: interrupted", err=True)
-        sys.exit(err.status if isinstance(err, Interrupted) else 130)
+        _fail("fishgen: interrupted", err.status if isinstance(err, Interrupted) else 130, kind="interrupted")
     except OSError as err:
-        click.echo(f"fishgen: {err.filename or ''}: {err.strerror or err}", err=True)
-        sys.exit(1)
+        _fail(f"fishgen: {err.filename or ''}: {err.strerror or err}", 1, err.filename, kind="os")
+
+
+def _fail(message: str, status: int, file: str | None = None, line: int | None = None,
+          kind: str = "input") -> None:
+    click.echo(error_line(message, status, file=file, line=line, kind=kind), err=True)
+    sys.exit(status)

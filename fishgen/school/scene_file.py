@@ -30,14 +30,14 @@ from __future__ import annotations
 
 import math
 import os
-import re
-import sys
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
 from fishgen.errors import FishgenError, describe
 from fishgen.school.model import MODELS, PsoParams, TargetPath
+from fishgen.tomlfile import Where as _Where
+from fishgen.tomlfile import loads as _loads
 
 MAX_FISH = 100_000
 MAX_FRAMES = 100_000
@@ -69,34 +69,6 @@ class SceneFile:
     target: TargetPath = TargetPath()
     predator: TargetPath | None = None
     pso: PsoParams = PsoParams()
-
-
-class _Where:
-    """Line numbers of keys in the TOML text, for messages (tomllib keeps none)."""
-
-    def __init__(self, text: str, file: str):
-        self.lines = text.splitlines()
-        self.file = file
-
-    def line(self, key: str, table: str | None = None, nth: int = 0) -> int | None:
-        section, count = None, -1
-        for number, raw in enumerate(self.lines, 1):
-            stripped = raw.strip()
-            header = re.match(r"^\[\[?\s*([A-Za-z_.]+)\s*\]\]?", stripped)
-            if header:
-                section = header[1]
-                if section == table:
-                    count += 1
-                continue
-            if section == table and (table is None or count == nth) and re.match(
-                    rf"^{re.escape(key)}\s*=", stripped):
-                return number
-        return None
-
-    def fail(self, what: str, found: Any, key: str, table: str | None = None, nth: int = 0) -> FishgenError:
-        plain = isinstance(found, str) and found.startswith(("a ", "an ", "no "))
-        shown = found if plain else describe(str(found))
-        return FishgenError(f"expected {what}, found {shown}", self.file, self.line(key, table, nth))
 
 
 def _number(where: _Where, value: Any, key: str, low: float, high: float, table: str | None = None,
@@ -172,11 +144,6 @@ def _csv_points(where: _Where, path: Path, table: str) -> tuple[tuple[float, flo
 
 def load_scene_file(path: str | os.PathLike) -> SceneFile:
     """Read and check a school scene file."""
-    if sys.version_info >= (3, 11):
-        import tomllib
-    else:  # Python 3.10: the same parser as a package
-        import tomli as tomllib
-
     path = Path(path)
     file = os.fspath(path)
     if path.is_dir():
@@ -187,13 +154,7 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
         raise FishgenError(f"expected a scene file of at most {MAX_SCENE_BYTES:,} bytes, found a larger file",
                            path)
     text = path.read_bytes().decode("utf-8", errors="replace").removeprefix("\ufeff")
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        match = re.search(r"\(at line (\d+), column \d+\)", str(err))
-        message = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(err)) or "valid TOML"
-        raise FishgenError(f"expected TOML, found {message[0].lower() + message[1:]}", file,
-                           int(match[1]) if match else None) from None
+    data = _loads(text, file)
     where = _Where(text, file)
     known = {"model", "frames", "fps", "seed", "bounds", "layout", "species", "target", "predator", "pso"}
     for key in data:

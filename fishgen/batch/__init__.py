@@ -1,0 +1,117 @@
+"""Batches: regenerate whole asset sets reproducibly, incrementally and in parallel.
+
+    from fishgen.batch import run_batch
+    from fishgen.batch.manifest import load_manifest
+    outcomes = run_batch(load_manifest("params/assets.toml"), workers=2)
+
+A job whose inputs, options and fishgen version are unchanged and whose outputs are intact is
+skipped (:mod:`fishgen.batch.record`); the others run in this process, a local process pool or
+on a Dask cluster (:mod:`fishgen.batch.runner`), each through the library API
+(:mod:`fishgen.batch.jobs`). Nothing here imports numpy: a batch where nothing changed never
+loads it.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fishgen.batch.manifest import Job, Manifest
+from fishgen.batch.record import Hashes, Record, relative
+from fishgen.errors import FishgenError
+
+LOCK_NAME = ".fishgen-batch.lock"
+STATUSES = ("built", "skipped", "failed", "not run")
+
+
+@dataclass
+class Outcome:
+    """What happened to one job, for the progress lines and the report."""
+
+    job: Job
+    status: str                                    # one of STATUSES
+    reason: str | None = None                      # why it ran ("bonybream.txt changed"), or None
+    seconds: float = 0.0
+    inputs: dict[str, str] = field(default_factory=dict)    # out-relative path -> sha256
+    outputs: dict[str, str] = field(default_factory=dict)   # out-relative path -> sha256
+    error: dict[str, Any] | None = None
+    notes: list[str] = field(default_factory=list)
+
+
+def run_batch(manifest: Manifest, *, workers: int = 1, force: bool = False, fail_fast: bool = False,
+              scheduler: str | None = None, started: Callable[[int], None] | None = None,
+              finished: Callable[[Outcome], None] | None = None) -> list[Outcome]:
+    """Bring every output of ``manifest`` up to date; returns one outcome per job, in manifest order.
+
+    ``started(n)`` is called once with the number of jobs that will run; ``finished`` with each
+    job's outcome as it is known (skipped ones first).
+    """
+    from fishgen.batch.runner import run_jobs
+
+    out = manifest.out
+    outcomes: dict[str, Outcome] = {}
+
+    def tell(outcome: Outcome) -> None:
+        outcomes[outcome.job.name] = outcome
+        if finished is not None:
+            finished(outcome)
+
+    with _locked(out):
+        record = Record(out)
+        hashes = Hashes()
+        todo: list[tuple[Job, str]] = []
+        for job in manifest.jobs:
+            reason = "--force" if force else record.stale(job, hashes)
+            if reason is None:
+                entry = record.jobs[job.name]
+                tell(Outcome(job, "skipped", inputs=dict(entry["inputs"]), outputs=dict(entry["outputs"])))
+            else:
+                todo.append((job, reason))
+        if started is not None:
+            started(len(todo))
+        reasons = {job.name: reason for job, reason in todo}
+
+        def done(job: Job, result) -> bool:
+            if result.status == "built":
+                record.put(job.name, record.entry(job, result.inputs, result.outputs))
+            inputs = {relative(p, out): h for p, h in result.inputs.items()}
+            outputs = {relative(p, out): h for p, h in result.outputs.items()}
+            tell(Outcome(job, result.status, reasons[job.name], result.seconds, inputs, outputs, result.error,
+                         result.notes))
+            return fail_fast and result.status == "failed"
+
+        try:
+            run_jobs([job for job, _ in todo], done, workers=workers, scheduler=scheduler)
+        finally:
+            if todo and not record.damaged:
+                record.save()  # once, durably, however the run ended
+    return [outcomes.get(job.name) or Outcome(job, "not run", reasons.get(job.name)) for job in manifest.jobs]
+
+
+@contextmanager
+def _locked(out: Path) -> Iterator[None]:
+    """One batch at a time per out folder: two would race on the record and the outputs."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        handle = open(out / LOCK_NAME, "a+b")  # held open for the whole batch
+    except OSError as err:
+        raise FishgenError(f"expected a writable out folder, found {err.strerror or err}", out) from None
+    try:
+        try:
+            import fcntl
+        except ImportError:  # Windows: no advisory locks; one batch per folder is then up to the user
+            yield
+            return
+        try:
+            fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise FishgenError("expected no other `fishgen batch` writing this out folder, found one running",
+                               out) from None
+        yield
+    finally:
+        handle.close()
+
+
+__all__ = ["Outcome", "STATUSES", "run_batch"]

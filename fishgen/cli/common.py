@@ -1,0 +1,115 @@
+"""Options every command gets without declaring them: ``--quiet``, ``--verbose`` and ``--json``.
+
+:class:`fishgen.cli.LazyGroup` adds them to each command as it loads it (and the group has them
+too, so ``fishgen --json build ...`` works), so a new command gets them for free.
+
+- ``--quiet``: nothing on stdout (no summary line, no progress); warnings and errors still go to
+  stderr.
+- ``--verbose``: each file written (from :mod:`fishgen.atomic`) and the command's time, on stderr;
+  commands may say more (``fishgen batch`` says why each job ran).
+- ``--json``: an error that ends the command is one JSON object on stderr,
+  ``{"error": ..., "file": ..., "line": ..., "exit": ..., "kind": ...}``.
+"""
+from __future__ import annotations
+
+import functools
+import json
+import sys
+import time
+from contextlib import nullcontext, redirect_stdout
+from typing import Any
+
+import click
+
+QUIET, NORMAL, VERBOSE = 0, 1, 2
+_state: dict[str, Any] = {"verbosity": NORMAL, "json": False}
+
+
+def reset(json_errors: bool = False) -> None:
+    """Back to the defaults (one process may run several commands: the tests do)."""
+    _state.update(verbosity=NORMAL, json=json_errors)
+
+
+def verbosity() -> int:
+    return int(_state["verbosity"])
+
+
+def json_errors() -> bool:
+    return bool(_state["json"])
+
+
+def error_line(message: str, status: int, *, file: str | None = None, line: int | None = None,
+               kind: str = "input", **extra: Any) -> str:
+    """An error as the user asked for it: the plain one line, or one JSON object."""
+    if not json_errors():
+        return message
+    return json.dumps({"error": message, "file": file, "line": line, "exit": status, "kind": kind, **extra})
+
+
+def _set(key: str, value: Any):
+    def callback(ctx: click.Context, param: click.Parameter, given: bool) -> None:
+        if given:
+            _state[key] = value
+    return callback
+
+
+def _options() -> list[click.Option]:
+    return [
+        click.Option(["-q", "--quiet"], is_flag=True, expose_value=False, is_eager=True,
+                     callback=_set("verbosity", QUIET),
+                     help="Print nothing on stdout (no summary, no progress); errors still go to stderr."),
+        click.Option(["-v", "--verbose"], is_flag=True, expose_value=False, is_eager=True,
+                     callback=_set("verbosity", VERBOSE),
+                     help="Also print each file written and the time taken, on stderr."),
+        click.Option(["--json"], is_flag=True, expose_value=False, is_eager=True, callback=_set("json", True),
+                     help='Print an error as one JSON object on stderr: {"error", "file", "line", "exit", '
+                          '"kind"}.'),
+    ]
+
+
+def add_common_options(command: click.Command, wrap: bool = True) -> click.Command:
+    """Give ``command`` the common options (once); ``wrap`` makes them act on its callback."""
+    if getattr(command, "_fishgen_common", False):
+        return command
+    taken = {name for p in command.params for name in getattr(p, "opts", [])}
+    command.params.extend(o for o in _options() if not taken & set(o.opts))
+    if wrap and command.callback is not None:
+        command.callback = _wrapped(command.callback, command.name or "fishgen")
+    command._fishgen_common = True  # type: ignore[attr-defined]
+    return command
+
+
+def _wrapped(callback, name: str):
+    @functools.wraps(callback)
+    def run(*args: Any, **kwargs: Any) -> Any:
+        level = verbosity()
+        start = time.perf_counter()
+        if level >= VERBOSE:
+            _log_to_stderr()
+        # Quiet: stdout goes nowhere. click.echo looks sys.stdout up at each call, so this catches
+        # every summary line without each command checking a flag.
+        with _devnull() if level <= QUIET else nullcontext() as sink:
+            with redirect_stdout(sink) if sink is not None else nullcontext():
+                result = callback(*args, **kwargs)
+        if level >= VERBOSE:
+            click.echo(f"fishgen {name}: done in {time.perf_counter() - start:.2f} s", err=True)
+        return result
+    return run
+
+
+def _devnull():
+    import os
+
+    return open(os.devnull, "w", encoding="utf-8")
+
+
+def _log_to_stderr() -> None:
+    import logging
+
+    logger = logging.getLogger("fishgen")
+    if not any(getattr(h, "_fishgen", False) for h in logger.handlers):
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("fishgen: %(message)s"))
+        handler._fishgen = True  # type: ignore[attr-defined]
+        logger.addHandler(handler)
+    logger.setLevel(logging.INFO)

@@ -1,0 +1,60 @@
+"""TOML input files (school scenes, batch manifests): parse with ``FILE:LINE`` errors, locate keys.
+
+tomllib keeps no line numbers, so :class:`Where` finds a key's line in the text for messages.
+Leaf module: no numpy, so `fishgen batch` can read its manifest on the fast no-change path.
+"""
+from __future__ import annotations
+
+import re
+import sys
+from typing import Any
+
+from fishgen.errors import FishgenError, describe
+
+
+def loads(text: str, file: str) -> dict[str, Any]:
+    """Parse TOML text; a syntax error is the one-line ``FILE:LINE: expected TOML, found ...``."""
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # Python 3.10: the same parser as a package
+        import tomli as tomllib
+
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        match = re.search(r"\(at line (\d+), column \d+\)", str(err))
+        message = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(err)) or "valid TOML"
+        raise FishgenError(f"expected TOML, found {message[0].lower() + message[1:]}", file,
+                           int(match[1]) if match else None) from None
+
+
+class Where:
+    """Line numbers of keys in the TOML text, for messages (tomllib keeps none)."""
+
+    def __init__(self, text: str, file: str):
+        self.lines = text.splitlines()
+        self.file = file
+
+    def line(self, key: str, table: str | None = None, nth: int = 0) -> int | None:
+        """The line of ``key`` at the top level, or in the ``nth`` ``[table]``/``[[table]]``;
+        without such a key, the table's header line."""
+        section, count, header_line = None, -1, None
+        for number, raw in enumerate(self.lines, 1):
+            stripped = raw.strip()
+            header = re.match(r"^\[\[?\s*([A-Za-z_.-]+)\s*\]\]?", stripped)
+            if header:
+                section = header[1]
+                if section == table:
+                    count += 1
+                    if count == nth:
+                        header_line = number
+                continue
+            if section == table and (table is None or count == nth) and re.match(
+                    rf"^{re.escape(key)}\s*=", stripped):
+                return number
+        return header_line
+
+    def fail(self, what: str, found: Any, key: str, table: str | None = None, nth: int = 0) -> FishgenError:
+        plain = isinstance(found, str) and found.startswith(("a ", "an ", "no "))
+        shown = found if plain else describe(str(found))
+        return FishgenError(f"expected {what}, found {shown}", self.file, self.line(key, table, nth))

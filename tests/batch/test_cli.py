@@ -1,0 +1,94 @@
+"""`fishgen batch` as a pipeline sees it: one line per job, --quiet/--verbose, --json errors, the report."""
+from __future__ import annotations
+
+import json
+import shutil
+
+from fishgen.batch.manifest import derived_seed
+from tests.batch.conftest import batch, hashes, statuses
+from tests.conftest import ROOT
+
+
+def test_one_plain_line_per_job_and_a_summary_when_not_on_a_terminal(shipped):
+    run = batch(shipped / "params" / "assets.toml", "-j", "2")
+    lines = run.stdout.splitlines()
+    assert run.returncode == 0 and len(lines) == 9 and run.stderr == ""
+    assert all(line.startswith("built    ") and line.endswith(" s)") for line in lines[:8])
+    assert lines[8].endswith("8 jobs, 8 built, 0 skipped, 0 failed in " + lines[8].split(" in ")[1])
+
+
+def test_quiet_prints_nothing_and_verbose_says_why_each_job_ran(shipped):
+    manifest = shipped / "params" / "assets.toml"
+    quiet = batch(manifest, "-j", "2", "--quiet")
+    assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == ""
+    species = shipped / "params" / "pineapplefish.txt"
+    species.write_text(species.read_text() + "// edited\n")
+    verbose = batch(manifest, "--verbose")
+    assert "built    fish/pineapplefish.glb" in verbose.stdout
+    assert "../../params/pineapplefish.txt changed" in verbose.stdout
+    assert "skipped  fish/bonybream.glb" in verbose.stdout and "fishgen batch: done in" in verbose.stderr
+
+
+def test_the_report_has_each_jobs_inputs_options_output_hashes_time_status_and_error(shipped):
+    shutil.copy(ROOT / "tests" / "fixtures" / "appendix_a_as_printed.txt", shipped / "params" / "bad.txt")
+    manifest = shipped / "params" / "assets.toml"
+    manifest.write_text(manifest.read_text() + '\n[[build]]\ninput = "bad.txt"\noutput = "fish/bad.glb"\n')
+    run = batch(manifest, "-j", "2", "--report", shipped / "report.json")
+    assert run.returncode == 2
+    report = json.loads((shipped / "report.json").read_text())
+    assert report["counts"] == {"built": 8, "skipped": 0, "failed": 1, "not run": 0}
+    jobs = {job["name"]: job for job in report["jobs"]}
+    out = shipped / "out" / "assets"
+    fish = jobs["fish/bonybream.glb"]
+    assert fish["status"] == "built" and fish["kind"] == "build" and fish["seconds"] > 0
+    assert fish["output_sha256"] == hashes(out)["fish/bonybream.glb"]
+    assert fish["options"] == {"fins": None, "fps": 30.0, "length": None, "textures": None}
+    assert set(fish["inputs"]) == {"../../params/bonybream.txt", "../../textures/bonybream.png",
+                                   "../../textures/bonybream_mask.png"}
+    assert all(len(digest) == 64 for digest in fish["inputs"].values())
+    assert jobs["clouds/table_4_3.glb"]["options"]["seed"] == derived_seed("clouds/table_4_3.glb")
+    bad = jobs["fish/bad.glb"]
+    assert bad["status"] == "failed" and bad["output_sha256"] is None
+    assert bad["error"] == {"message": bad["error"]["message"], "file": str(shipped / "params" / "bad.txt"),
+                            "line": 2, "kind": "input"}
+    batch(manifest, "--report", shipped / "report.json")
+    assert json.loads((shipped / "report.json").read_text())["counts"]["skipped"] == 8
+
+
+def test_json_errors_one_object_per_failed_job_and_one_for_the_batch(shipped):
+    shutil.copy(ROOT / "tests" / "fixtures" / "appendix_a_as_printed.txt", shipped / "params" / "bad.txt")
+    manifest = shipped / "params" / "m.toml"
+    manifest.write_text('[[build]]\ninput = "bad.txt"\noutput = "bad.glb"\n')
+    run = batch(manifest, "--out", shipped / "o", "--json")
+    errors = [json.loads(line) for line in run.stderr.splitlines()]
+    assert run.returncode == 2 and len(errors) == 2
+    assert errors[0]["job"] == "bad.glb" and errors[0]["line"] == 2 and errors[0]["exit"] == 2
+    assert errors[0]["file"] == str(shipped / "params" / "bad.txt") and errors[0]["kind"] == "input"
+    assert errors[1]["error"] == "fishgen: 1 of 1 jobs failed (each said why above)"
+    assert errors[1]["exit"] == 2
+    manifest.write_text('[[build]]\ninput = "bad.txt"\noutput = "bad.glb"\nfins = 3\n')
+    wrong = batch(manifest, "--json")
+    error = json.loads(wrong.stderr)
+    assert wrong.returncode == 2 and error["file"] == str(manifest) and error["line"] == 4
+
+
+def test_a_folder_builds_every_species_and_cube_file_with_default_options(shipped, gltf_validator):
+    run = batch(shipped / "params", "--out", shipped / "all", "-j", "2")
+    assert run.returncode == 0, run.stderr
+    names = set(statuses(run.stdout))
+    assert names == {"bonybream.glb", "centroberyx.glb", "pineapplefish.glb", "threadfingoldie.glb",
+                     "clouds/table_4_2.glb", "clouds/table_4_3.glb", "clouds/table_4_4.glb"}
+    gltf_validator(*(shipped / "all" / name for name in sorted(names)))
+    no_out = batch(shipped / "params")
+    assert no_out.returncode == 2 and "expected --out FOLDER" in no_out.stderr
+
+
+def test_two_batches_may_not_write_one_out_folder_at_once(shipped):
+    import fcntl
+
+    out = shipped / "o"
+    out.mkdir()
+    with open(out / ".fishgen-batch.lock", "a+b") as lock:
+        fcntl.flock(lock.fileno(), fcntl.LOCK_EX)
+        run = batch(shipped / "params" / "assets.toml", "--out", out)
+    assert run.returncode == 2 and "found one running" in run.stderr and not (out / "fish").exists()

@@ -1,0 +1,137 @@
+"""Manifests: typed jobs, every option as the commands take it, one-line FILE:LINE errors."""
+from __future__ import annotations
+
+import click
+import pytest
+
+from fishgen.batch.manifest import (
+    CLOUD_METHODS,
+    DEFAULT_MAX_PARTICLES,
+    FIN_MODES,
+    SCHOOL_MODELS,
+    derived_seed,
+    load_manifest,
+    scan_folder,
+)
+from fishgen.errors import FishgenError
+from tests.conftest import PARAMS
+
+
+def write(tmp_path, text: str):
+    path = tmp_path / "m.toml"
+    path.write_text(text)
+    return path
+
+
+def test_the_example_manifest_builds_every_shipped_species_a_school_and_the_three_clouds():
+    manifest = load_manifest(PARAMS / "assets.toml")
+    kinds = [job.kind for job in manifest.jobs]
+    assert kinds.count("school") == 1 and kinds.count("clouds") == 3
+    built = {job.inputs[0].name for job in manifest.jobs if job.kind == "build"}
+    assert built == {p.name for p in PARAMS.glob("*.txt")}
+    assert {job.inputs[0].name for job in manifest.jobs if job.kind == "clouds"} == {
+        p.name for p in (PARAMS / "clouds").glob("*.awn")}
+    assert manifest.out == (PARAMS.parent / "out" / "assets").resolve()
+
+
+def test_options_are_filled_with_the_commands_defaults_and_seeds_come_from_the_output_name(tmp_path):
+    manifest = load_manifest(write(tmp_path, """
+[[build]]
+input = "a.txt"
+output = "a.glb"
+[[clouds]]
+inputs = ["c.awn", "d.awn"]
+output = "sky/c.ply"
+offset = [[0, 0, 0], [1, 2, 3]]
+[[clouds]]
+input = "c.awn"
+output = "seeded.ply"
+seed = 5
+"""), out=tmp_path / "o")
+    build, clouds, seeded = manifest.jobs
+    assert build.options == {"fins": None, "length": None, "fps": 30.0, "textures": None}
+    assert build.output == tmp_path / "o" / "a.glb" and build.inputs == (tmp_path / "a.txt",)
+    assert clouds.options["seed"] == derived_seed("sky/c.ply") and clouds.options["method"] == "paper"
+    assert clouds.options["offset"] == [[0, 0, 0], [1, 2, 3]]
+    assert clouds.where == f"{tmp_path / 'm.toml'}:7"
+    assert seeded.options["seed"] == 5
+    assert derived_seed("a.ply") != derived_seed("b.ply")
+
+
+def test_a_school_scene_file_keeps_its_own_seed_and_species_files_get_one_from_the_job(tmp_path):
+    manifest = load_manifest(write(tmp_path, """
+[[school]]
+input = "reef.toml"
+output = "reef.glb"
+[[school]]
+inputs = ["a.txt", "b.txt"]
+output = "ab.glb"
+"""))
+    assert manifest.jobs[0].options["seed"] is None  # the scene file's, as `fishgen school` does
+    assert manifest.jobs[1].options["seed"] == derived_seed("ab.glb")
+
+
+@pytest.mark.parametrize("text,line,message", [
+    ('[[build]]\ninput = "a.txt"\noutput = "a.glb"\nfins = "sparkly"\n', 4,
+     "expected fins as one of blend, mask, opaque, found 'sparkly'"),
+    ('[[build]]\ninput = "a.txt"\noutput = "a.glb"\nlength = -1\n', 4,
+     "expected length as a number from 0.001 to 10000, found '-1'"),
+    ('[[build]]\ninput = "a.txt"\noutput = "a.glb"\ncolour = 1\n', 4, "found 'colour'"),
+    ('[[build]]\ninput = "a.txt"\noutput = "a.ply.txt"\n', 3, "expected an output ending in"),
+    ('[[school]]\ninput = "a.txt"\noutput = "a.obj"\n', 3, "holds node animation"),
+    ('[[build]]\ninput = "a.txt"\noutput = "../a.glb"\n', 3, "inside the out folder"),
+    ('[[build]]\ninput = "a.txt"\n', 1, "expected output as a file name"),
+    ('[[build]]\ninputs = ["a.txt", "b.txt"]\noutput = "a.glb"\n', 2, "one species file"),
+    ('[[clouds]]\ninputs = ["a.awn", "b.awn"]\noutput = "a.ply"\noffset = [[0, 0, 0]]\n', 4,
+     "one [x, y, z] per input (2)"),
+    ('[[clouds]]\ninput = "a.awn"\noutput = "a.ply"\nbillboards = "yes"\n', 4, "true or false"),
+    ('[[build]]\ninput = "a.txt"\noutput = "a.glb"\n\n[[build]]\ninput = "b.txt"\noutput = "a.glb"\n', 7,
+     "one job per output, the first at"),
+    ('[[bild]]\ninput = "a.txt"\n', 1, "expected one of out, [[build]]"),
+    ('[[build]\ninput = "a.txt"\n', 1, "expected TOML"),
+    ('out = "o"\n', None, "expected at least one [[build]]"),
+])
+def test_every_mistake_is_one_line_at_its_place(tmp_path, text, line, message):
+    path = write(tmp_path, text)
+    with pytest.raises(FishgenError) as caught:
+        load_manifest(path)
+    assert caught.value.file == str(path) and caught.value.line == line
+    assert message in caught.value.message and "\n" not in str(caught.value)
+
+
+def test_a_folder_scan_makes_one_default_job_per_species_and_cube_file(tmp_path):
+    manifest = scan_folder(PARAMS, tmp_path / "out")
+    names = sorted(job.name for job in manifest.jobs)
+    assert names == sorted([f"{p.stem}.glb" for p in PARAMS.glob("*.txt")]
+                           + [f"clouds/{p.stem}.glb" for p in (PARAMS / "clouds").glob("*.awn")])
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(FishgenError, match="expected species files"):
+        scan_folder(tmp_path / "empty", tmp_path / "o2")
+
+
+def test_the_mirrored_constants_agree_with_the_library():
+    from fishgen.assembly.fin_modes import FIN_MODES as LIBRARY_FIN_MODES
+    from fishgen.clouds import DEFAULT_MAX_PARTICLES as LIBRARY_MAX
+    from fishgen.clouds import METHODS
+    from fishgen.school.model import MODELS
+
+    assert FIN_MODES == LIBRARY_FIN_MODES and tuple(SCHOOL_MODELS) == tuple(MODELS)
+    assert tuple(CLOUD_METHODS) == tuple(METHODS) and DEFAULT_MAX_PARTICLES == LIBRARY_MAX
+
+
+# Options a manifest job spells differently or leaves to the command: the output is `output`, a
+# build job's format is its output's extension, and a school's side outputs are `fishgen school`'s.
+NOT_IN_MANIFESTS = {"output", "format", "tracks", "metrics", "plot"}
+
+
+@pytest.mark.parametrize("kind", ["build", "school", "clouds"])
+def test_a_job_takes_every_option_of_its_command(kind):
+    """When a command gains an option, a batch job must take it too (and jobs.py pass it on)."""
+    from fishgen.batch.manifest import OPTIONS
+    from fishgen.cli import cli
+
+    command = cli.get_command(None, kind)  # type: ignore[arg-type]
+    names = {opt.lstrip("-") for p in command.params if isinstance(p, click.Option) for opt in p.opts
+             if opt.startswith("--")}
+    names -= {"quiet", "verbose", "json", "help"} | NOT_IN_MANIFESTS
+    assert names == set(OPTIONS[kind])

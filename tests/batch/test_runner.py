@@ -1,0 +1,174 @@
+"""Where jobs run: the same bytes from -j 1, -j 2 and Dask; a bad job fails alone; a killed batch
+leaves whole files and a consistent record, and the next run finishes only what is missing."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.batch.conftest import batch, hashes, record, statuses
+from tests.conftest import ROOT, run_cli
+
+BAD = ROOT / "tests" / "fixtures" / "appendix_a_as_printed.txt"  # fails at its line 2
+
+
+def test_the_example_gives_identical_bytes_with_one_or_two_processes(shipped):
+    manifest = shipped / "params" / "assets.toml"
+    one, two = shipped / "j1", shipped / "j2"
+    assert batch(manifest, "--out", one, "-j", "1").returncode == 0
+    assert batch(manifest, "--out", two, "-j", "2").returncode == 0
+    assert hashes(one) == hashes(two) and len(hashes(one)) == 8
+
+
+def bad_and_good(shipped, fail_fast: bool = False):
+    shutil.copy(BAD, shipped / "params" / "bad.txt")
+    manifest = shipped / "params" / "mixed.toml"
+    manifest.write_text('out = "../out/mixed"\n'
+                        '[[build]]\ninput = "bad.txt"\noutput = "bad.glb"\n'
+                        '[[build]]\ninput = "bonybream.txt"\noutput = "good.glb"\n'
+                        '[[clouds]]\ninput = "clouds/table_4_2.awn"\noutput = "cloud.ply"\n')
+    return manifest, shipped / "out" / "mixed"
+
+
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_a_bad_input_fails_only_its_own_job_with_its_line(shipped, jobs):
+    manifest, out = bad_and_good(shipped)
+    run = batch(manifest, "-j", jobs, "--report", shipped / "report.json")
+    assert run.returncode == 2
+    assert f"{shipped / 'params' / 'bad.txt'}:2: expected the header record" in run.stderr
+    assert "Traceback" not in run.stderr
+    assert statuses(run.stdout) == {"good.glb": "built", "cloud.ply": "built"}
+    assert set(hashes(out)) == {"good.glb", "cloud.ply"} and set(record(out)) == {"good.glb", "cloud.ply"}
+    jobs_report = {j["name"]: j for j in json.loads((shipped / "report.json").read_text())["jobs"]}
+    assert jobs_report["bad.glb"]["status"] == "failed"
+    assert jobs_report["bad.glb"]["error"]["line"] == 2 and jobs_report["bad.glb"]["error"]["kind"] == "input"
+    # Only the failed job runs again.
+    again = batch(manifest)
+    assert again.returncode == 2 and statuses(again.stdout) == {"good.glb": "skipped", "cloud.ply": "skipped"}
+
+
+def test_fail_fast_starts_nothing_after_the_first_failure(shipped):
+    manifest, out = bad_and_good(shipped)
+    run = batch(manifest, "-j", "1", "--fail-fast")
+    assert run.returncode == 2 and "2 not run" in run.stdout
+    assert not out.joinpath("good.glb").exists()
+
+
+def many_builds(shipped, count: int):
+    """``count`` builds of one species to different names: every output has the same bytes."""
+    manifest = shipped / "params" / "many.toml"
+    manifest.write_text('out = "../out/many"\n' + "".join(
+        f'[[build]]\ninput = "bonybream.txt"\noutput = "fish{i:03d}.glb"\n' for i in range(count)))
+    return manifest, shipped / "out" / "many"
+
+
+@pytest.mark.parametrize("signum,status", [(signal.SIGTERM, 143), (signal.SIGINT, 130), (signal.SIGKILL, -9)])
+def test_a_batch_killed_midway_leaves_whole_files_and_the_next_run_finishes_it(shipped, signum, status):
+    manifest, out = many_builds(shipped, 120)
+    assert run_cli("build", manifest.parent / "bonybream.txt", "-o", shipped / "one.glb").returncode == 0
+    whole = hashes(shipped)["one.glb"]
+    proc = subprocess.Popen([sys.executable, "-m", "fishgen", "batch", str(manifest), "-j", "2"], cwd=ROOT,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and proc.poll() is None:  # until a few jobs are recorded
+        try:
+            if len(record(out)) >= 5:
+                break
+        except (OSError, ValueError):
+            pass
+        time.sleep(0.01)
+    assert proc.poll() is None, "the batch finished before it could be interrupted"
+    proc.send_signal(signum)
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == status, stderr
+    if signum != signal.SIGKILL:
+        assert stderr.endswith("fishgen: interrupted\n") and "Traceback" not in stderr
+    time.sleep(1.0 if signum == signal.SIGKILL else 0)  # orphaned workers finish their one job each
+    outputs = hashes(out)
+    assert 5 <= len(outputs) < 120
+    assert set(outputs.values()) == {whole}  # no partial file
+    done = record(out)
+    assert all(entry["outputs"][name] == outputs[name] for name, entry in done.items())  # consistent
+    if signum != signal.SIGKILL:  # the workers were stopped and cleaned up after themselves
+        assert [p.name for p in out.rglob(".*.tmp")] == []
+    again = batch(manifest, "-j", "2")
+    assert again.returncode == 0, again.stderr
+    found = statuses(again.stdout)
+    assert {n for n, s in found.items() if s == "skipped"} == set(done)
+    assert set(found) == {f"fish{i:03d}.glb" for i in range(120)}
+    assert set(hashes(out).values()) == {whole}
+
+
+def descendants(pid: int) -> list[int]:
+    """Every process below ``pid`` (the forkserver's workers are the batch's grandchildren)."""
+    parents = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            parents[int(stat.parent.name)] = int(stat.read_bytes().rpartition(b")")[2].split()[1])
+        except (OSError, ValueError, IndexError):
+            continue
+    found, frontier = [], [pid]
+    while frontier:
+        children = [child for child, parent in parents.items() if parent in frontier]
+        found += children
+        frontier = children
+    return found
+
+
+def helper(pid: int, batch_pid: int) -> bool:
+    """multiprocessing's resource tracker, or a forkserver (the batch's child; its workers are not)."""
+    try:
+        cmdline = Path(f"/proc/{pid}/cmdline").read_bytes()
+        parent = int(Path(f"/proc/{pid}/stat").read_bytes().rpartition(b")")[2].split()[1])
+    except (OSError, ValueError):
+        return True
+    return b"resource_tracker" in cmdline or (b"forkserver" in cmdline and parent == batch_pid)
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers through /proc")
+def test_a_killed_worker_is_replaced_and_its_jobs_are_tried_again(shipped):
+    manifest, out = many_builds(shipped, 120)
+    proc = subprocess.Popen([sys.executable, "-m", "fishgen", "batch", str(manifest), "-j", "2"], cwd=ROOT,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and proc.poll() is None:
+        try:
+            if len(record(out)) >= 5:
+                break
+        except (OSError, ValueError):
+            pass
+        time.sleep(0.01)
+    workers = [pid for pid in descendants(proc.pid) if not helper(pid, proc.pid)]
+    assert workers, "no worker found"
+    os.kill(workers[0], signal.SIGKILL)
+    stdout, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 0 and stderr == "", stderr
+    outputs = hashes(out)
+    assert len(outputs) == 120 and len(set(outputs.values())) == 1  # every file built, and whole
+    assert set(record(out)) == set(outputs)
+    again = batch(manifest, "-j", "2")
+    assert again.returncode == 0 and set(statuses(again.stdout).values()) == {"skipped"}
+
+
+def test_a_dask_cluster_builds_the_same_bytes_as_the_local_pool(shipped):
+    distributed = pytest.importorskip("distributed")
+    manifest = shipped / "params" / "assets.toml"
+    assert batch(manifest, "--out", shipped / "local", "-j", "2").returncode == 0
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, protocol="tcp",
+                                  host="127.0.0.1", dashboard_address=None) as cluster:
+        run = batch(manifest, "--out", shipped / "dask", "--scheduler", cluster.scheduler_address,
+                    "--report", shipped / "dask.json")
+        assert run.returncode == 0, run.stderr
+        assert run.stdout.rstrip().endswith(f"({cluster.scheduler_address})")
+        again = batch(manifest, "--out", shipped / "dask", "--scheduler", cluster.scheduler_address)
+    assert hashes(shipped / "dask") == hashes(shipped / "local")
+    assert set(statuses(again.stdout).values()) == {"skipped"}
+    report = json.loads((shipped / "dask.json").read_text())
+    assert report["scheduler"] == cluster.scheduler_address and report["counts"]["built"] == 8

@@ -1,0 +1,48 @@
+"""--quiet, --verbose and --json on every command, and one exit-status table for all of them."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from fishgen.cli import COMMANDS
+from tests.conftest import PARAMS, run_cli
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_every_command_takes_quiet_verbose_and_json(command):
+    help_text = run_cli(command, "--help").stdout
+    for option in ("--quiet", "--verbose", "--json"):
+        assert option in help_text, f"fishgen {command} has no {option}"
+
+
+def test_quiet_drops_the_summary_and_verbose_lists_each_file_written(tmp_path):
+    out = tmp_path / "b.glb"
+    quiet = run_cli("build", PARAMS / "bonybream.txt", "-o", out, "--quiet")
+    assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == "" and out.is_file()
+    verbose = run_cli("-v", "clouds", PARAMS / "clouds" / "table_4_2.awn", "-o", tmp_path / "c.ply")
+    assert verbose.returncode == 0 and verbose.stdout.startswith(str(tmp_path / "c.ply"))
+    assert f"fishgen: wrote {tmp_path / 'c.ply'}\n" in verbose.stderr
+    assert "fishgen clouds: done in" in verbose.stderr
+
+
+@pytest.mark.parametrize("args,status,kind,line", [
+    (["build", "{missing}", "-o", "{out}"], 2, "input", None),
+    (["build", str(PARAMS.parent / "tests" / "fixtures" / "appendix_a_as_printed.txt"), "-o", "{out}"], 2,
+     "input", 2),
+    (["build", "--no-such-option"], 2, "usage", None),
+    (["clouds", str(PARAMS / "clouds" / "table_4_2.awn"), "-o", "{out}.txt"], 2, "input", None),
+    (["school", str(PARAMS / "bonybream.txt"), "-o", "{out}.obj"], 2, "input", None),
+])
+def test_json_errors_are_one_object_with_the_exit_status(tmp_path, args, status, kind, line):
+    filled = [a.format(missing=tmp_path / "none.txt", out=tmp_path / "x.glb") for a in args]
+    for placed in (["--json", *filled], [*filled, "--json"]):
+        run = run_cli(*placed)
+        error = json.loads(run.stderr)
+        assert run.returncode == status == error["exit"] and error["kind"] == kind and error["line"] == line
+        assert set(error) == {"error", "file", "line", "exit", "kind"} and "\n" not in error["error"]
+
+
+def test_version():
+    run = run_cli("--version")
+    assert run.returncode == 0 and run.stdout.startswith("fishgen, version ")
