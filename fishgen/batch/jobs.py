@@ -12,7 +12,7 @@ import os
 import time
 import traceback
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -67,7 +67,8 @@ def _build(job: Job, reads: list[Path]) -> list[Path]:
     reads.extend(job.inputs)
     species = load_species(job.inputs[0], o["textures"])
     reads.extend(t for t in (species.colour_texture, species.mask_texture) if t is not None)
-    scene = build_fish(species, fins=o["fins"], length=o["length"], fps=o["fps"])
+    scene = build_fish(species, fins=o["fins"], length=o["length"], fps=o["fps"], swim=o["swim"],
+                       speed=o["speed"])
     return export(scene, job.output, require=[MESHES])
 
 
@@ -75,13 +76,7 @@ def _school(job: Job, reads: list[Path]) -> list[Path]:
     from fishgen.exchange import export
     from fishgen.exchange.registry import MESHES, NODE_ANIMATION
     from fishgen.school import run_school
-    from fishgen.school.scene_file import (
-        MAX_FISH,
-        MAX_FISH_FRAMES,
-        SceneFile,
-        SpeciesEntry,
-        load_scene_file,
-    )
+    from fishgen.school.scene_file import SceneFile, SpeciesEntry, check_size, load_scene_file, with_options
     from fishgen.species.parser import load_species
 
     o = job.options
@@ -92,20 +87,15 @@ def _school(job: Job, reads: list[Path]) -> list[Path]:
     else:
         scene = SceneFile(species=tuple(SpeciesEntry(p, 50) for p in job.inputs))
     # The options override the scene file exactly as `fishgen school`'s do.
-    if o["count"] is not None:
-        scene = replace(scene, species=tuple(replace(e, count=o["count"]) for e in scene.species))
-    for name in ("frames", "fps", "seed", "model"):
-        if o[name] is not None:
-            scene = replace(scene, **{name: o[name]})
-    total = sum(e.count for e in scene.species)
-    if total > MAX_FISH or total * scene.frames > MAX_FISH_FRAMES:
-        raise FishgenError(f"expected at most {MAX_FISH:,} fish and {MAX_FISH_FRAMES:,} fish x frames, "
-                           f"found {total:,} fish x {scene.frames:,} frames", job.source, job.line)
+    scene = with_options(scene, count=o["count"], frames=o["frames"], fps=o["fps"], seed=o["seed"],
+                         model=o["model"])
+    check_size(scene, job.source, job.line)
     for entry in scene.species:  # the species and their textures are inputs too
         species = load_species(entry.file, o["textures"])
         reads.append(Path(entry.file))
         reads.extend(t for t in (species.colour_texture, species.mask_texture) if t is not None)
-    run = run_school(scene, fins=o["fins"], tolerance=o["tolerance"], textures_dir=o["textures"])
+    run = run_school(scene, fins=o["fins"], swim=o["swim"], tolerance=o["tolerance"],
+                     textures_dir=o["textures"])
     return export(run.scene, job.output, require=[MESHES, NODE_ANIMATION])
 
 

@@ -30,13 +30,14 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any
 
+from fishgen.assembly.fin_modes import FIN_MODES
+from fishgen.assembly.swim_modes import DEFAULT_SPEED, SWIM_MODES
 from fishgen.errors import FishgenError
 from fishgen.exchange.registry import MESHES, NODE_ANIMATION, POINTS, output_format
 from fishgen.tomlfile import Where, loads
 
 KINDS = ("build", "school", "clouds")
 # These mirror the library's constants without importing numpy (a test checks they agree).
-FIN_MODES = ("blend", "mask", "opaque")
 SCHOOL_MODELS = ("boids", "pso")
 CLOUD_METHODS = ("paper", "uniform")
 DEFAULT_MAX_PARTICLES = 50_000_000
@@ -123,13 +124,14 @@ def _offsets(value: Any, fail: Callable[[str], FishgenError]) -> list[list[float
 # name -> (check, default). Names and ranges are those of the command's own options.
 OPTIONS: dict[str, dict[str, tuple[Check, Any]]] = {
     "build": {"fins": (_choice(FIN_MODES), None), "length": (_number(0.001, 1e4), None),
-              "fps": (_number(1, 1000), 30.0), "textures": (_folder, None)},
+              "fps": (_number(1, 1000), 30.0), "swim": (_choice(SWIM_MODES), "body"),
+              "speed": (_number(0.01, 100), DEFAULT_SPEED), "textures": (_folder, None)},
     "school": {"count": (_number(1, 100_000, whole=True), None),
                "frames": (_number(2, 100_000, whole=True), None), "fps": (_number(1, 1000), None),
                "seed": (_number(0, SEED_LIMIT - 1, whole=True), None),
                "model": (_choice(SCHOOL_MODELS), None),
                "tolerance": (_number(0, 1), 0.002), "fins": (_choice(FIN_MODES), None),
-               "textures": (_folder, None)},
+               "swim": (_choice(SWIM_MODES), "body"), "textures": (_folder, None)},
     "clouds": {"offset": (_offsets, None), "seed": (_number(0, SEED_LIMIT - 1, whole=True), None),
                "method": (_choice(CLOUD_METHODS), "paper"), "billboards": (_flag, False),
                "max-particles": (_number(1, 2**62, whole=True), DEFAULT_MAX_PARTICLES)},

@@ -62,13 +62,12 @@ def school(inputs, output, count, frames, fps, seed, model, tolerance, tracks, m
       fishgen school params/bonybream.txt --count 200 -o out/school.glb
       fishgen school params/reef.toml -o out/reef.glb --metrics out/reef.json --tracks out/reef.npz
     """
-    from dataclasses import replace
 
     from fishgen.cli.params import check_inputs
     from fishgen.errors import FishgenError
     from fishgen.exchange import export
     from fishgen.exchange.registry import FORMATS, MESHES, NODE_ANIMATION, output_format
-    from fishgen.school.scene_file import MAX_FISH, MAX_FISH_FRAMES, SceneFile, SpeciesEntry, load_scene_file
+    from fishgen.school.scene_file import SceneFile, SpeciesEntry, check_size, load_scene_file, with_options
 
     output_format(output, [MESHES, NODE_ANIMATION])
     scene_files = [p for p in inputs if p.suffix.lower() == ".toml"]
@@ -80,15 +79,8 @@ def school(inputs, output, count, frames, fps, seed, model, tolerance, tracks, m
     else:
         check_inputs(inputs, "school", [FORMATS["species"]], default=FORMATS["species"])
         scene = SceneFile(species=tuple(SpeciesEntry(p, 50) for p in inputs))
-    if count is not None:
-        scene = replace(scene, species=tuple(replace(e, count=count) for e in scene.species))
-    for name, value in (("frames", frames), ("fps", fps), ("seed", seed), ("model", model)):
-        if value is not None:
-            scene = replace(scene, **{name: value})
-    total = sum(e.count for e in scene.species)
-    if total > MAX_FISH or total * scene.frames > MAX_FISH_FRAMES:  # before anything is built
-        raise FishgenError(f"expected at most {MAX_FISH:,} fish and {MAX_FISH_FRAMES:,} fish x frames, "
-                           f"found {total:,} fish x {scene.frames:,} frames")
+    scene = with_options(scene, count=count, frames=frames, fps=fps, seed=seed, model=model)
+    check_size(scene)  # before anything is built
     for extra, suffixes in ((tracks, (".csv", ".npz")), (metrics, (".json",)), (plot, (".png",))):
         if extra is not None and extra.suffix.lower() not in suffixes:
             raise FishgenError(f"expected a file ending in {' or '.join(suffixes)}, found "

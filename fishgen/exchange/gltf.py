@@ -234,7 +234,7 @@ def _plain(obj: Any, keep_empty: bool = False) -> Any:
         if kind is gl.GLTF2:  # leave out pygltflib's private state (a loaded blob, a path)
             items = [(key, value) for key, value in items if not key.startswith("_")]
         keep_empty = False
-    out = {}
+    out: dict[str, Any] = {}
     for key, value in items:
         if value is None:
             if keep_empty:

@@ -71,6 +71,26 @@ class SceneFile:
     pso: PsoParams = PsoParams()
 
 
+def with_options(scene: SceneFile, *, count: int | None = None, frames: int | None = None,
+                 fps: float | None = None, seed: int | None = None, model: str | None = None) -> SceneFile:
+    """``scene`` with the options given (not None) overriding it, as `fishgen school`'s flags do;
+    ``count`` sets every species' count."""
+    if count is not None:
+        scene = replace(scene, species=tuple(replace(e, count=count) for e in scene.species))
+    given: dict[str, Any] = {name: value for name, value in
+                             (("frames", frames), ("fps", fps), ("seed", seed), ("model", model))
+                             if value is not None}
+    return replace(scene, **given)
+
+
+def check_size(scene: SceneFile, file: str | None = None, line: int | None = None) -> None:
+    """Refuse absurd schools before anything is built: MAX_FISH fish, MAX_FISH_FRAMES fish x frames."""
+    total = sum(e.count for e in scene.species)
+    if total > MAX_FISH or total * scene.frames > MAX_FISH_FRAMES:
+        raise FishgenError(f"expected at most {MAX_FISH:,} fish and {MAX_FISH_FRAMES:,} fish x frames, "
+                           f"found {total:,} fish x {scene.frames:,} frames", file, line)
+
+
 def _number(where: _Where, value: Any, key: str, low: float, high: float, table: str | None = None,
             nth: int = 0, whole: bool = False) -> Any:
     kind = "a whole number" if whole else "a number"

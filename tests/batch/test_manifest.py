@@ -49,7 +49,8 @@ output = "seeded.ply"
 seed = 5
 """), out=tmp_path / "o")
     build, clouds, seeded = manifest.jobs
-    assert build.options == {"fins": None, "length": None, "fps": 30.0, "textures": None}
+    assert build.options == {"fins": None, "length": None, "fps": 30.0, "swim": "body", "speed": 1.0,
+                             "textures": None}
     assert build.output == tmp_path / "o" / "a.glb" and build.inputs == (tmp_path / "a.txt",)
     assert clouds.options["seed"] == derived_seed("sky/c.ply") and clouds.options["method"] == "paper"
     assert clouds.options["offset"] == [[0, 0, 0], [1, 2, 3]]
