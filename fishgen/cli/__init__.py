@@ -21,6 +21,10 @@ COMMANDS = {
     "view": ("fishgen.cli.view", "view", "Open an asset in a self-contained three.js viewer page."),
     "school": ("fishgen.cli.school", "school",
                "Simulate a fish school and bake it into an animated glb, tracks and measures."),
+    "texture": ("fishgen.cli.texture", "texture",
+                "Make a species from a side photo of a fish: texture, texture points, fin mask."),
+    "species": ("fishgen.cli.species", "species",
+                "Sample plausible new species (shape, fins, motion) with painted textures."),
 }
 
 
