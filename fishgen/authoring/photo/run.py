@@ -45,6 +45,7 @@ class TextureResult:
     source: str
     unseen: list[str] = field(default_factory=list)
     iou: float | None = None
+    level_mask: np.ndarray | None = field(default=None, repr=False)   # the silhouette, head left, level
 
 
 @dataclass(frozen=True)
@@ -214,7 +215,8 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
             rebuilt = load_species(staged)
             files[Path(options.compare)], iou = _compare(photo, sil.mask, measured.frame_mask, rebuilt)
     write_files(files)
-    return TextureResult(species, list(files), measured.angle, measured.mirrored, sil.source, unseen, iou)
+    return TextureResult(species, list(files), measured.angle, measured.mirrored, sil.source, unseen, iou,
+                         measured.frame_mask)
 
 
 def _compare(photo: Photo, mask: np.ndarray, frame_mask: np.ndarray, rebuilt: Species) -> tuple[bytes, float]:

@@ -61,7 +61,15 @@ def background_model_mask(rgb: np.ndarray) -> np.ndarray:
                  + (gy / h)[..., None] * coef[2][None, None, :])
     distance = np.linalg.norm((img - predicted) / mad[None, None, :], axis=2)
     contrast = np.linalg.norm(img - predicted, axis=2)
-    return (distance > NOISE_SIGMAS) & (contrast > MIN_CONTRAST)
+    raw = (distance > NOISE_SIGMAS) & (contrast > MIN_CONTRAST)
+    # The outline's own pixels are partly fish: keep one when it carries at least half the
+    # contrast of the solid fish just inside it -- the 50 % line of an anti-aliased or
+    # JPEG-smeared edge rather than its faint halo. Only that one rim layer is judged, so
+    # a pale patch beside a dark one inside the fish (an eye) is never cut out.
+    core = ndimage.binary_erosion(raw, structure=np.ones((3, 3), bool))
+    inside = ndimage.maximum_filter(np.where(core, contrast, 0.0), size=5)
+    rim = raw & ~core
+    return core | (rim & ((contrast >= 0.5 * inside) | (inside == 0)))
 
 
 def _mask_file(path: str | os.PathLike, size: tuple[int, int]) -> np.ndarray:
@@ -92,8 +100,11 @@ def _one_fish(raw: np.ndarray, photo: Photo, source: str) -> np.ndarray:
         many = int((sizes >= SECOND_OBJECT * sizes[order[0]]).sum())
         raise FishgenError(f"expected one fish, found {many} objects of similar size; crop the photo to "
                            "one fish or give --mask", photo.path)
-    # The closing only decides what belongs together; the outline is the unclosed one.
-    fish = ndimage.binary_fill_holes(clean & (labels == order[0] + 1))
+    # The closing decides what belongs together and which holes are holes (a pale eye ring on
+    # the outline leaves a gap a few pixels wide); the outline itself is the unclosed one.
+    closed = labels == order[0] + 1
+    holes = ndimage.binary_fill_holes(closed) & ~closed
+    fish = ndimage.binary_fill_holes((clean & closed) | holes)
     edges = {"top": fish[0].sum(), "bottom": fish[-1].sum(), "left": fish[:, 0].sum(),
              "right": fish[:, -1].sum()}
     cut = [name for name, n in edges.items() if n >= 2]

@@ -1,0 +1,51 @@
+"""Measured accuracy of `fishgen texture` on synthetic photos of the shipped species.
+
+    python benchmarks/texture.py            # a table: species x photo kind
+
+Each photo is an orthographic side render (tests/authoring/photos.py), varied as
+the robustness tests vary it. Columns: the rebuilt fish's silhouette IoU against
+the photo's (in the fish's own level, head-left frame), the worst and mean body
+texture point error and the worst fin point error, as fractions of the texture
+size, and the seconds `make_texture` took.
+"""
+from __future__ import annotations
+
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from fishgen.authoring.photo.compare import silhouette_iou  # noqa: E402
+from fishgen.authoring.photo.run import make_texture  # noqa: E402
+from fishgen.species.parser import load_species  # noqa: E402
+from tests.authoring import photos as ph  # noqa: E402
+from tests.authoring.test_photo_roundtrip import KINDS  # noqa: E402
+
+
+def main() -> None:
+    print(f"{'species':16s} {'photo':15s} {'IoU':>6s} {'body max':>9s} {'body mean':>9s} "
+          f"{'worst fin':>18s} {'s':>5s}")
+    for name in ("bonybream", "centroberyx", "pineapplefish", "threadfingoldie"):
+        species = load_species(ROOT / "params" / f"{name}.txt")
+        clean = ph.render_photo(species)
+        for kind, make in KINDS.items():
+            photo = make(clean)
+            with tempfile.TemporaryDirectory() as tmp:
+                path = Path(tmp) / "photo.png"
+                photo.save(path)
+                start = time.perf_counter()
+                result = make_texture(path, species, Path(tmp) / "new.txt")
+                seconds = time.perf_counter() - start
+                rebuilt = load_species(Path(tmp) / "new.txt")
+                body, fins = ph.errors(rebuilt, photo)
+                iou = silhouette_iou(result.level_mask, ph.rendered_mask(rebuilt))
+            worst = max(fins, key=lambda n: fins[n])
+            print(f"{name:16s} {kind:15s} {iou:6.3f} {body.max():9.4f} {body.mean():9.4f} "
+                  f"{worst + ' ' + format(fins[worst], '.4f'):>18s} {seconds:5.2f}")
+
+
+if __name__ == "__main__":
+    main()
