@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import re
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,7 +52,13 @@ def load_photo(path: str | os.PathLike) -> Photo:
                 rgba = np.asarray(img.convert("RGBA"))
     except FishgenError:
         raise
-    except (UnidentifiedImageError, Image.DecompressionBombError, Image.DecompressionBombWarning) as err:
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as err:
+        # PIL refuses very large headers itself, before our own check can see the size.
+        found = re.search(r"\((\d+) pixels\)", str(err))
+        size = f"{int(found[1]) / 1e6:.0f} megapixels" if found else "a larger one"
+        raise FishgenError(f"expected a photo of at most {MAX_PHOTO_PIXELS // 1_000_000} megapixels, "
+                           f"found {size}", path) from None
+    except UnidentifiedImageError as err:
         raise FishgenError(f"expected a photo (PNG, JPEG, WebP, ...), found {_why(err)}", path) from None
     except (OSError, ValueError, SyntaxError) as err:
         raise FishgenError(f"expected a readable photo, found a damaged file ({err})", path) from None
@@ -62,5 +69,4 @@ def load_photo(path: str | os.PathLike) -> Photo:
 
 
 def _why(err: Exception) -> str:
-    text = str(err).split(" could ")[0] if str(err) else type(err).__name__
-    return "an image too large to decode" if "decompression" in text.lower() else f"not an image ({text})"
+    return "a file that is not an image PIL can read"
