@@ -1,14 +1,15 @@
-"""--fit-shape: the base species' body profile, proportions, fin places and fin sizes fitted to
+"""--fit-shape: the base species' body profile, proportions and fin sizes fitted to
 the photo's silhouette, so the 3D fish has the photographed fish's outline.
 
 Only what a side view shows is fitted: the profile (as FishShapeSpline control
 points), the depth-to-length ratio (scaleY; scaleZ keeps the base's width-to-
-depth ratio), the BodySections the dorsal, anal and pelvic fins span, and every
-fin's length. Angles, triangle counts and motion stay the base species'.
+depth ratio) and every fin's length. Where fins stand (their BodySections),
+their angles, triangle counts and motion stay the base species': moving a fin
+to where the outline bulges proved less reliable than the base's layout, so
+pick a base species whose fins are laid out like the photographed fish's.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -18,26 +19,56 @@ from fishgen.species.model import Species
 
 #: Where the fitted spline's control points sit along the body (nose 0, tail 1).
 CONTROL_X = (0.04, 0.12, 0.25, 0.4, 0.55, 0.7, 0.82, 0.93)
-ROUNDS = 3
+ROUNDS = 2
+DEAD_BAND = 0.2
+MIN_FIN_AREA = 200
+#: Radius of the disk that opens fins off the body, as a share of the body's half depth.
+OPENING = 0.5
 #: A fitted fin keeps between these multiples of the base species' fin length.
 FIN_RANGE = (0.4, 2.5)
 
 
-def fit_shape(base: Species, mask: np.ndarray, note: Callable[[str], None]) -> Species:
+def fit_shape(base: Species, mask: np.ndarray) -> Species:
     from fishgen.authoring.photo.run import analyse
 
-    fitted = base
+    # Round 0 takes the body's outline from the silhouette opened by a disk (fins are thinner
+    # than the body), not from the base profile, which may be nothing like this fish's.
+    fitted = _fit_body(base, _opened_outline(analyse(mask, base)))
     for _ in range(ROUNDS):   # each round's profile is a better prior for the body under the fins
         seen = analyse(mask, fitted)
-        fitted = _fit_fin_places(_fit_body(fitted, seen.outline), seen.outline)
+        fitted = _fit_body(fitted, seen.outline)
     seen = analyse(mask, fitted)
-    fitted = _fit_fin_sizes(fitted, {n: r.reach for n, r in seen.fins.items() if r.seen})
-    note(f"fitted shape: scaleY {fitted.scale[1]:.4g} (base {base.scale[1]:.4g}), "
-         f"{len(fitted.shape_params) // 2} spline control points")
-    return fitted
+    # A fin of a few pixels (BonyBream's adipose) has no reach worth measuring.
+    reach = {n: r.reach for n, r in seen.fins.items() if r.seen and r.area >= MIN_FIN_AREA}
+    return _fit_fin_sizes(fitted, reach)
+
+
+def _opened_outline(a):
+    """The body outline with fins removed by a morphological opening (via distance transforms),
+    the raw outline kept where the body is thinner than the disk (nose, tail base)."""
+    from scipy import ndimage  # type: ignore[import-untyped]
+
+    from fishgen.authoring.photo import columns
+
+    o = a.outline
+    mask = a.frame.mask
+    xc = np.arange(mask.shape[1]) + 0.5
+    mid = o.midline(xc)
+    top, bottom = columns.run_through(mask, mid)
+    depth = np.nanmax(bottom - top)
+    radius = OPENING * depth / 2
+    eroded = ndimage.distance_transform_edt(mask) > radius
+    opened = ndimage.distance_transform_edt(~eroded) <= radius
+    otop, obottom = columns.run_through(opened & mask, mid)
+    up = np.where(np.isnan(otop), mid - top, mid - otop)
+    down = np.where(np.isnan(obottom), bottom - mid, obottom - mid)
+    inside = (xc >= o.x0) & (xc <= o.x0 + o.x_scale)
+    return replace(o, upper=np.where(inside, up, np.nan), lower=np.where(inside, down, np.nan))
 
 
 def _fit_body(base: Species, outline) -> Species:
+    """FishShapeSpline control points through the measured half depth; scaleY rescaled only when
+    the profile would leave the usual 0.2..0.6 peak radius."""
     u = np.asarray(CONTROL_X)
     x = outline.x0 + u * outline.x_scale
     up, down = outline.half_heights(x)
@@ -46,7 +77,6 @@ def _fit_body(base: Species, outline) -> Species:
     half = 0.5 * (up + down) / max(reach, 1e-6)    # radius in frame pixels
     radius_per_length = half / outline.x_scale  # radius / body length
     sx, sy, sz = base.scale
-    # Keep the base's scaleY if the profile stays within (0, 1]; else rescale scaleY to fit.
     r = radius_per_length * sx / sy
     peak = float(r.max())
     if peak > 0.6 or peak < 0.2:
@@ -58,45 +88,14 @@ def _fit_body(base: Species, outline) -> Species:
     return replace(base, shape_class="FishShapeSpline", shape_params=params, scale=(sx, sy, sz))
 
 
-def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
-    edges = np.diff(np.r_[0, flags.astype(np.int8), 0])
-    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1, strict=True))
-
-
-def _fit_fin_places(sp: Species, outline) -> Species:
-    """Dorsal and anal (and pelvic) fins over the BodySections where the outline is fin."""
-    b = sp.body_sections
-
-    def section(col: float) -> int:
-        u = (col + 0.5 - outline.x0) / outline.x_scale
-        return int(np.clip(round(u * (b - 1)), 1, b - 2))
-
-    def nearest_run(flags: np.ndarray, start: int, end: int) -> tuple[int, int] | None:
-        centre = outline.x0 + (start + end) / 2 / (b - 1) * outline.x_scale
-        lo = outline.x0 + 0.08 * outline.x_scale
-        hi = outline.x0 + 0.9 * outline.x_scale
-        runs = [(a, z) for a, z in _runs(flags) if z > lo and a < hi and z - a >= 3]
-        if not runs:
-            return None
-        a, z = min(runs, key=lambda az: abs((az[0] + az[1]) / 2 - centre))
-        s, e = section(a), section(z)
-        return (s, max(e, s + 1)) if e < b - 1 or s + 1 < b - 1 else None
-
-    out = sp
-    for name, flags in (("dorsal", outline.fin_upper), ("anal", outline.fin_lower)):
-        fin = getattr(sp, name)
-        if fin.present:
-            found = nearest_run(flags, fin.start_section, fin.end_section)
-            if found:
-                out = replace(out, **{name: replace(fin, start_section=found[0], end_section=found[1])})
-    return out
-
-
 def _fit_fin_sizes(sp: Species, reach: dict[str, float]) -> Species:
     lo, hi = FIN_RANGE
 
     def k(name: str) -> float:
-        return float(np.clip(reach.get(name, 1.0), lo, hi))
+        # Within DEAD_BAND the base's fin stays: a masked photo's fins are rounded and eroded
+        # a little by the mask, which is no reason to shrink the geometry.
+        ratio = float(np.clip(reach.get(name, 1.0), lo, hi))
+        return 1.0 if abs(ratio - 1.0) <= DEAD_BAND else ratio
 
     c = sp.caudal
     kc = k("caudal")

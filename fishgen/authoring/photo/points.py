@@ -60,6 +60,7 @@ class FinResult:
     seen: bool
     stretch: float         # how much the fin's outer edge was moved to meet the photo's fin
     reach: float = 1.0     # the photo's fin reach over the base species' (what --fit-shape scales by)
+    area: int = 0          # pixels the base species' fin covers in the frame
 
 
 #: Fixel's order per fin kind: indices of base (attached) and outer vertices.
@@ -77,8 +78,9 @@ def _rows(name: str, count: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def fin_points(name: str, fin_xy: np.ndarray, faces: np.ndarray, outline: BodyOutline, view: SideView,
-               mask: np.ndarray, body: np.ndarray) -> FinResult:
-    """One fin's texture points; ``body`` is the body's region in the frame (bool mask)."""
+               mask: np.ndarray, body: np.ndarray, search: float = 1 / 3) -> FinResult:
+    """One fin's texture points; ``body`` is the body's region in the frame (bool mask). Fin
+    pixels count up to ``search`` x the fin's size beyond where the base species puts it."""
     pts = thesis_to_frame(outline, view, fin_xy)
     if name == "pectoral":  # it lies over the flank in a side view: what is there is its texture
         return FinResult(pts, True, 1.0)
@@ -88,7 +90,13 @@ def fin_points(name: str, fin_xy: np.ndarray, faces: np.ndarray, outline: BodyOu
 
     outside, _ = ndimage.label(mask & ~body, structure=np.ones((3, 3), bool))
     touching = np.unique(outside[expected & (outside > 0)])
-    fin_pixels = np.isin(outside, touching[touching > 0]) & _grown(expected, pts)
+    fin_pixels = np.isin(outside, touching[touching > 0]) & _grown(expected, pts, search)
+    # Beside a fin (the anal fin next to the caudal) another fin may join its blob outside the
+    # body: only columns over the fin's own span, a quarter of its width either way, count.
+    lo, hi = pts[:, 0].min(), pts[:, 0].max()
+    pad = 0.25 * (hi - lo)
+    cols = np.arange(mask.shape[1]) + 0.5
+    fin_pixels &= ((cols >= lo - pad) & ((cols <= hi + pad) | (name == "caudal")))[None, :]
     if area == 0 or fin_pixels.sum() < SEEN_SHARE * area:
         return FinResult(_on_skin(pts, base_idx, body, outline), False, 0.0)
     base_c = pts[base_idx].mean(axis=0)
@@ -98,18 +106,18 @@ def fin_points(name: str, fin_xy: np.ndarray, faces: np.ndarray, outline: BodyOu
         return FinResult(pts, True, 1.0)
     d = outward / norm
     ys, xs = np.nonzero(fin_pixels)
-    reach_seen = np.percentile((np.stack([xs + 0.5, ys + 0.5], 1) - base_c) @ d, 99.5)
+    reach_seen = float(((np.stack([xs + 0.5, ys + 0.5], 1) - base_c) @ d).max())  # a thin tip is few pixels
     reach_model = ((pts[outer_idx] - base_c) @ d).max()
     # Only ever grow: the texture's fin must cover the fin the photo shows. A smaller fin in the
     # photo keeps its own size (the mask or blending shows it as it is); --fit-shape resizes fins.
     reach = float(reach_seen / reach_model) if reach_model > 0 else 1.0
     stretch = float(np.clip(reach, 1.0, 1.6))
     if stretch < 1.03:
-        return FinResult(pts, True, 1.0, reach)
+        return FinResult(pts, True, 1.0, reach, area)
     moved = pts.copy()
     along = (pts[outer_idx] - base_c) @ d
     moved[outer_idx] += ((stretch - 1.0) * along)[:, None] * d[None, :]
-    return FinResult(moved, True, stretch, reach)
+    return FinResult(moved, True, stretch, reach, area)
 
 
 def _raster(pts: np.ndarray, faces: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
@@ -122,12 +130,11 @@ def _raster(pts: np.ndarray, faces: np.ndarray, shape: tuple[int, int]) -> np.nd
     return np.asarray(img) >= 128
 
 
-def _grown(expected: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    """The expected fin area, widened by a third of its size: a real fin is rarely where the
+def _grown(expected: np.ndarray, pts: np.ndarray, search: float) -> np.ndarray:
+    """The expected fin area, widened by ``search`` x its size: a real fin is rarely where the
     base species puts it to the pixel."""
-
     size = float(np.ptp(pts, axis=0).max())
-    reach = max(2, int(size / 3))
+    reach = max(2, int(size * search))
     dist = ndimage.distance_transform_edt(~expected)
     return dist <= reach
 

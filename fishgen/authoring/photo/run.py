@@ -97,7 +97,7 @@ class Analysis:
     fins: dict[str, fixel.FinResult]
 
 
-def analyse(mask: np.ndarray, base: Species, spacing: str = "projected") -> Analysis:
+def analyse(mask: np.ndarray, base: Species, spacing: str = "projected", search: float = 1 / 3) -> Analysis:
     view = side_view(base)
     ys, xs = np.nonzero(mask)
     cal = calibrate(view, float(max(np.ptp(xs), np.ptp(ys))))
@@ -105,7 +105,7 @@ def analyse(mask: np.ndarray, base: Species, spacing: str = "projected") -> Anal
     outline = body_outline(fr.mask, view, cal)
     body = fixel.body_points(outline, base.body_sections, base.circle_sections, spacing)
     region = body_region(outline, fr.mask.shape)
-    fins = {name: fixel.fin_points(name, xy, view.fin_faces[name], outline, view, fr.mask, region)
+    fins = {name: fixel.fin_points(name, xy, view.fin_faces[name], outline, view, fr.mask, region, search)
             for name, xy in view.fins.items()}
     return Analysis(view, fr, outline, body, fins)
 
@@ -166,8 +166,6 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
     """Measure ``photo_path``, write the new species file beside its texture and mask, atomically."""
     from fishgen.atomic import write_files
     from fishgen.authoring.photo import fxl
-    from fishgen.species.parser import load_species, parse_species
-    from fishgen.species.writer import format_species
 
     out = Path(out)
     if out.suffix.lower() != ".txt":
@@ -179,11 +177,57 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
     sil = silhouette(photo, options.mask)
     base = with_counts(base, options.body_sections, options.circle_sections)
     imported = fxl.read_fxl(options.fxl_in) if options.fxl_in is not None else {}
+    textures = texture_bytes(photo, sil.mask)
+    chosen = _candidate(photo, sil.mask, base, out, options, imported, textures)
+    shown: tuple[np.ndarray, float] | None = None   # the chosen fish rendered, and its IoU
     if options.fit_shape:
         from fishgen.authoring.photo.fit import fit_shape
 
-        base = fit_shape(base, sil.mask, note)
-    measured = measure(photo, base, sil.mask, options.spacing)
+        fitted = _candidate(photo, sil.mask, fit_shape(base, sil.mask), out, options, imported, textures)
+        # Keep the fit only if the rebuilt fish matches the photo better than the base's geometry.
+        shown, tried = (_rendered(photo, c, out) for c in (chosen, fitted))
+        iou_base, iou_fit = shown[1], tried[1]
+        if iou_fit >= iou_base:
+            note(f"fitted shape: silhouette IoU {iou_base:.3f} with the base's geometry -> {iou_fit:.3f}")
+            chosen, shown = fitted, tried
+        else:
+            note(f"fitted shape not kept: silhouette IoU {iou_fit:.3f}, the base's geometry gives "
+                 f"{iou_base:.3f}")
+    for name in chosen.unseen:
+        note(f"note: no {name} fin found in the photo; its texture is body skin near its attachment")
+    files = dict(chosen.files)
+    if options.fxl_out is not None:
+        tp = chosen.species.texture_points
+        assert tp is not None
+        files[Path(options.fxl_out)] = fxl.format_fxl(tp, chosen.species.circle_sections).encode()
+    iou = None
+    if options.compare is not None:
+        if shown is None:
+            shown = _rendered(photo, chosen, out)
+        files[Path(options.compare)], iou = _compare_png(photo, *shown)
+    write_files(files)
+    return TextureResult(chosen.species, list(files), chosen.measured.angle, chosen.measured.mirrored,
+                         sil.source, list(chosen.unseen), iou, chosen.measured.frame_mask)
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    species: Species
+    files: dict[Path, bytes]
+    measured: Measured
+
+    @property
+    def unseen(self) -> tuple[str, ...]:
+        return self.measured.unseen
+
+
+def _candidate(photo: Photo, mask: np.ndarray, base: Species, out: Path, options: TextureOptions,
+               imported: dict[str, list[tuple[float, float]]], textures: tuple[bytes, bytes]) -> _Candidate:
+    """The species file (and its texture files) ``base``'s geometry gives with this photo."""
+    from fishgen.species.parser import parse_species
+    from fishgen.species.writer import format_species
+
+    measured = measure(photo, base, mask, options.spacing)
     pts = measured.points
     for part, values in imported.items():
         want = len(getattr(pts, part))
@@ -191,46 +235,42 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
             raise FishgenError(f"expected {want} //{part} points for {base.name}'s geometry, found "
                                f"{len(values)}", options.fxl_in)
         pts = replace(pts, **{part: tuple(values)})
-    unseen = [n for n in measured.unseen if n not in imported]
-    for name in unseen:
-        note(f"note: no {name} fin found in the photo; its texture is body skin near its attachment")
+    measured = replace(measured, unseen=tuple(n for n in measured.unseen if n not in imported))
     name = species_name(out)
     colour_name, mask_name = f"{name}.png", f"{name}_mask.png"
     species = replace(base, name=name, textured=True, texture_points=pts, colour_texture=None,
                       mask_texture=None, source=None)
     text = format_species(species, colour_name, mask_name)
     parse_species(text, out)   # what we write must read back (section ranges, counts)
-    colour, bw = texture_bytes(photo, sil.mask)
-    files: dict[Path, bytes] = {out: text.encode(), out.with_name(colour_name): colour,
-                                out.with_name(mask_name): bw}
-    if options.fxl_out is not None:
-        files[Path(options.fxl_out)] = fxl.format_fxl(pts, species.circle_sections).encode()
-    iou = None
-    if options.compare is not None:
-        with tempfile.TemporaryDirectory(prefix="fishgen-texture-") as tmp:
-            staged = Path(tmp) / out.name
-            for path, data in files.items():
-                if path.suffix.lower() in (".txt", ".png") and path.parent == out.parent:
-                    (Path(tmp) / path.name).write_bytes(data)
-            rebuilt = load_species(staged)
-            files[Path(options.compare)], iou = _compare(photo, sil.mask, measured.frame_mask, rebuilt)
-    write_files(files)
-    return TextureResult(species, list(files), measured.angle, measured.mirrored, sil.source, unseen, iou,
-                         measured.frame_mask)
+    files = {out: text.encode(), out.with_name(colour_name): textures[0],
+             out.with_name(mask_name): textures[1]}
+    return _Candidate(species, files, measured)
 
 
-def _compare(photo: Photo, mask: np.ndarray, frame_mask: np.ndarray, rebuilt: Species) -> tuple[bytes, float]:
-    from fishgen.authoring.photo.compare import compare_image, render_side, silhouette_iou
+def _rendered(photo: Photo, candidate: _Candidate, out: Path) -> tuple[np.ndarray, float]:
+    """The candidate rebuilt from its files and rendered side-on at about the photo's size, and its
+    silhouette IoU with the photo's fish (head left, level)."""
+    from fishgen.authoring.photo.compare import render_side, silhouette_iou
+    from fishgen.species.parser import load_species
 
-    w, h = photo.size
-    k = min(1.0, 1024 / max(w, h))
-    rw, rh = max(64, round(w * k)), max(64, round(h * k))
-    render = render_side(rebuilt, rw, rh)
-    iou = silhouette_iou(frame_mask, render[:, :, 3] >= 64)
-    opaque = np.full(mask.shape, 255, np.uint8)
-    rgba = np.dstack([photo.rgb, opaque if photo.alpha is None else photo.alpha])
+    with tempfile.TemporaryDirectory(prefix="fishgen-texture-") as tmp:
+        for path, data in candidate.files.items():
+            (Path(tmp) / path.name).write_bytes(data)
+        rebuilt = load_species(Path(tmp) / out.name)
+        w, h = photo.size
+        k = min(1.0, 1024 / max(w, h))
+        render = render_side(rebuilt, max(64, round(w * k)), max(64, round(h * k)))
+    return render, silhouette_iou(candidate.measured.frame_mask, render[:, :, 3] >= 64)
+
+
+def _compare_png(photo: Photo, render: np.ndarray, iou: float) -> tuple[bytes, float]:
     from PIL import Image
 
+    from fishgen.authoring.photo.compare import compare_image
+
+    rh, rw = render.shape[:2]
+    opaque = np.full(photo.rgb.shape[:2], 255, np.uint8)
+    rgba = np.dstack([photo.rgb, opaque if photo.alpha is None else photo.alpha])
     small = np.asarray(Image.fromarray(rgba, "RGBA").resize((rw, rh), Image.Resampling.LANCZOS))
     sheet = compare_image(small, render, f"fishgen texture: rebuilt (silhouette IoU {iou:.3f})")
     buf = io.BytesIO()
