@@ -6,7 +6,8 @@ Each photo is an orthographic side render (tests/authoring/photos.py), varied as
 the robustness tests vary it. Columns: the rebuilt fish's silhouette IoU against
 the photo's (in the fish's own level, head-left frame), the worst and mean body
 texture point error and the worst fin point error, as fractions of the texture
-size, and the seconds `make_texture` took.
+size, and the seconds `make_texture` took. A three.js row (photos from three.js in
+Chromium, tests/authoring/threejs.py) is added when Chromium and node_modules/three are there.
 """
 from __future__ import annotations
 
@@ -26,12 +27,21 @@ from tests.authoring.test_photo_roundtrip import KINDS  # noqa: E402
 
 
 def main() -> None:
+    from tests.authoring.threejs import ThreePhotographer, unavailable
+
     print(f"{'species':16s} {'photo':15s} {'IoU':>6s} {'body max':>9s} {'body mean':>9s} "
           f"{'worst fin':>18s} {'s':>5s}")
+    three = None
+    if unavailable() is None:
+        three = ThreePhotographer(Path(tempfile.mkdtemp(prefix="fishgen-three-")))
     for name in ("bonybream", "centroberyx", "pineapplefish", "threadfingoldie"):
         species = load_species(ROOT / "params" / f"{name}.txt")
         clean = ph.render_photo(species)
-        for kind, make in KINDS.items():
+        kinds = dict(KINDS)
+        if three is not None:
+            shot = three.photo(species)
+            kinds["three.js"] = lambda _p, shot=shot: shot
+        for kind, make in kinds.items():
             photo = make(clean)
             with tempfile.TemporaryDirectory() as tmp:
                 path = Path(tmp) / "photo.png"
@@ -45,6 +55,8 @@ def main() -> None:
             worst = max(fins, key=lambda n: fins[n])
             print(f"{name:16s} {kind:15s} {iou:6.3f} {body.max():9.4f} {body.mean():9.4f} "
                   f"{worst + ' ' + format(fins[worst], '.4f'):>18s} {seconds:5.2f}")
+    if three is not None:
+        three.close()
 
 
 if __name__ == "__main__":
