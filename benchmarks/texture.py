@@ -1,6 +1,7 @@
 """Measured accuracy of `fishgen texture` on synthetic photos of the shipped species.
 
     python benchmarks/texture.py            # a table: species x photo kind
+    python benchmarks/texture.py --fit      # and --fit-shape: each photo on each base species
 
 Each photo is an orthographic side render (tests/authoring/photos.py), varied as
 the robustness tests vary it. Columns: the rebuilt fish's silhouette IoU against
@@ -59,5 +60,32 @@ def main() -> None:
         three.close()
 
 
+def fit_table() -> None:
+    """--fit-shape across bases: the rebuilt fish's IoU with the base's geometry and with the fit."""
+    from fishgen.authoring.photo.run import TextureOptions
+
+    names = ("bonybream", "centroberyx", "pineapplefish", "threadfingoldie")
+    print(f"\n{'photo of':16s} {'base':16s} {'IoU base':>9s} {'IoU fit':>8s} {'kept':>5s} {'s':>5s}")
+    for name in names:
+        photo = ph.render_photo(load_species(ROOT / "params" / f"{name}.txt"))
+        for base_name in names:
+            base = load_species(ROOT / "params" / f"{base_name}.txt")
+            notes: list[str] = []
+            with tempfile.TemporaryDirectory() as tmp:
+                path = Path(tmp) / "photo.png"
+                photo.save(path)
+                start = time.perf_counter()
+                make_texture(path, base, Path(tmp) / "new.txt", TextureOptions(fit_shape=True), notes.append)
+                seconds = time.perf_counter() - start
+            text = next(n for n in notes if "fitted shape" in n)
+            numbers = [float(w.rstrip(",")) for w in text.replace("->", " ").split() if w[:2] == "0."]
+            kept = "fitted shape:" in text
+            base_iou, fit_iou = (numbers[0], numbers[1]) if kept else (numbers[1], numbers[0])
+            print(f"{name:16s} {base_name:16s} {base_iou:9.3f} {fit_iou:8.3f} {'yes' if kept else 'no':>5s} "
+                  f"{seconds:5.1f}")
+
+
 if __name__ == "__main__":
     main()
+    if "--fit" in sys.argv:
+        fit_table()

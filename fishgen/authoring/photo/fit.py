@@ -40,7 +40,13 @@ def fit_shape(base: Species, mask: np.ndarray) -> Species:
     seen = analyse(mask, fitted)
     # A fin of a few pixels (BonyBream's adipose) has no reach worth measuring.
     reach = {n: r.reach for n, r in seen.fins.items() if r.seen and r.area >= MIN_FIN_AREA}
-    return _fit_fin_sizes(fitted, reach)
+    fitted = _fit_fin_sizes(fitted, reach)
+    # Then where the fins stand, their lengths and angles, by the overlap of the side views.
+    from fishgen.authoring.photo.finfit import fit_fins
+
+    seen = analyse(mask, fitted)
+    fitted, _ = fit_fins(fitted, seen.outline, seen.frame.mask)
+    return fitted
 
 
 def _opened_outline(a):
