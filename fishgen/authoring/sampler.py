@@ -42,8 +42,9 @@ RANGES: dict[str, tuple[float, float]] = {
     "anal_proportion": (0.85, 0.9),
     "pelvic_circle": (0.79, 0.92),      # x CircleSections: low on the left flank
     "pelvic_start": (0.25, 0.45),
+    "pelvic_span": (0.09, 0.2),         # x BodySections, as BonyBream's 4-7 of 16 .. goldie's 6-8 of 24
     "pelvic_length": (0.1, 0.5),
-    "pelvic_end_length": (0.3, 1.1),
+    "pelvic_end_length": (0.3, 0.8),   # threadfin goldie's 1.1 filament read as a wing on deep bodies
     "pelvic_angle": (55.0, 90.0),
     "pectoral_start": (0.2, 0.33),
     "pectoral_circle": (0.04, 0.17),
@@ -145,13 +146,13 @@ def sample_species(seed: int, name: str | None = None) -> Sample:
                           0.02 if has_adipose else 0.0, 30.0 if has_adipose else 0.0, 0.5)
     p0 = _section(rng, "pelvic_start", b)
     paired_period = period * int(rng.choice((1, 2))) // int(rng.choice((1, 2)))
-    p1 = min(p0 + int(rng.integers(1, 4)), b - 2)
+    p1 = min(p0 + max(1, round(_u(rng, "pelvic_span") * (b - 1))), b - 2)
     pelvic = PelvicFin(int(round(_u(rng, "pelvic_circle") * c)) % c, p0, max(p1, p0),
                        _u(rng, "pelvic_length"), _u(rng, "pelvic_end_length"), _u(rng, "pelvic_angle"),
                        *_swing(rng, "paired_swing", paired_period))
     q_circle = max(1, int(round(_u(rng, "pectoral_circle") * c)))
     pectoral = PectoralFin(_section(rng, "pectoral_start", b), q_circle,
-                           int(rng.integers(2, max(3, c // 4 + 1))), _u(rng, "pectoral_length"),
+                           int(rng.integers(2, max(3, min(4, c // 4) + 1))), _u(rng, "pectoral_length"),
                            _u(rng, "pectoral_angle"), _u(rng, "pectoral_proportion"), 0.0,
                            *_swing(rng, "paired_swing", paired_period))
     palette = _palette(rng)
