@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import io
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 from PIL import Image
@@ -23,6 +24,7 @@ from fishgen.preview.pipeline import subject_points
 from fishgen.species.model import Species
 
 SIZE = (1024, 512)
+PARAMS_DIR = Path(__file__).resolve().parents[2] / "params"
 
 
 @dataclass(frozen=True)

@@ -74,3 +74,25 @@ def test_texture_is_the_photo_upside_down(tmp_path, gl_available, photos):
     # Inside the fish the texture holds the photo's colours; the mask is its silhouette.
     assert np.abs(upright[fish] - photo.rgba[:, :, :3][fish].astype(int)).mean() < 1.0
     assert (mask == fish).mean() > 0.999
+
+
+def test_large_photo_is_measured_on_a_smaller_copy(tmp_path, gl_available):
+    """A photo over 2048 px a side (here with a hand-made --mask of its own size) is measured on
+    a scaled-down copy; the points are fractions, so they are as good, and the texture keeps the
+    photo's resolution."""
+    from PIL import Image
+
+    from fishgen.authoring.photo.run import TextureOptions
+
+    species = load_species(ph.PARAMS_DIR / "pineapplefish.txt")
+    photo = ph.on_background(ph.render_photo(species, (2600, 1300)), (180, 190, 200), (180, 190, 200))
+    photo.save(tmp_path / "big.png")
+    hand_made = ((ph.render_photo(species, (2600, 1300)).rgba[:, :, 3] >= 128) * 255).astype("uint8")
+    Image.fromarray(hand_made).save(tmp_path / "mask.png")
+    make_texture(tmp_path / "big.png", species, tmp_path / "new.txt",
+                 TextureOptions(mask=tmp_path / "mask.png"))
+    rebuilt = load_species(tmp_path / "new.txt")
+    body, fins = ph.errors(rebuilt, photo)
+    assert body.max() <= BODY_TOLERANCE and max(fins.values()) <= FIN_TOLERANCE
+    assert Image.open(tmp_path / "new.png").size == (2600, 1300)
+    assert Image.open(tmp_path / "new_mask.png").size == (2600, 1300)

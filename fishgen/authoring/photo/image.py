@@ -28,6 +28,23 @@ class Photo:
         return self.rgb.shape[1], self.rgb.shape[0]
 
 
+def working_copy(photo: Photo, longest: int) -> Photo:
+    """``photo`` scaled down to at most ``longest`` pixels a side (area-averaged), for measuring:
+    texture points are fractions of the picture, so they do not depend on its resolution."""
+    from PIL import Image
+
+    w, h = photo.size
+    if max(w, h) <= longest:
+        return photo
+    k = longest / max(w, h)
+    size = (max(1, round(w * k)), max(1, round(h * k)))
+    rgb = np.asarray(Image.fromarray(photo.rgb, "RGB").resize(size, Image.Resampling.BOX))
+    alpha = None
+    if photo.alpha is not None:
+        alpha = np.asarray(Image.fromarray(photo.alpha, "L").resize(size, Image.Resampling.BOX))
+    return Photo(np.ascontiguousarray(rgb), alpha, photo.path)
+
+
 def load_photo(path: str | os.PathLike) -> Photo:
     """Read ``path`` as RGB (+ alpha). Absurd sizes are refused from the header alone."""
     from PIL import Image, ImageOps, UnidentifiedImageError

@@ -14,7 +14,7 @@ import numpy as np
 from fishgen.authoring.photo import points as fixel
 from fishgen.authoring.photo.anatomy import BodyOutline, body_outline, body_region, calibrate
 from fishgen.authoring.photo.frame import Frame, fish_frame
-from fishgen.authoring.photo.image import Photo, load_photo
+from fishgen.authoring.photo.image import Photo, load_photo, working_copy
 from fishgen.authoring.photo.sideview import SideView, side_view
 from fishgen.authoring.photo.silhouette import silhouette
 from fishgen.errors import FishgenError
@@ -22,6 +22,8 @@ from fishgen.species.model import PectoralFin, PelvicFin, Species, TexturePoints
 
 #: Largest texture written; a bigger photo is scaled down (texture points are fractions, unchanged).
 MAX_TEXTURE_SIDE = 4096
+#: Largest side the photo is measured at.
+MEASURE_SIDE = 2048
 
 
 @dataclass(frozen=True)
@@ -135,23 +137,26 @@ def species_name(out: Path) -> str:
     return name or "fish"
 
 
-def texture_bytes(photo: Photo, mask: np.ndarray) -> tuple[bytes, bytes]:
-    """(colour, mask) PNGs stored upside down as VRFish wants them (chapter 6). The background
-    around the fish takes the nearest fish colour, so blended fin edges and mipmaps show fish,
-    not the photo's backdrop; the mask keeps the true outline."""
+def texture_bytes(original: Photo, work: Photo, mask: np.ndarray) -> tuple[bytes, bytes]:
+    """(colour, mask) PNGs stored upside down as VRFish wants them (chapter 6), from the photo at
+    up to MAX_TEXTURE_SIDE pixels a side. The background around the fish takes the nearest fish
+    colour, so blended fin edges and mipmaps show fish, not the photo's backdrop; the mask keeps
+    the true outline. ``mask`` is the silhouette measured on ``work``."""
     from PIL import Image, ImageOps
     from scipy import ndimage  # type: ignore[import-untyped]
 
-    _, (iy, ix) = ndimage.distance_transform_edt(~mask, return_indices=True)
-    padded = photo.rgb[iy, ix]
-    colour = Image.fromarray(np.ascontiguousarray(padded), "RGB")
-    bw = Image.fromarray(mask.astype(np.uint8) * 255, "L")
+    colour = Image.fromarray(original.rgb, "RGB")
     longest = max(colour.size)
     if longest > MAX_TEXTURE_SIDE:
         k = MAX_TEXTURE_SIDE / longest
-        new = (max(1, round(colour.size[0] * k)), max(1, round(colour.size[1] * k)))
-        colour = colour.resize(new, Image.Resampling.LANCZOS)
-        bw = bw.resize(new, Image.Resampling.NEAREST)
+        colour = colour.resize((max(1, round(colour.size[0] * k)), max(1, round(colour.size[1] * k))),
+                               Image.Resampling.LANCZOS)
+    bw = Image.fromarray(mask.astype(np.uint8) * 255, "L")
+    if bw.size != colour.size:   # measured on a smaller copy: a smooth edge, not blocks
+        bw = bw.resize(colour.size, Image.Resampling.BILINEAR).point(lambda v: 255 if v >= 128 else 0)
+    fish = np.asarray(bw) >= 128
+    _, (iy, ix) = ndimage.distance_transform_edt(~fish, return_indices=True)
+    colour = Image.fromarray(np.ascontiguousarray(np.asarray(colour)[iy, ix]), "RGB")
     out = []
     for img in (colour, bw):
         buf = io.BytesIO()
@@ -173,11 +178,14 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
     if options.spacing not in fixel.SPACINGS:
         raise FishgenError(f"expected --spacing {'|'.join(fixel.SPACINGS)}, found {options.spacing!r}")
     note = on_note or (lambda _text: None)
-    photo = load_photo(photo_path)
-    sil = silhouette(photo, options.mask)
+    original = load_photo(photo_path)
+    # Measured on at most MEASURE_SIDE pixels a side: a 0.05 % step is finer than any tolerance,
+    # and a 64-megapixel photo would otherwise need gigabytes.
+    photo = working_copy(original, MEASURE_SIDE)
+    sil = silhouette(photo, options.mask, original.size)
     base = with_counts(base, options.body_sections, options.circle_sections)
     imported = fxl.read_fxl(options.fxl_in) if options.fxl_in is not None else {}
-    textures = texture_bytes(photo, sil.mask)
+    textures = texture_bytes(original, photo, sil.mask)
     chosen = _candidate(photo, sil.mask, base, out, options, imported, textures)
     shown: tuple[np.ndarray, float] | None = None   # the chosen fish rendered, and its IoU
     if options.fit_shape:

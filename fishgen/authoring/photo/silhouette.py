@@ -29,10 +29,12 @@ class Silhouette:
     source: str            # "alpha", "background model" or "mask file"
 
 
-def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None) -> Silhouette:
-    """The fish's silhouette, checked: one object, wholly inside the frame."""
+def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None,
+               mask_size: tuple[int, int] | None = None) -> Silhouette:
+    """The fish's silhouette, checked: one object, wholly inside the frame. A mask file must be
+    ``mask_size`` (the original photo's, when ``photo`` is a scaled-down working copy)."""
     if mask_path is not None:
-        raw, source = _mask_file(mask_path, photo.size), "mask file"
+        raw, source = _mask_file(mask_path, mask_size or photo.size, photo.size), "mask file"
     elif photo.alpha is not None:
         raw, source = photo.alpha >= ALPHA_CUTOFF, "alpha"
     else:
@@ -43,7 +45,7 @@ def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None) -> Silh
 def background_model_mask(rgb: np.ndarray) -> np.ndarray:
     """Pixels whose colour the border's planar colour model does not explain."""
     h, w = rgb.shape[:2]
-    img = ndimage.uniform_filter(rgb.astype(np.float32), size=(3, 3, 1))
+    img = ndimage.uniform_filter(rgb.astype(np.float32), size=(3, 3, 1))   # float32 halves the memory
     b = max(2, round(0.02 * min(h, w)))
     border = np.zeros((h, w), bool)
     border[:b], border[-b:], border[:, :b], border[:, -b:] = True, True, True, True
@@ -56,11 +58,14 @@ def background_model_mask(rgb: np.ndarray) -> np.ndarray:
         resid = colours - design @ coef
         mad = np.median(np.abs(resid[keep]), axis=0) * 1.4826 + 0.5
         keep = (np.abs(resid) <= 4 * mad).all(axis=1)
-    gy, gx = np.mgrid[0:h, 0:w]
-    predicted = (coef[0][None, None, :] + (gx / w)[..., None] * coef[1][None, None, :]
-                 + (gy / h)[..., None] * coef[2][None, None, :])
-    distance = np.linalg.norm((img - predicted) / mad[None, None, :], axis=2)
-    contrast = np.linalg.norm(img - predicted, axis=2)
+    c = coef.astype(np.float32)
+    gx = (np.arange(w, dtype=np.float32) / w)[None, :, None]
+    gy = (np.arange(h, dtype=np.float32) / h)[:, None, None]
+    diff = img - (c[0] + gx * c[1] + gy * c[2])      # the photo minus the backdrop it should show
+    contrast = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+    scaled = diff / mad.astype(np.float32)
+    distance = np.sqrt(np.einsum("ijk,ijk->ij", scaled, scaled))
+    del diff, scaled
     raw = (distance > NOISE_SIGMAS) & (contrast > MIN_CONTRAST)
     # The outline's own pixels are partly fish: keep one when it carries at least half the
     # contrast of the solid fish just inside it -- the 50 % line of an anti-aliased or
@@ -72,7 +77,9 @@ def background_model_mask(rgb: np.ndarray) -> np.ndarray:
     return core | (rim & ((contrast >= 0.5 * inside) | (inside == 0)))
 
 
-def _mask_file(path: str | os.PathLike, size: tuple[int, int]) -> np.ndarray:
+def _mask_file(path: str | os.PathLike, size: tuple[int, int], work: tuple[int, int]) -> np.ndarray:
+    from PIL import Image
+
     from fishgen.authoring.photo.image import load_photo
 
     m = load_photo(path)
@@ -80,7 +87,11 @@ def _mask_file(path: str | os.PathLike, size: tuple[int, int]) -> np.ndarray:
         raise FishgenError(f"expected a mask the size of the photo ({size[0]} x {size[1]}), "
                            f"found {m.size[0]} x {m.size[1]}", path)
     grey = m.rgb.mean(axis=2)
-    return (grey >= 128) if m.alpha is None else (m.alpha >= 128) & (grey >= 128)
+    white = (grey >= 128) if m.alpha is None else (m.alpha >= 128) & (grey >= 128)
+    if work != size:
+        img = Image.fromarray(white.astype(np.uint8) * 255).resize(work, Image.Resampling.BILINEAR)
+        white = np.asarray(img) >= 128
+    return white
 
 
 def _one_fish(raw: np.ndarray, photo: Photo, source: str) -> np.ndarray:
