@@ -17,6 +17,8 @@ from fishgen.authoring.photo.sideview import SideView, rasterize
 
 #: How far in from the ends the tail base is looked for, as a share of the fish's length.
 TAIL_SEARCH = 0.4
+#: The snout, as a share of the body length from the nose: never taken for fin.
+SNOUT = 0.1
 #: An outline column stands out as fin when it exceeds the body model by this share (+ 1.5 px).
 FIN_TOLERANCE = 0.04
 
@@ -112,14 +114,15 @@ def body_outline(mask: np.ndarray, view: SideView, cal: Calibration) -> BodyOutl
     prior_down = -prior_down
     x_scale = (x1 - x0) / view.length
     front = u < 0.5
-    upper, fin_up, k_up = _body_side(seen_up, prior_up * x_scale, inside, front)
-    lower, fin_down, k_down = _body_side(seen_down, prior_down * x_scale, inside, front)
+    snout = u < SNOUT
+    upper, fin_up, k_up = _body_side(seen_up, prior_up * x_scale, inside, front, snout)
+    lower, fin_down, k_down = _body_side(seen_down, prior_down * x_scale, inside, front, snout)
     return BodyOutline(x0, x1, nose[1], slope, upper, lower, fin_up, fin_down,
                        x_scale * 0.5 * (k_up + k_down))
 
 
-def _body_side(seen: np.ndarray, prior: np.ndarray, inside: np.ndarray,
-               front: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+def _body_side(seen: np.ndarray, prior: np.ndarray, inside: np.ndarray, front: np.ndarray,
+               snout: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """Body half-height along one side: the outline where it is body, the base profile (scaled to
     the body's visible ratio on either side) where fins stand on it. Returns it, the fin flags
     and the median visible ratio of photo to base profile."""
@@ -137,7 +140,8 @@ def _body_side(seen: np.ndarray, prior: np.ndarray, inside: np.ndarray,
     # Fins are wider at their base than where they stand clear of the body: widen each flag.
     from scipy import ndimage  # type: ignore[import-untyped]
 
-    fin = ndimage.binary_dilation(fin, iterations=2) & inside
+    # No fin stands on the snout: a blunt head above a pointed base profile is still head.
+    fin = ndimage.binary_dilation(fin, iterations=2) & inside & ~snout
     ok = usable & ~fin
     xs = np.flatnonzero(ok)
     ratio_everywhere = np.interp(np.arange(seen.size), xs, ratio[xs]) if xs.size else np.full(seen.shape, k)

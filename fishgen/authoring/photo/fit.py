@@ -1,12 +1,11 @@
-"""--fit-shape: the base species' body profile, proportions and fin sizes fitted to
-the photo's silhouette, so the 3D fish has the photographed fish's outline.
+"""--fit-shape: the base species' body profile, proportions and fins fitted to the photo's
+silhouette, so the 3D fish has the photographed fish's outline.
 
 Only what a side view shows is fitted: the profile (as FishShapeSpline control
 points), the depth-to-length ratio (scaleY; scaleZ keeps the base's width-to-
-depth ratio) and every fin's length. Where fins stand (their BodySections),
-their angles, triangle counts and motion stay the base species': moving a fin
-to where the outline bulges proved less reliable than the base's layout, so
-pick a base species whose fins are laid out like the photographed fish's.
+depth ratio), and where the dorsal, anal and pelvic fins stand, every fin's
+lengths and angles (:mod:`.finfit`). Triangle counts, motion and behaviour stay
+the base species'.
 """
 from __future__ import annotations
 
@@ -20,12 +19,9 @@ from fishgen.species.model import Species
 #: Where the fitted spline's control points sit along the body (nose 0, tail 1).
 CONTROL_X = (0.04, 0.12, 0.25, 0.4, 0.55, 0.7, 0.82, 0.93)
 ROUNDS = 2
-DEAD_BAND = 0.2
-MIN_FIN_AREA = 200
+FIN_ROUNDS = 2
 #: Radius of the disk that opens fins off the body, as a share of the body's half depth.
 OPENING = 0.5
-#: A fitted fin keeps between these multiples of the base species' fin length.
-FIN_RANGE = (0.4, 2.5)
 
 
 def fit_shape(base: Species, mask: np.ndarray) -> Species:
@@ -37,15 +33,14 @@ def fit_shape(base: Species, mask: np.ndarray) -> Species:
     for _ in range(ROUNDS):   # each round's profile is a better prior for the body under the fins
         seen = analyse(mask, fitted)
         fitted = _fit_body(fitted, seen.outline)
-    seen = analyse(mask, fitted)
-    # A fin of a few pixels (BonyBream's adipose) has no reach worth measuring.
-    reach = {n: r.reach for n, r in seen.fins.items() if r.seen and r.area >= MIN_FIN_AREA}
-    fitted = _fit_fin_sizes(fitted, reach)
-    # Then where the fins stand, their lengths and angles, by the overlap of the side views.
+    # Then the fins: where they stand, their lengths and angles, by the overlap of the side
+    # views; the body is refitted once more under the new fins (they move the tail point).
     from fishgen.authoring.photo.finfit import fit_fins
 
-    seen = analyse(mask, fitted)
-    fitted, _ = fit_fins(fitted, seen.outline, seen.frame.mask)
+    for _ in range(FIN_ROUNDS):
+        seen = analyse(mask, fitted)
+        fitted, _ = fit_fins(fitted, seen.outline, seen.frame.mask)
+        fitted = _fit_body(fitted, analyse(mask, fitted).outline)
     return fitted
 
 
@@ -92,26 +87,3 @@ def _fit_body(base: Species, outline) -> Species:
     r = np.clip(r, 1e-3, 10.0)
     params = tuple(float(v) for pair in zip(u, r, strict=True) for v in pair)
     return replace(base, shape_class="FishShapeSpline", shape_params=params, scale=(sx, sy, sz))
-
-
-def _fit_fin_sizes(sp: Species, reach: dict[str, float]) -> Species:
-    lo, hi = FIN_RANGE
-
-    def k(name: str) -> float:
-        # Within DEAD_BAND the base's fin stays: a masked photo's fins are rounded and eroded
-        # a little by the mask, which is no reason to shrink the geometry.
-        ratio = float(np.clip(reach.get(name, 1.0), lo, hi))
-        return 1.0 if abs(ratio - 1.0) <= DEAD_BAND else ratio
-
-    c = sp.caudal
-    kc = k("caudal")
-    out = replace(sp, caudal=replace(c, top_line=c.top_line * kc, bottom_line=c.bottom_line * kc,
-                                     middle_line=c.middle_line * kc))
-    for name in ("dorsal", "adipose", "anal"):
-        f = getattr(out, name)
-        if f.present:
-            out = replace(out, **{name: replace(f, start_length=f.start_length * k(name),
-                                                end_length=f.end_length * k(name))})
-    p = out.pelvic
-    return replace(out, pelvic=replace(p, start_length=p.start_length * k("pelvic"),
-                                       end_length=p.end_length * k("pelvic")))
