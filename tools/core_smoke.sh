@@ -24,4 +24,7 @@ for input in fish.obj fish.ply fish.glb cloud.ply latin1.obj "$root/params/bonyb
   run "$fishgen" preview "$input" -o preview.png --size 64x48
 done
 run "$fishgen" view fish.glb --no-serve -o page.html
+run "$fishgen" species --random --seed 1 -o sampled.txt
+run "$fishgen" preview sampled.txt --view side --ortho --background transparent --size 256x128 -o photo.png
+run "$fishgen" texture photo.png -s sampled.txt -o fromphoto.txt --fit-shape --compare compare.png
 echo "core install: every command ran without a traceback"

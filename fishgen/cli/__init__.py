@@ -25,6 +25,10 @@ COMMANDS = {
                "Simulate a fish school and bake it into an animated glb, tracks and measures."),
     "batch": ("fishgen.cli.batch", "batch",
               "Regenerate an asset set from a manifest or folder, incrementally and in parallel."),
+    "texture": ("fishgen.cli.texture", "texture",
+                "Make a species from a side photo of a fish: texture, texture points, fin mask."),
+    "species": ("fishgen.cli.species", "species",
+                "Sample plausible new species (shape, fins, motion) with painted textures."),
 }
 
 

@@ -40,8 +40,11 @@ VIEW_NAMES = ("side", "top", "front", "three-quarter")
               help="Random seed (0 or more) for filling .awn cube files, as `fishgen clouds` uses it.")
 @click.option("--textures", type=click.Path(file_okay=False), default=None, metavar="DIR",
               help="Folder of species textures  [default: as `fishgen build` resolves them]")
+@click.option("--ortho", is_flag=True, default=False,
+              help="Orthographic camera: no perspective, e.g. a side view to use as a photo for "
+                   "`fishgen texture`.")
 def preview(inputs, output, view, size, time_, clip, background, frames, loop_fps, duration, columns, seed,
-            textures):
+            textures, ortho):
     """Render INPUT... to an image, as a game engine would show it.
 
     INPUT is a species file (.txt), a cloud cube file (.awn) or an asset
@@ -64,7 +67,8 @@ def preview(inputs, output, view, size, time_, clip, background, frames, loop_fp
     width, height = parse_size(size)
     options = PreviewOptions(view=view, width=width, height=height, time=time_,
                              background=parse_background(background), frames=frames, fps=loop_fps,
-                             duration=duration, columns=columns, clip=clip, seed=seed, textures_dir=textures)
+                             duration=duration, columns=columns, clip=clip, seed=seed, textures_dir=textures,
+                             ortho=ortho)
     bar = None
 
     def start(total: int) -> None:

@@ -31,6 +31,9 @@ class Camera:
     aspect: float
     near: float
     far: float
+    ortho: bool = False
+    """Orthographic: the frame spans the view cone's width at the target's distance, so a side
+    view reads as a field-guide photo with no perspective (what `fishgen texture` measures)."""
 
     def view(self) -> np.ndarray:
         f = _unit(self.target - self.eye)
@@ -44,6 +47,10 @@ class Camera:
     def projection(self) -> np.ndarray:
         t = 1.0 / math.tan(self.fov_y / 2)
         n, f = self.near, self.far
+        if self.ortho:
+            half = float(np.linalg.norm(self.target - self.eye)) / t
+            return np.array([[1 / (half * self.aspect), 0, 0, 0], [0, 1 / half, 0, 0],
+                             [0, 0, 2 / (n - f), (f + n) / (n - f)], [0, 0, 0, 1]])
         return np.array([[t / self.aspect, 0, 0, 0], [0, t, 0, 0],
                          [0, 0, (f + n) / (n - f), 2 * f * n / (n - f)], [0, 0, -1, 0]])
 
@@ -62,7 +69,7 @@ def view_basis(view: str, azimuth: float = 0.0) -> tuple[np.ndarray, np.ndarray]
 
 
 def frame(points: np.ndarray, view: str, aspect: float, azimuths=(0.0,),
-          target: np.ndarray | None = None) -> Camera:
+          target: np.ndarray | None = None, ortho: bool = False) -> Camera:
     """A camera on ``view`` that keeps every point of ``points`` (N, 3) in frame.
 
     With several ``azimuths`` (a turntable), one distance and target serve them all.
@@ -97,7 +104,7 @@ def frame(points: np.ndarray, view: str, aspect: float, azimuths=(0.0,),
     dist = max(dist, 1e-3 * span, 1e-6)
     d0, up0 = view_basis(view, azimuths[0])
     return Camera(eye=centre + d0 * dist, target=centre, up=up0, fov_y=FOV_Y, aspect=aspect,
-                  near=max(dist - span * 1.5, dist * 0.01), far=dist + span * 1.5)
+                  near=max(dist - span * 1.5, dist * 0.01), far=dist + span * 1.5, ortho=ortho)
 
 
 def turned(camera: Camera, view: str, azimuth: float) -> Camera:
@@ -105,4 +112,4 @@ def turned(camera: Camera, view: str, azimuth: float) -> Camera:
     d, up = view_basis(view, azimuth)
     dist = float(np.linalg.norm(camera.eye - camera.target))
     return Camera(eye=camera.target + d * dist, target=camera.target, up=up, fov_y=camera.fov_y,
-                  aspect=camera.aspect, near=camera.near, far=camera.far)
+                  aspect=camera.aspect, near=camera.near, far=camera.far, ortho=camera.ortho)

@@ -52,6 +52,7 @@ class PreviewOptions:
     clip: str | None = None
     seed: int = 0
     textures_dir: str | None = None
+    ortho: bool = False                # orthographic camera (no perspective)
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -193,7 +194,7 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
             points = subject_points(scene, sorted(set(times), key=lambda t: -1 if t is None else t),
                                     options.clip)
             base = frame(points, options.view, options.width / options.height,
-                         azimuths=tuple(sorted(set(azimuths))))
+                         azimuths=tuple(sorted(set(azimuths))), ortho=options.ortho)
             images = []
             for t, az in zip(times, azimuths, strict=True):
                 cam = turned(base, options.view, az) if az else base

@@ -1,0 +1,55 @@
+"""Render a species side-on as the photo shows a fish, and measure how alike two silhouettes are."""
+from __future__ import annotations
+
+import numpy as np
+
+from fishgen.species.model import Species
+
+
+def render_side(species: Species, width: int, height: int) -> np.ndarray:
+    """(H, W, 4) uint8 orthographic left-side render on a transparent background, head left."""
+    from fishgen.assembly.fish import build_fish
+    from fishgen.preview.camera import frame
+    from fishgen.preview.pipeline import subject_points
+    from fishgen.preview.render import Renderer
+
+    scene = build_fish(species)
+    camera = frame(subject_points(scene, [None], None), "side", width / height, ortho=True)
+    renderer = Renderer(width, height)
+    try:
+        return renderer.render(scene, camera, None, (0.0, 0.0, 0.0, 0.0))
+    finally:
+        renderer.release()
+
+
+def _crop(mask: np.ndarray) -> np.ndarray:
+    ys, xs = np.nonzero(mask)
+    return mask[ys.min():ys.max() + 1, xs.min():xs.max() + 1]
+
+
+def silhouette_iou(a: np.ndarray, b: np.ndarray) -> float:
+    """IoU of two silhouettes after each is cropped to its bounding box and ``b`` is scaled onto
+    ``a``'s: a shape measure, blind to where and how large each fish sits in its frame."""
+    from PIL import Image
+
+    ca, cb = _crop(a), _crop(b)
+    img = Image.fromarray(cb.astype(np.uint8) * 255).resize((ca.shape[1], ca.shape[0]),
+                                                             Image.Resampling.BILINEAR)
+    cb2 = np.asarray(img) >= 128
+    union = (ca | cb2).sum()
+    return float((ca & cb2).sum() / union) if union else 0.0
+
+
+def compare_image(photo_rgba: np.ndarray, render_rgba: np.ndarray, caption: str):
+    """The photo and the rebuilt fish side by side on a light grey ground, with a caption."""
+    from PIL import Image, ImageDraw
+
+    h = max(photo_rgba.shape[0], render_rgba.shape[0])
+    w = photo_rgba.shape[1] + render_rgba.shape[1]
+    sheet = Image.new("RGBA", (w, h + 28), (236, 238, 240, 255))
+    sheet.alpha_composite(Image.fromarray(photo_rgba, "RGBA"), (0, 0))
+    sheet.alpha_composite(Image.fromarray(render_rgba, "RGBA"), (photo_rgba.shape[1], 0))
+    draw = ImageDraw.Draw(sheet)
+    draw.text((8, h + 8), "photo", fill=(40, 40, 40, 255))
+    draw.text((photo_rgba.shape[1] + 8, h + 8), caption, fill=(40, 40, 40, 255))
+    return sheet.convert("RGB")

@@ -1,0 +1,89 @@
+"""Decode a photo safely: the size is checked from the header before any pixel is decoded."""
+from __future__ import annotations
+
+import os
+import re
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from fishgen.errors import FishgenError
+
+#: Largest photo accepted, in pixels (about a 64-megapixel camera frame).
+MAX_PHOTO_PIXELS = 64_000_000
+#: Smallest side accepted: below this a fish has too few pixels to measure.
+MIN_PHOTO_SIDE = 64
+
+
+@dataclass(frozen=True)
+class Photo:
+    rgb: np.ndarray              # (H, W, 3) uint8, upright as the file shows it
+    alpha: np.ndarray | None     # (H, W) uint8 when the file has an alpha channel worth using
+    path: Path
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return self.rgb.shape[1], self.rgb.shape[0]
+
+
+def working_copy(photo: Photo, longest: int) -> Photo:
+    """``photo`` scaled down to at most ``longest`` pixels a side (area-averaged), for measuring:
+    texture points are fractions of the picture, so they do not depend on its resolution."""
+    from PIL import Image
+
+    w, h = photo.size
+    if max(w, h) <= longest:
+        return photo
+    k = longest / max(w, h)
+    size = (max(1, round(w * k)), max(1, round(h * k)))
+    rgb = np.asarray(Image.fromarray(photo.rgb, "RGB").resize(size, Image.Resampling.BOX))
+    alpha = None
+    if photo.alpha is not None:
+        alpha = np.asarray(Image.fromarray(photo.alpha, "L").resize(size, Image.Resampling.BOX))
+    return Photo(np.ascontiguousarray(rgb), alpha, photo.path)
+
+
+def load_photo(path: str | os.PathLike) -> Photo:
+    """Read ``path`` as RGB (+ alpha). Absurd sizes are refused from the header alone."""
+    from PIL import Image, ImageOps, UnidentifiedImageError
+
+    path = Path(path)
+    if not path.is_file():
+        raise FishgenError("expected a photo file, found nothing there" if not path.exists()
+                           else "expected a photo file, found a folder or special file", path)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            with Image.open(path) as img:
+                w, h = img.size            # from the header; nothing is decoded yet
+                if w * h > MAX_PHOTO_PIXELS:
+                    raise FishgenError(f"expected a photo of at most {MAX_PHOTO_PIXELS // 1_000_000} "
+                                       f"megapixels, found {w} x {h}", path)
+                if min(w, h) < MIN_PHOTO_SIDE:
+                    raise FishgenError(f"expected a photo at least {MIN_PHOTO_SIDE} pixels a side, "
+                                       f"found {w} x {h}", path)
+                img = ImageOps.exif_transpose(img)  # phones store portrait shots sideways
+                has_alpha = img.mode in ("RGBA", "LA", "PA") or "transparency" in img.info
+                rgba = np.asarray(img.convert("RGBA"))
+    except FishgenError:
+        raise
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as err:
+        # PIL refuses very large headers itself, before our own check can see the size.
+        found = re.search(r"\((\d+) pixels\)", str(err))
+        size = f"{int(found[1]) / 1e6:.0f} megapixels" if found else "a larger one"
+        raise FishgenError(f"expected a photo of at most {MAX_PHOTO_PIXELS // 1_000_000} megapixels, "
+                           f"found {size}", path) from None
+    except UnidentifiedImageError as err:
+        raise FishgenError(f"expected a photo (PNG, JPEG, WebP, ...), found {_why(err)}", path) from None
+    except (OSError, ValueError, SyntaxError) as err:
+        raise FishgenError(f"expected a readable photo, found a damaged file ({err})", path) from None
+    alpha = rgba[:, :, 3]
+    # An alpha channel that is opaque everywhere says nothing about the background.
+    usable = has_alpha and bool((alpha < 128).any())
+    return Photo(np.ascontiguousarray(rgba[:, :, :3]), alpha.copy() if usable else None, path)
+
+
+def _why(err: Exception) -> str:
+    return "a file that is not an image PIL can read"

@@ -1,0 +1,286 @@
+"""`fishgen texture`: a species file, its texture and fin mask from one side photo of a fish."""
+from __future__ import annotations
+
+import io
+import os
+import re
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from fishgen.authoring.photo import points as fixel
+from fishgen.authoring.photo.anatomy import BodyOutline, body_outline, body_region, calibrate
+from fishgen.authoring.photo.frame import Frame, fish_frame
+from fishgen.authoring.photo.image import Photo, load_photo, working_copy
+from fishgen.authoring.photo.sideview import SideView, side_view
+from fishgen.authoring.photo.silhouette import silhouette
+from fishgen.errors import FishgenError
+from fishgen.species.model import PectoralFin, PelvicFin, Species, TexturePoints, VerticalFin
+
+#: Largest texture written; a bigger photo is scaled down (texture points are fractions, unchanged).
+MAX_TEXTURE_SIDE = 4096
+#: Largest side the photo is measured at.
+MEASURE_SIDE = 2048
+
+
+@dataclass(frozen=True)
+class TextureOptions:
+    mask: Path | None = None
+    fit_shape: bool = False
+    body_sections: int | None = None
+    circle_sections: int | None = None
+    spacing: str = "projected"
+    compare: Path | None = None
+    fxl_in: Path | None = None
+    fxl_out: Path | None = None
+
+
+@dataclass
+class TextureResult:
+    species: Species
+    written: list[Path]
+    angle: float
+    mirrored: bool
+    source: str
+    unseen: list[str] = field(default_factory=list)
+    iou: float | None = None
+    level_mask: np.ndarray | None = field(default=None, repr=False)   # the silhouette, head left, level
+
+
+@dataclass(frozen=True)
+class Measured:
+    """Everything measured on the photo, in the photo's own pixels."""
+    points: TexturePoints
+    frame_mask: np.ndarray
+    angle: float
+    mirrored: bool
+    unseen: tuple[str, ...]
+
+
+def with_counts(base: Species, sections: int | None, circles: int | None) -> Species:
+    """``base`` at another level of detail: fin sections and circle points move with the body."""
+    b0, c0 = base.body_sections, base.circle_sections
+    b, c = sections or b0, circles or c0
+    if (b, c) == (b0, c0):
+        return base
+
+    def sec(k: int) -> int:
+        return int(np.clip(round(k * (b - 1) / (b0 - 1)), 0, b - 1))
+
+    def circ(k: int) -> int:
+        return int(round(k * c / c0)) % c
+
+    def vertical(f: VerticalFin) -> VerticalFin:
+        start, end = sec(f.start_section), sec(f.end_section)
+        return replace(f, start_section=start, end_section=max(end, min(start + 1, b - 1)))
+
+    p: PelvicFin = base.pelvic
+    ps, pe = sec(p.start_section), sec(p.end_section)
+    q: PectoralFin = base.pectoral
+    return replace(base, body_sections=b, circle_sections=c, dorsal=vertical(base.dorsal),
+                   adipose=vertical(base.adipose), anal=vertical(base.anal),
+                   pelvic=replace(p, start_circle=circ(p.start_circle), start_section=ps,
+                                  end_section=max(pe, min(ps + 1, b - 1))),
+                   pectoral=replace(q, start_section=sec(q.start_section), start_circle=circ(q.start_circle),
+                                    triangles=max(1, min(q.triangles, c // 2))),
+                   texture_points=None)
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """The photo measured against one species' geometry, in the fish's frame."""
+    view: SideView
+    frame: Frame
+    outline: BodyOutline
+    body: np.ndarray                       # (B, C, 2) frame points
+    fins: dict[str, fixel.FinResult]
+
+
+def analyse(mask: np.ndarray, base: Species, spacing: str = "projected", search: float = 1 / 3) -> Analysis:
+    view = side_view(base)
+    ys, xs = np.nonzero(mask)
+    cal = calibrate(view, float(max(np.ptp(xs), np.ptp(ys))))
+    fr = fish_frame(mask, cal.tail_drop)
+    outline = body_outline(fr.mask, view, cal)
+    body = fixel.body_points(outline, base.body_sections, base.circle_sections, spacing)
+    region = body_region(outline, fr.mask.shape)
+    fins = {name: fixel.fin_points(name, xy, view.fin_faces[name], outline, view, fr.mask, region, search)
+            for name, xy in view.fins.items()}
+    return Analysis(view, fr, outline, body, fins)
+
+
+def measure(photo: Photo, base: Species, mask: np.ndarray, spacing: str = "projected") -> Measured:
+    """Fixel's points for ``base``'s geometry, measured on ``photo``."""
+    a = analyse(mask, base, spacing)
+    size = np.array(photo.size, float)
+
+    def uv(frame_pts: np.ndarray) -> tuple[tuple[float, float], ...]:
+        p = np.clip(a.frame.to_photo(frame_pts.reshape(-1, 2)) / size, 0.0, 1.0)
+        return tuple((float(u), float(v)) for u, v in p)
+
+    parts: dict[str, tuple[tuple[float, float], ...]] = {"body": uv(a.body)}
+    for name in ("caudal", "dorsal", "adipose", "anal", "pectoral", "pelvic"):
+        count = getattr(base, name).texture_point_count
+        if name in a.fins:
+            parts[name] = uv(a.fins[name].points)
+        else:  # an absent fin still has its points in the file
+            parts[name] = uv(np.tile(a.body[0, 0], (count, 1)))
+    unseen = tuple(name for name, res in a.fins.items() if not res.seen)
+    return Measured(TexturePoints(**parts), a.frame.mask, a.frame.angle, a.frame.mirrored, unseen)
+
+
+def species_name(out: Path) -> str:
+    name = re.sub(r"[^A-Za-z0-9_]+", "_", out.stem).strip("_")
+    return name or "fish"
+
+
+def texture_bytes(original: Photo, work: Photo, mask: np.ndarray) -> tuple[bytes, bytes]:
+    """(colour, mask) PNGs stored upside down as VRFish wants them (chapter 6), from the photo at
+    up to MAX_TEXTURE_SIDE pixels a side. The background around the fish takes the nearest fish
+    colour, so blended fin edges and mipmaps show fish, not the photo's backdrop; the mask keeps
+    the true outline. ``mask`` is the silhouette measured on ``work``."""
+    from PIL import Image, ImageOps
+    from scipy import ndimage  # type: ignore[import-untyped]
+
+    colour = Image.fromarray(original.rgb, "RGB")
+    longest = max(colour.size)
+    if longest > MAX_TEXTURE_SIDE:
+        k = MAX_TEXTURE_SIDE / longest
+        colour = colour.resize((max(1, round(colour.size[0] * k)), max(1, round(colour.size[1] * k))),
+                               Image.Resampling.LANCZOS)
+    bw = Image.fromarray(mask.astype(np.uint8) * 255, "L")
+    if bw.size != colour.size:   # measured on a smaller copy: a smooth edge, not blocks
+        bw = bw.resize(colour.size, Image.Resampling.BILINEAR).point(lambda v: 255 if v >= 128 else 0)
+    fish = np.asarray(bw) >= 128
+    _, (iy, ix) = ndimage.distance_transform_edt(~fish, return_indices=True)
+    colour = Image.fromarray(np.ascontiguousarray(np.asarray(colour)[iy, ix]), "RGB")
+    out = []
+    for img in (colour, bw):
+        buf = io.BytesIO()
+        ImageOps.flip(img).save(buf, "PNG", compress_level=6)
+        out.append(buf.getvalue())
+    return out[0], out[1]
+
+
+def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.PathLike,
+                 options: TextureOptions = TextureOptions(),
+                 on_note: Callable[[str], None] | None = None) -> TextureResult:
+    """Measure ``photo_path``, write the new species file beside its texture and mask, atomically."""
+    from fishgen.atomic import write_files
+    from fishgen.authoring.photo import fxl
+
+    out = Path(out)
+    if out.suffix.lower() != ".txt":
+        raise FishgenError(f"expected -o to name a species file (.txt), found {out.name!r}")
+    if options.spacing not in fixel.SPACINGS:
+        raise FishgenError(f"expected --spacing {'|'.join(fixel.SPACINGS)}, found {options.spacing!r}")
+    note = on_note or (lambda _text: None)
+    original = load_photo(photo_path)
+    # Measured on at most MEASURE_SIDE pixels a side: a 0.05 % step is finer than any tolerance,
+    # and a 64-megapixel photo would otherwise need gigabytes.
+    photo = working_copy(original, MEASURE_SIDE)
+    sil = silhouette(photo, options.mask, original.size)
+    base = with_counts(base, options.body_sections, options.circle_sections)
+    imported = fxl.read_fxl(options.fxl_in) if options.fxl_in is not None else {}
+    textures = texture_bytes(original, photo, sil.mask)
+    chosen = _candidate(photo, sil.mask, base, out, options, imported, textures)
+    shown: tuple[np.ndarray, float] | None = None   # the chosen fish rendered, and its IoU
+    if options.fit_shape:
+        from fishgen.authoring.photo.fit import fit_shape
+
+        fitted = _candidate(photo, sil.mask, fit_shape(base, sil.mask), out, options, imported, textures)
+        # Keep the fit only if the rebuilt fish matches the photo better than the base's geometry.
+        shown, tried = (_rendered(photo, c, out) for c in (chosen, fitted))
+        iou_base, iou_fit = shown[1], tried[1]
+        if iou_fit >= iou_base:
+            note(f"fitted shape: silhouette IoU {iou_base:.3f} with the base's geometry -> {iou_fit:.3f}")
+            chosen, shown = fitted, tried
+        else:
+            note(f"fitted shape not kept: silhouette IoU {iou_fit:.3f}, the base's geometry gives "
+                 f"{iou_base:.3f}")
+    for name in chosen.unseen:
+        note(f"note: no {name} fin found in the photo; its texture is body skin near its attachment")
+    files = dict(chosen.files)
+    if options.fxl_out is not None:
+        tp = chosen.species.texture_points
+        assert tp is not None
+        files[Path(options.fxl_out)] = fxl.format_fxl(tp, chosen.species.circle_sections).encode()
+    iou = None
+    if options.compare is not None:
+        if shown is None:
+            shown = _rendered(photo, chosen, out)
+        files[Path(options.compare)], iou = _compare_png(photo, *shown)
+    write_files(files)
+    return TextureResult(chosen.species, list(files), chosen.measured.angle, chosen.measured.mirrored,
+                         sil.source, list(chosen.unseen), iou, chosen.measured.frame_mask)
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    species: Species
+    files: dict[Path, bytes]
+    measured: Measured
+
+    @property
+    def unseen(self) -> tuple[str, ...]:
+        return self.measured.unseen
+
+
+def _candidate(photo: Photo, mask: np.ndarray, base: Species, out: Path, options: TextureOptions,
+               imported: dict[str, list[tuple[float, float]]], textures: tuple[bytes, bytes]) -> _Candidate:
+    """The species file (and its texture files) ``base``'s geometry gives with this photo."""
+    from fishgen.species.parser import parse_species
+    from fishgen.species.writer import format_species
+
+    measured = measure(photo, base, mask, options.spacing)
+    pts = measured.points
+    for part, values in imported.items():
+        want = len(getattr(pts, part))
+        if len(values) != want:
+            raise FishgenError(f"expected {want} //{part} points for {base.name}'s geometry, found "
+                               f"{len(values)}", options.fxl_in)
+        pts = replace(pts, **{part: tuple(values)})
+    measured = replace(measured, unseen=tuple(n for n in measured.unseen if n not in imported))
+    name = species_name(out)
+    colour_name, mask_name = f"{name}.png", f"{name}_mask.png"
+    species = replace(base, name=name, textured=True, texture_points=pts, colour_texture=None,
+                      mask_texture=None, source=None)
+    text = format_species(species, colour_name, mask_name)
+    parse_species(text, out)   # what we write must read back (section ranges, counts)
+    files = {out: text.encode(), out.with_name(colour_name): textures[0],
+             out.with_name(mask_name): textures[1]}
+    return _Candidate(species, files, measured)
+
+
+def _rendered(photo: Photo, candidate: _Candidate, out: Path) -> tuple[np.ndarray, float]:
+    """The candidate rebuilt from its files and rendered side-on at about the photo's size, and its
+    silhouette IoU with the photo's fish (head left, level)."""
+    from fishgen.authoring.photo.compare import render_side, silhouette_iou
+    from fishgen.species.parser import load_species
+
+    with tempfile.TemporaryDirectory(prefix="fishgen-texture-") as tmp:
+        for path, data in candidate.files.items():
+            (Path(tmp) / path.name).write_bytes(data)
+        rebuilt = load_species(Path(tmp) / out.name)
+        w, h = photo.size
+        k = min(1.0, 1024 / max(w, h))
+        render = render_side(rebuilt, max(64, round(w * k)), max(64, round(h * k)))
+    return render, silhouette_iou(candidate.measured.frame_mask, render[:, :, 3] >= 64)
+
+
+def _compare_png(photo: Photo, render: np.ndarray, iou: float) -> tuple[bytes, float]:
+    from PIL import Image
+
+    from fishgen.authoring.photo.compare import compare_image
+
+    rh, rw = render.shape[:2]
+    opaque = np.full(photo.rgb.shape[:2], 255, np.uint8)
+    rgba = np.dstack([photo.rgb, opaque if photo.alpha is None else photo.alpha])
+    small = np.asarray(Image.fromarray(rgba, "RGBA").resize((rw, rh), Image.Resampling.LANCZOS))
+    sheet = compare_image(small, render, f"fishgen texture: rebuilt (silhouette IoU {iou:.3f})")
+    buf = io.BytesIO()
+    sheet.save(buf, "PNG")
+    return buf.getvalue(), iou

@@ -1,0 +1,131 @@
+"""Fish versus background: alpha when the photo has it, else a colour model of the frame's border.
+
+The border model is a plane per colour channel (a mild lighting gradient is a
+plane) fitted robustly to a strip around the frame; a pixel is fish when its
+colour lies far outside the border's own spread. The photo is box-filtered
+first so sensor noise and JPEG ringing average out before anything is judged.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage  # type: ignore[import-untyped]
+
+from fishgen.authoring.photo.image import Photo
+from fishgen.errors import FishgenError
+
+ALPHA_CUTOFF = 64          # translucent (blended) fins still count as fish
+MIN_FISH_FRACTION = 0.002  # of the frame; less is "no fish"
+SECOND_OBJECT = 0.25       # a second blob this big relative to the fish is "several objects"
+NOISE_SIGMAS = 5.0         # colour distance, in border standard deviations, that is surely not background
+MIN_CONTRAST = 20.0        # ... and never less than this (0-255 units), for flat synthetic backgrounds
+
+
+@dataclass(frozen=True)
+class Silhouette:
+    mask: np.ndarray       # (H, W) bool, the fish alone
+    source: str            # "alpha", "background model" or "mask file"
+
+
+def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None,
+               mask_size: tuple[int, int] | None = None) -> Silhouette:
+    """The fish's silhouette, checked: one object, wholly inside the frame. A mask file must be
+    ``mask_size`` (the original photo's, when ``photo`` is a scaled-down working copy)."""
+    if mask_path is not None:
+        raw, source = _mask_file(mask_path, mask_size or photo.size, photo.size), "mask file"
+    elif photo.alpha is not None:
+        raw, source = photo.alpha >= ALPHA_CUTOFF, "alpha"
+    else:
+        raw, source = background_model_mask(photo.rgb), "background model"
+    return Silhouette(_one_fish(raw, photo, source), source)
+
+
+def background_model_mask(rgb: np.ndarray) -> np.ndarray:
+    """Pixels whose colour the border's planar colour model does not explain."""
+    h, w = rgb.shape[:2]
+    img = ndimage.uniform_filter(rgb.astype(np.float32), size=(3, 3, 1))   # float32 halves the memory
+    b = max(2, round(0.02 * min(h, w)))
+    border = np.zeros((h, w), bool)
+    border[:b], border[-b:], border[:, :b], border[:, -b:] = True, True, True, True
+    yy, xx = np.nonzero(border)
+    design = np.stack([np.ones(yy.size), xx / w, yy / h], axis=1)
+    colours = img[yy, xx].astype(np.float64)
+    keep = np.ones(yy.size, bool)
+    for _ in range(3):  # drop border pixels the plane cannot explain (a fin tip, a label)
+        coef, *_ = np.linalg.lstsq(design[keep], colours[keep], rcond=None)
+        resid = colours - design @ coef
+        mad = np.median(np.abs(resid[keep]), axis=0) * 1.4826 + 0.5
+        keep = (np.abs(resid) <= 4 * mad).all(axis=1)
+    c = coef.astype(np.float32)
+    gx = (np.arange(w, dtype=np.float32) / w)[None, :, None]
+    gy = (np.arange(h, dtype=np.float32) / h)[:, None, None]
+    diff = img - (c[0] + gx * c[1] + gy * c[2])      # the photo minus the backdrop it should show
+    contrast = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+    scaled = diff / mad.astype(np.float32)
+    distance = np.sqrt(np.einsum("ijk,ijk->ij", scaled, scaled))
+    del diff, scaled
+    raw = (distance > NOISE_SIGMAS) & (contrast > MIN_CONTRAST)
+    # The outline's own pixels are partly fish: keep one when it carries at least half the
+    # contrast of the solid fish just inside it -- the 50 % line of an anti-aliased or
+    # JPEG-smeared edge rather than its faint halo. Only that one rim layer is judged, so
+    # a pale patch beside a dark one inside the fish (an eye) is never cut out.
+    core = ndimage.binary_erosion(raw, structure=np.ones((3, 3), bool))
+    inside = ndimage.maximum_filter(np.where(core, contrast, 0.0), size=5)
+    rim = raw & ~core
+    return core | (rim & ((contrast >= 0.5 * inside) | (inside == 0)))
+
+
+def _mask_file(path: str | os.PathLike, size: tuple[int, int], work: tuple[int, int]) -> np.ndarray:
+    from PIL import Image
+
+    from fishgen.authoring.photo.image import load_photo
+
+    m = load_photo(path)
+    if m.size != size:
+        raise FishgenError(f"expected a mask the size of the photo ({size[0]} x {size[1]}), "
+                           f"found {m.size[0]} x {m.size[1]}", path)
+    grey = m.rgb.mean(axis=2)
+    white = (grey >= 128) if m.alpha is None else (m.alpha >= 128) & (grey >= 128)
+    if work != size:
+        img = Image.fromarray(white.astype(np.uint8) * 255).resize(work, Image.Resampling.BILINEAR)
+        white = np.asarray(img) >= 128
+    return white
+
+
+def _one_fish(raw: np.ndarray, photo: Photo, source: str) -> np.ndarray:
+    h, w = raw.shape
+    clean = ndimage.binary_opening(raw, structure=np.ones((3, 3), bool)) if source != "alpha" else raw
+    # Close small gaps so a fin ray or a thin tail lobe stays joined to its fish.
+    joined = ndimage.binary_closing(clean, structure=np.ones((5, 5), bool), border_value=0) | clean
+    labels, count = ndimage.label(joined, structure=np.ones((3, 3), bool))
+    if count == 0:
+        raise FishgenError(f"expected a fish in the photo, found none ({_hint(source)})", photo.path)
+    sizes = np.bincount(labels.ravel())[1:]
+    order = np.argsort(sizes)[::-1]
+    if sizes[order[0]] < MIN_FISH_FRACTION * h * w:
+        raise FishgenError(f"expected a fish in the photo, found no object larger than "
+                           f"{MIN_FISH_FRACTION:.1%} of the frame ({_hint(source)})", photo.path)
+    if count > 1 and sizes[order[1]] >= SECOND_OBJECT * sizes[order[0]]:
+        many = int((sizes >= SECOND_OBJECT * sizes[order[0]]).sum())
+        raise FishgenError(f"expected one fish, found {many} objects of similar size; crop the photo to "
+                           "one fish or give --mask", photo.path)
+    # The closing decides what belongs together and which holes are holes (a pale eye ring on
+    # the outline leaves a gap a few pixels wide); the outline itself is the unclosed one.
+    closed = labels == order[0] + 1
+    holes = ndimage.binary_fill_holes(closed) & ~closed
+    fish = ndimage.binary_fill_holes((clean & closed) | holes)
+    edges = {"top": fish[0].sum(), "bottom": fish[-1].sum(), "left": fish[:, 0].sum(),
+             "right": fish[:, -1].sum()}
+    cut = [name for name, n in edges.items() if n >= 2]
+    if cut:
+        raise FishgenError(f"expected the whole fish inside the frame, found it cut off at the "
+                           f"{' and '.join(cut)} edge{'s' if len(cut) > 1 else ''}", photo.path)
+    return fish
+
+
+def _hint(source: str) -> str:
+    return {"alpha": "the alpha channel is empty",
+            "background model": "nothing stands out from the background; try --mask",
+            "mask file": "the mask is black"}[source]

@@ -1,0 +1,30 @@
+"""Round-trip fixtures: one rendered photo per shipped species, made once per session."""
+from __future__ import annotations
+
+import pytest
+
+SHIPPED = ("bonybream", "centroberyx", "pineapplefish", "threadfingoldie")
+
+
+@pytest.fixture(scope="session")
+def photos():
+    """species name -> (species, Photo)."""
+    from fishgen.species.parser import load_species
+    from tests.authoring.photos import render_photo
+    from tests.conftest import PARAMS
+
+    out = {}
+    for name in SHIPPED:
+        sp = load_species(PARAMS / f"{name}.txt")
+        out[name] = (sp, render_photo(sp))
+    return out
+
+
+@pytest.fixture(scope="session")
+def gl_available():
+    try:
+        import moderngl
+
+        moderngl.create_context(standalone=True, backend="egl").release()
+    except Exception as err:  # noqa: BLE001 - any failure means no context
+        pytest.fail(f"no headless OpenGL: install libegl1 libegl-mesa0 libgl1-mesa-dri ({err})")

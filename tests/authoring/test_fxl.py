@@ -1,0 +1,70 @@
+"""Fixel's .FXL files: the thesis' sample reads, fishgen's own files round-trip, faults name a line."""
+from __future__ import annotations
+
+import pytest
+
+from fishgen.authoring.photo.fxl import format_fxl, parse_fxl
+from fishgen.errors import FishgenError
+from fishgen.species.parser import load_species
+from tests.conftest import PARAMS
+
+# Appendix B.10 as printed (the first line runs header, count and points together).
+APPENDIX_B = """//dorsal 14 0.228515625 0.00390625 0.13671875 0.31640625
+0.396484375 0.328125
+0.439453125 0.1796875
+0.181640625 0.29296875
+0.22265625 0.2890625
+0.263671875 0.29296875
+0.3125 0.30078125
+0.353515625 0.30859375
+0.2265625 0.01953125
+0.23046875 0.02734375
+0.234375 0.0390625
+0.244140625 0.046875
+0.25 0.05859375
+//anal
+8
+0.40625 0.875
+0.37890625 0.71875
+0.5390625 0.65625
+0.59765625 0.76171875
+0.431640625 0.69921875
+0.486328125 0.6796875
+0.41015625 0.84765625
+0.41796875 0.83203125
+"""
+
+
+def test_appendix_b_sample_reads():
+    parts = parse_fxl(APPENDIX_B)
+    assert sorted(parts) == ["anal", "dorsal"]
+    assert len(parts["dorsal"]) == 14 and len(parts["anal"]) == 8
+    assert parts["dorsal"][0] == (0.228515625, 0.00390625)
+    assert parts["anal"][-1] == (0.41796875, 0.83203125)
+
+
+def test_round_trip_of_bonybream_points():
+    sp = load_species(PARAMS / "bonybream.txt")
+    assert sp.texture_points is not None
+    text = format_fxl(sp.texture_points, sp.circle_sections)
+    assert text.splitlines()[:3] == ["//body", "192", "0 0 0.015625 0.3046875"]
+    parts = parse_fxl(text)
+    for name, pts in parts.items():
+        assert tuple(pts) == getattr(sp.texture_points, name)
+
+
+@pytest.mark.parametrize("text, line, words", [
+    ("//dorsal\n2\n0.1 0.2\n", 3, "expected 2 points"),
+    ("//dorsal\nmany\n", 2, "expected a point count"),
+    ("//dorsal\n1\n0.1 1.5\n", 3, "from 0 to 1"),
+    ("//dorsal\n1\n0.1 nan\n", 3, "from 0 to 1"),
+    ("//dorsal\n1\n0.1 x\n", 3, "expected a number"),
+    ("//dorsal\n1\n0.1 0.2\n//dorsal\n1\n0.1 0.2\n", 4, "each part once"),
+    ("//fins\n1\n0.1 0.2\n", 2, "//part line first"),
+    ("//body\n1\n0 0 0.1 0.2\n//fins\n", 4, "part name"),
+    ("// just a comment\n", 1, "found none"),
+])
+def test_faults_name_their_line(text, line, words):
+    with pytest.raises(FishgenError) as err:
+        parse_fxl(text, "p.FXL")
+    assert err.value.line == line and words in err.value.message

@@ -1,0 +1,98 @@
+"""Round trip: render a shipped species side-on as a photo, make a species from it, rebuild.
+
+Checks (issue 12): the rebuilt fish's silhouette overlaps the photo's with IoU >= 0.95;
+body texture points lie within 2 % of the texture size of the true ones; every fin's
+points within 5 %. Measures with tolerances, never pixel diffs.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fishgen.authoring.photo.compare import silhouette_iou
+from fishgen.authoring.photo.run import make_texture
+from fishgen.species.parser import load_species
+from tests.authoring import photos as ph
+from tests.authoring.conftest import SHIPPED
+
+BODY_TOLERANCE = 0.02
+FIN_TOLERANCE = 0.05
+MIN_IOU = 0.95
+
+KINDS = {
+    "transparent": lambda p: p,
+    "plain": lambda p: ph.on_background(p, (190, 205, 220), (190, 205, 220)),
+    "gradient+noise": lambda p: ph.on_background(p, noise=6.0),
+    "jpeg": lambda p: ph.jpeg(ph.on_background(p, (200, 200, 200), (170, 180, 190)), 60),
+    "mirrored": ph.mirrored,
+    "rotated+10": lambda p: ph.rotated(p, 10.0),
+    "rotated-10": lambda p: ph.rotated(p, -10.0),
+}
+
+
+def run_round_trip(tmp_path, species, photo: ph.Photo, fmt: str = "PNG"):
+    path = tmp_path / ("photo.png" if fmt == "PNG" else "photo.jpg")
+    photo.save(path, fmt, **({"quality": 95} if fmt == "JPEG" else {}))
+    result = make_texture(path, species, tmp_path / "new.txt")
+    rebuilt = load_species(tmp_path / "new.txt")
+    body, fins = ph.errors(rebuilt, photo)
+    return result, rebuilt, body, fins
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+@pytest.mark.parametrize("name", SHIPPED)
+def test_round_trip_points(tmp_path, gl_available, photos, name, kind):
+    species, clean = photos[name]
+    photo = KINDS[kind](clean)
+    result, rebuilt, body, fins = run_round_trip(tmp_path, species, photo)
+    assert result.mirrored == (kind == "mirrored")
+    assert body.max() <= BODY_TOLERANCE, f"{name}/{kind}: body point off by {body.max():.4f}"
+    worst = max(fins, key=lambda n: fins[n])
+    assert fins[worst] <= FIN_TOLERANCE, f"{name}/{kind}: {worst} fin off by {fins[worst]:.4f}"
+    assert not result.unseen
+
+
+@pytest.mark.parametrize("kind", ["transparent", "jpeg", "rotated+10"])
+@pytest.mark.parametrize("name", SHIPPED)
+def test_round_trip_silhouette(tmp_path, gl_available, photos, name, kind):
+    """The rebuilt fish, rendered as the photo was, against the photo's fish turned level."""
+    species, photo = photos[name]
+    result, rebuilt, _, _ = run_round_trip(tmp_path, species, KINDS[kind](photo))
+    iou = silhouette_iou(result.level_mask, ph.rendered_mask(rebuilt))
+    assert iou >= MIN_IOU, f"{name}/{kind}: IoU {iou:.3f}"
+
+
+def test_texture_is_the_photo_upside_down(tmp_path, gl_available, photos):
+    from PIL import Image
+
+    species, photo = photos["centroberyx"]
+    run_round_trip(tmp_path, species, photo)
+    stored = np.asarray(Image.open(tmp_path / "new.png").convert("RGB")).astype(int)
+    mask = np.asarray(Image.open(tmp_path / "new_mask.png").convert("L"))[::-1] >= 128
+    fish = photo.rgba[:, :, 3] >= 64
+    upright = stored[::-1]
+    # Inside the fish the texture holds the photo's colours; the mask is its silhouette.
+    assert np.abs(upright[fish] - photo.rgba[:, :, :3][fish].astype(int)).mean() < 1.0
+    assert (mask == fish).mean() > 0.999
+
+
+def test_large_photo_is_measured_on_a_smaller_copy(tmp_path, gl_available):
+    """A photo over 2048 px a side (here with a hand-made --mask of its own size) is measured on
+    a scaled-down copy; the points are fractions, so they are as good, and the texture keeps the
+    photo's resolution."""
+    from PIL import Image
+
+    from fishgen.authoring.photo.run import TextureOptions
+
+    species = load_species(ph.PARAMS_DIR / "pineapplefish.txt")
+    photo = ph.on_background(ph.render_photo(species, (2600, 1300)), (180, 190, 200), (180, 190, 200))
+    photo.save(tmp_path / "big.png")
+    hand_made = ((ph.render_photo(species, (2600, 1300)).rgba[:, :, 3] >= 128) * 255).astype("uint8")
+    Image.fromarray(hand_made).save(tmp_path / "mask.png")
+    make_texture(tmp_path / "big.png", species, tmp_path / "new.txt",
+                 TextureOptions(mask=tmp_path / "mask.png"))
+    rebuilt = load_species(tmp_path / "new.txt")
+    body, fins = ph.errors(rebuilt, photo)
+    assert body.max() <= BODY_TOLERANCE and max(fins.values()) <= FIN_TOLERANCE
+    assert Image.open(tmp_path / "new.png").size == (2600, 1300)
+    assert Image.open(tmp_path / "new_mask.png").size == (2600, 1300)

@@ -1,0 +1,92 @@
+"""Photos of fishgen fish from a second renderer: three.js (GLTFLoader + WebGLRenderer) in headless
+Chromium, side-on with an orthographic camera whose frustum is set here, so where each ring and
+fin vertex lands on the picture is known exactly (the truth for the round trip)."""
+from __future__ import annotations
+
+import base64
+import io
+import threading
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+from fishgen.assembly.fish import METRES_PER_WORLD_UNIT, THESIS_TO_GLTF, build_fish
+from fishgen.species.model import Species
+from tests.authoring.photos import SIZE, Photo, truth_points
+from tests.clients.matrix import CHROMIUM, CHROMIUM_ARGS, THREE_DIR, _Handler
+
+HERE = Path(__file__).resolve().parent
+FILL = 0.85
+
+
+def unavailable() -> str | None:
+    if CHROMIUM is None:
+        return "chromium is not installed (Debian: apt-get install chromium)"
+    if not (THREE_DIR / "build" / "three.module.js").is_file():
+        return "three.js is not installed: run `npm ci`"
+    try:
+        import playwright  # noqa: F401
+    except ImportError:
+        return "playwright not installed"
+    return None
+
+
+class ThreePhotographer:
+    """One local server (three.js, this page, the assets) and one Chromium page for all photos."""
+
+    def __init__(self, assets: Path):
+        from playwright.sync_api import sync_playwright
+
+        handler = type("Handler", (_Handler,), {"mounts": {"/three/": THREE_DIR.resolve(), "/page/": HERE,
+                                                          "/assets/": assets.resolve()}, "log": []})
+        handler.extensions_map = {**SimpleHTTPRequestHandler.extensions_map, ".js": "text/javascript"}
+        self.server = ThreadingHTTPServer(("127.0.0.1", 0), handler)
+        self.base = f"http://127.0.0.1:{self.server.server_address[1]}"
+        threading.Thread(target=self.server.serve_forever, daemon=True).start()
+        self._pw = sync_playwright().start()
+        self.browser = self._pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        self.page = self.browser.new_page()
+        self.page.goto(f"{self.base}/page/threejs_photo.html")
+        self.page.wait_for_function("window.pageReady === true", timeout=30_000)
+        self.assets = assets
+
+    def photo(self, species: Species, size=SIZE) -> Photo:
+        import fishgen
+
+        w, h = size
+        scene = build_fish(species)
+        glb = self.assets / f"{species.name}.glb"
+        fishgen.export(scene, glb)
+        metres = species.world_scale * METRES_PER_WORLD_UNIT
+        centre = np.array([0.5 * species.scale[0], 0.0, 0.0])
+
+        def world(p3: np.ndarray) -> np.ndarray:
+            return (np.asarray(p3, float) - centre) @ THESIS_TO_GLTF.T * metres
+
+        body, fins = truth_points(species, world)
+        pts = np.concatenate([body, *fins.values()])
+        cy, cz = (pts[:, 1].min() + pts[:, 1].max()) / 2, (pts[:, 2].min() + pts[:, 2].max()) / 2
+        half_h = max(np.ptp(pts[:, 1]) / 2, np.ptp(pts[:, 2]) / 2 * h / w) / FILL
+        half_w = half_h * w / h
+        cam = {"width": w, "height": h, "halfWidth": half_w, "halfHeight": half_h, "centreY": cy,
+               "centreZ": cz, "distance": 10.0 * float(np.abs(pts).max() + 1)}
+        url = f"{self.base}/assets/{glb.name}"
+        result = self.page.evaluate("([u, c]) => window.photograph(u, c)", [url, cam])
+        if "error" in result:
+            raise RuntimeError(result["error"])
+        png = base64.b64decode(result["png"].split(",", 1)[1])
+        rgba = np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"))
+
+        def screen(g: np.ndarray) -> np.ndarray:   # camera on +X looking -X: screen right is -Z
+            return np.stack([(-(g[:, 2] - cz) + half_w) / (2 * half_w) * w,
+                             (half_h - (g[:, 1] - cy)) / (2 * half_h) * h], 1)
+
+        return Photo(np.ascontiguousarray(rgba), screen(body), {n: screen(p) for n, p in fins.items()})
+
+    def close(self) -> None:
+        self.browser.close()
+        self._pw.stop()
+        self.server.shutdown()
+        self.server.server_close()

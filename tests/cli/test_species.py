@@ -1,0 +1,38 @@
+"""`fishgen species --random`: one species or a folder of them, deterministic, buildable."""
+from __future__ import annotations
+
+from tests.conftest import assert_valid_gltf
+
+
+def test_one_random_species_builds_clean(tmp_path, cli):
+    r = cli("species", "--random", "--seed", "7", "-o", tmp_path / "fish7.txt")
+    assert r.returncode == 0, r.stderr
+    for name in ("fish7.txt", "fish7.png", "fish7_mask.png"):
+        assert (tmp_path / name).is_file()
+    b = cli("build", tmp_path / "fish7.txt", "-o", tmp_path / "fish7.glb")
+    assert b.returncode == 0, b.stderr
+    assert_valid_gltf(tmp_path / "fish7.glb")
+
+
+def test_same_seed_same_files(tmp_path, cli):
+    for folder in ("a", "b"):
+        assert cli("species", "--random", "--seed", "3", "-o", tmp_path / folder / "f.txt").returncode == 0
+    for name in ("f.txt", "f.png", "f_mask.png"):
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+
+
+def test_count_writes_a_folder(tmp_path, cli):
+    r = cli("species", "--random", "--seed", "10", "--count", "3", "-o", tmp_path / "reef")
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in (tmp_path / "reef").glob("*.txt")) == \
+        ["species_10.txt", "species_11.txt", "species_12.txt"]
+
+
+def test_mistakes_are_one_line(tmp_path, cli):
+    r = cli("species", "--seed", "1", "-o", tmp_path / "x.txt")
+    assert r.returncode == 2 and "--random" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    r = cli("species", "--random", "-o", tmp_path / "x.glb")
+    assert r.returncode == 2 and "species file (.txt)" in r.stderr
+    (tmp_path / "file").write_text("")
+    r = cli("species", "--random", "--count", "2", "-o", tmp_path / "file")
+    assert r.returncode == 2 and "expected a folder" in r.stderr

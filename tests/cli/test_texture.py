@@ -1,0 +1,156 @@
+"""`fishgen texture` from the command line: one command from photo to a buildable species, notes
+for unseen fins, and one-line errors (exit 2, no traceback, nothing written) for bad photos."""
+from __future__ import annotations
+
+import struct
+import zlib
+
+import numpy as np
+import pytest
+from PIL import Image, ImageDraw, ImageFilter
+
+from tests.conftest import PARAMS, assert_valid_gltf
+
+SMALL = (640, 320)
+
+
+@pytest.fixture(scope="module")
+def bream_photo(tmp_path_factory):
+    from fishgen.species.parser import load_species
+    from tests.authoring.photos import render_photo
+
+    try:
+        import moderngl
+
+        moderngl.create_context(standalone=True, backend="egl").release()
+    except Exception as err:  # noqa: BLE001 - any failure means no context
+        pytest.fail(f"no headless OpenGL: install libegl1 libegl-mesa0 libgl1-mesa-dri ({err})")
+    folder = tmp_path_factory.mktemp("photos")
+    photo = render_photo(load_species(PARAMS / "bonybream.txt"), SMALL)
+    photo.save(folder / "bream.png")
+    return folder / "bream.png", photo
+
+
+def test_photo_to_fish_in_one_command(tmp_path, cli, bream_photo):
+    path, _ = bream_photo
+    out = tmp_path / "out" / "mybream.txt"
+    r = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", out, "--compare", tmp_path / "cmp.png",
+            "--fxl-out", tmp_path / "pts.FXL")
+    assert r.returncode == 0, r.stderr
+    assert "silhouette from the alpha" in r.stderr and "IoU" in r.stderr
+    for name in ("mybream.txt", "mybream.png", "mybream_mask.png"):
+        assert (out.parent / name).is_file()
+    assert (tmp_path / "cmp.png").is_file() and (tmp_path / "pts.FXL").is_file()
+    glb = tmp_path / "mybream.glb"
+    b = cli("build", out, "-o", glb)
+    assert b.returncode == 0, b.stderr
+    assert_valid_gltf(glb)
+    # Fixel's points carry over: reading the .FXL back gives the same species file.
+    again = tmp_path / "again" / "mybream.txt"
+    r2 = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", again, "--fxl-in", tmp_path / "pts.FXL")
+    assert r2.returncode == 0, r2.stderr
+    assert again.read_text() == out.read_text()
+
+
+def test_mirrored_jpeg_and_level_of_detail_options(tmp_path, cli, bream_photo):
+    _, photo = bream_photo
+    rgba = photo.rgba[:, ::-1]
+    a = rgba[:, :, 3:4] / 255.0
+    rgb = (rgba[:, :, :3] * a + np.array([180, 200, 215]) * (1 - a)).astype(np.uint8)
+    Image.fromarray(rgb).save(tmp_path / "p.jpg", quality=80)
+    r = cli("texture", tmp_path / "p.jpg", "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "n.txt",
+            "--body-sections", "24", "--circle-sections", "16", "--spacing", "even")
+    assert r.returncode == 0, r.stderr
+    assert "background model" in r.stderr and "head on the right" in r.stderr
+    lines = (tmp_path / "n.txt").read_text().splitlines()
+    assert str(24 * 16) in lines
+
+
+def test_unseen_fin_falls_back_to_skin_and_says_so(tmp_path, cli, bream_photo):
+    from fishgen.authoring.photo.sideview import side_view
+    from fishgen.species.parser import load_species
+
+    _, photo = bream_photo
+    rgba = photo.rgba.copy()
+    dorsal = photo.fins["dorsal"]
+    img = Image.new("L", SMALL, 0)
+    draw = ImageDraw.Draw(img)
+    for tri in side_view(load_species(PARAMS / "bonybream.txt")).fin_faces["dorsal"]:
+        draw.polygon([(float(x), float(y)) for x, y in dorsal[tri]], fill=255)
+    grown = np.asarray(img.filter(ImageFilter.MaxFilter(5))) > 0
+    top = dorsal[:, 1].max() - 3           # clear the fin down to just above its base line
+    rgba[grown & (np.arange(SMALL[1])[:, None] < top), 3] = 0
+    Image.fromarray(rgba).save(tmp_path / "nodorsal.png")
+    r = cli("texture", tmp_path / "nodorsal.png", "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "n.txt")
+    assert r.returncode == 0, r.stderr
+    assert "no dorsal fin found in the photo" in r.stderr
+
+
+def _png_header_only(path, width, height):
+    """A PNG whose header claims ``width`` x ``height``: refused before a pixel is decoded."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    header = chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0))
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + header
+                     + chunk(b"IDAT", zlib.compress(b"\0" * 64)) + chunk(b"IEND", b""))
+
+
+def _photos(tmp_path, bream_photo):
+    _, photo = bream_photo
+    blank = np.zeros((SMALL[1], SMALL[0], 4), np.uint8)
+    Image.fromarray(blank).save(tmp_path / "blank.png")
+    two = np.zeros((SMALL[1], SMALL[0] * 2 + 20, 4), np.uint8)
+    two[:, :SMALL[0]] = photo.rgba
+    two[:, SMALL[0] + 20:] = photo.rgba
+    Image.fromarray(two).save(tmp_path / "two.png")
+    cols = np.flatnonzero(photo.rgba[:, :, 3].any(axis=0))
+    Image.fromarray(np.ascontiguousarray(photo.rgba[:, cols[0] + 30:])).save(tmp_path / "cut.png")
+    _png_header_only(tmp_path / "huge.png", 30000, 30000)   # PIL itself refuses this header
+    _png_header_only(tmp_path / "big.png", 9000, 9000)      # PIL would decode it; fishgen does not
+    (tmp_path / "notes.png").write_text("not a picture\n")
+    Image.fromarray(photo.rgba[:40, :40]).save(tmp_path / "tiny.png")
+    return {"blank.png": "expected a fish in the photo, found none",
+            "two.png": "expected one fish, found 2 objects",
+            "cut.png": "cut off at the left edge",
+            "huge.png": "at most 64 megapixels, found 900 megapixels",
+            "big.png": "at most 64 megapixels, found 9000 x 9000",
+            "notes.png": "expected a photo",
+            "tiny.png": "at least 64 pixels a side",
+            "missing.png": "found nothing there"}
+
+
+def test_bad_photos_get_one_line_errors_and_nothing_is_written(tmp_path, cli, bream_photo):
+    for name, words in _photos(tmp_path, bream_photo).items():
+        out = tmp_path / "o" / "x.txt"
+        r = cli("texture", tmp_path / name, "-s", PARAMS / "bonybream.txt", "-o", out)
+        assert r.returncode == 2, (name, r.stderr)
+        assert "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1, (name, r.stderr)
+        assert words in r.stderr, (name, r.stderr)
+        assert str(tmp_path / name) in r.stderr, (name, r.stderr)
+        assert not out.parent.exists() or not any(out.parent.iterdir()), name
+
+
+def test_failure_after_measuring_leaves_no_file(tmp_path, cli, bream_photo):
+    path, _ = bream_photo
+    (tmp_path / "cmp.png").mkdir()            # the comparison cannot be written
+    r = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "n.txt", "--compare",
+            tmp_path / "cmp.png")
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert not (tmp_path / "n.txt").exists() and not (tmp_path / "n.png").exists()
+
+
+def test_bad_mask_and_fxl(tmp_path, cli, bream_photo):
+    path, _ = bream_photo
+    Image.new("L", (10, 10)).resize((100, 100)).save(tmp_path / "m.png")
+    r = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "n.txt", "--mask",
+            tmp_path / "m.png")
+    assert r.returncode == 2 and "mask the size of the photo" in r.stderr
+    (tmp_path / "p.FXL").write_text("//dorsal\n2\n0.1 0.2\n0.3 0.4\n")
+    r = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "n.txt", "--fxl-in",
+            tmp_path / "p.FXL")
+    assert r.returncode == 2 and "expected 8 //dorsal points" in r.stderr and "p.FXL" in r.stderr
+
+
+def test_help_is_fast_and_lists_both_commands(cli):
+    r = cli("--help")
+    assert r.returncode == 0 and "texture" in r.stdout and "species" in r.stdout

@@ -1,0 +1,28 @@
+"""`fishgen preview --ortho`: no perspective, so depth does not move a point on the picture."""
+from __future__ import annotations
+
+import numpy as np
+
+from fishgen.preview.camera import frame
+from tests.conftest import PARAMS
+
+
+def test_orthographic_projection_ignores_depth():
+    pts = np.array([[-1.0, -0.5, -2.0], [1.0, 0.5, 2.0]])
+    cam = frame(pts, "side", 2.0, ortho=True)
+    vp = cam.projection() @ cam.view()
+    near = vp @ np.array([0.5, 0.2, 0.3, 1.0])
+    far = vp @ np.array([-0.5, 0.2, 0.3, 1.0])   # same point seen from +X, one unit deeper
+    assert np.allclose(near[:2] / near[3], far[:2] / far[3])
+    assert abs(near[2] / near[3]) < 1 and abs(far[2] / far[3]) < 1   # both inside the depth range
+
+
+def test_ortho_option_renders_a_transparent_side_photo(tmp_path, cli, gl_available):
+    from PIL import Image
+
+    out = tmp_path / "side.png"
+    r = cli("preview", PARAMS / "bonybream.txt", "--view", "side", "--ortho", "--background", "transparent",
+            "--size", "320x160", "-o", out)
+    assert r.returncode == 0, r.stderr
+    alpha = np.asarray(Image.open(out))[:, :, 3]
+    assert alpha[0, 0] == 0 and (alpha > 0).mean() > 0.1
