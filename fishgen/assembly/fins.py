@@ -50,8 +50,11 @@ def pelvic_params(fin: PelvicFin) -> PelvicParams:
                         movement_angle=fin.movement_angle, step_size=fin.step_size)
 
 
-def build_fins(species: Species, rings: np.ndarray) -> list[Fin]:
-    """All fins in scaled thesis space; right-hand paired fins mirror the left ones."""
+def build_fins(species: Species, rings: np.ndarray, clear_of_caudal: bool = True) -> list[Fin]:
+    """All fins in scaled thesis space; right-hand paired fins mirror the left ones.
+
+    ``clear_of_caudal``: end vertical fins in front of the caudal fin (what a built fish gets);
+    False gives every section the species file names, one vertex per texture point (authoring)."""
     s = np.asarray(species.scale, dtype=np.float64)
     tp = species.texture_points
 
@@ -64,14 +67,16 @@ def build_fins(species: Species, rings: np.ndarray) -> list[Fin]:
     # The caudal fin and the vertical fins lie in one plane: where they overlap, renderers flicker
     # and path tracers show black. A vertical fin ends on the last section that keeps it in front
     # of the caudal fin (docs/decisions.md); the species file's own numbers are left as they are.
-    tail_front = float(caudal.mesh.positions[:, 0].min()) if len(caudal.mesh.faces) else np.inf
+    tail_front = np.inf
+    if clear_of_caudal and len(caudal.mesh.faces):
+        tail_front = float(caudal.mesh.positions[:, 0].min())
     for name, fin, side in (("dorsal", species.dorsal, 1.0), ("adipose", species.adipose, 1.0),
                             ("anal", species.anal, -1.0)):
         if fin.present:
             params = vertical_params(fin)
             built = vertical_fin(f"{name}_fin", params, rings, s, side, uv(name))
             while (built.mesh.positions[:, 0].max() > tail_front + 1e-9
-                   and params.end_section > params.start_section):
+                   and params.end_section > params.start_section + 1):  # a fin needs two sections
                 params = replace(params, end_section=params.end_section - 1)
                 built = vertical_fin(f"{name}_fin", params, rings, s, side, _first(uv(name), params))
             if built.mesh.positions[:, 0].max() <= tail_front + 1e-9:

@@ -37,7 +37,9 @@ def project_texture_points(species: Species, aspect: float = 2.0) -> Species:
 
     rings, _ = ring_positions(profile_for(species.shape_class, species.shape_params),
                               species.body_sections, species.circle_sections, species.scale)
-    fins = {f.name: f for f in build_fins(replace(species, texture_points=None), rings)}
+    # every section the file names: one texture point per vertex of these fins
+    whole = build_fins(replace(species, texture_points=None), rings, clear_of_caudal=False)
+    fins = {f.name: f for f in whole}
     side = [rings.reshape(-1, 3)[:, :2]] + [f.mesh.positions[:, :2] for n, f in fins.items()
                                             if n in ("caudal_fin", "dorsal_fin", "adipose_fin", "anal_fin")]
     keep = np.concatenate(side)

@@ -56,7 +56,9 @@ def side_view(species: Species) -> SideView:
 
     rings, _ = ring_positions(profile_for(species.shape_class, species.shape_params),
                               species.body_sections, species.circle_sections, species.scale)
-    built = {f.name: f for f in build_fins(replace(species, texture_points=None), rings)}
+    # every section the file names: its texture points are one per vertex of these fins
+    whole = build_fins(replace(species, texture_points=None), rings, clear_of_caudal=False)
+    built = {f.name: f for f in whole}
     fins, faces = {}, {}
     for name, part in FIN_PARTS.items():
         if part in built:
