@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import time
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -72,6 +73,10 @@ def job_key(job: Job, inputs: Mapping[str, str], base: Path) -> str:
     return hashlib.sha256(json.dumps(doc, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
 
 
+SAVE_INTERVAL = 0.25
+"""Seconds between rewrites of the record during a run (each job's entry is kept in memory)."""
+
+
 class Record:
     """The record file of one out folder."""
 
@@ -80,6 +85,7 @@ class Record:
         self.path = out / RECORD_NAME
         self.jobs: dict[str, dict[str, Any]] = {}
         self.damaged = False  # unreadable: every job rebuilds, and the next save repairs it
+        self._saved = time.monotonic()
         try:
             data = json.loads(self.path.read_bytes())
         except FileNotFoundError:
@@ -133,17 +139,26 @@ class Record:
                 "outputs": {relative(p, self.out): h for p, h in sorted(outputs.items())}}
 
     def put(self, name: str, entry: dict[str, Any]) -> None:
-        """Set a job's entry and write the record atomically. A failed job keeps its old entry:
-        its old output is still there, whole, and its changed inputs make it run again."""
+        """Set a job's entry; the record is rewritten atomically at most every SAVE_INTERVAL
+        seconds (and once at the end, however the run ends). A batch killed before a rewrite
+        loses only that moment's entries: those jobs run again, their outputs whole either way.
+        A failed job keeps its old entry: its old output is still there, whole, and its changed
+        inputs make it run again."""
         self.jobs[name] = entry
-        self.save(durable=False)
+        if time.monotonic() - self._saved >= SAVE_INTERVAL:
+            self.save(durable=False)
 
     def save(self, durable: bool = True) -> None:
         """Replace the record file atomically. ``durable=False`` skips the fsync: the rename alone
         is atomic against a killed process, and after a power cut an older or unreadable record
         only means more jobs run (an fsync per job cost 1 s over 100 builds here)."""
-        doc = {"format": FORMAT, "version": FORMAT_VERSION, "jobs": dict(sorted(self.jobs.items()))}
-        data = (json.dumps(doc, indent=1, sort_keys=True) + "\n").encode("utf-8")
+        # One line per job: readable, diffable, and written by json's C encoder (an indented dump
+        # goes through the pure-Python one: rewriting it after each of 100 jobs took 1.2 s of CPU
+        # away from the workers on a 2-core machine).
+        jobs = ",\n".join(f" {json.dumps(name)}:{json.dumps(entry, sort_keys=True, separators=(',', ':'))}"
+                           for name, entry in sorted(self.jobs.items()))
+        data = (f'{{"format":{json.dumps(FORMAT)},"version":{json.dumps(FORMAT_VERSION)},"jobs":{{\n'
+                f"{jobs}\n}}}}\n").encode()
         if durable:
             write_bytes(self.path, data)
         else:
@@ -155,3 +170,4 @@ class Record:
                 temporary.unlink(missing_ok=True)
                 raise
         self.damaged = False
+        self._saved = time.monotonic()
