@@ -52,3 +52,14 @@ def run_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
 @pytest.fixture
 def cli():
     return run_cli
+
+
+@pytest.fixture(scope="session")
+def gl_available():
+    """An OpenGL context from EGL (Mesa llvmpipe on CI), for the tests that render."""
+    try:
+        import moderngl
+
+        moderngl.create_context(standalone=True, backend="egl").release()
+    except Exception as err:  # noqa: BLE001 - any failure means no context
+        pytest.fail(f"no headless OpenGL: install libegl1 libegl-mesa0 libgl1-mesa-dri ({err})")

@@ -18,13 +18,3 @@ def photos():
         sp = load_species(PARAMS / f"{name}.txt")
         out[name] = (sp, render_photo(sp))
     return out
-
-
-@pytest.fixture(scope="session")
-def gl_available():
-    try:
-        import moderngl
-
-        moderngl.create_context(standalone=True, backend="egl").release()
-    except Exception as err:  # noqa: BLE001 - any failure means no context
-        pytest.fail(f"no headless OpenGL: install libegl1 libegl-mesa0 libgl1-mesa-dri ({err})")

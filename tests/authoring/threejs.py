@@ -15,22 +15,13 @@ from PIL import Image
 from fishgen.assembly.fish import METRES_PER_WORLD_UNIT, THESIS_TO_GLTF, build_fish
 from fishgen.species.model import Species
 from tests.authoring.photos import SIZE, Photo, truth_points
-from tests.clients.matrix import CHROMIUM, CHROMIUM_ARGS, THREE_DIR, _Handler
+from tests.clients.matrix import CHROMIUM, CHROMIUM_ARGS, THREE_DIR, _Handler, three_unavailable
 
 HERE = Path(__file__).resolve().parent
 FILL = 0.85
 
 
-def unavailable() -> str | None:
-    if CHROMIUM is None:
-        return "chromium is not installed (Debian: apt-get install chromium)"
-    if not (THREE_DIR / "build" / "three.module.js").is_file():
-        return "three.js is not installed: run `npm ci`"
-    try:
-        import playwright  # noqa: F401
-    except ImportError:
-        return "playwright not installed"
-    return None
+unavailable = three_unavailable  # the client matrix's own check
 
 
 class ThreePhotographer:

@@ -1,17 +1,7 @@
-"""Preview tests need an OpenGL context from EGL (Mesa llvmpipe on CI)."""
+"""Preview fixtures: one asset of each format (the OpenGL check, `gl_available`, is in tests/conftest.py)."""
 from __future__ import annotations
 
 import pytest
-
-
-@pytest.fixture(scope="session")
-def gl_available():
-    try:
-        import moderngl
-
-        moderngl.create_context(standalone=True, backend="egl").release()
-    except Exception as err:  # noqa: BLE001 - any failure means no context
-        pytest.fail(f"no headless OpenGL: install libegl1 libegl-mesa0 libgl1-mesa-dri ({err})")
 
 
 @pytest.fixture(scope="session")
