@@ -12,7 +12,7 @@ import numpy as np
 
 from fishgen.geometry.body_wave import BodyWave, wave_targets, wave_weights
 from fishgen.scene.model import Channel, Sampler, Scene
-from fishgen.scene.pose import pose
+from fishgen.scene.pose import Pose, pose
 
 TARGETS = 4
 LOOP_FREQUENCY_SLACK = 0.05
@@ -30,9 +30,9 @@ def wave_nodes(scene: Scene) -> list[int]:
             and len(scene.meshes[node.mesh].weights) == TARGETS]
 
 
-def body_axis(scene: Scene) -> tuple[float, float]:
-    """(z of the nose, body length) in metres of the fish at rest: the nose is +Z."""
-    posed = pose(scene)
+def body_axis(scene: Scene, posed: Pose | None = None) -> tuple[float, float]:
+    """(z of the nose, body length) in metres of the fish at rest (or ``posed``): the nose is +Z."""
+    posed = posed or pose(scene)
     lo, hi = np.inf, -np.inf
     for i, node in enumerate(scene.nodes):
         if node.mesh is None:
@@ -47,10 +47,10 @@ def body_axis(scene: Scene) -> tuple[float, float]:
 def add_wave_targets(scene: Scene, wave: BodyWave) -> bool:
     """Give every mesh of the fish ``scene`` (at rest, one node per mesh) the four wave targets;
     False (and nothing added) for a fish with no length to bend along."""
-    nose, length = body_axis(scene)
+    posed = pose(scene)
+    nose, length = body_axis(scene, posed)
     if not (np.isfinite(length) and length > 0):
         return False
-    posed = pose(scene)
     for i, node in enumerate(scene.nodes):
         if node.mesh is None:
             continue

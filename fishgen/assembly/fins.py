@@ -78,7 +78,8 @@ def build_fins(species: Species, rings: np.ndarray, clear_of_caudal: bool = True
             while (built.mesh.positions[:, 0].max() > tail_front + 1e-9
                    and params.end_section > params.start_section + 1):  # a fin needs two sections
                 params = replace(params, end_section=params.end_section - 1)
-                built = vertical_fin(f"{name}_fin", params, rings, s, side, _first(uv(name), params))
+                points = _shortened_points(uv(name), params)
+                built = vertical_fin(f"{name}_fin", params, rings, s, side, points)
             if built.mesh.positions[:, 0].max() <= tail_front + 1e-9:
                 fins.append(built)
     for left in (pectoral_fin(pectoral_params(species.pectoral), rings, s, uv("pectoral")),
@@ -88,7 +89,8 @@ def build_fins(species: Species, rings: np.ndarray, clear_of_caudal: bool = True
 
 
 
-def _first(points: tuple[tuple[float, float], ...] | None, params: VerticalParams):
+def _shortened_points(points: tuple[tuple[float, float], ...] | None,
+                      params: VerticalParams) -> tuple[tuple[float, float], ...] | None:
     """The texture points of a vertical fin shortened to ``params``' sections: Fixel's order is
     T_0, B_0, B_n, T_n, B_1..B_{n-1}, T_1..T_{n-1} (n + 1 sections), so the new end takes the
     points of the section it now ends on."""

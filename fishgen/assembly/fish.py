@@ -12,6 +12,14 @@ from __future__ import annotations
 import numpy as np
 
 from fishgen.assembly.animation import MAX_CLIP_FRAMES, FinMotion, axis_rotation_quaternions, clip_frames
+from fishgen.assembly.body_wave import (
+    add_wave_targets,
+    loop_beats,
+    loop_keys,
+    loop_laps,
+    wave_channels,
+    weight_sampler,
+)
 from fishgen.assembly.fin_modes import FIN_MODES
 from fishgen.assembly.fins import build_fins
 from fishgen.assembly.materials import default_fin_mode, load_textures, make_materials
@@ -135,8 +143,6 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
                            "choose movement angles and step sizes with a small common multiple",
                            species.source, species.line_of(slowest.split("_")[0]))
     if swim == "body" and frames:
-        from fishgen.assembly.body_wave import loop_laps
-
         frames *= loop_laps(wave, speed, frames / fps, MAX_CLIP_FRAMES // frames)
     channels = []
     for node, _, motion, axis in motions:
@@ -155,14 +161,6 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
 def _body_wave(scene: Scene, wave: BodyWave, speed: float, clip_seconds: float | None) -> list[Channel]:
     """Wave targets on every part and the weights channels of a seamless loop: a whole number of
     beats in the fins' loop, or one beat when no fin moves."""
-    from fishgen.assembly.body_wave import (
-        add_wave_targets,
-        loop_beats,
-        loop_keys,
-        wave_channels,
-        weight_sampler,
-    )
-
     if not add_wave_targets(scene, wave):
         return []
     seconds = clip_seconds if clip_seconds else 1.0 / float(wave.frequency(speed))

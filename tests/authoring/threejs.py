@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import base64
 import io
-import threading
-from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +13,7 @@ from PIL import Image
 from fishgen.assembly.fish import METRES_PER_WORLD_UNIT, THESIS_TO_GLTF, build_fish
 from fishgen.species.model import Species
 from tests.authoring.photos import SIZE, Photo, truth_points
-from tests.clients.matrix import CHROMIUM, CHROMIUM_ARGS, THREE_DIR, _Handler, three_unavailable
+from tests.clients.matrix import THREE_DIR, LocalBrowser, three_unavailable
 
 HERE = Path(__file__).resolve().parent
 FILL = 0.85
@@ -24,21 +22,11 @@ FILL = 0.85
 unavailable = three_unavailable  # the client matrix's own check
 
 
-class ThreePhotographer:
+class ThreePhotographer(LocalBrowser):
     """One local server (three.js, this page, the assets) and one Chromium page for all photos."""
 
     def __init__(self, assets: Path):
-        from playwright.sync_api import sync_playwright
-
-        handler = type("Handler", (_Handler,), {"mounts": {"/three/": THREE_DIR.resolve(), "/page/": HERE,
-                                                          "/assets/": assets.resolve()}, "log": []})
-        handler.extensions_map = {**SimpleHTTPRequestHandler.extensions_map, ".js": "text/javascript"}
-        self.server = ThreadingHTTPServer(("127.0.0.1", 0), handler)
-        self.base = f"http://127.0.0.1:{self.server.server_address[1]}"
-        threading.Thread(target=self.server.serve_forever, daemon=True).start()
-        self._pw = sync_playwright().start()
-        self.browser = self._pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        self.page = self.browser.new_page()
+        super().__init__({"/three/": THREE_DIR, "/page/": HERE, "/assets/": assets})
         self.page.goto(f"{self.base}/page/threejs_photo.html")
         self.page.wait_for_function("window.pageReady === true", timeout=30_000)
         self.assets = assets
@@ -75,9 +63,3 @@ class ThreePhotographer:
                              (half_h - (g[:, 1] - cy)) / (2 * half_h) * h], 1)
 
         return Photo(np.ascontiguousarray(rgba), screen(body), {n: screen(p) for n, p in fins.items()})
-
-    def close(self) -> None:
-        self.browser.close()
-        self._pw.stop()
-        self.server.shutdown()
-        self.server.server_close()

@@ -417,15 +417,14 @@ class _Handler(SimpleHTTPRequestHandler):
         pass
 
 
-class ThreeClient:
-    """One local HTTP server, one Chromium, one harness page for all the three.js cells."""
+class LocalBrowser:
+    """A local HTTP server for ``mounts`` (URL prefix -> folder) on loopback, and one headless
+    Chromium page; ``close()`` stops both."""
 
-    def __init__(self, asset_dir: Path):
+    def __init__(self, mounts: dict[str, Path]):
         from playwright.sync_api import sync_playwright
 
-        handler = type("Handler", (_Handler,), {"mounts": {"/three/": THREE_DIR.resolve(),
-                                                          "/harness/": HERE,
-                                                          "/assets/": asset_dir.resolve()},
+        handler = type("Handler", (_Handler,), {"mounts": {k: v.resolve() for k, v in mounts.items()},
                                                 "log": []})
         handler.extensions_map = {**SimpleHTTPRequestHandler.extensions_map, ".js": "text/javascript"}
         self.handler = handler
@@ -435,6 +434,21 @@ class ThreeClient:
         self._pw = sync_playwright().start()
         self.browser = self._pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         self.page = self.browser.new_page()
+
+    def close(self) -> None:
+        try:
+            self.browser.close()
+            self._pw.stop()
+        finally:
+            self.server.shutdown()
+            self.server.server_close()
+
+
+class ThreeClient(LocalBrowser):
+    """One local HTTP server, one Chromium, one harness page for all the three.js cells."""
+
+    def __init__(self, asset_dir: Path):
+        super().__init__({"/three/": THREE_DIR, "/harness/": HERE, "/assets/": asset_dir})
         self.console: list[str] = []
         self.requests: list[tuple[str, int | str]] = []
         self.outside: list[str] = []
@@ -466,14 +480,6 @@ class ThreeClient:
                 and not (s == "failed net::ERR_ABORTED" and u in answered)]
         out += [f"outside request {u}" for u in self.outside]
         return out
-
-    def close(self) -> None:
-        try:
-            self.browser.close()
-            self._pw.stop()
-        finally:
-            self.server.shutdown()
-            self.server.server_close()
 
     def check(self, asset: Asset) -> str:
         self.console.clear()
