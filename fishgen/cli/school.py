@@ -62,7 +62,6 @@ def school(inputs, output, count, frames, fps, seed, model, tolerance, tracks, m
       fishgen school params/bonybream.txt --count 200 -o out/school.glb
       fishgen school params/reef.toml -o out/reef.glb --metrics out/reef.json --tracks out/reef.npz
     """
-
     from fishgen.cli.params import check_inputs
     from fishgen.errors import FishgenError
     from fishgen.exchange import export
