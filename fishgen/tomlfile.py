@@ -32,27 +32,41 @@ class Where:
     """Line numbers of keys in the TOML text, for messages (tomllib keeps none)."""
 
     def __init__(self, text: str, file: str):
-        self.lines = text.splitlines()
+        self.text = text
         self.file = file
+        self._index: tuple[dict, dict] | None = None
+
+    def _indexed(self) -> tuple[dict, dict]:
+        """One pass over the text: each table header's line, each key's first line per table
+        (a manifest of many jobs asks once per job, so a scan per question would be quadratic)."""
+        if self._index is None:
+            headers: dict[tuple[str, int], int] = {}
+            keys: dict[tuple[str | None, int, str], int] = {}
+            counts: dict[str, int] = {}
+            section: str | None = None
+            for number, raw in enumerate(self.text.splitlines(), 1):
+                stripped = raw.strip()
+                header = re.match(r"^\[\[?\s*([A-Za-z_.-]+)\s*\]\]?", stripped)
+                if header:
+                    section = header[1]
+                    counts[section] = counts.get(section, -1) + 1
+                    headers.setdefault((section, counts[section]), number)
+                    continue
+                key = re.match(r"^([^=]*?)\s*=", stripped)
+                if key:
+                    nth = 0 if section is None else counts[section]
+                    keys.setdefault((section, nth, key[1]), number)
+            self._index = headers, keys
+        return self._index
 
     def line(self, key: str, table: str | None = None, nth: int = 0) -> int | None:
         """The line of ``key`` at the top level, or in the ``nth`` ``[table]``/``[[table]]``;
         without such a key, the table's header line."""
-        section, count, header_line = None, -1, None
-        for number, raw in enumerate(self.lines, 1):
-            stripped = raw.strip()
-            header = re.match(r"^\[\[?\s*([A-Za-z_.-]+)\s*\]\]?", stripped)
-            if header:
-                section = header[1]
-                if section == table:
-                    count += 1
-                    if count == nth:
-                        header_line = number
-                continue
-            if section == table and (table is None or count == nth) and re.match(
-                    rf"^{re.escape(key)}\s*=", stripped):
-                return number
-        return header_line
+        headers, keys = self._indexed()
+        found = keys.get((table, 0 if table is None else nth, key))
+        if found is not None:
+            return found
+        return None if table is None else headers.get((table, nth))
 
     def fail(self, what: str, found: Any, key: str, table: str | None = None, nth: int = 0) -> FishgenError:
         plain = isinstance(found, str) and found.startswith(("a ", "an ", "no "))

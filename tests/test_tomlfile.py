@@ -1,0 +1,48 @@
+"""fishgen.tomlfile: TOML parse errors and key lines for FILE:LINE messages."""
+import pytest
+
+from fishgen.errors import FishgenError
+from fishgen.tomlfile import Where, loads
+
+TEXT = """\
+out = "../out"
+seed = 3
+
+[[build]]
+input = "a.txt"
+output = "a.glb"
+
+[[build]]
+output = "b.glb"
+input = "b.txt"
+
+[school]
+count = 10
+[school.options]
+count = 5
+"""
+
+
+def test_where_finds_each_key_in_its_own_table_entry():
+    where = Where(TEXT, "m.toml")
+    assert where.line("out") == 1
+    assert where.line("seed") == 2
+    assert where.line("output", "build", 0) == 6
+    assert where.line("output", "build", 1) == 9
+    assert where.line("input", "build", 1) == 10
+    assert where.line("count", "school") == 13
+    assert where.line("count", "school.options") == 15
+
+
+def test_where_falls_back_to_the_table_header_and_knows_no_missing_top_level_key():
+    where = Where(TEXT, "m.toml")
+    assert where.line("missing", "build", 1) == 8
+    assert where.line("missing") is None
+    assert where.line("output", "build", 2) is None
+    assert where.line("count") is None  # a table's key is not a top-level key
+
+
+def test_loads_reports_the_line_of_a_syntax_error():
+    with pytest.raises(FishgenError) as err:
+        loads('a = 1\nb = = 2\n', "bad.toml")
+    assert str(err.value).startswith("bad.toml:2: expected TOML, found ")
