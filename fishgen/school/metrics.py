@@ -52,6 +52,12 @@ def nose_directions(headings: np.ndarray) -> np.ndarray:
     return np.stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)], axis=-1)
 
 
+def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Angle between vectors along the last axis; atan2(|a x b|, a . b) stays exact near 0, where
+    arccos of a dot product a rounding error away from 1 reads 1e-8 radians."""
+    return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.einsum("...c,...c->...", a, b))
+
+
 def measures(tracks: Tracks, body_lengths: float | Sequence[float] | np.ndarray) -> dict[str, np.ndarray]:
     pos = np.asarray(tracks.positions, dtype=np.float64)
     vel = np.asarray(tracks.velocities, dtype=np.float64)
@@ -69,12 +75,10 @@ def measures(tracks: Tracks, body_lengths: float | Sequence[float] | np.ndarray)
             polar[:, g] = np.linalg.norm(unit[:, sel].mean(axis=1), axis=1)
 
     nose = nose_directions(np.asarray(tracks.headings, dtype=np.float64))
-    cosang = np.clip(np.einsum("fnc,fnc->fn", nose, unit), -1.0, 1.0)
-    ang = np.arccos(cosang)
+    ang = _angle(nose, unit)
     turn = np.zeros(frames)
     if frames > 1:
-        step = np.clip(np.einsum("fnc,fnc->fn", nose[1:], nose[:-1]), -1.0, 1.0)
-        turn[1:] = np.arccos(step).max(axis=1) if n else 0.0
+        turn[1:] = _angle(nose[1:], nose[:-1]).max(axis=1) if n else 0.0
 
     nn = np.full(frames, np.nan)
     overlaps = np.zeros(frames, dtype=np.int64)

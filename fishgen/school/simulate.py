@@ -50,10 +50,11 @@ BOUNDS_MARGIN = 3.0        # body lengths inside the walls where they start to s
 PSO_REFERENCE_DT = 0.05    # Figure 2.2's time step; inertia is re-timed from it
 PSO_MIN_TURN = 0.25        # x max_turn: the least turn rate a pso fish has next to the target
 SEPARATION_PASSES = 1
+WANDER_POOL = 4096         # random wander points drawn at a time
 # k-nearest lists are rebuilt every this many frames: (fewer than this many fish, frames)
 NEIGHBOUR_REFRESH = ((300, 1), (5000, 8), (None, 8))
 PARALLEL_QUERY_FISH = 5000
-HEADING_CHUNK = 64         # frames per vectorised heading pass
+HEADING_CHUNK_ELEMENTS = 4096  # fish x frames per vectorised heading pass
 JITTERED = ("random", "center", "keepaway", "speed", "direction", "flee")
 
 
@@ -75,19 +76,20 @@ def simulate(config: SchoolConfig, progress: Progress | None = None) -> Tracks:
         if f > 0:
             sim.step(f, None if target is None else target[f],
                      None if predator is None else predator[f])
-        positions[f] = sim.pos
-        velocities[f] = sim.vel
+        positions[f] = sim.pos.T
+        velocities[f] = sim.vel.T
         if progress is not None:
             progress(f + 1)
-    # headings for all frames at once, in chunks that bound the temporaries' memory; each chunk
-    # starts from the previous one's last frame so signs stay continuous (q and -q are one rotation)
-    for start in range(0, frames, HEADING_CHUNK):
-        first = max(start - 1, 0)
-        q = headings_from_velocities(velocities[first:start + HEADING_CHUNK])
+    # headings for all frames, a few frames at a time: small chunks keep numpy's temporaries in the
+    # CPU cache (at 1,000 fish, 64-frame chunks ran 2.5x slower than 4-frame ones). Each chunk's
+    # sign follows the previous chunk's last frame (q and -q are one rotation, but a sign flip
+    # breaks linear key interpolation).
+    chunk = max(1, HEADING_CHUNK_ELEMENTS // max(n, 1))
+    for start in range(0, frames, chunk):
+        q = headings_from_velocities(velocities[start:start + chunk])
         if start > 0:
             q *= np.where(np.einsum("nk,nk->n", q[0], headings[start - 1]) < 0, -1.0, 1.0)[:, None]
-            q = q[1:]
-        headings[start:start + HEADING_CHUNK] = q
+        headings[start:start + chunk] = q
     return Tracks(times=times, positions=positions, velocities=velocities,
                   headings=headings, group=sim.group.copy(),
                   scale=sim.scale.copy(), target=target, predator=predator)
@@ -100,11 +102,25 @@ def headings_from_velocities(velocities: np.ndarray) -> np.ndarray:
     one rotation, but a sign flip breaks linear key interpolation).
     """
     v = np.asarray(velocities, dtype=np.float64)
-    horiz = np.hypot(v[..., 0], v[..., 2])
-    yaw = np.arctan2(v[..., 0], v[..., 2])
-    pitch = np.arctan2(-v[..., 1], horiz)
-    a, b = np.sin(yaw / 2), np.cos(yaw / 2)
-    c, e = np.sin(pitch / 2), np.cos(pitch / 2)
+    vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
+    horiz = np.sqrt(vx * vx + vz * vz)
+    # half-angle (cos, sin) pairs straight from the vector, no trigonometry: for the yaw,
+    # (cos, sin)(yaw / 2) ~ (horiz + vz, vx), with horiz + vz = vx^2 / (horiz - vz) where vz < 0
+    # so that a fish swimming almost straight back loses no precision; a vertical or zero velocity
+    # has no yaw (atan2(0, 0) = 0) and a fish swimming straight back has yaw pi
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cos_yaw = np.where(vz >= 0, horiz + vz, vx * vx / (horiz - vz))
+    length = np.sqrt(cos_yaw * cos_yaw + vx * vx)
+    turned = length > 0
+    safe = np.where(turned, length, 1.0)
+    b = np.where(turned, cos_yaw / safe, horiz == 0)     # cos(yaw / 2)
+    a = np.where(turned, vx / safe, horiz > 0)           # sin(yaw / 2)
+    # pitch: (cos, sin)(pitch / 2) ~ (|v| + horiz, -vy), never both 0 but for v = 0 (no pitch)
+    cos_pitch = np.sqrt(horiz * horiz + vy * vy) + horiz
+    length = np.sqrt(cos_pitch * cos_pitch + vy * vy)
+    safe = np.where(length > 0, length, 1.0)
+    e = np.where(length > 0, cos_pitch / safe, 1.0)      # cos(pitch / 2)
+    c = -vy / safe                                       # sin(pitch / 2)
     q = np.stack([b * c, e * a, -a * c, b * e], axis=-1)
     if q.ndim == 3 and q.shape[0] > 1:
         dots = np.einsum("fnk,fnk->fn", q[1:], q[:-1])
@@ -114,6 +130,10 @@ def headings_from_velocities(velocities: np.ndarray) -> np.ndarray:
 
 
 class _Simulation:
+    """The school's state between frames, kept component-major: positions, headings and velocities
+    are (3, N) and neighbour lists (k, N), so that every numpy pass runs along the fish (a trailing
+    axis of 3 makes numpy's inner loops three elements long, several times slower at 1,000 fish)."""
+
     def __init__(self, config: SchoolConfig) -> None:
         _check(config)
         self.cfg = config
@@ -143,8 +163,8 @@ class _Simulation:
         self.flee_dist = np.array([g.brain.flee[1] for g in groups])[self.group] * self.length
         cr = np.array([g.brain.change_rate for g in groups])[self.group]
         self.change_rate = np.maximum(1.0, cr * np.clip(1.0 + j * rng.standard_normal(n), 0.5, 1.5))
-        self.lo = np.asarray(config.bounds[0], dtype=np.float64)
-        self.hi = np.asarray(config.bounds[1], dtype=np.float64)
+        self.lo = np.asarray(config.bounds[0], dtype=np.float64)[:, None]
+        self.hi = np.asarray(config.bounds[1], dtype=np.float64)[:, None]
         self.pos = self._layout(rng)
         d = _random_units(rng, n, vertical=WANDER_VERTICAL)
         if config.model == "pso":
@@ -152,28 +172,32 @@ class _Simulation:
         else:
             speed = self.cruise.copy()
         self.dir = d
-        self.vel = d * speed[:, None]
+        self.vel = d * speed
         # wander spline state: previous and next random point (as directions), phase in frames
         self.w_prev = d.copy()
         self.w_next = _random_units(rng, n, vertical=WANDER_VERTICAL)
         self.w_phase = rng.uniform(0.0, 1.0, n) * self.change_rate
+        self.w_pool, self.w_used = np.empty((3, 0)), 0
         self.fallback = _random_units(rng, n, vertical=1.0)  # push-apart direction for coincident fish
         self.refresh = next(r for limit, r in NEIGHBOUR_REFRESH if limit is None or n < limit)
         # Threads pay off only for big trees: below that the locks cost more than the queries.
         self.workers = -1 if n >= PARALLEL_QUERY_FISH else 1
         self.k = max(1, min(int(config.neighbours), n - 1)) if n > 1 else 0
-        # per-fish constants of the urges, as columns (hot path: no per-step recomputation)
+        # per-fish constants of the urges (hot path: no per-step recomputation)
         cruise = self.cruise
-        self.g_center = (GAIN_CENTER * w["center"] * cruise)[:, None]
-        self.g_direction = (GAIN_DIRECTION * w["direction"] * cruise)[:, None]
-        self.g_keepaway = (GAIN_KEEPAWAY * w["keepaway"] * cruise)[:, None]
-        self.g_contact = (GAIN_CONTACT * cruise)[:, None]
-        self.g_speed = (GAIN_SPEED * w["speed"])[:, None]
-        self.g_random = (GAIN_RANDOM * w["random"] * cruise)[:, None]
-        self.g_bounds = (2.0 * GAIN_BOUNDS * cruise)[:, None]
-        self.perception = (config.perception * self.length)[:, None]
-        self.inv_length = (1.0 / self.length)[:, None]
-        self.margin = np.minimum(BOUNDS_MARGIN * self.length[:, None], 0.25 * (self.hi - self.lo))
+        self.g_center = GAIN_CENTER * w["center"] * cruise
+        self.g_direction = GAIN_DIRECTION * w["direction"] * cruise
+        self.g_keepaway = GAIN_KEEPAWAY * w["keepaway"] * cruise
+        self.g_contact = GAIN_CONTACT * cruise
+        self.g_speed = GAIN_SPEED * w["speed"]
+        self.g_random = GAIN_RANDOM * w["random"] * cruise
+        self.g_bounds = 2.0 * GAIN_BOUNDS * cruise
+        self.perception = config.perception * self.length
+        self.inv_length = 1.0 / self.length
+        self.inv_repel = 1.0 / np.maximum(self.repel, 1e-12)
+        self.ones = np.ones((1, n))
+        margin = np.minimum(BOUNDS_MARGIN * self.length, 0.25 * (self.hi - self.lo))   # (3, N)
+        self.inner_lo, self.inner_hi, self.inv_margin = self.lo + margin, self.hi - margin, 1.0 / margin
         self._neighbours()
         for _ in range(4):
             self._separate()
@@ -182,7 +206,7 @@ class _Simulation:
     # ----------------------------------------------------------------- start layout
     def _layout(self, rng: np.random.Generator) -> np.ndarray:
         cfg, n = self.cfg, self.n
-        lo, hi = self.lo, self.hi
+        lo, hi = self.lo[:, 0], self.hi[:, 0]
         extent = hi - lo
         centre = (lo + hi) / 2
         pos = np.empty((n, 3))
@@ -199,7 +223,7 @@ class _Simulation:
             if cfg.layout == "sphere":
                 r = spacing * np.cbrt(3.0 * m / (4.0 * np.pi))
                 r = min(r, 0.45 * float(np.min(extent)), 0.9 * float(room[0]))
-                u = _random_units(rng, m, vertical=1.0)
+                u = _random_units(rng, m, vertical=1.0).T
                 pos[sel] = gc + u * (r * np.cbrt(rng.uniform(0.0, 1.0, m)))[:, None]
             elif cfg.layout == "box":
                 inset = np.minimum(group.body_length, 0.25 * extent)
@@ -217,36 +241,39 @@ class _Simulation:
                 p[:, axis] += np.linspace(-width / 2, width / 2, m)
                 p += rng.normal(0.0, 0.05 * spacing, (m, 3))
                 pos[sel] = p
-        return np.clip(pos, lo, hi)
+        return np.ascontiguousarray(np.clip(pos, lo, hi).T)
 
     # ----------------------------------------------------------------- neighbours
     def _neighbours(self) -> None:
-        """k nearest same-species (`nb`), 4 nearest of any species (`near`), nearest other species."""
-        n, pos = self.n, self.pos
-        self.nb = np.zeros((n, max(self.k, 1)), dtype=np.int64)
-        self.nb_ok = np.zeros((n, max(self.k, 1)), dtype=bool)
-        self.other = None
+        """k nearest same-species (`nb`), 4 nearest of any species (`near`), nearest other species,
+        each as (k, N), and the per-pair constants the step reads with them."""
+        nb, nb_ok, near, near_ok = self._find_neighbours()
+        self.nb, self.nb_ok = np.ascontiguousarray(nb.T), np.ascontiguousarray(nb_ok.T)
+        self.near, self.near_ok = np.ascontiguousarray(near.T), np.ascontiguousarray(near_ok.T)
+        self.near_need = HARD_SEPARATION * 0.5 * (self.length + self.length[self.near])
+        self.inv_near_reach = 1.0 / np.maximum(self.near_need * (CONTACT_DISTANCE / HARD_SEPARATION), 1e-12)
+        self.nb_perception = np.where(self.nb_ok, self.perception, -1.0)  # no mate: never seen
+        self.near_is_nb = self.n_groups == 1 and self.k >= self.near.shape[0]  # `near` = first of `nb`
+
+    def _find_neighbours(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(nb, nb_ok, near, near_ok) as (N, k) from k-d trees; sets `other`."""
+        n = self.n
+        pos = self.pos.T
+        nb = np.zeros((n, max(self.k, 1)), dtype=np.int64)
+        nb_ok = np.zeros((n, max(self.k, 1)), dtype=bool)
+        self.other: np.ndarray | None = None
         if n < 2:
-            self.near = np.zeros((n, 1), dtype=np.int64)
-            self.near_ok = np.zeros((n, 1), dtype=bool)
-            self.near_need = np.zeros((n, 1))
-            self.near_reach = np.zeros((n, 1))
-            self.near_is_nb = False
-            return
+            return nb, nb_ok, np.zeros((n, 1), dtype=np.int64), np.zeros((n, 1), dtype=bool)
         m = min(4, n - 1)
         tree = cKDTree(pos)
         k_all = max(self.k, m) if self.n_groups == 1 else m
         _, idx = tree.query(pos, k=k_all + 1, workers=self.workers)
         idx = idx[:, 1:]  # drop self (nearest; coincident fish are separated beforehand)
-        self.near = np.ascontiguousarray(idx[:, :m])
-        self.near_ok = idx[:, :m] != np.arange(n)[:, None]
-        self.near_need = HARD_SEPARATION * 0.5 * (self.length[:, None] + self.length[self.near])
-        self.near_reach = self.near_need * (CONTACT_DISTANCE / HARD_SEPARATION)
-        self.near_is_nb = self.n_groups == 1 and self.k >= m  # then `near` = first m of `nb`
+        near = idx[:, :m]
+        near_ok = near != np.arange(n)[:, None]
         if self.n_groups == 1:
-            self.nb = np.ascontiguousarray(idx[:, : self.k])
-            self.nb_ok = self.nb != np.arange(n)[:, None]
-            return
+            nb = idx[:, : self.k]
+            return nb, nb != np.arange(n)[:, None], near, near_ok
         other = np.full(n, -1, dtype=np.int64)
         other_d = np.full(n, np.inf)
         for g in range(self.n_groups):
@@ -258,8 +285,8 @@ class _Simulation:
             _, li = t.query(pos[members], k=kk, workers=self.workers)
             li = li.reshape(members.size, kk)[:, 1:]
             got = li.shape[1]
-            self.nb[members, :got] = members[li]
-            self.nb_ok[members, :got] = members[li] != members[:, None]
+            nb[members, :got] = members[li]
+            nb_ok[members, :got] = members[li] != members[:, None]
             outsiders = np.flatnonzero(self.group != g)
             if outsiders.size:
                 dd, oi = t.query(pos[outsiders], k=1, workers=self.workers)
@@ -267,6 +294,7 @@ class _Simulation:
                 other[outsiders[better]] = members[oi[better]]
                 other_d[outsiders[better]] = dd[better]
         self.other = other
+        return nb, nb_ok, near, near_ok
 
     # ----------------------------------------------------------------- one step
     def step(self, frame: int, target: np.ndarray | None, predator: np.ndarray | None) -> None:
@@ -277,8 +305,8 @@ class _Simulation:
         boids = self.cfg.model != "pso"
         if not (boids and self.near_is_nb):
             # from each of the few nearest fish (any species) to me, and how far: shared by the urges
-            self.near_to = np.take(self.pos, self.near, axis=0) - self.pos[:, None, :]
-            self.near_dist = np.sqrt(np.einsum("nkc,nkc->nk", self.near_to, self.near_to))
+            self.near_to = np.take(self.pos, self.near, axis=1) - self.pos[:, None, :]
+            self.near_dist = _norm(self.near_to)
         max_turn: np.ndarray | float
         if boids:
             new_vel, max_turn, v_min, v_max = self._boids()
@@ -296,17 +324,17 @@ class _Simulation:
         new_vel += acc * self.dt
         v_max = v_max * (1.0 + FLEE_SPEEDUP * flee_boost)
         self.dir = _turn_towards(self.dir, new_vel, max_turn * self.dt)
-        speed = np.minimum(np.maximum(np.sqrt(np.einsum("nc,nc->n", new_vel, new_vel)), v_min), v_max)
+        speed = np.minimum(np.maximum(_norm(new_vel), v_min), v_max)
         if predator is not None:  # fleeing fish speed up
             fast = np.minimum(v_max, self.cruise * (1.0 + FLEE_SPEEDUP * flee_boost))
             speed = np.where(flee_boost > 0, np.maximum(speed, fast), speed)
-        self.vel = self.dir * speed[:, None]
+        self.vel = self.dir * speed
         self.pos = self.pos + self.vel * self.dt
         if self.n > 1:
             # only fish that were within one step's closing distance of a too-near neighbour can be
             # too near now (pairs close by at most both speeds x dt; the pushes add a little more)
             closing = 2.5 * float(np.max(v_max)) * self.dt
-            rows = np.flatnonzero(np.any((self.near_dist - self.near_need) < closing, axis=1))
+            rows = np.flatnonzero(np.any(self.near_dist < self.near_need + closing, axis=0))
             for _ in range(SEPARATION_PASSES):
                 self._separate(rows)
         self._clamp()
@@ -315,50 +343,45 @@ class _Simulation:
         pos, d, v = self.pos, self.dir, self.vel
         cruise = self.cruise
         # keep own velocity (relax towards cruising speed along the heading) and the wander spline
-        acc = self.g_speed * (d * cruise[:, None] - v) + self.g_random * (self._wander() - d)
+        acc = self.g_speed * (d * cruise - v) + self.g_random * (self._wander() - d)
         if self.n > 1:
-            # one gather of the school-mates' positions and headings: (N, k, 6)
-            mates = np.take(np.concatenate([pos, d], axis=1), self.nb, axis=0)
-            mates -= np.concatenate([pos, np.zeros_like(pos)], axis=1)[:, None, :]  # me to them
-            off = mates[..., :3]
-            dist = np.sqrt(np.einsum("nkc,nkc->nk", off, off))
-            seen = self.nb_ok & (dist < self.perception)
-            cnt = np.count_nonzero(seen, axis=1)
-            has = (cnt > 0)[:, None]
-            sums = np.einsum("nk,nkc->nc", seen.astype(np.float64), mates)
-            sums *= has / np.maximum(cnt, 1)[:, None]
+            # one gather of the school-mates' positions, headings and a 1 (their count): (7, k, N)
+            mates = np.take(np.concatenate([pos, d, self.ones]), self.nb, axis=1)
+            off = mates[:3] - pos[:, None, :]  # me to them
+            dist = _norm(off)
+            seen = (dist < self.nb_perception).astype(np.float64)
+            sums = np.einsum("kn,ckn->cn", seen, mates)
+            cnt = sums[6]
+            has = cnt > 0
+            mean = has / np.maximum(cnt, 1.0)
             # cohesion: towards the centre of the perceived school-mates, in body lengths, capped
-            coh = sums[:, :3] * self.inv_length
-            cn = np.sqrt(np.einsum("nc,nc->n", coh, coh))[:, None]
-            acc += self.g_center / np.maximum(cn, 1.0) * coh
+            coh = (sums[:3] - cnt * pos) * (mean * self.inv_length)
+            acc += self.g_center / np.maximum(_norm(coh), 1.0) * coh
             # alignment: towards their mean heading
-            acc += self.g_direction * (sums[:, 3:] - d * has)
+            acc += self.g_direction * (sums[3:6] * mean - d * has)
             if self.near_is_nb:
-                m = self.near.shape[1]
+                m = self.near.shape[0]
                 self.near_to = off[:, :m]
-                self.near_dist = dist[:, :m]
+                self.near_dist = dist[:m]
             # keepaway inside the repel distance (any species), and bodies that nearly touch push
             # apart whatever the brain (the swim-through fix): one weighted sum over the nearest
-            strength = self._contact_strength() * self.g_contact
-            strength += self._keepaway_strength(self.repel) * self.g_keepaway
+            dist = self.near_dist
+            strength = np.maximum(1.0 - dist * self.inv_near_reach, 0.0) * self.g_contact
+            strength += np.maximum(1.0 - dist * self.inv_repel, 0.0) * self.g_keepaway
+            strength *= self.near_ok / np.maximum(dist, 1e-12)
             acc += self._push(strength)
         new_vel = v + acc * self.dt
         return new_vel, self.cfg.max_turn, MIN_SPEED * cruise, cruise * 2.0
 
-    def _keepaway_strength(self, radius: np.ndarray) -> np.ndarray:
-        """Per nearest fish: 1 at contact falling to 0 at `radius`, over the distance (for `_push`)."""
-        dist = self.near_dist
-        reach = np.maximum(1.0 - dist / radius[:, None], 0.0) * self.near_ok
-        return reach / np.maximum(dist, 1e-12)
-
     def _contact_strength(self) -> np.ndarray:
+        """Per nearest fish: 1 at contact falling to 0 at the contact distance, over the distance."""
         dist = self.near_dist
-        reach = np.maximum(1.0 - dist / self.near_reach, 0.0) * self.near_ok
+        reach = np.maximum(1.0 - dist * self.inv_near_reach, 0.0) * self.near_ok
         return reach / np.maximum(dist, 1e-12)
 
     def _push(self, strength: np.ndarray) -> np.ndarray:
         """Sum over the nearest fish of strength x offset away from them."""
-        return -np.einsum("nk,nkc->nc", strength, self.near_to)
+        return -np.einsum("kn,ckn->cn", strength, self.near_to)
 
     def _wander(self) -> np.ndarray:
         """A point on each fish's wander spline (as a direction); new random point every change_rate."""
@@ -367,45 +390,50 @@ class _Simulation:
         if due.any():
             idx = np.flatnonzero(due)
             self.w_phase[idx] -= self.change_rate[idx]
-            self.w_prev[idx] = self.w_next[idx]
-            self.w_next[idx] = _random_units(self.rng, idx.size, vertical=WANDER_VERTICAL)
-        h = np.clip(self.w_phase / self.change_rate, 0.0, 1.0)
-        h = (h * h * (3.0 - 2.0 * h))[:, None]
-        u = (1.0 - h) * self.w_prev + h * self.w_next
-        return u / np.maximum(np.sqrt(np.einsum("nc,nc->n", u, u)), 1e-9)[:, None]
+            self.w_prev[:, idx] = self.w_next[:, idx]
+            self.w_next[:, idx] = self._wander_points(idx.size)
+        h = np.minimum(np.maximum(self.w_phase / self.change_rate, 0.0), 1.0)
+        h = h * h * (3.0 - 2.0 * h)
+        u = self.w_prev + h * (self.w_next - self.w_prev)
+        return u / np.maximum(_norm(u), 1e-9)
+
+    def _wander_points(self, count: int) -> np.ndarray:
+        """The next `count` random wander points, drawn many at a time: a few fish need one each
+        frame, and one draw per frame cost more than the rest of the wander spline."""
+        if self.w_pool.shape[1] - self.w_used < count:
+            self.w_pool = _random_units(self.rng, max(WANDER_POOL, count), vertical=WANDER_VERTICAL)
+            self.w_used = 0
+        self.w_used += count
+        return self.w_pool[:, self.w_used - count:self.w_used]
 
     def _pso(self, target: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         p = self.cfg.pso
         pos, v, L, rng = self.pos, self.vel, self.length, self.rng
         n = self.n
         assert target is not None
-        to_t = pos - target
-        dist_t = np.linalg.norm(to_t, axis=1)
+        dist_t = _norm(pos - target[:, None])
         # global best per species: the fish nearest the target; the leader itself seeks the target
-        best = np.empty((n, 3))
+        best = np.empty((3, n))
         for g in range(self.n_groups):
             members = np.flatnonzero(self.group == g)
             if members.size == 0:
                 continue
             lead = members[np.argmin(dist_t[members])]
-            best[members] = pos[lead]
-            best[lead] = target
+            best[:, members] = pos[:, lead, None]
+            best[:, lead] = target
         r = rng.uniform(0.0, 1.0, (n, 3))
-        force = np.zeros((n, 3))
+        force = np.zeros((3, n))
         if n > 1:
-            x1 = pos[self.near[:, 0]]
-            away = pos - x1
-            d1 = np.linalg.norm(away, axis=1)
-            inside = (d1 < p.repulsion_radius * L) & self.near_ok[:, 0]
+            away = -self.near_to[:, 0]
+            d1 = self.near_dist[0]
+            inside = (d1 < p.repulsion_radius * L) & self.near_ok[0]
             slow = np.where(inside, p.slowdown, 1.0)
-            unit = away / np.maximum(d1, 1e-12)[:, None]
-            force += (inside * p.repulsion * r[:, 1] * L)[:, None] * unit
-            second = self.nb[:, 1] if self.nb.shape[1] > 1 else self.nb[:, 0]
-            ok2 = self.nb_ok[:, 1] if self.nb.shape[1] > 1 else self.nb_ok[:, 0]
-            force += (slow * p.attraction * r[:, 2] * ok2)[:, None] * (pos[second] - pos)
+            force += (inside * p.repulsion * r[:, 1] * L / np.maximum(d1, 1e-12)) * away
+            second, ok2 = (self.nb[1], self.nb_ok[1]) if self.nb.shape[0] > 1 else (self.nb[0], self.nb_ok[0])
+            force += (slow * p.attraction * r[:, 2] * ok2) * (pos[:, second] - pos)
         else:
             slow = np.ones(n)
-        force += (slow * p.global_weight * r[:, 0])[:, None] * (best - pos)
+        force += (slow * p.global_weight * r[:, 0]) * (best - pos)
         w_eff = p.inertia ** (self.dt / PSO_REFERENCE_DT)
         gain = (1.0 - w_eff) / (1.0 - p.inertia) if p.inertia < 1.0 else self.dt / PSO_REFERENCE_DT
         new_vel = w_eff * v + gain * force
@@ -415,29 +443,27 @@ class _Simulation:
 
     # ----------------------------------------------------------------- shared urges
     def _bounds_accel(self) -> np.ndarray:
-        margin = self.margin
-        below = np.minimum(np.maximum((self.lo + margin - self.pos) / margin, 0.0), 1.0)
-        above = np.minimum(np.maximum((self.pos - (self.hi - margin)) / margin, 0.0), 1.0)
+        pos = self.pos
+        below = np.minimum(np.maximum((self.inner_lo - pos) * self.inv_margin, 0.0), 1.0)
+        above = np.minimum(np.maximum((pos - self.inner_hi) * self.inv_margin, 0.0), 1.0)
         return self.g_bounds * (below - above)
 
     def _other_species_accel(self) -> np.ndarray:
         if self.other is None:
             return np.zeros_like(self.pos)
         ok = self.other >= 0
-        off = self.pos - self.pos[np.where(ok, self.other, 0)]
-        dist = np.linalg.norm(off, axis=1)
+        off = self.pos - self.pos[:, np.where(ok, self.other, 0)]
+        dist = _norm(off)
         radius = OTHER_SPECIES_DISTANCE * self.length
         strength = np.clip(1.0 - dist / radius, 0.0, None) * ok * self.w["keepaway"]
-        unit = off / np.maximum(dist, 1e-12)[:, None]
-        return (GAIN_OTHER_SPECIES * self.cruise * strength)[:, None] * unit
+        return (GAIN_OTHER_SPECIES * self.cruise * strength / np.maximum(dist, 1e-12)) * off
 
     def _flee_accel(self, predator: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        off = self.pos - predator
-        dist = np.linalg.norm(off, axis=1)
+        off = self.pos - predator[:, None]
+        dist = _norm(off)
         near = np.clip(1.0 - dist / np.maximum(self.flee_dist, 1e-12), 0.0, 1.0)
         near = near * (self.w["flee"] > 0)
-        unit = off / np.maximum(dist, 1e-12)[:, None]
-        acc = (GAIN_FLEE * self.w["flee"] * self.cruise * near)[:, None] * unit
+        acc = (GAIN_FLEE * self.w["flee"] * self.cruise * near / np.maximum(dist, 1e-12)) * off
         return acc, np.sqrt(near)
 
     # ----------------------------------------------------------------- constraints
@@ -452,52 +478,65 @@ class _Simulation:
         if rows is not None:
             if rows.size == 0:
                 return
-            near, need, ok = near[rows], need[rows], ok[rows]
-        mine = pos if rows is None else pos[rows]
-        off = mine[:, None, :] - np.take(pos, near, axis=0)     # from neighbour to me
-        dist = np.sqrt(np.einsum("nkc,nkc->nk", off, off))
+            near, need, ok = near[:, rows], need[:, rows], ok[:, rows]
+        mine = pos if rows is None else pos[:, rows]
+        off = mine[:, None, :] - np.take(pos, near, axis=1)     # from neighbour to me: (3, m, rows)
+        dist = _norm(off)
         short = np.maximum(need - dist, 0.0) * ok
         if not short.any():
             return
         tiny = dist < 1e-9
-        scale = short / np.maximum(dist, 1e-12)
-        push = np.einsum("nk,nkc->nc", scale, off)
+        push = np.einsum("kn,ckn->cn", short / np.maximum(dist, 1e-12), off)
         if tiny.any():  # coincident fish: each goes its own fixed random way
-            fallback = self.fallback if rows is None else self.fallback[rows]
-            push += np.einsum("nk,nc->nc", short * tiny, fallback)
+            fallback = self.fallback if rows is None else self.fallback[:, rows]
+            push += (short * tiny).sum(axis=0) * fallback
         if rows is None:
             self.pos = pos + 0.5 * push
         else:
-            self.pos[rows] += 0.5 * push
+            self.pos[:, rows] += 0.5 * push
 
     def _clamp(self) -> None:
         np.clip(self.pos, self.lo, self.hi, out=self.pos)
 
 
+def _norm(v: np.ndarray) -> np.ndarray:
+    """Lengths of component-major vectors: (3, ...) -> (...)."""
+    return np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+
+
 def _turn_towards(d: np.ndarray, want: np.ndarray, max_angle: np.ndarray | float) -> np.ndarray:
-    """Unit directions `d` rotated towards `want` by at most `max_angle` radians."""
-    wn = np.sqrt(np.einsum("nc,nc->n", want, want))[:, None]
+    """Unit directions `d` (3, N) rotated towards `want` by at most `max_angle` radians.
+
+    A fish that wants to turn by less than that simply takes the wanted direction; only the others
+    (few, once a school has formed) pay for the rotation's trigonometry."""
+    wn = _norm(want)
     t = np.where(wn > 1e-12, want / np.maximum(wn, 1e-12), d)
-    c = np.minimum(np.maximum(np.einsum("nc,nc->n", d, t), -1.0), 1.0)
-    perp = t - c[:, None] * d
-    pn = np.sqrt(np.einsum("nc,nc->n", perp, perp))
+    c = np.minimum(np.maximum(d[0] * t[0] + d[1] * t[1] + d[2] * t[2], -1.0), 1.0)
+    limit = np.cos(np.minimum(max_angle, np.pi))
+    rows = np.flatnonzero(c < limit)
+    if rows.size == 0:
+        return t
+    d_r, c_r = d[:, rows], c[rows]
+    perp = t[:, rows] - c_r * d_r
+    pn = _norm(perp)
     flat = pn < 1e-9
-    if flat.any():  # exactly behind (or ahead): turn about the vertical, or about X if vertical
-        alt = np.cross(d[flat], np.array([0.0, 1.0, 0.0]))
+    if flat.any():  # exactly behind: turn about the vertical, or about X if vertical
+        alt = np.cross(d_r[:, flat].T, np.array([0.0, 1.0, 0.0]))
         bad = np.linalg.norm(alt, axis=1) < 1e-6
-        alt[bad] = np.cross(d[flat][bad], np.array([1.0, 0.0, 0.0]))
-        perp[flat] = alt
+        alt[bad] = np.cross(d_r[:, flat][:, bad].T, np.array([1.0, 0.0, 0.0]))
+        perp[:, flat] = alt.T
         pn[flat] = np.linalg.norm(alt, axis=1)
-    a = np.minimum(np.arccos(c), max_angle)
-    out = np.cos(a)[:, None] * d + (np.sin(a) / pn)[:, None] * perp
-    return out / np.sqrt(np.einsum("nc,nc->n", out, out))[:, None]
+    a = np.minimum(np.arccos(c_r), max_angle if np.ndim(max_angle) == 0 else max_angle[rows])
+    out = np.cos(a) * d_r + (np.sin(a) / pn) * perp
+    t[:, rows] = out / _norm(out)
+    return t
 
 
 def _random_units(rng: np.random.Generator, n: int, vertical: float) -> np.ndarray:
-    u = rng.standard_normal((n, 3))
-    u[:, 1] *= vertical
-    norm = np.linalg.norm(u, axis=1, keepdims=True)
-    return u / np.maximum(norm, 1e-12)
+    """n random unit directions as (3, n), flattened vertically by `vertical`."""
+    u = rng.standard_normal((n, 3)).T.copy()
+    u[1] *= vertical
+    return u / np.maximum(_norm(u), 1e-12)
 
 
 def _check(config: SchoolConfig) -> None:
