@@ -10,6 +10,12 @@ with the body wave (every fish's four morph weights keyed every frame) under 1.5
 --repeat runs, one row each. A fish-step is one fish moved by one frame: a run of F frames is F - 1
 steps (frame 0 is the start layout). Mesa is a benchmark-only dependency:
 pip install "mesa[network]>=3,<4". `--quick` is a smoke run with small sizes.
+
+Mesa runs in two spaces. The target is judged in the issue's: the example's own 100 x 100 space
+whatever the number of agents (Mesa's default width and height; this is the set-up in which it
+"manages about 9 steps/s at 1,000 agents", as the issue says). The second keeps the example's
+density (100 agents per 100 x 100, the space grown with N): each agent then sees about 3 others
+instead of about 30, and Mesa runs faster. Both ratios are printed.
 """
 from __future__ import annotations
 
@@ -62,9 +68,16 @@ def mesa_model():
     return BoidFlockers
 
 
-def time_mesa(model_class, count: int, steps: int, repeat: int) -> list[float] | None:
+MESA_SPACES = {"issue": "mesa, space 100", "density": "mesa, space grown"}  # row names
+
+
+def mesa_width(count: int, space: str) -> float:
+    """The side of Mesa's square space: the example's 100, or grown to keep its density."""
+    return 100.0 if space == "issue" else 100 * (count / 100) ** 0.5
+
+
+def time_mesa(model_class, count: int, steps: int, repeat: int, width: float) -> list[float] | None:
     """Seconds of `steps` steps (model construction not counted); None when over MESA_BUDGET."""
-    width = 100 * (count / 100) ** 0.5  # the example's density: 100 agents on 100 x 100
     runs = []
     for k in range(repeat):
         model = model_class(population_size=count, width=width, height=width, vision=10, seed=1)
@@ -177,8 +190,8 @@ def main() -> None:
           f"Python {sys.version.split()[0]}, {versions}")
     print()
     print(f"{'simulation':24} {'fish':>6} {'steps':>6} {'median s':>9} {'min s':>7} {'runs':>4} "
-          f"{'fish-steps/s':>13} {'vs mesa':>8}")
-    ratio_at: dict[int, float] = {}
+          f"{'fish-steps/s':>13} {'boids/it':>8}")
+    ratio_at: dict[tuple[int, str], float] = {}  # fishgen boids / Mesa, per (fish, Mesa's space)
 
     def row(name, count, steps, runs, rate, versus=""):
         print(f"{name:24} {count:6,} {steps:6,} {statistics.median(runs):9.3f} {min(runs):7.3f} "
@@ -187,20 +200,20 @@ def main() -> None:
     for count, frames, steps in sizes:
         fish = {model: time_fishgen(count, frames, model, repeat) for model in ("boids", "pso")}
         rates = {model: count * (frames - 1) / statistics.median(runs) for model, runs in fish.items()}
-        mruns = None if BoidFlockers is None else time_mesa(BoidFlockers, count, steps,
-                                                             1 if count >= 10000 else repeat)
-        mrate = None if mruns is None else count * steps / statistics.median(mruns)
         for model, runs in fish.items():
-            versus = "" if mrate is None else f"{rates[model] / mrate:,.0f}x"
-            row(f"fishgen {model}", count, frames - 1, runs, rates[model], versus)
-        if mrate is not None:
-            ratio_at[count] = rates["boids"] / mrate
-            row("mesa boid_flockers", count, steps, mruns, mrate, "1x")
-        elif BoidFlockers is None:
-            print(f"{'mesa boid_flockers':24} {count:6,}   " + MESA_HINT)
-        else:
-            print(f"{'mesa boid_flockers':24} {count:6,} {steps:6,}   skipped: {steps} steps over "
-                  f"{MESA_BUDGET:.0f} s")
+            row(f"fishgen {model}", count, frames - 1, runs, rates[model])
+        for space, name in MESA_SPACES.items():
+            if BoidFlockers is None:
+                print(f"{name:24} {count:6,}   " + MESA_HINT)
+                continue
+            mruns = time_mesa(BoidFlockers, count, steps, 1 if count >= 10000 else repeat,
+                              mesa_width(count, space))
+            if mruns is None:
+                print(f"{name:24} {count:6,} {steps:6,}   skipped: {steps} steps over {MESA_BUDGET:.0f} s")
+                continue
+            mrate = count * steps / statistics.median(mruns)
+            ratio_at[(count, space)] = rates["boids"] / mrate
+            row(name, count, steps, mruns, mrate, f"{rates['boids'] / mrate:,.0f}x")
 
     sim_s, wall_s, peak = big_run(*big)
     with tempfile.TemporaryDirectory(prefix="fishgen-bench-") as tmp:
@@ -223,8 +236,12 @@ def main() -> None:
 
     print()
     print("targets (issue 9)" + (" -- --quick sizes, not the targets' sizes" if args.quick else ""))
-    if 1000 in ratio_at:
-        print(f"  boids >= 100x Mesa at 1,000 fish: {ratio_at[1000]:,.0f}x  {verdict(ratio_at[1000] >= 100)}")
+    if (1000, "issue") in ratio_at:
+        ratio = ratio_at[(1000, "issue")]
+        other = ratio_at.get((1000, "density"))
+        also = "" if other is None else f" (with Mesa's space grown to keep its density: {other:,.0f}x)"
+        print(f"  boids >= 100x Mesa at 1,000 fish, Mesa in the issue's 100 x 100 space: "
+              f"{ratio:,.0f}x  {verdict(ratio >= 100)}{also}")
     else:
         print("  boids >= 100x Mesa at 1,000 fish: not measured (" +
               ("mesa not installed)" if BoidFlockers is None else "Mesa skipped)"))

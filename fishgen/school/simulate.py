@@ -526,7 +526,7 @@ def _turn_towards(d: np.ndarray, want: np.ndarray, max_angle: np.ndarray | float
         alt[bad] = np.cross(d_r[:, flat][:, bad].T, np.array([1.0, 0.0, 0.0]))
         perp[:, flat] = alt.T
         pn[flat] = np.linalg.norm(alt, axis=1)
-    a = np.minimum(np.arccos(c_r), max_angle if np.ndim(max_angle) == 0 else max_angle[rows])
+    a = np.minimum(np.arccos(c_r), max_angle if np.ndim(max_angle) == 0 else np.asarray(max_angle)[rows])
     out = np.cos(a) * d_r + (np.sin(a) / pn) * perp
     t[:, rows] = out / _norm(out)
     return t
