@@ -1,16 +1,19 @@
 """Speed of `fishgen batch`: 100 builds with -j 1 beside -j 2, and the rerun where nothing changed.
 
-    python benchmarks/batch.py [--repeat 3] [--jobs 100]
+    python benchmarks/batch.py [--repeat 5] [--jobs 100]
 
 Targets (issue 11): on a 2-core machine 100 builds run at least 1.8x faster with -j 2 than with
 -j 1; a rerun of 100 jobs with nothing changed takes under 1 s. Each figure is a whole command
 (start-up, manifest, record, workers), the -j 1 and -j 2 runs alternating so that the machine's
 noise falls on both alike; medians over --repeat runs. The jobs build the four shipped species in
-turn, each to its own output, with --force so that every run builds all of them.
+turn, each to its own output, with --force so that every run builds all of them. fishgen's
+bytecode is compiled first, as an installed package's is (pip compiles it; an editable checkout
+under PYTHONDONTWRITEBYTECODE would otherwise compile every module from source in every run).
 """
 from __future__ import annotations
 
 import argparse
+import compileall
 import os
 import shutil
 import statistics
@@ -46,9 +49,10 @@ def run(*args: str) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--jobs", type=int, default=100)
     args = parser.parse_args()
+    compileall.compile_dir(ROOT / "fishgen", quiet=1)
     load = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         path = manifest(Path(tmp), args.jobs)
@@ -66,7 +70,11 @@ def main() -> None:
               f"{args.jobs / statistics.median(runs):6.1f} jobs/s")
     ratio = statistics.median(times["-j 1"]) / statistics.median(times["-j 2"])
     best = min(times["-j 1"]) / min(times["-j 2"])
-    print(f"  -j 2 is {ratio:.2f}x -j 1 by medians, {best:.2f}x by the fastest runs (target: at least 1.8x)")
+    # each -j 1 run beside the -j 2 run right after it: the machine's slower spells fall on both
+    pairs = sorted(one / two for one, two in zip(times["-j 1"], times["-j 2"], strict=True))
+    print(f"  -j 2 is {ratio:.2f}x -j 1 by medians, {best:.2f}x by the fastest runs, "
+          f"{statistics.median(pairs):.2f}x by the median of the {len(pairs)} side-by-side pairs "
+          f"({pairs[0]:.2f} to {pairs[-1]:.2f}) (target: at least 1.8x)")
     print(f"  rerun with nothing changed, {args.jobs} jobs: {statistics.median(unchanged):.3f} s median of "
           f"{len(unchanged)} (target: under 1 s)")
 
