@@ -85,8 +85,10 @@ def run_batch(manifest: Manifest, *, workers: int = 1, force: bool = False, fail
         try:
             run_jobs([job for job, _ in todo], done, workers=workers, scheduler=scheduler)
         finally:
-            if todo and not record.damaged:
-                record.save()  # once, durably, however the run ended
+            # once, durably, however the run ended; an unreadable record is replaced once this run
+            # has something to put in its place (it started empty)
+            if todo and (record.jobs or not record.damaged):
+                record.save()
     return [outcomes.get(job.name) or Outcome(job, "not run", reasons.get(job.name)) for job in manifest.jobs]
 
 
