@@ -51,8 +51,10 @@ PSO_REFERENCE_DT = 0.05    # Figure 2.2's time step; inertia is re-timed from it
 PSO_MIN_TURN = 0.25        # x max_turn: the least turn rate a pso fish has next to the target
 SEPARATION_PASSES = 1
 WANDER_POOL = 4096         # random wander points drawn at a time
-# k-nearest lists are rebuilt every this many frames: (fewer than this many fish, frames)
-NEIGHBOUR_REFRESH = ((300, 1), (5000, 8), (None, 8))
+# k-nearest lists are rebuilt every frame below this many fish, else at most this many seconds
+# of simulated time apart (all distances are still measured every frame from current positions)
+NEIGHBOUR_REFRESH_FISH = 300
+NEIGHBOUR_REFRESH_SECONDS = 0.5
 PARALLEL_QUERY_FISH = 5000
 HEADING_CHUNK_ELEMENTS = 4096  # fish x frames per vectorised heading pass
 JITTERED = ("random", "center", "keepaway", "speed", "direction", "flee")
@@ -179,7 +181,9 @@ class _Simulation:
         self.w_phase = rng.uniform(0.0, 1.0, n) * self.change_rate
         self.w_pool, self.w_used = np.empty((3, 0)), 0
         self.fallback = _random_units(rng, n, vertical=1.0)  # push-apart direction for coincident fish
-        self.refresh = next(r for limit, r in NEIGHBOUR_REFRESH if limit is None or n < limit)
+        self.refresh = 1
+        if n >= NEIGHBOUR_REFRESH_FISH:
+            self.refresh = max(1, int(NEIGHBOUR_REFRESH_SECONDS * config.fps))
         # Threads pay off only for big trees: below that the locks cost more than the queries.
         self.workers = -1 if n >= PARALLEL_QUERY_FISH else 1
         self.k = max(1, min(int(config.neighbours), n - 1)) if n > 1 else 0
