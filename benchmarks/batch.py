@@ -1,6 +1,6 @@
 """Speed of `fishgen batch`: 100 builds with -j 1 beside -j 2, and the rerun where nothing changed.
 
-    python benchmarks/batch.py [--repeat 5] [--jobs 100]
+    python benchmarks/batch.py [--repeat 5] [--jobs 100] [--python PATH]
 
 Targets (issue 11): on a 2-core machine 100 builds run at least 1.8x faster with -j 2 than with
 -j 1; a rerun of 100 jobs with nothing changed takes under 1 s. Each figure is a whole command
@@ -9,6 +9,8 @@ noise falls on both alike; medians over --repeat runs. The jobs build the four s
 turn, each to its own output, with --force so that every run builds all of them. fishgen's
 bytecode is compiled first, as an installed package's is (pip compiles it; an editable checkout
 under PYTHONDONTWRITEBYTECODE would otherwise compile every module from source in every run).
+`--python` runs another interpreter's fishgen, e.g. a fresh virtualenv's `pip install .`, as a
+user has it: no editable-install finder, no site-wide .pth files run at every start.
 """
 from __future__ import annotations
 
@@ -37,9 +39,10 @@ def manifest(folder: Path, jobs: int) -> Path:
     return path
 
 
-def run(*args: str) -> float:
+def run(python: str, folder: Path, *args: str) -> float:
     start = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "fishgen", "batch", *args, "--quiet"], cwd=ROOT,
+    # run from the scratch folder: from the checkout, `-m fishgen` would import the source tree
+    proc = subprocess.run([python, "-m", "fishgen", "batch", *args, "--quiet"], cwd=folder,
                           capture_output=True, text=True)
     elapsed = time.perf_counter() - start
     if proc.returncode != 0:
@@ -51,19 +54,22 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--jobs", type=int, default=100)
+    parser.add_argument("--python", default=sys.executable,
+                        help="the interpreter whose fishgen runs (default: this one)")
     args = parser.parse_args()
     compileall.compile_dir(ROOT / "fishgen", quiet=1)
     load = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
-        path = manifest(Path(tmp), args.jobs)
-        run(str(path), "-j", "2")  # warm the file cache and the record
+        folder = Path(tmp)
+        path = manifest(folder, args.jobs)
+        run(args.python, folder, str(path), "-j", "2")  # warm the file cache and the record
         times: dict[str, list[float]] = {"-j 1": [], "-j 2": []}
         for _ in range(args.repeat):
             for workers in ("1", "2"):
-                times[f"-j {workers}"].append(run(str(path), "-j", workers, "--force"))
-        unchanged = [run(str(path)) for _ in range(max(5, args.repeat))]
+                times[f"-j {workers}"].append(run(args.python, folder, str(path), "-j", workers, "--force"))
+        unchanged = [run(args.python, folder, str(path)) for _ in range(max(5, args.repeat))]
     print(f"fishgen batch: {args.jobs} builds of the 4 shipped species, {os.cpu_count()} cores, "
-          f"Python {sys.version.split()[0]}, median of {args.repeat} (min, max); load average before "
+          f"{args.python}, median of {args.repeat} (min, max); load average before "
           f"{load[0]:.1f}, after {os.getloadavg()[0]:.1f} (other processes' share of the cores)")
     for label, runs in times.items():
         print(f"  {label}   {statistics.median(runs):7.2f} s   ({min(runs):.2f}, {max(runs):.2f})   "
