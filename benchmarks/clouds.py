@@ -14,6 +14,7 @@ against its rate at the largest measured size (the loop is linear), marked "*".
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import os
 import random
@@ -175,10 +176,14 @@ def main() -> None:
             slow = median_time(lambda: plain_fill(cubes, 1), reps)
             plain_rate, mark = n / slow, ""
         else:
+            if plain_rate is None:  # every size is above --baseline-max: measure the loop there once
+                m = int(args.baseline_max)
+                plain_rate = m / median_time(functools.partial(plain_fill, scaled_cubes(m), 1), 1)
             slow, mark = n / plain_rate, "*"
         print(f"| {n:,} | {fast * 1e3:,.1f} ms | {n / fast / 1e6:,.1f} M | "
               f"{slow * 1e3:,.0f} ms{mark} | {n / slow / 1e6:,.2f} M{mark} | {slow / fast:,.0f}x{mark} |")
-    print("\n* extrapolated from the plain loop's rate at the largest size it ran (it is linear).")
+    print("\n* extrapolated from the plain loop's rate at the largest size it ran, or at --baseline-max "
+          "(it is linear).")
 
     n = int(args.command_size)
     with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:
