@@ -203,10 +203,10 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
 
 
 def _primitive(buf: _Buffer, prim: Primitive) -> dict[str, Any]:
-    names = [n for n in _ATTRIBUTE_ORDER if n in prim.attributes]
-    names += [n for n in prim.attributes if n not in _ATTRIBUTE_ORDER]
-    attributes = {name: buf.accessor(prim.attributes[name], target=ARRAY_BUFFER, bounds=name == "POSITION",
-                                     normalized=name in _NORMALIZED) for name in names}
+    stored = {name: buf.accessor(array, target=ARRAY_BUFFER, bounds=name == "POSITION",
+                                 normalized=name in _NORMALIZED) for name, array in prim.attributes.items()}
+    names = [n for n in _ATTRIBUTE_ORDER if n in stored] + [n for n in stored if n not in _ATTRIBUTE_ORDER]
+    attributes = {name: stored[name] for name in names}  # stored as they come, listed in pygltflib's order
     indices = None
     if prim.indices is not None:
         flat = np.asarray(prim.indices).ravel()

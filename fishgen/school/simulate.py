@@ -104,6 +104,9 @@ def headings_from_velocities(velocities: np.ndarray) -> np.ndarray:
     one rotation, but a sign flip breaks linear key interpolation).
     """
     v = np.asarray(velocities, dtype=np.float64)
+    # the half angles depend only on the direction: scaled so that squares neither overflow nor vanish
+    big = np.abs(v).max(axis=-1, keepdims=True)
+    v = v / np.where(big > 0, big, 1.0)
     vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
     horiz = np.sqrt(vx * vx + vz * vz)
     # half-angle (cos, sin) pairs straight from the vector, no trigonometry: for the yaw,

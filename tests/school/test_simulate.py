@@ -137,7 +137,8 @@ def test_headings_agree_with_yaw_then_pitch_angles_at_the_awkward_directions():
     """The trigonometry-free half angles match atan2's yaw and pitch, including straight back,
     straight up and down, no velocity at all, and almost straight back (no lost precision)."""
     v = np.array([[0.0, 0, -1], [-0.0, 0, -3], [1e-12, 0, -1], [-1e-12, 0.2, -1], [0, 1, 0],
-                  [0, -2, 0], [0, 0, 0], [1, 0, 0], [-0.5, -0.5, 0.1], [2, 1, -1e-9]])
+                  [0, -2, 0], [0, 0, 0], [1, 0, 0], [-0.5, -0.5, 0.1], [2, 1, -1e-9],
+                  [1e200, 0, -1e200], [1e-300, 0, 0], [3e-200, -1e-200, 2e-200]])
     yaw = np.arctan2(v[:, 0], v[:, 2])
     pitch = np.arctan2(-v[:, 1], np.hypot(v[:, 0], v[:, 2]))
     a, b, c, e = np.sin(yaw / 2), np.cos(yaw / 2), np.sin(pitch / 2), np.cos(pitch / 2)
