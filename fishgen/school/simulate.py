@@ -104,10 +104,12 @@ def headings_from_velocities(velocities: np.ndarray) -> np.ndarray:
     one rotation, but a sign flip breaks linear key interpolation).
     """
     v = np.asarray(velocities, dtype=np.float64)
-    # the half angles depend only on the direction: scaled so that squares neither overflow nor vanish
-    big = np.abs(v).max(axis=-1, keepdims=True)
-    v = v / np.where(big > 0, big, 1.0)
     vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
+    # the half angles depend only on the direction: scaled so that squares neither overflow nor
+    # vanish (component by component: a reduction over a trailing axis of 3 is slow in numpy)
+    big = np.maximum(np.maximum(np.abs(vx), np.abs(vy)), np.abs(vz))
+    inv = 1.0 / np.where(big > 0, big, 1.0)
+    vx, vy, vz = vx * inv, vy * inv, vz * inv
     horiz = np.sqrt(vx * vx + vz * vz)
     # half-angle (cos, sin) pairs straight from the vector, no trigonometry: for the yaw,
     # (cos, sin)(yaw / 2) ~ (horiz + vz, vx), with horiz + vz = vx^2 / (horiz - vz) where vz < 0
