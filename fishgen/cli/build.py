@@ -7,6 +7,7 @@ import click
 
 from fishgen.assembly.fin_modes import FIN_MODES
 from fishgen.assembly.swim_modes import DEFAULT_SPEED, SWIM_MODES
+from fishgen.cli.common import error_line
 from fishgen.cli.params import FiniteRange
 from fishgen.exchange.registry import MESHES, extensions, formats
 
@@ -86,7 +87,8 @@ def build(species_files: tuple[Path, ...], output: Path | None, fmt: str, fins: 
         except FishgenError as err:
             if len(species_files) == 1:
                 raise
-            click.echo(str(err), err=True)
+            # each bad file on its own line, as --json asks: the others still build
+            click.echo(error_line(str(err), 2, file=err.file, line=err.line), err=True)
             failures += 1
             continue
         click.echo(summary(scene, target, written))  # type: ignore[arg-type]
