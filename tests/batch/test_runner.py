@@ -69,21 +69,28 @@ def many_builds(shipped, count: int):
     return manifest, shipped / "out" / "many"
 
 
+def start_batch_until_recorded(manifest: Path, out: Path, jobs: int = 5) -> subprocess.Popen:
+    """`fishgen batch MANIFEST -j 2` in the background, returned once its record holds `jobs`
+    entries (or it ended, or a minute passed)."""
+    proc = subprocess.Popen([sys.executable, "-m", "fishgen", "batch", str(manifest), "-j", "2"], cwd=ROOT,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and proc.poll() is None:
+        try:
+            if len(record(out)) >= jobs:
+                break
+        except (OSError, ValueError):  # not written yet, or caught mid-rename
+            pass
+        time.sleep(0.01)
+    return proc
+
+
 @pytest.mark.parametrize("signum,status", [(signal.SIGTERM, 143), (signal.SIGINT, 130), (signal.SIGKILL, -9)])
 def test_a_batch_killed_midway_leaves_whole_files_and_the_next_run_finishes_it(shipped, signum, status):
     manifest, out = many_builds(shipped, 120)
     assert run_cli("build", manifest.parent / "bonybream.txt", "-o", shipped / "one.glb").returncode == 0
     whole = hashes(shipped)["one.glb"]
-    proc = subprocess.Popen([sys.executable, "-m", "fishgen", "batch", str(manifest), "-j", "2"], cwd=ROOT,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and proc.poll() is None:  # until a few jobs are recorded
-        try:
-            if len(record(out)) >= 5:
-                break
-        except (OSError, ValueError):
-            pass
-        time.sleep(0.01)
+    proc = start_batch_until_recorded(manifest, out)
     assert proc.poll() is None, "the batch finished before it could be interrupted"
     proc.send_signal(signum)
     stdout, stderr = proc.communicate(timeout=60)
@@ -135,16 +142,7 @@ def helper(pid: int, batch_pid: int) -> bool:
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers through /proc")
 def test_a_killed_worker_is_replaced_and_its_jobs_are_tried_again(shipped):
     manifest, out = many_builds(shipped, 120)
-    proc = subprocess.Popen([sys.executable, "-m", "fishgen", "batch", str(manifest), "-j", "2"], cwd=ROOT,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and proc.poll() is None:
-        try:
-            if len(record(out)) >= 5:
-                break
-        except (OSError, ValueError):
-            pass
-        time.sleep(0.01)
+    proc = start_batch_until_recorded(manifest, out)
     workers = [pid for pid in descendants(proc.pid) if not helper(pid, proc.pid)]
     assert workers, "no worker found"
     os.kill(workers[0], signal.SIGKILL)

@@ -449,17 +449,9 @@ def test_scale_zero_and_scale_animated_to_zero_load_and_pose(tmp_path):
     assert np.allclose(pose(scene, 1.0).world[0][:3, :3], 0)
 
 
-@pytest.fixture(scope="module")
-def gl():
-    try:
-        import moderngl
-
-        moderngl.create_context(standalone=True, backend="egl").release()
-    except Exception as err:  # noqa: BLE001 - any failure means no context
-        pytest.fail(f"no headless OpenGL: install libegl1 libegl-mesa0 libgl1-mesa-dri ({err})")
 
 
-@pytest.mark.usefixtures("gl")
+@pytest.mark.usefixtures("gl_available")
 @pytest.mark.parametrize("case", ["scale zero", "scale animated to zero"])
 def test_cli_renders_zero_scale(tmp_path, case):
     doc = Doc()
@@ -476,7 +468,7 @@ def test_cli_renders_zero_scale(tmp_path, case):
         assert result.returncode == 0 and out.is_file(), result.stderr
 
 
-@pytest.mark.usefixtures("gl")
+@pytest.mark.usefixtures("gl_available")
 def test_cli_reports_a_hostile_glb_in_one_line(tmp_path):
     doc = Doc()
     doc.d["accessors"][doc.pos]["count"] = 10**8
