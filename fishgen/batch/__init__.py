@@ -83,7 +83,8 @@ def run_batch(manifest: Manifest, *, workers: int = 1, force: bool = False, fail
             return fail_fast and result.status == "failed"
 
         try:
-            run_jobs([job for job, _ in todo], done, workers=workers, scheduler=scheduler)
+            run_jobs([job for job, _ in todo], done, workers=workers, scheduler=scheduler,
+                     fail_fast=fail_fast)
         finally:
             # once, durably, however the run ended; an unreadable record is replaced once this run
             # has something to put in its place (it started empty)

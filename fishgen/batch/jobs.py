@@ -138,6 +138,7 @@ RUNNERS = {"build": _build, "school": _school, "clouds": _clouds}
 
 _busy = False    # a local pool worker is running a job (its SIGTERM must unwind the atomic writer)
 _orphan = False  # the batch that started this worker is gone (killed with SIGKILL)
+_failed: Any = None  # the pool's Event: a job failed under --fail-fast, start no other
 
 
 class Stopped(BaseException):
@@ -150,12 +151,16 @@ def _stop(signum: int, _frame: object) -> None:
     os._exit(128 + signum)  # idle: nothing to clean up, and no traceback from the pool's loop
 
 
-def init_worker(batch_pid: int) -> None:
+def init_worker(batch_pid: int, failed: Any = None) -> None:
     """A local pool's worker: SIGTERM stops it cleanly; Ctrl-C is the parent's to handle (it stops
     the workers itself, so the terminal's SIGINT to the whole group is ignored here); and when
-    the batch itself is killed, the worker finishes the file it is writing and exits."""
+    the batch itself is killed, the worker finishes the file it is writing and exits. ``failed``
+    is the pool's multiprocessing Event for --fail-fast."""
     import signal
     import threading
+
+    global _failed
+    _failed = failed
 
     signal.signal(signal.SIGTERM, _stop)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -190,15 +195,26 @@ def _alive(pid: int) -> bool:
         return True
 
 
-def run_in_worker(job: Job) -> Result:
-    """:func:`run_job` in a local pool worker, which exits once a SIGTERM has unwound the job."""
+def run_in_worker(jobs: tuple[Job, ...], fail_fast: bool = False) -> list[Result]:
+    """:func:`run_job` for a chunk of jobs in a local pool worker, which exits once a SIGTERM has
+    unwound the job. Under ``fail_fast`` the chunk stops at a failed job, and at the next job once
+    any worker's job failed: the results are then fewer than the jobs."""
     global _busy
+    results: list[Result] = []
     _busy = True
     try:
-        return run_job(job)
+        for job in jobs:
+            if _failed is not None and _failed.is_set():
+                break
+            results.append(run_job(job))
+            if _orphan:  # nobody is waiting for the results; the outputs are whole either way
+                os._exit(1)
+            if fail_fast and results[-1].status == "failed":
+                if _failed is not None:
+                    _failed.set()
+                break
+        return results
     except Stopped as stop:
         os._exit(stop.args[0])
     finally:
         _busy = False
-        if _orphan:  # nobody is waiting for the result; the output is whole either way
-            os._exit(1)

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from fishgen.batch.runner import MAX_CHUNK, chunk_size
 from tests.batch.conftest import batch, hashes, record, statuses
 from tests.conftest import ROOT, run_cli
 
@@ -59,6 +60,51 @@ def test_fail_fast_starts_nothing_after_the_first_failure(shipped):
     run = batch(manifest, "-j", "1", "--fail-fast")
     assert run.returncode == 2 and "2 not run" in run.stdout
     assert not out.joinpath("good.glb").exists()
+
+
+def test_fail_fast_with_a_pool_stops_every_worker_at_its_next_job(shipped):
+    manifest, out = bad_and_good(shipped)
+    manifest.write_text(manifest.read_text() + "".join(
+        f'[[build]]\ninput = "bonybream.txt"\noutput = "more{i:02d}.glb"\n' for i in range(40)))
+    run = batch(manifest, "-j", "2", "--fail-fast")
+    assert run.returncode == 2
+    built = statuses(run.stdout)
+    # the bad job is the first of the first chunk: the other worker finishes the job it is on
+    assert len(built) <= 4 and f"{43 - 1 - len(built)} not run" in run.stdout
+
+
+@pytest.mark.parametrize("jobs,workers", [(100, 2), (1000, 8), (7, 2), (3, 4)])
+def test_a_pool_hands_out_chunks_that_shrink_to_single_jobs_at_the_end(jobs, workers):
+    sizes, left = [], jobs
+    while left:
+        sizes.append(chunk_size(left, workers))
+        left -= sizes[-1]
+    assert sum(sizes) == jobs and max(sizes) <= MAX_CHUNK and sizes == sorted(sizes, reverse=True)
+    assert sizes[-2 * workers:] == [1] * min(2 * workers, len(sizes))  # the workers finish together
+    if jobs >= 100:
+        assert len(sizes) <= jobs / 3  # a round trip per chunk, not per job
+
+
+@pytest.mark.parametrize("kind", ["build", "school", "clouds"])
+def test_a_worker_starts_with_every_module_its_jobs_import(shipped, kind):
+    """What the pool imports before it forks (or its forkserver preloads) is all a job needs:
+    no worker imports fishgen, numpy, Pillow or scipy itself."""
+    code = f"""
+import importlib, sys
+from pathlib import Path
+from fishgen.batch.manifest import load_manifest
+from fishgen.batch.runner import preload
+from fishgen.batch.jobs import run_job
+job = next(j for j in load_manifest(Path("assets.toml")).jobs if j.kind == {kind!r})
+for module in preload({{{kind!r}}}):
+    importlib.import_module(module)
+before = set(sys.modules)
+assert run_job(job).status == "built"
+print(sorted(m for m in set(sys.modules) - before if m.split(".")[0] in ("fishgen", "numpy", "PIL", "scipy")))
+"""
+    run = subprocess.run([sys.executable, "-c", code], cwd=shipped / "params", capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip() == "[]"
 
 
 def many_builds(shipped, count: int):
