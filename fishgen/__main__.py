@@ -1,3 +1,3 @@
-from fishgen.cli import main
+from fishgen.cli import run
 
-main()
+run()

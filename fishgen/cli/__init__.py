@@ -5,9 +5,12 @@ Subcommands live in their own modules and are imported only when invoked, so
 """
 from __future__ import annotations
 
+import atexit
 import importlib
+import os
 import signal
 import sys
+import threading
 
 import click
 
@@ -113,6 +116,35 @@ def main(argv: list[str] | None = None) -> None:
         _fail("fishgen: interrupted", err.status if isinstance(err, Interrupted) else 130, kind="interrupted")
     except OSError as err:
         _fail(f"fishgen: {err.filename or ''}: {err.strerror or err}", 1, err.filename, kind="os")
+
+
+def run() -> None:
+    """The `fishgen` command (console script and ``python -m fishgen``): :func:`main`, then an exit
+    that does not tear the interpreter down.
+
+    Freeing every loaded module's objects one by one took 25 ms after a build (a tenth of it) and
+    50 ms after a batch's pool, with nothing left to gain: every file fishgen writes is closed and
+    renamed into place before :func:`main` returns. The exit handlers still run and the standard
+    streams are flushed; with another thread still running, Python exits as usual and waits for it.
+    """
+    try:
+        main()
+        status = 0
+    except SystemExit as stop:
+        if stop.code is None or isinstance(stop.code, int):
+            status = stop.code or 0
+        else:
+            print(stop.code, file=sys.stderr)
+            status = 1
+    if threading.active_count() > 1:
+        sys.exit(status)
+    atexit._run_exitfuncs()
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except (OSError, ValueError):  # a reader that went away (`fishgen ... | head`): nothing to add
+        pass
+    os._exit(status)
 
 
 def _fail(message: str, status: int, file: str | None = None, line: int | None = None,
