@@ -139,13 +139,18 @@ class atomic_open:
 
     def __enter__(self) -> BinaryIO:
         _check_target(self.path)
+        self._tmp = None
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             fd, self._tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp",
                                              dir=self.path.parent)
-        except OSError as err:
-            raise _fail(self.path, err) from None
-        self._handle = os.fdopen(fd, "wb")
+            self._handle = os.fdopen(fd, "wb")
+        except BaseException as err:  # also SIGTERM or Ctrl-C before the `with` body: no temp file left
+            if self._tmp is not None:
+                _discard(self._tmp)
+            if isinstance(err, OSError):
+                raise _fail(self.path, err) from None
+            raise
         return self._handle
 
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,

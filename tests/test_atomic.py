@@ -63,3 +63,14 @@ def test_streaming_writer_discards_on_error(tmp_path):
             handle.write(b"partial")
             raise RuntimeError("interrupted")
     assert target.read_bytes() == b"good" and leftovers(tmp_path) == []
+
+
+def test_streaming_writer_interrupted_while_opening_leaves_no_temp_file(tmp_path, monkeypatch):
+    def interrupted(*args, **kwargs):  # SIGTERM in a batch worker raises at any line
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(os, "fdopen", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        with atomic_open(tmp_path / "fish.glb"):
+            pass
+    assert list(tmp_path.iterdir()) == []

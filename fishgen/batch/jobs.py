@@ -138,7 +138,7 @@ RUNNERS = {"build": _build, "school": _school, "clouds": _clouds}
 
 _busy = False    # a local pool worker is running a job (its SIGTERM must unwind the atomic writer)
 _orphan = False  # the batch that started this worker is gone (killed with SIGKILL)
-_failed: Any = None  # the pool's Event: a job failed under --fail-fast, start no other
+_failed: Any = None  # the pool's shared byte: 1 once a job failed under --fail-fast, start no other
 
 
 class Stopped(BaseException):
@@ -155,7 +155,7 @@ def init_worker(batch_pid: int, failed: Any = None) -> None:
     """A local pool's worker: SIGTERM stops it cleanly; Ctrl-C is the parent's to handle (it stops
     the workers itself, so the terminal's SIGINT to the whole group is ignored here); and when
     the batch itself is killed, the worker finishes the file it is writing and exits. ``failed``
-    is the pool's multiprocessing Event for --fail-fast."""
+    is the pool's shared byte for --fail-fast (a RawValue: no lock a killed worker could hold)."""
     import signal
     import threading
 
@@ -204,17 +204,19 @@ def run_in_worker(jobs: tuple[Job, ...], fail_fast: bool = False) -> list[Result
     _busy = True
     try:
         for job in jobs:
-            if _failed is not None and _failed.is_set():
+            if _failed is not None and _failed.value:
                 break
             results.append(run_job(job))
             if _orphan:  # nobody is waiting for the results; the outputs are whole either way
                 os._exit(1)
             if fail_fast and results[-1].status == "failed":
                 if _failed is not None:
-                    _failed.set()
+                    _failed.value = 1
                 break
         return results
     except Stopped as stop:
         os._exit(stop.args[0])
     finally:
         _busy = False
+        if _orphan:  # the watcher saw the batch die while this worker was busy
+            os._exit(1)

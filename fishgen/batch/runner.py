@@ -3,8 +3,9 @@
 Every runner hands each finished job's :class:`~fishgen.batch.jobs.Result` to ``done`` in the
 calling thread as it finishes (a local pool's, as its chunk finishes), so the record is updated
 as the batch goes. On Ctrl-C or SIGTERM the local workers are stopped with SIGTERM (their atomic
-writers remove their temp files) and Dask's futures are cancelled; a worker that dies fails only
-the jobs it was running.
+writers remove their temp files) and Dask's futures are cancelled. A worker that dies breaks its
+pool: the jobs the pool held run again, each alone, and only a job that kills a worker on its own
+fails.
 """
 from __future__ import annotations
 
@@ -99,8 +100,10 @@ def chunk_size(left: int, workers: int) -> int:
 
 def _pool(jobs: Sequence[Job], done: Done, workers: int, fail_fast: bool = False) -> None:
     """A local process pool with two chunks queued per worker (a worker never waits for this
-    process to hand it the next one). A pool a dead worker broke is replaced and the jobs it held
-    are tried once more, each alone; a job that breaks a second pool fails."""
+    process to hand it the next one). A pool a dead worker broke is replaced, and the jobs it held
+    (the dead worker's, and those merely queued behind it) are suspects: each runs again alone,
+    with nothing else in flight, so a death then names its job. A job that kills a worker on its
+    own twice fails."""
     from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
     from concurrent.futures.process import BrokenProcessPool
 
@@ -108,12 +111,12 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int, fail_fast: bool = False
         os.environ.setdefault(var, "1")  # before numpy is imported: the pool is the parallelism
     pending = deque(jobs)
     context = _context({job.kind for job in jobs})
-    failed = context.Event()  # set by a worker whose job failed under --fail-fast
     stop = False
-    lost: set[str] = set()  # jobs a dead worker took down once
+    lost: set[str] = set()  # suspects: jobs a broken pool held
+    struck: set[str] = set()  # suspects that were running alone when their pool broke
 
     def next_chunk() -> tuple[Job, ...]:
-        if pending[0].name in lost:  # tried again alone: a second death then names its job
+        if pending[0].name in lost:
             return (pending.popleft(),)
         chunk = [pending.popleft()]
         size = chunk_size(len(pending) + 1, workers)
@@ -121,14 +124,23 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int, fail_fast: bool = False
             chunk.append(pending.popleft())
         return tuple(chunk)
 
+    def suspect_alone(running: dict) -> bool:
+        """A suspect runs with nothing else in flight, and waits until nothing is."""
+        return bool(running) and (pending[0].name in lost or any(
+            chunk[0].name in lost for chunk in running.values()))
+
     while pending and not stop:
+        # per pool: a worker of a broken pool may have set it before its failed job's result came
+        # back; that job runs again in the next pool, which must not start stopped
+        failed = context.RawValue("b", 0)  # a job failed under --fail-fast: start no other
         pool = ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
                                    initializer=init_worker, initargs=(os.getpid(), failed))
         running: dict[Future, tuple[Job, ...]] = {}
         broken = clean = False
         try:
             while pending or running:
-                while pending and len(running) < 2 * workers and not (stop or broken):
+                while (pending and len(running) < 2 * workers
+                       and not (stop or broken or suspect_alone(running))):
                     chunk = next_chunk()
                     try:
                         running[pool.submit(run_in_worker, chunk, fail_fast)] = chunk
@@ -144,21 +156,30 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int, fail_fast: bool = False
                         results = future.result()
                     except BrokenProcessPool:
                         broken = True
-                        # tried once more, alone: perhaps only queued behind the job that died
-                        again = [job for job in chunk if job.name not in lost]
-                        lost.update(job.name for job in again)
-                        pending.extendleft(reversed(again))
-                        chunk = tuple(job for job in chunk if job not in again)
-                        results = [_failed(job, "a worker process died twice while building it (killed, "
-                                                "or out of memory)") for job in chunk]
+                        chunk, results = _broken(chunk, lost, struck, pending)
                     # a chunk cut short by --fail-fast returns fewer results: the rest were not run
                     for job, result in zip(chunk, results, strict=False):
                         stop = done(job, result) or stop
                 if stop:
-                    failed.set()  # the chunks already handed out start no further job
+                    failed.value = 1  # the chunks already handed out start no further job
             clean = True
         finally:
             _close(pool, clean)
+
+
+def _broken(chunk: tuple[Job, ...], lost: set[str], struck: set[str],
+            pending: deque[Job]) -> tuple[tuple[Job, ...], list[Result]]:
+    """The jobs of a chunk whose pool broke: what to report now (a suspect that killed a worker
+    on its own a second time), the others back at the front of the queue as suspects."""
+    if len(chunk) == 1 and chunk[0].name in lost:  # it ran alone: it killed the worker itself
+        job = chunk[0]
+        if job.name in struck:
+            return chunk, [_failed(job, "a worker process died twice while building it on its own "
+                                        "(killed, or out of memory)")]
+        struck.add(job.name)  # once more: the kill may have come from outside (an OOM killer)
+    lost.update(job.name for job in chunk)
+    pending.extendleft(reversed(chunk))
+    return (), []
 
 
 def _close(pool, clean: bool) -> None:

@@ -138,12 +138,16 @@ def run() -> None:
             status = 1
     if threading.active_count() > 1:
         sys.exit(status)
+    for signum in (signal.SIGINT, signal.SIGTERM):  # too late to interrupt: nothing is left to stop
+        if signal.getsignal(signum) is _interrupt:
+            signal.signal(signum, signal.SIG_DFL)
     atexit._run_exitfuncs()
-    try:
-        sys.stdout.flush()
-        sys.stderr.flush()
-    except (OSError, ValueError):  # a reader that went away (`fishgen ... | head`): nothing to add
-        pass
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            if stream is not None:
+                stream.flush()
+        except (OSError, ValueError):  # a reader that went away (`fishgen ... | head`): nothing to add
+            pass
     os._exit(status)
 
 

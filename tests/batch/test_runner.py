@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from fishgen.batch.jobs import Result
+from fishgen.batch.manifest import Job
 from fishgen.batch.runner import MAX_CHUNK, chunk_size
 from tests.batch.conftest import batch, hashes, record, statuses
 from tests.conftest import ROOT, run_cli
@@ -83,6 +85,80 @@ def test_a_pool_hands_out_chunks_that_shrink_to_single_jobs_at_the_end(jobs, wor
     assert sizes[-2 * workers:] == [1] * min(2 * workers, len(sizes))  # the workers finish together
     if jobs >= 100:
         assert len(sizes) <= jobs / 3  # a round trip per chunk, not per job
+
+
+class SlowToSend:
+    """A result that takes a second to pickle: its worker's failure is known to the other workers
+    (the shared --fail-fast flag) a second before it reaches the command."""
+
+    def __reduce__(self):
+        time.sleep(1.0)
+        return (str, ("slow",))
+
+
+def fake_run_job(job: Job) -> Result:
+    """Jobs named for what they do to their worker, for the pool's tests (forked workers inherit it)."""
+    import fishgen.batch.jobs as jobs
+
+    marker = job.output.with_suffix(".died")
+    if job.name.startswith("kills-always") or (job.name.startswith("kills-once") and not marker.exists()):
+        marker.touch()
+        os.kill(os.getpid(), signal.SIGKILL)
+    started = job.output.parent / "kills-on-failure.started"
+    if job.name.startswith("kills-on-failure"):  # stands for a worker lost at the wrong moment
+        started.touch()
+        waited = time.monotonic()
+        while not jobs._failed.value and time.monotonic() - waited < 0.5:
+            time.sleep(0.001)
+        os.kill(os.getpid(), signal.SIGKILL)
+    if job.name.startswith("bad"):
+        waited = time.monotonic()
+        while "slow" in job.name and not started.exists() and time.monotonic() - waited < 2:
+            time.sleep(0.001)  # fails once the other worker is on kills-on-failure
+        return Result(job.name, "failed", error={"message": "bad", "file": None, "line": None, "kind": "input"},
+                      notes=[SlowToSend()] if "slow" in job.name else [])
+    time.sleep(0.01)
+    return Result(job.name, "built")
+
+
+def fake_pool(tmp_path, monkeypatch, names: list[str], fail_fast: bool = False) -> dict[str, list]:
+    """Run fake jobs through the local pool of 2 workers; every call of `done`, by job name."""
+    import threading
+
+    import fishgen.batch.jobs as jobs
+    from fishgen.batch.runner import _pool
+
+    if threading.active_count() > 1 or not sys.platform.startswith("linux"):
+        pytest.skip("the workers must be forked to inherit the fake jobs")
+    monkeypatch.setattr(jobs, "run_job", fake_run_job)
+    reported: dict[str, list] = {}
+
+    def done(job, result) -> bool:
+        reported.setdefault(job.name, []).append((result.status, (result.error or {}).get("message")))
+        return fail_fast and result.status == "failed"
+
+    _pool([Job("build", name, (), tmp_path / f"{name}.glb") for name in names], done, 2, fail_fast)
+    return reported
+
+
+def test_a_job_that_kills_its_worker_fails_alone_and_the_jobs_queued_beside_it_are_built(tmp_path, monkeypatch):
+    names = [f"fish{i:02d}" for i in range(30)]
+    names[3:3] = ["kills-always"]
+    names[20:20] = ["kills-once"]  # an outside kill (an OOM killer) is forgiven once
+    reported = fake_pool(tmp_path, monkeypatch, names)
+    assert all(len(calls) == 1 for calls in reported.values()) and set(reported) == set(names)
+    assert reported.pop("kills-always") == [("failed", "a worker process died twice while building it on its "
+                                                         "own (killed, or out of memory)")]
+    assert {calls[0] for calls in reported.values()} == {("built", None)}
+
+
+def test_fail_fast_reports_a_failure_whose_pool_broke_before_it_came_back(tmp_path, monkeypatch):
+    # bad-slow fails and the flag is up; its worker is terminated with the broken pool before its
+    # result arrives, so it runs again in the next pool, which must not start with the flag up
+    names = ["bad-slow", "kills-on-failure"] + [f"fish{i:02d}" for i in range(8)]
+    reported = fake_pool(tmp_path, monkeypatch, names, fail_fast=True)
+    assert all(len(calls) == 1 for calls in reported.values())
+    assert [name for name, calls in reported.items() if calls[0][0] == "failed"]  # the batch fails
 
 
 @pytest.mark.parametrize("kind", ["build", "school", "clouds"])
