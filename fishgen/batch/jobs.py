@@ -138,7 +138,7 @@ RUNNERS = {"build": _build, "school": _school, "clouds": _clouds}
 
 _busy = False    # a local pool worker is running a job (its SIGTERM must unwind the atomic writer)
 _orphan = False  # the batch that started this worker is gone (killed with SIGKILL)
-_failed: Any = None  # the pool's shared byte: 1 once a job failed under --fail-fast, start no other
+_failure_flag: Any = None  # the pool's shared byte: 1 once a job failed under --fail-fast, start no other
 
 
 class Stopped(BaseException):
@@ -159,8 +159,8 @@ def init_worker(batch_pid: int, failed: Any = None) -> None:
     import signal
     import threading
 
-    global _failed
-    _failed = failed
+    global _failure_flag
+    _failure_flag = failed
 
     signal.signal(signal.SIGTERM, _stop)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -204,14 +204,14 @@ def run_in_worker(jobs: tuple[Job, ...], fail_fast: bool = False) -> list[Result
     _busy = True
     try:
         for job in jobs:
-            if _failed is not None and _failed.value:
+            if _failure_flag is not None and _failure_flag.value:
                 break
             results.append(run_job(job))
             if _orphan:  # nobody is waiting for the results; the outputs are whole either way
                 os._exit(1)
             if fail_fast and results[-1].status == "failed":
-                if _failed is not None:
-                    _failed.value = 1
+                if _failure_flag is not None:
+                    _failure_flag.value = 1
                 break
         return results
     except Stopped as stop:

@@ -30,16 +30,16 @@ Done = Callable[[Job, Result], bool]
 _PILLOW = ["PIL.Image", "PIL.ImageOps", "PIL.PngImagePlugin", "PIL.JpegImagePlugin", "PIL.BmpImagePlugin",
            "PIL.GifImagePlugin", "PIL.PpmImagePlugin"]
 _FISH = ["fishgen.assembly.fish", "fishgen.assembly.materials", "fishgen.species.parser", *_PILLOW]
-PRELOAD = {"build": ["fishgen.batch.jobs", *_FISH, "fishgen.exchange.gltf"],
-           "school": ["fishgen.batch.jobs", *_FISH, "fishgen.school", "fishgen.school.simulate",
-                      "fishgen.school.bake", "fishgen.school.scene_file", "fishgen.exchange.gltf"],
-           "clouds": ["fishgen.batch.jobs", "fishgen.clouds", "fishgen.clouds.scene", "numpy.random",
-                      "fishgen.exchange.gltf"]}
+PRELOAD = {"build": _FISH,
+           "school": [*_FISH, "fishgen.school", "fishgen.school.simulate", "fishgen.school.bake",
+                      "fishgen.school.scene_file"],
+           "clouds": ["fishgen.clouds", "fishgen.clouds.scene", "numpy.random"]}
 
 
 def preload(kinds: set[str]) -> list[str]:
     """The modules the jobs of these kinds need, in import order."""
-    return list(dict.fromkeys(m for kind in sorted(kinds) for m in PRELOAD[kind]))
+    jobs = [m for kind in sorted(kinds) for m in PRELOAD[kind]]
+    return list(dict.fromkeys(["fishgen.batch.jobs", *jobs, "fishgen.exchange.gltf"]))
 
 
 def run_jobs(jobs: Sequence[Job], done: Done, *, workers: int = 1, scheduler: str | None = None,
