@@ -40,7 +40,7 @@ MESA_BUDGET = 60.0   # seconds: a Mesa size whose steps would take longer than t
 
 def school_config(count: int, frames: int, model: str = "boids"):
     """One BonyBream-sized group in the region `fishgen school` gives it by default."""
-    from fishgen.school import DEFAULT_BOUNDS_BODY_LENGTHS
+    from fishgen.school.run import DEFAULT_BOUNDS_BODY_LENGTHS
     from fishgen.school.model import Group, SchoolConfig
 
     half = DEFAULT_BOUNDS_BODY_LENGTHS * BODY_LENGTH * max(1.0, count ** (1 / 3))

@@ -5,12 +5,27 @@
     export_cloud(cloud, "cloud.glb", billboards=True)
 
 Several files make one scene with ``merge_clouds([fill_cloud(a, offset=...), ...])``.
+The package itself imports nothing heavy (numpy stays out of ``fishgen --help``); its public
+names load their modules when first used.
 """
-from fishgen.clouds.export import FORMATS, check_output, export_cloud
-from fishgen.clouds.fill import METHODS, fill_cloud, merge_clouds
-from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, Cloud, Cube, CubeFile
-from fishgen.clouds.parser import CubeFileWarning, load_cubes, parse_cubes
+from __future__ import annotations
 
-__all__ = ["Cloud", "Cube", "CubeFile", "CubeFileWarning", "DEFAULT_MAX_PARTICLES", "FORMATS",
-           "METHODS", "check_output", "export_cloud", "fill_cloud", "load_cubes", "merge_clouds",
-           "parse_cubes"]
+import importlib
+
+_API = {
+    "FORMATS": "fishgen.clouds.export", "check_output": "fishgen.clouds.export",
+    "export_cloud": "fishgen.clouds.export",
+    "METHODS": "fishgen.clouds.fill", "fill_cloud": "fishgen.clouds.fill",
+    "merge_clouds": "fishgen.clouds.fill",
+    "DEFAULT_MAX_PARTICLES": "fishgen.clouds.model", "Cloud": "fishgen.clouds.model",
+    "Cube": "fishgen.clouds.model", "CubeFile": "fishgen.clouds.model",
+    "CubeFileWarning": "fishgen.clouds.parser", "load_cubes": "fishgen.clouds.parser",
+    "parse_cubes": "fishgen.clouds.parser",
+}
+__all__ = sorted(_API)
+
+
+def __getattr__(name: str):
+    if name in _API:
+        return getattr(importlib.import_module(_API[name]), name)
+    raise AttributeError(f"module 'fishgen.clouds' has no attribute {name!r}")
