@@ -31,7 +31,7 @@ _PILLOW = ["PIL.Image", "PIL.ImageOps", "PIL.PngImagePlugin", "PIL.JpegImagePlug
            "PIL.GifImagePlugin", "PIL.PpmImagePlugin"]
 _FISH = ["fishgen.assembly.fish", "fishgen.assembly.materials", "fishgen.species.parser", *_PILLOW]
 PRELOAD = {"build": _FISH,
-           "school": [*_FISH, "fishgen.school", "fishgen.school.simulate", "fishgen.school.bake",
+           "school": [*_FISH, "fishgen.school.run", "fishgen.school.simulate", "fishgen.school.bake",
                       "fishgen.school.scene_file"],
            "clouds": ["fishgen.clouds", "fishgen.clouds.scene", "numpy.random"]}
 
