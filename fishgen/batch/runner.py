@@ -33,7 +33,8 @@ _FISH = ["fishgen.assembly.fish", "fishgen.assembly.materials", "fishgen.species
 PRELOAD = {"build": _FISH,
            "school": [*_FISH, "fishgen.school.run", "fishgen.school.simulate", "fishgen.school.bake",
                       "fishgen.school.scene_file"],
-           "clouds": ["fishgen.clouds", "fishgen.clouds.scene", "numpy.random"]}
+           "clouds": ["fishgen.clouds.parser", "fishgen.clouds.fill", "fishgen.clouds.export", "fishgen.clouds.scene",
+                      "numpy.random"]}
 
 
 def preload(kinds: set[str]) -> list[str]:
