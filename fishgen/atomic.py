@@ -4,6 +4,10 @@ A failed or interrupted run never leaves a partial file and never clobbers a
 good one. Multi-file outputs (OBJ + MTL + textures, glTF + bin + images) are
 staged together and renamed only once every part was written; if a rename
 fails part-way, the targets already replaced get their old contents back.
+
+A command with several outputs (a school's glb, tracks, metrics and plot) writes them inside
+:func:`together`: every writer then stages, and the whole set is renamed at the end, or none of it.
+Inside :func:`protecting`, no file may be written over one of the command's inputs.
 """
 from __future__ import annotations
 
@@ -11,42 +15,93 @@ import logging
 import os
 import stat
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 from types import TracebackType
 from typing import BinaryIO, Literal, TypeVar
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, SystemFailure, UsageError, cannot
 
 #: A path type: any one of them per call (a Mapping's key type cannot widen).
 _PathT = TypeVar("_PathT", bound="str | os.PathLike[str]")
 _log = logging.getLogger("fishgen")  # `--verbose` shows each file written; silent otherwise
+_staging: ContextVar[list[tuple[str, Path]] | None] = ContextVar("fishgen_staging", default=None)
+_inputs: ContextVar[dict[tuple[int, int], str] | None] = ContextVar("fishgen_inputs", default=None)
 
 
-def _fail(target: Path, err: OSError) -> FishgenError:
-    """An OS error about a temp file or rename, reported against the user's target."""
-    reason = err.strerror or str(err)
+@contextmanager
+def together() -> Iterator[None]:
+    """Every file written inside is staged and renamed into place when the block ends without an
+    exception; otherwise none is."""
+    staged: list[tuple[str, Path]] = []
+    token = _staging.set(staged)
+    try:
+        yield
+    except BaseException:
+        for tmp, _ in staged:
+            _discard(tmp)
+        raise
+    finally:
+        _staging.reset(token)
+    _commit(staged)
+
+
+@contextmanager
+def protecting(paths: Iterable[str | os.PathLike]) -> Iterator[None]:
+    """No file written inside may be one of ``paths`` (the command's inputs), whatever its name."""
+    ids = dict(_inputs.get() or {})
+    for path in paths:
+        try:
+            info = os.stat(path)
+        except OSError:
+            continue
+        ids[(info.st_dev, info.st_ino)] = os.fspath(path)
+    token = _inputs.set(ids)
+    try:
+        yield
+    finally:
+        _inputs.reset(token)
+
+
+def _land(staged: list[tuple[str, Path]]) -> None:
+    """Rename staged files into place now, or leave them to the enclosing :func:`together`."""
+    pending = _staging.get()
+    if pending is None:
+        _commit(staged)
+    else:
+        pending.extend(staged)
+
+
+def _fail(target: Path, err: OSError) -> SystemFailure:
+    """An OS error about a temp file or rename, reported against the user's target (a full disk's
+    error names no file, so the target is always named here)."""
     if target.is_dir():
-        reason = "a folder is in the way"
-    return FishgenError(f"cannot write {target}: {reason}")
+        return SystemFailure(f"cannot write {target}: a folder is in the way", target)
+    return cannot("write", target, err)
 
 
-def _check_target(target: Path) -> None:
+def check_target(target: Path) -> None:
     """Only a missing file or a regular file may be replaced: renaming over a FIFO or a device
     node (``-o /dev/null`` run as root) would replace the special file itself."""
     if target.is_dir():
         raise FishgenError(f"expected an output file, found a folder at {target}")
     try:
-        mode = target.stat().st_mode
+        info = target.stat()
     except OSError:
         return  # nothing there (or a dangling link): the rename creates the file
-    if not stat.S_ISREG(mode):
+    if not stat.S_ISREG(info.st_mode):
         raise FishgenError("expected a regular file or no file as the output, found a device, pipe or "
                            "other special file", target)
+    same = (_inputs.get() or {}).get((info.st_dev, info.st_ino))
+    if same is not None:
+        raise UsageError(f"expected an output that is not one of the command's inputs, found "
+                         f"{os.fspath(target)!r}, which is the input {same!r}")
 
 
 def _stage(path: Path, data: bytes) -> str:
-    _check_target(path)
+    check_target(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -77,7 +132,7 @@ def write_files(files: Mapping[_PathT, bytes]) -> None:
     """Write every ``path -> bytes`` entry atomically: all of them, or none."""
     targets = [Path(p) for p in files]
     for target in targets:
-        _check_target(target)
+        check_target(target)
     staged: list[tuple[str, Path]] = []
     try:
         for target, data in zip(targets, files.values(), strict=True):
@@ -86,7 +141,7 @@ def write_files(files: Mapping[_PathT, bytes]) -> None:
         for tmp, _ in staged:
             _discard(tmp)
         raise
-    _commit(staged)
+    _land(staged)
 
 
 def _commit(staged: list[tuple[str, Path]]) -> None:
@@ -138,7 +193,7 @@ class atomic_open:
         self._handle: BinaryIO | None = None
 
     def __enter__(self) -> BinaryIO:
-        _check_target(self.path)
+        check_target(self.path)
         self._tmp = None
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -163,8 +218,11 @@ class atomic_open:
             self._handle.close()
             if exc_type is None:
                 os.chmod(self._tmp, 0o644)
-                os.replace(self._tmp, self.path)
-                _log.info("wrote %s", self.path)
+                if _staging.get() is None:
+                    os.replace(self._tmp, self.path)
+                    _log.info("wrote %s", self.path)
+                else:
+                    _land([(self._tmp, self.path)])
                 return False
         except OSError as err:
             _discard(self._tmp)
@@ -173,4 +231,8 @@ class atomic_open:
             _discard(self._tmp)
             raise
         _discard(self._tmp)
+        if isinstance(exc, OSError) and exc.filename is None:
+            # A write to the handle failed (a full disk, a file size limit): its error names no
+            # file, so say which output it was.
+            raise _fail(self.path, exc) from None
         return False

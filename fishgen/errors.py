@@ -1,15 +1,32 @@
-"""The one error type fishgen raises for bad input.
+"""The errors fishgen raises, each with the exit status of the README's table.
 
-Every message reads ``FILE:LINE: expected ..., found ...`` so that a user (or an
-editor jumping to the location) can fix the input without reading a traceback.
+Every message reads ``FILE:LINE: expected ..., found ...`` (or ``fishgen: PATH: reason`` when the
+system refused), so that a user, or an editor jumping to the location, can act without reading a
+traceback. The class says what went wrong; the CLI and ``--json`` take ``status`` and ``kind``
+from it, never from attributes set on the side.
+
+| class               | status | kind        | what went wrong                                        |
+|---------------------|-------:|-------------|--------------------------------------------------------|
+| FishgenError        | 2      | input       | bad input, or an impossible request                     |
+| UsageError          | 2      | usage       | a bad command line (an option's value, a missing -o)   |
+| SystemFailure       | 1      | os          | a file could not be read or written for a reason       |
+|                     |        |             | outside the input (a full disk, a write refused, a     |
+|                     |        |             | port taken, a scheduler out of reach)                  |
+| MissingDependency   | 1      | dependency  | an optional package is not installed                   |
+| JobsFailed          | 2 or 1 | jobs        | batch jobs failed: 2 if any on bad input, else 1       |
 """
 from __future__ import annotations
 
+import copy
 import os
 
 
 class FishgenError(Exception):
-    """Bad input or an impossible request, reported without a traceback."""
+    """Bad input or an impossible request, reported without a traceback (exit status 2)."""
+
+    status = 2
+    kind = "input"
+    job: str | None = None   # the batch job it failed, when it is a job's error
 
     def __init__(self, message: str, file: str | os.PathLike | None = None,
                  line: int | None = None):
@@ -18,16 +35,73 @@ class FishgenError(Exception):
         self.line = line
         super().__init__(str(self))
 
+    def of_job(self, name: str) -> FishgenError:
+        """This error as batch job ``name``'s: the job is named in the message unless a
+        ``FILE:LINE`` already says where."""
+        clone = copy.copy(self)
+        clone.job = name
+        if self.file is None:
+            clone.message = f"{name}: {self.message}"
+        clone.args = (str(clone),)
+        return clone
+
     def __str__(self) -> str:
         where = ""
         if self.file is not None:
             where = f"{self.file}:{self.line}: " if self.line is not None else f"{self.file}: "
         return where + self.message
 
+    def __reduce__(self):  # pickled across batch workers with its message, place and class intact
+        return (type(self), (self.message, self.file, self.line))
+
+
+class UsageError(FishgenError):
+    """A bad command line: an option's value, or options that cannot go together (status 2)."""
+
+    kind = "usage"
+
+
+class SystemFailure(FishgenError):
+    """The system refused, not the input: a full disk, a write refused, a port already in use, an
+    unreachable scheduler (status 1). The message names the path or the resource."""
+
+    status = 1
+    kind = "os"
+
+    def __str__(self) -> str:  # the path is in the message ("cannot write PATH: reason")
+        return self.message
+
+
+class MissingDependency(FishgenError):
+    """An optional package a feature needs is not installed (status 1); says what to install."""
+
+    status = 1
+    kind = "dependency"
+
+
+class JobsFailed(FishgenError):
+    """Some of a batch's jobs failed: status 2 when any failed on bad input, else 1 (a pipeline
+    can then retry only the others)."""
+
+    kind = "jobs"
+
+    def __init__(self, message: str, any_input: bool):
+        super().__init__(message)
+        self.status = 2 if any_input else 1
+
+    def __reduce__(self):
+        return (type(self), (self.message, self.status == 2))
+
 
 def expected(what: str, found: str, file=None, line=None) -> FishgenError:
     """Build the canonical ``expected X, found Y`` error."""
     return FishgenError(f"expected {what}, found {found}", file, line)
+
+
+def cannot(action: str, path: str | os.PathLike, err: OSError) -> SystemFailure:
+    """An OS error while reading or writing ``path``, with the path always named (a full disk's
+    ``OSError`` carries none)."""
+    return SystemFailure(f"cannot {action} {os.fspath(path)}: {err.strerror or err}", path)
 
 
 def describe(token: str, limit: int = 40) -> str:
