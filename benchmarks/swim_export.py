@@ -178,7 +178,7 @@ def fin_gap(scene: Scene, samples: int = 49) -> float:
     body = next(i for i in drawn if names[i] == "body")
     fins = [i for i in drawn if names[i] != "body"][:8]
     lo, hi = bounds(scene)
-    length = float(scene.info.get("body_length", hi[2] - lo[2]))
+    length = float(hi[2] - lo[2])
     rest = pose(scene)
     rest_body = trimesh.Trimesh(deformed(scene, body, drawn[body], rest)[0], drawn[body].indices, process=False)
     touching = {}

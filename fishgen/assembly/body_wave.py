@@ -63,7 +63,6 @@ def add_wave_targets(scene: Scene, wave: BodyWave) -> bool:
             shifts = wave_targets((nose - z) / length, wave) * length        # (4, n) metres
             prim.targets = [{"POSITION": (shift[:, None] * lateral).astype(np.float32)} for shift in shifts]
         mesh.weights = [0.0] * TARGETS
-    scene.info["body_length"] = length
     return True
 
 

@@ -9,6 +9,8 @@ drives their weights (:mod:`fishgen.assembly.body_wave`).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from fishgen.assembly.animation import MAX_CLIP_FRAMES, FinMotion, axis_rotation_quaternions, clip_frames
@@ -42,12 +44,37 @@ THESIS_TO_GLTF = np.array([[0.0, 0.0, 1.0],
                            [-1.0, 0.0, 0.0]])
 
 
+@dataclass(frozen=True)
+class FishFacts:
+    """What the builder knows about the fish it built, so that nobody measures it again."""
+
+    name: str
+    body_length: float           # nose to tail-fin tip in metres, at rest (the scene's extent along Z)
+    fin_mode: str                # blend | mask | opaque
+    swim: str                    # body | fins
+    fps: float
+    speed: float                 # cruising speed of the swim loop, body lengths per second
+    tail_beat_hz: float | None   # the body wave's frequency; None without a body wave
+    clip_seconds: float | None   # the swim loop's length; None when nothing moves
+
+
+@dataclass(frozen=True)
+class Fish:
+    scene: Scene
+    facts: FishFacts
 
 
 def build_fish(species: Species, *, fins: str | None = None, length: float | None = None,
                fps: float = 30.0, swim: str = "body", speed: float = DEFAULT_SPEED,
                wave: BodyWave | None = None) -> Scene:
-    """Build the fish of ``species``.
+    """The scene of :func:`make_fish` (the library's one-line way to a fish)."""
+    return make_fish(species, fins=fins, length=length, fps=fps, swim=swim, speed=speed, wave=wave).scene
+
+
+def make_fish(species: Species, *, fins: str | None = None, length: float | None = None,
+              fps: float = 30.0, swim: str = "body", speed: float = DEFAULT_SPEED,
+              wave: BodyWave | None = None) -> Fish:
+    """Build the fish of ``species``, and say what was built.
 
     ``fins``: ``blend``, ``mask`` or ``opaque`` (default: ``mask`` when the file
     says masked and the fish is textured, else ``blend``). ``length``: nose-to-tail
@@ -88,6 +115,8 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
     # Scaled thesis space -> glTF axes in metres, centred on the body's middle.
     nose_to_tail = max(float(body.mesh.positions[:, 0].max()),
                        *(float(f.mesh.positions[:, 0].max()) for f in fin_list))
+    foremost = min(float(body.mesh.positions[:, 0].min()),
+                   *(float(f.mesh.positions[:, 0].min()) for f in fin_list))
     metres = (length / nose_to_tail) if length is not None else (
         species.world_scale * METRES_PER_WORLD_UNIT)
     centre = np.array([0.5 * species.scale[0], 0.0, 0.0])
@@ -95,7 +124,7 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
     def place(points: np.ndarray) -> np.ndarray:
         return (points - centre) @ THESIS_TO_GLTF.T * metres
 
-    scene = Scene(name=species.name, info={"fin_mode": mode, "kind": "fish"})
+    scene = Scene(name=species.name)
     root = scene.add_node(Node(name=species.name))
     skin = load_textures(species, mode)
     texture = scene.add_image(Image("skin", skin["skin"])) if "skin" in skin else None
@@ -144,33 +173,35 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
                            species.source, species.line_of(slowest.split("_")[0]))
     if swim == "body" and frames:
         frames *= loop_laps(wave, speed, frames / fps, MAX_CLIP_FRAMES // frames)
-    channels = []
+    channels: list[Channel] = []
     for node, _, motion, axis in motions:
         keys, angles = motion.keys(frames)
         quaternions = axis_rotation_quaternions(angles, axis).astype(np.float32)
         channels.append(Channel(node, "rotation", Sampler((keys / fps).astype(np.float32), quaternions)))
+    frequency = None
     if swim == "body":
-        channels += _body_wave(scene, wave, speed, frames / fps if frames else None)
+        waved, frequency = _body_wave(scene, wave, speed, frames / fps if frames else None)
+        channels += waved
     if channels:
         scene.clips.append(Clip("swim", channels))
-    scene.info["fps"] = float(fps)
-    scene.info["swim"] = swim
-    return scene
+    clip = scene.clip("swim")
+    facts = FishFacts(species.name, (nose_to_tail - foremost) * metres, mode, swim, float(fps), float(speed),
+                      frequency, clip.duration if clip is not None else None)
+    return Fish(scene, facts)
 
 
-def _body_wave(scene: Scene, wave: BodyWave, speed: float, clip_seconds: float | None) -> list[Channel]:
-    """Wave targets on every part and the weights channels of a seamless loop: a whole number of
-    beats in the fins' loop, or one beat when no fin moves."""
+def _body_wave(scene: Scene, wave: BodyWave, speed: float,
+               clip_seconds: float | None) -> tuple[list[Channel], float | None]:
+    """Wave targets on every part and the weights channels of a seamless loop (a whole number of
+    beats in the fins' loop, or one beat when no fin moves), and the tail-beat frequency."""
     if not add_wave_targets(scene, wave):
-        return []
+        return [], None
     seconds = clip_seconds if clip_seconds else 1.0 / float(wave.frequency(speed))
     beats, frequency = loop_beats(wave, speed, seconds)
-    scene.info["tail_beat_hz"] = frequency
-    scene.info["swim_speed"] = speed
-    return wave_channels(scene, weight_sampler(*loop_keys(beats, frequency)))
+    return wave_channels(scene, weight_sampler(*loop_keys(beats, frequency))), float(frequency)
 
 
-def species_scene(path, *, textures_dir=None, **_) -> Scene:
+def species_scene(path, *, textures_dir=None) -> Scene:
     """The fish a species file builds with default options (the registry's species reader)."""
     from fishgen.species.parser import load_species
 

@@ -30,7 +30,7 @@ _QUAD = np.array([[0, 1, 2], [0, 2, 3]], np.uint32)
 
 
 def cloud_scene(cloud: Cloud, *, billboards: bool = False, name: str = "cloud") -> Scene:
-    scene = Scene(name=name, info={"kind": "cloud", "particles": len(cloud)})
+    scene = Scene(name=name)
     prim = _billboards(cloud, scene) if billboards else _points(cloud)
     mesh = scene.add_mesh(Mesh(name, [prim]))
     scene.add_node(Node(name=name, mesh=mesh))
@@ -66,12 +66,12 @@ PREVIEW_PARTICLES = 100_000
 about 2.5 s, and a 46-byte file of 2x10^7 particles took 6.6 GB and 42 s before this cap."""
 
 
-def cube_file_scene(path: str | os.PathLike, *, seed: int = 0, most: int = PREVIEW_PARTICLES, **_) -> Scene:
+def cube_file_scene(path: str | os.PathLike, *, seed: int = 0, most: int = PREVIEW_PARTICLES) -> Scene:
     """A cube file filled as `fishgen clouds` fills it, as points (what the preview draws).
 
     A file of more than ``most`` particles is filled with every cube's count
     scaled down alike (its shape and density pattern kept), and the scene's
-    ``info["note"]`` says so.
+    ``note`` says so.
     """
     from dataclasses import replace
     from pathlib import Path
@@ -88,5 +88,5 @@ def cube_file_scene(path: str | os.PathLike, *, seed: int = 0, most: int = PREVI
         note = f"{path}: previewing {cubes.total:,} of its {whole:,} particles"
     scene = cloud_scene(fill_cloud(cubes, seed=seed), name=Path(path).stem)
     if note:
-        scene.info["note"] = note
+        scene.note = note
     return scene

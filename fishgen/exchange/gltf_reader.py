@@ -80,7 +80,7 @@ _IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
 
 
 def read_gltf(path: str | Path | None = None, *, data: bytes | None = None,
-              label: str | None = None, **_) -> Scene:
+              label: str | None = None) -> Scene:
     """Load a .glb/.gltf file (or GLB ``data``) as a Scene; bad files raise FishgenError."""
     where = str(path) if path is not None else "<glb>"
     try:
@@ -805,7 +805,7 @@ class _Reader:
 
     def scene(self, label: str) -> Scene:
         lists = self.lists
-        scene = Scene(name=label, info={"source": self.where})
+        scene = Scene(name=label, source=self.where)
         for k, m in enumerate(lists["meshes"]):
             prims = [self.primitive(p, f"meshes[{k}].primitives[{j}]") for j, p in enumerate(m["primitives"])]
             scene.meshes.append(Mesh(_name(m, f"mesh{k}"), [p for p in prims if p is not None],

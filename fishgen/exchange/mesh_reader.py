@@ -41,7 +41,7 @@ _PLY_SIZES = {"char": 1, "uchar": 1, "int8": 1, "uint8": 1, "short": 2, "ushort"
               "double": 8, "float64": 8}
 
 
-def read_mesh_file(path: str | Path, **_) -> Scene:
+def read_mesh_file(path: str | Path) -> Scene:
     """Load an .obj or .ply file as a Scene; unreadable files raise FishgenError.
 
     The whole read is guarded, not only trimesh's parse: a face index past the
@@ -93,7 +93,7 @@ def _read(path: Path) -> Scene:
         _check_ply_header(path)
         loaded = trimesh.load(str(path), process=False, resolver=resolver)
     geoms = loaded.dump(concatenate=False) if isinstance(loaded, trimesh.Scene) else [loaded]
-    scene = Scene(name=path.stem, info={"source": str(path)})
+    scene = Scene(name=path.stem, source=str(path))
     for k, geom in enumerate(geoms):
         if isinstance(geom, trimesh.PointCloud):
             prim = _points(geom, path)

@@ -51,7 +51,7 @@ class PreviewOptions:
     columns: int | None = None
     clip: str | None = None
     seed: int = 0
-    textures_dir: str | None = None
+    textures_dir: str | os.PathLike | None = None
     ortho: bool = False                # orthographic camera (no perspective)
 
 
@@ -65,17 +65,15 @@ def parse_size(text: str) -> tuple[int, int]:
 
 def parse_background(text: str) -> tuple[int, int, int, int]:
     """A CSS colour (``#8cadcc``, ``#rrggbbaa``, ``white``) or ``transparent``."""
-    from PIL import ImageColor
+    import click
 
-    if text.strip().lower() in ("transparent", "none"):
-        return (0, 0, 0, 0)
+    from fishgen.options import Colour
+
     try:
-        rgba = ImageColor.getcolor(text.strip(), "RGBA")
-    except ValueError:
+        return Colour().convert(text, None, None)
+    except click.BadParameter:
         raise FishgenError(f"expected --background as a colour (#8cadcc, white) or transparent, "
                            f"found {text!r}") from None
-    r, g, b, a = rgba if isinstance(rgba, tuple) else (rgba, rgba, rgba, 255)
-    return int(r), int(g), int(b), int(a)
 
 
 def check_output(out: Path, options: PreviewOptions, inputs: int = 1) -> int:
@@ -182,7 +180,7 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
         if options.clip is not None and scene.clips and scene.clip(options.clip) is None:
             names = ", ".join(a.name for a in scene.clips)
             raise FishgenError(f"expected --clip to name one of {names}, found {options.clip!r}",
-                               str(scene.info.get("source", scene.name)))
+                               scene.source or scene.name)
     renderer = Renderer(options.width, options.height)
     r, g, b, a = (c / 255.0 for c in options.background)
     bg = (r, g, b, a)
@@ -259,8 +257,8 @@ def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options
     frames = check_output(out, options, len(inputs))
     scenes = [load_input(p, textures_dir=options.textures_dir, seed=options.seed) for p in inputs]
     for scene in scenes:  # e.g. a cloud previewed with fewer particles than it holds
-        if on_note and "note" in scene.info:
-            on_note(str(scene.info["note"]))
+        if on_note and scene.note:
+            on_note(scene.note)
     if on_loaded:
         on_loaded(len(scenes) * frames)
     per_scene, step = render_frames(scenes, options, frames, progress)

@@ -185,7 +185,7 @@ class Renderer:
             try:
                 img = np.ascontiguousarray(scene.images[index].rgba())
             except Exception as err:  # Pillow raises anything from OSError to SyntaxError
-                source = scene.info.get("source")  # a path string when the scene was read from a file
+                source = scene.source  # a path string when the scene was read from a file
                 raise FishgenError(f"expected a readable texture image, found {scene.images[index].name!r} "
                                    f"damaged ({type(err).__name__})",
                                    source if isinstance(source, str) else None) from None

@@ -161,8 +161,10 @@ class Clip:
 
 @dataclass
 class Scene:
-    """A whole asset. ``roots`` are the top-level nodes; ``info`` carries summary facts
-    (``fin_mode`` of a fish, ``source`` of a reader) that writers may ignore."""
+    """A whole asset. ``roots`` are the top-level nodes. ``source`` is the file a reader read it
+    from, and ``note`` what a reader wants the user told (a subsampled cloud); writers ignore both.
+    What a builder knows about what it built travels beside the scene, typed
+    (:class:`fishgen.assembly.fish.FishFacts`), never inside it."""
 
     name: str = ""
     nodes: list[Node] = field(default_factory=list)
@@ -172,7 +174,8 @@ class Scene:
     images: list[Image] = field(default_factory=list)
     skins: list[Skin] = field(default_factory=list)
     clips: list[Clip] = field(default_factory=list)
-    info: dict[str, str | float | int] = field(default_factory=dict)
+    source: str | None = None
+    note: str | None = None
 
     # -- building ------------------------------------------------------------------
     def add_node(self, node: Node, parent: int | None = None) -> int:

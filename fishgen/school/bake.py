@@ -99,7 +99,7 @@ def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, 
 
     ``wave``: the body wave the species were built with (default :class:`BodyWave`); it drives
     the species whose meshes carry the wave targets."""
-    school = Scene(name="school", info={"kind": "school", "fish": int(len(tracks.group))})
+    school = Scene(name="school")
     templates = [merge_species(school, fish) for fish in fish_scenes]
     swims = [fish.clip("swim") for fish in fish_scenes]
     times = np.asarray(tracks.times, np.float64)

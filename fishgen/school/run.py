@@ -23,6 +23,7 @@ class SchoolRun:
     scene: Scene
     body_lengths: np.ndarray       # (N,) metres, per fish (its species' length x its size jitter)
     species_names: list[str]
+    read: tuple[Path, ...] = ()    # the species files and the textures they named
 
     @property
     def group_lengths(self) -> list[float]:
@@ -50,21 +51,20 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
                textures_dir: str | os.PathLike | None = None,
                progress: Callable[[int], None] | None = None) -> SchoolRun:
     """Build each species once, simulate the school, and bake it into one scene."""
-    from fishgen.assembly.fish import build_fish
-    from fishgen.scene.pose import bounds
+    from fishgen.assembly.fish import make_fish
     from fishgen.school.bake import bake
     from fishgen.school.simulate import simulate
     from fishgen.species.parser import load_species
 
     fishes, groups = [], []
+    read: list[Path] = []
     for entry in scene_file.species:
         species = load_species(entry.file, textures_dir)
-        fish = build_fish(species, fins=fins, fps=scene_file.fps, swim=swim, speed=entry.speed)
-        lo, hi = bounds(fish)
-        length = float(hi[2] - lo[2])
+        read += [Path(entry.file), *species.side_files]
+        fish = make_fish(species, fins=fins, fps=scene_file.fps, swim=swim, speed=entry.speed)
         units = species.world_scale * species.scale[0]
-        fishes.append(fish)
-        groups.append(Group(Path(entry.file).stem, entry.count, length, entry.speed,
+        fishes.append(fish.scene)
+        groups.append(Group(Path(entry.file).stem, entry.count, fish.facts.body_length, entry.speed,
                             brain_of(species, units)))
     count = sum(g.count for g in groups)
     region = scene_file.bounds
@@ -79,4 +79,4 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
     tracks = simulate(config, progress=progress)
     lengths = np.array([groups[g].body_length for g in tracks.group]) * tracks.scale
     scene = bake(fishes, tracks, tolerance=tolerance, seed=scene_file.seed, body_lengths=lengths)
-    return SchoolRun(config, tracks, scene, lengths, [g.name for g in groups])
+    return SchoolRun(config, tracks, scene, lengths, [g.name for g in groups], tuple(dict.fromkeys(read)))

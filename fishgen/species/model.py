@@ -143,3 +143,8 @@ class Species:
 
     def line_of(self, record: str) -> int | None:
         return self.record_lines.get(record)
+
+    @property
+    def side_files(self) -> tuple[Path, ...]:
+        """The textures the file names (what a build reads besides the file itself)."""
+        return tuple(t for t in (self.colour_texture, self.mask_texture) if t is not None)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from fishgen.assembly.animation import FinMotion, clip_frames
-from fishgen.assembly.fish import build_fish
+from fishgen.assembly.fish import build_fish, make_fish
 from fishgen.errors import FishgenError
 from fishgen.species.parser import load_species
 from tests.conftest import PARAMS
@@ -159,13 +159,15 @@ def test_loop_length_error_points_at_the_fin_record():
 
 
 def test_with_the_body_wave_the_tail_fin_rides_the_wave_and_the_loop_closes(bony):
-    scene = build_fish(bony, fps=30)
+    fish = make_fish(bony, fps=30)
+    scene = fish.scene
     assert "caudal_fin" not in swim_channels(scene)          # its swing is the wave's (decisions.md)
     clip = scene.clip("swim")
-    beats = clip.duration * scene.info["tail_beat_hz"]
+    assert fish.facts.clip_seconds == clip.duration
+    beats = clip.duration * fish.facts.tail_beat_hz
     laps = clip.duration / 1.6                                # fin loop: pelvic 24, pectoral 16 frames
     assert beats == pytest.approx(round(beats), abs=1e-5) and laps == pytest.approx(round(laps), abs=1e-5)
-    assert scene.info["tail_beat_hz"] == pytest.approx(1.5, rel=0.05)   # St 0.3 at 1 body length/s
+    assert fish.facts.tail_beat_hz == pytest.approx(1.5, rel=0.05)   # St 0.3 at 1 body length/s
     for channel in clip.channels:
         assert np.allclose(channel.sampler.values[0], channel.sampler.values[-1], atol=1e-6)
         assert channel.sampler.times[-1] == pytest.approx(clip.duration)

@@ -79,12 +79,13 @@ def test_three_js_plays_the_body_wave_at_full_amplitude(matrix, three):
     """three.js's own morph code moves BonyBream's tail tip as the wave says (issue 10, within 10 %)."""
     import numpy as np
 
-    from fishgen.assembly.fish import build_fish
+    from fishgen.assembly.fish import make_fish
     from fishgen.exchange import export
     from fishgen.geometry.body_wave import BodyWave
     from fishgen.species.parser import load_species
 
-    scene = build_fish(load_species(ROOT / "params" / "bonybream.txt"))
+    fish = make_fish(load_species(ROOT / "params" / "bonybream.txt"))
+    scene = fish.scene
     export(scene, matrix.asset_dir / "wave" / "bonybream.glb")
     duration = scene.clip("swim").duration
     times = np.linspace(0.0, duration, 600, endpoint=False)
@@ -95,4 +96,4 @@ def test_three_js_plays_the_body_wave_at_full_amplitude(matrix, three):
     assert result["influences"] == 4
     assert np.ptp(lateral) == pytest.approx(wave.tail_peak_to_peak * result["length"], rel=0.10)
     upward = np.count_nonzero((lateral[:-1] < lateral.mean()) & (lateral[1:] >= lateral.mean()))
-    assert upward / duration == pytest.approx(scene.info["tail_beat_hz"], rel=0.10)
+    assert upward / duration == pytest.approx(fish.facts.tail_beat_hz, rel=0.10)
