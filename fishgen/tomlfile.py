@@ -5,6 +5,7 @@ Leaf module: no numpy, so `fishgen batch` can read its manifest on the fast no-c
 """
 from __future__ import annotations
 
+import os
 import re
 import sys
 from typing import Any
@@ -72,3 +73,29 @@ class Where:
         plain = isinstance(found, str) and found.startswith(("a ", "an ", "no "))
         shown = found if plain else describe(str(found))
         return FishgenError(f"expected {what}, found {shown}", self.file, self.line(key, table, nth))
+
+
+def _top_keys(path: str | os.PathLike) -> set[str]:
+    """The top-level keys of a small TOML file; none when it is unreadable, too big or not TOML."""
+    try:
+        with open(path, "rb") as handle:
+            data = handle.read(_SNIFF_BYTES + 1)
+        if len(data) > _SNIFF_BYTES:
+            return set()
+        return set(loads(data.decode("utf-8", errors="replace").removeprefix("\ufeff"), os.fspath(path)))
+    except (OSError, FishgenError):
+        return set()
+
+
+_SNIFF_BYTES = 16 << 20
+
+
+def is_school_scene(path: str | os.PathLike) -> bool:
+    """A school scene file names its species (``[[species]]``)."""
+    return "species" in _top_keys(path)
+
+
+def is_batch_manifest(path: str | os.PathLike) -> bool:
+    """A batch manifest lists jobs (``[[build]]``, ``[[school]]``, ``[[clouds]]``) or its ``out``."""
+    keys = _top_keys(path)
+    return "species" not in keys and bool(keys & {"build", "school", "clouds", "out"})

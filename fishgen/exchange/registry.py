@@ -7,8 +7,13 @@ all come from here. Adding a format is one module plus one ``register_format``
 call below.
 
 Writers are ``write(scene, path) -> list[Path]`` (atomic, every file written);
-readers are ``read(path) -> Scene``. Source formats (species and cube files)
-have a reader that builds the scene and name the command that makes assets from them.
+readers are ``read(path, **options) -> Scene``, taking exactly the options the format declares
+(``reads_with``). Source formats (species and cube files) have a reader that builds the scene and
+name the command that makes assets from them.
+
+An extension may belong to several formats (meshio's idea): ``.toml`` is a school scene or a
+batch manifest. Each such format declares a ``sniff`` that tells its files by their content, and
+:func:`detect` asks them.
 """
 from __future__ import annotations
 
@@ -36,22 +41,38 @@ class Format:
     reader: str | None = None
     viewer: bool = False            # the three.js viewer page can show it
     command: str | None = None      # for source formats: the command that turns them into assets
+    reads_with: tuple[str, ...] = ()  # the options its reader takes, of READER_OPTIONS
+    sniff: str | None = None        # "module:function(path) -> bool": is this file of this format?
 
     def write(self, scene, path: Path) -> list[Path]:
         return _load(self.writer)(scene, path)
 
-    def read(self, path: Path, **options):
-        return _load(self.reader)(path, **options)
+    def read(self, path: Path, **offered):
+        """Read ``path``; of the ``offered`` options (each one of READER_OPTIONS, or it is a
+        TypeError) the reader gets those it declares taking."""
+        unknown = set(offered) - set(READER_OPTIONS)
+        if unknown:
+            raise TypeError(f"no reader takes {', '.join(sorted(unknown))}")
+        return _load(self.reader)(path, **{k: v for k, v in offered.items() if k in self.reads_with})
+
+    def matches(self, path: Path) -> bool:
+        return self.sniff is None or bool(_load(self.sniff)(path))
 
 
 FORMATS: dict[str, Format] = {}
+READER_OPTIONS = ("textures_dir", "seed")
+"""What a caller may offer readers: a species file's texture folder, a cube file's fill seed."""
 
 
 def register_format(fmt: Format) -> Format:
     for ext in fmt.extensions:
-        taken = next((f.name for f in FORMATS.values() if ext in f.extensions), None)
-        if taken is not None:
-            raise ValueError(f"{ext} is already registered to {taken}")
+        shared = [f for f in FORMATS.values() if ext in f.extensions]
+        if shared and (fmt.sniff is None or any(f.sniff is None for f in shared)):
+            raise ValueError(f"{ext} is already registered to {shared[0].name}; formats that share an "
+                             "extension each need a sniff")
+    unknown = set(fmt.reads_with) - set(READER_OPTIONS)
+    if unknown:
+        raise ValueError(f"{fmt.name}: no such reader option {', '.join(sorted(unknown))}")
     FORMATS[fmt.name] = fmt
     return fmt
 
@@ -77,8 +98,22 @@ def extensions(fmts: Iterable[Format]) -> tuple[str, ...]:
 
 
 def by_extension(path: str | os.PathLike) -> Format | None:
+    """The first format registered for ``path``'s extension (the only one, unless it is shared)."""
+    return next(iter(candidates(path)), None)
+
+
+def candidates(path: str | os.PathLike) -> list[Format]:
     ext = Path(path).suffix.lower()
-    return next((f for f in FORMATS.values() if ext in f.extensions), None)
+    return [f for f in FORMATS.values() if ext in f.extensions]
+
+
+def detect(path: str | os.PathLike) -> Format | None:
+    """The format of an existing file: by extension, and by content where formats share it.
+    None when no format claims the extension, or none of the sharing formats' sniffs agree."""
+    found = candidates(path)
+    if len(found) <= 1:
+        return found[0] if found else None
+    return next((f for f in found if f.matches(Path(path))), None)
 
 
 def output_format(path: str | os.PathLike, holding: Iterable[str] = (), what: str = "output") -> Format:
@@ -109,7 +144,10 @@ def input_format(path: str | os.PathLike, *, kinds: Iterable[Format], command: s
     files are often named ``*.txt`` but need not be).
     """
     allowed = list(kinds)
-    fmt = by_extension(path)
+    found = candidates(path)
+    fmt = detect(path) if Path(path).is_file() else None
+    if fmt is None:  # no content to tell by (or no sniff agreed): the one this command reads
+        fmt = next((f for f in found if f in allowed), found[0] if found else None)
     if fmt in allowed:
         return fmt
     if fmt is not None:
@@ -118,8 +156,9 @@ def input_format(path: str | os.PathLike, *, kinds: Iterable[Format], command: s
                            f"found {fmt.description}{use}", path)
     if default is not None:
         return default
-    found = Path(path).suffix or "no extension"
-    raise FishgenError(f"expected an input ending in {', '.join(extensions(allowed))}, found {found!r}", path)
+    suffix = Path(path).suffix or "no extension"
+    raise FishgenError(f"expected an input ending in {', '.join(extensions(allowed))}, found {suffix!r}",
+                       path)
 
 
 def lost(fmt: Format, scene) -> list[str]:
@@ -148,8 +187,11 @@ register_format(Format("npy", (".npy",), "NumPy structured array of particles", 
                        "fishgen.exchange.table:write_npy"))
 register_format(Format("species", (".txt",), "a VRFish species file",
                        frozenset({MESHES, TEXTURES, NODE_ANIMATION}),
-                       reader="fishgen.assembly.fish:species_scene", command="build"))
+                       reader="fishgen.assembly.fish:species_scene", command="build",
+                       reads_with=("textures_dir",)))
 register_format(Format("school scene", (".toml",), "a school scene file", frozenset({MESHES, NODE_ANIMATION}),
-                       command="school"))
+                       command="school", sniff="fishgen.tomlfile:is_school_scene"))
+register_format(Format("batch manifest", (".toml",), "a batch manifest", command="batch",
+                       sniff="fishgen.tomlfile:is_batch_manifest"))
 register_format(Format("cubes", (".awn",), "a RekAwan cloud cube file", frozenset({POINTS}),
-                       reader="fishgen.clouds.scene:cube_file_scene", command="clouds"))
+                       reader="fishgen.clouds.scene:cube_file_scene", command="clouds", reads_with=("seed",)))

@@ -6,6 +6,7 @@ from pathlib import Path
 import pytest
 
 from fishgen.errors import FishgenError
+from tests.conftest import PARAMS
 from fishgen.exchange import export, registry
 from fishgen.exchange.registry import (FORMATS, MESHES, NODE_ANIMATION, POINTS, Format, formats,
                                        lost, output_format, register_format)
@@ -19,7 +20,7 @@ def test_every_writer_and_reader_entry_point_resolves():
 
 
 def test_cli_choices_come_from_the_registry():
-    from fishgen.cli.build import FISH_FORMATS
+    from fishgen.commands.build import FISH_FORMATS
     from fishgen.clouds.export import FORMATS as CLOUD_FORMATS
     from fishgen.viewer.page import KINDS
 
@@ -69,3 +70,30 @@ def write_xyz(scene, path: Path) -> list[Path]:
     (prim,) = scene.meshes[0].primitives
     path.write_text("".join(f"{x} {y} {z}\n" for x, y, z in prim.positions.tolist()))
     return [path]
+
+
+def test_an_extension_two_formats_share_is_told_apart_by_content(tmp_path):
+    """`.toml` is a school scene or a batch manifest (issue 19: a manifest given to `build`)."""
+    from fishgen.exchange.registry import detect
+
+    manifest, scene, broken = tmp_path / "m.toml", tmp_path / "s.toml", tmp_path / "b.toml"
+    manifest.write_text('[[build]]\ninput = "a.txt"\noutput = "a.glb"\n')
+    scene.write_text('[[species]]\nfile = "a.txt"\n')
+    broken.write_text("[[species]\n")
+    assert detect(manifest).name == "batch manifest" and detect(scene).name == "school scene"
+    assert detect(broken) is None  # then the command's own reader says where the TOML breaks
+
+
+def test_a_shared_extension_needs_a_sniff_on_every_format():
+    with pytest.raises(ValueError, match="each need a sniff"):
+        register_format(Format("toy scene", (".toml",), "a toy"))
+
+
+def test_readers_take_exactly_the_options_their_format_declares(tmp_path):
+    """No reader swallows unknown options: a mistyped one is a TypeError, not ignored."""
+    from fishgen.exchange.registry import FORMATS
+
+    with pytest.raises(TypeError, match="no reader takes sed"):
+        FORMATS["cubes"].read(PARAMS / "clouds" / "table_4_3.awn", sed=3)
+    scene = FORMATS["cubes"].read(PARAMS / "clouds" / "table_4_3.awn", seed=3, textures_dir=None)
+    assert scene.counts()["particles"] == 554
