@@ -24,22 +24,26 @@ def sample_files(seed: int, stem: str) -> dict[str, bytes]:
     return {f"{stem}.txt": text.encode(), f"{stem}.png": colour, f"{stem}_mask.png": mask}
 
 
-def write_samples(seed: int, count: int, output: Path) -> list[Path]:
+def write_samples(seed: int, count: int, output: Path, folder: bool | None = None) -> list[Path]:
+    """Write ``count`` sampled species from ``seed`` on: into the folder ``output`` when ``folder``
+    (default: when it has no extension), else as the one species file ``output``."""
     from fishgen.atomic import write_files
 
-    if count == 1 and output.suffix.lower() == ".txt":
-        folder, stems = output.parent, [_stem(output.stem)]
-    elif count == 1 and output.suffix:
-        raise FishgenError(f"expected -o to name a species file (.txt) or a folder, found {output.name!r}")
+    if folder is None:
+        folder = not output.suffix
+    if not folder:
+        if count != 1 or output.suffix.lower() != ".txt":
+            raise FishgenError(f"expected -o to name one species file (.txt) or a folder, found "
+                               f"{output.name!r}")
+        where, stems = output.parent, [_stem(output.stem)]
     else:
         if output.exists() and not output.is_dir():
-            raise FishgenError("expected a folder for --count above 1, found a file", output)
-        folder, stems = output, [f"species_{seed + k}" for k in range(count)]
+            raise FishgenError("expected a folder, found a file", output)
+        where, stems = output, [f"species_{seed + k}" for k in range(count)]
     written: list[Path] = []
     for k, stem in enumerate(stems):
-        files = {folder / name: data for name, data in sample_files(seed + k, stem).items()}
-        write_files(files)
-        written.append(folder / f"{stem}.txt")
+        write_files({where / name: data for name, data in sample_files(seed + k, stem).items()})
+        written.append(where / f"{stem}.txt")
     return written
 
 

@@ -16,7 +16,6 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from fishgen.batch.manifest import Job, Manifest
 from fishgen.batch.record import Hashes, Record, relative
@@ -36,7 +35,7 @@ class Outcome:
     seconds: float = 0.0
     inputs: dict[str, str] = field(default_factory=dict)    # out-relative path -> sha256
     outputs: dict[str, str] = field(default_factory=dict)   # out-relative path -> sha256
-    error: dict[str, Any] | None = None
+    error: FishgenError | None = None
     notes: list[str] = field(default_factory=list)
 
 

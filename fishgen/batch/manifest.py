@@ -23,39 +23,32 @@ Leaf module (no numpy): it is read on every run, including the fast run where no
 from __future__ import annotations
 
 import hashlib
-import math
 import os
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-from fishgen.assembly.fin_modes import FIN_MODES
-from fishgen.assembly.swim_modes import DEFAULT_SPEED, SWIM_MODES
+from fishgen.commands import MODULES, command
 from fishgen.errors import FishgenError
-from fishgen.exchange.registry import MESHES, NODE_ANIMATION, POINTS, output_format
+from fishgen.exchange.registry import output_format
+from fishgen.options import check_value, manifest_options
 from fishgen.tomlfile import Where, loads
 
-KINDS = ("build", "school", "clouds")
-# These mirror the library's constants without importing numpy (a test checks they agree).
-SCHOOL_MODELS = ("boids", "pso")
-CLOUD_METHODS = ("paper", "uniform")
-DEFAULT_MAX_PARTICLES = 50_000_000
+KINDS = tuple(name for name in MODULES if command(name).batch)
 MAX_MANIFEST_BYTES = 16 << 20
-#: What each kind's output must hold (the registry's words), checked when the manifest is read.
-HOLDS = {"build": [MESHES], "school": [MESHES, NODE_ANIMATION], "clouds": [POINTS]}
-SEED_LIMIT = 2**32  # seeds are 0 .. 2**32 - 1 for every kind, as `fishgen school` takes them
 
 
 @dataclass(frozen=True)
 class Job:
-    """One unit of work: a kind, its inputs, its options (every one, defaults filled) and its output."""
+    """One unit of work: a command, its inputs, its options record (every option, defaults filled)
+    and its output."""
 
     kind: str
     name: str                        # the output relative to the out folder, POSIX: the job's identity
     inputs: tuple[Path, ...]         # the files the manifest names (absolute)
     output: Path                     # absolute
-    options: Mapping[str, Any] = field(default_factory=dict)  # JSON values; folders as Path
+    options: Any = None              # the command's options record
     source: str = ""                 # the manifest (or the input of a folder scan) naming the job
     line: int | None = None          # the job's output line in its manifest
 
@@ -76,66 +69,6 @@ def derived_seed(name: str) -> int:
     """A job's seed from its identity (its output name), the same on every machine and run."""
     digest = hashlib.sha256(f"fishgen batch seed\0{name}".encode()).digest()
     return int.from_bytes(digest[:4], "big")
-
-
-# -- option checks: (value, fail) -> normalized value; ``fail(what)`` raises at the option's line ----
-
-Check = Callable[[Any, Callable[[str], FishgenError]], Any]
-
-
-def _number(low: float, high: float, whole: bool = False) -> Check:
-    def check(value: Any, fail: Callable[[str], FishgenError]) -> Any:
-        ok = isinstance(value, int) if whole else isinstance(value, (int, float))
-        if isinstance(value, bool) or not ok or not math.isfinite(value) or not low <= value <= high:
-            raise fail(f"{'a whole number' if whole else 'a number'} from {low:g} to {high:g}")
-        return int(value) if whole else float(value)
-    return check
-
-
-def _choice(choices: tuple[str, ...]) -> Check:
-    def check(value: Any, fail: Callable[[str], FishgenError]) -> Any:
-        if value not in choices:
-            raise fail(f"one of {', '.join(choices)}")
-        return value
-    return check
-
-
-def _flag(value: Any, fail: Callable[[str], FishgenError]) -> bool:
-    if not isinstance(value, bool):
-        raise fail("true or false")
-    return value
-
-
-def _folder(value: Any, fail: Callable[[str], FishgenError]) -> str:
-    if not isinstance(value, str) or not value:
-        raise fail("a folder name")
-    return value  # resolved against the manifest's folder by the caller
-
-
-def _offsets(value: Any, fail: Callable[[str], FishgenError]) -> list[list[float]]:
-    if not (isinstance(value, list) and all(isinstance(v, list) and len(v) == 3 for v in value)):
-        raise fail("a list of [x, y, z], one per input")
-    try:
-        return [[_number(-3.4e38, 3.4e38)(c, fail) for c in v] for v in value]
-    except FishgenError:
-        raise fail("a list of [x, y, z] of finite numbers within float32 range, one per input") from None
-
-
-# name -> (check, default). Names and ranges are those of the command's own options.
-OPTIONS: dict[str, dict[str, tuple[Check, Any]]] = {
-    "build": {"fins": (_choice(FIN_MODES), None), "length": (_number(0.001, 1e4), None),
-              "fps": (_number(1, 1000), 30.0), "swim": (_choice(SWIM_MODES), "body"),
-              "speed": (_number(0.01, 100), DEFAULT_SPEED), "textures": (_folder, None)},
-    "school": {"count": (_number(1, 100_000, whole=True), None),
-               "frames": (_number(2, 100_000, whole=True), None), "fps": (_number(1, 1000), None),
-               "seed": (_number(0, SEED_LIMIT - 1, whole=True), None),
-               "model": (_choice(SCHOOL_MODELS), None),
-               "tolerance": (_number(0, 1), 0.002), "fins": (_choice(FIN_MODES), None),
-               "swim": (_choice(SWIM_MODES), "body"), "textures": (_folder, None)},
-    "clouds": {"offset": (_offsets, None), "seed": (_number(0, SEED_LIMIT - 1, whole=True), None),
-               "method": (_choice(CLOUD_METHODS), "paper"), "billboards": (_flag, False),
-               "max-particles": (_number(1, 2**62, whole=True), DEFAULT_MAX_PARTICLES)},
-}
 
 
 def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None) -> Manifest:
@@ -182,7 +115,9 @@ def _job(where: Where, kind: str, nth: int, entry: dict[str, Any], folder: Path,
     def fail_at(key: str) -> Callable[[str], FishgenError]:
         return lambda what: where.fail(f"{key} as {what}", entry.get(key, "no value"), key, kind, nth)
 
-    known = {"input", "inputs", "output", *OPTIONS[kind]}
+    record = command(kind).options
+    declared = manifest_options(record)
+    known = {"input", "inputs", "output", *declared}
     for key in entry:
         if key not in known:
             raise where.fail(f"one of {', '.join(sorted(known))} in [[{kind}]]", key, key, kind, nth)
@@ -205,28 +140,29 @@ def _job(where: Where, kind: str, nth: int, entry: dict[str, Any], folder: Path,
     if relative.is_absolute() or ".." in relative.parts or relative.name in ("", "."):
         raise fail_at("output")("a file name inside the out folder (no absolute path, no ..)")
     try:
-        output_format(relative, HOLDS[kind])
+        output_format(relative, command(kind).holds)
     except FishgenError as err:
         raise FishgenError(err.message, where.file, where.line("output", kind, nth)) from None
     name = relative.as_posix()
-    options: dict[str, Any] = {}
-    for option, (check, default) in OPTIONS[kind].items():
-        value = check(entry[option], fail_at(option)) if option in entry else default
-        if option == "textures" and value is not None:
-            value = Path(os.path.abspath(folder / value))
-        options[option] = value
-    if kind == "clouds" and options["offset"] is not None and len(options["offset"]) != len(inputs):
+    values: dict[str, Any] = {}
+    for key, (f, spec) in declared.items():
+        if key in entry:
+            value = check_value(spec, entry[key], fail_at(key))
+            values[f.name] = Path(os.path.abspath(folder / value)) if spec.path else value
+    options = record(**values)
+    offsets = getattr(options, "offset", None)
+    if offsets and len(offsets) != len(inputs):
         raise fail_at("offset")(f"one [x, y, z] per input ({len(inputs)})")
-    _seed(kind, options, inputs, name)
-    return Job(kind, name, inputs, out / relative, options, where.file, where.line("output", kind, nth))
+    return Job(kind, name, inputs, out / relative, _seeded(kind, options, inputs, name), where.file,
+               where.line("output", kind, nth))
 
 
-def _seed(kind: str, options: dict[str, Any], inputs: tuple[Path, ...], name: str) -> None:
+def _seeded(kind: str, options: Any, inputs: tuple[Path, ...], name: str) -> Any:
     """Seeds come from the job's identity unless the manifest (or a school's scene file) sets one."""
-    if kind == "clouds" and options["seed"] is None:
-        options["seed"] = derived_seed(name)
-    if kind == "school" and options["seed"] is None and inputs[0].suffix.lower() != ".toml":
-        options["seed"] = derived_seed(name)
+    scene = kind == "school" and inputs[0].suffix.lower() == ".toml"
+    if getattr(options, "seed", 0) is None and not scene:
+        return replace(options, seed=derived_seed(name))
+    return options
 
 
 def scan_folder(folder: str | os.PathLike, out: str | os.PathLike) -> Manifest:
@@ -250,8 +186,7 @@ def scan_folder(folder: str | os.PathLike, out: str | os.PathLike) -> Manifest:
                 raise FishgenError(f"expected one source per output, found {seen[name].name} and {filename} "
                                    f"both making {name}", source)
             seen[name] = source
-            options = {option: default for option, (_, default) in OPTIONS[kind].items()}
-            _seed(kind, options, (source,), name)
+            options = _seeded(kind, command(kind).options(), (source,), name)
             jobs.append(Job(kind, name, (source,), out_dir / name, options, os.fspath(source)))
     if not jobs:
         raise FishgenError("expected species files (.txt) or cube files (.awn) in the folder, found none",

@@ -74,9 +74,21 @@ def _relative(path: str, base: str) -> str:
     return Path(os.path.relpath(path, base)).as_posix()
 
 
-def canonical_options(options: Mapping[str, Any], base: Path) -> dict[str, Any]:
-    """Options as JSON values: folders relative to the out folder, so keys match on any machine."""
-    return {k: relative(v, base) if isinstance(v, Path) else v for k, v in sorted(options.items())}
+def canonical_options(options: Any, base: Path) -> dict[str, Any]:
+    """The options a manifest may set, by their long names, as JSON values: folders relative to the
+    out folder, so keys match on any machine."""
+    from fishgen.options import manifest_options
+
+    return {key: _plain(getattr(options, f.name), base)
+            for key, (f, _) in sorted(manifest_options(type(options)).items())}
+
+
+def _plain(value: Any, base: Path) -> Any:
+    if isinstance(value, Path):
+        return relative(value, base)
+    if isinstance(value, (tuple, list)):
+        return [_plain(v, base) for v in value]
+    return value
 
 
 def job_key(job: Job, inputs: Mapping[str, str], base: Path) -> str:

@@ -12,6 +12,7 @@ from fishgen.atomic import write_bytes
 from fishgen.batch import STATUSES, Outcome
 from fishgen.batch.manifest import Manifest
 from fishgen.batch.record import canonical_options
+from fishgen.errors import FishgenError
 
 
 def report(manifest: Manifest, outcomes: Sequence[Outcome], seconds: float, workers: int,
@@ -45,10 +46,10 @@ def report(manifest: Manifest, outcomes: Sequence[Outcome], seconds: float, work
     }
 
 
-def _error(error: dict[str, Any] | None) -> dict[str, Any] | None:
+def _error(error: FishgenError | None) -> dict[str, Any] | None:
     if error is None:
         return None
-    return {k: error.get(k) for k in ("message", "file", "line", "kind")}
+    return {"message": str(error), "file": error.file, "line": error.line, "kind": error.kind}
 
 
 def write_report(path: str | os.PathLike, doc: dict[str, Any]) -> None:

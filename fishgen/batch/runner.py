@@ -10,15 +10,17 @@ fails.
 from __future__ import annotations
 
 import os
+import signal
 import sys
 import threading
+import time
 from collections import deque
 from collections.abc import Callable, Sequence
 
 # light: the jobs import the library only when one runs
-from fishgen.batch.jobs import Result, init_worker, run_in_worker, run_job
+from fishgen.batch.jobs import Result, WorkerLost, alive, init_worker, run_in_worker, run_job
 from fishgen.batch.manifest import Job
-from fishgen.errors import FishgenError
+from fishgen.errors import MissingDependency, SystemFailure
 
 Done = Callable[[Job, Result], bool]
 """Called with each finished job; returns True to stop starting new jobs (--fail-fast)."""
@@ -33,14 +35,17 @@ _FISH = ["fishgen.assembly.fish", "fishgen.assembly.materials", "fishgen.species
 PRELOAD = {"build": _FISH,
            "school": [*_FISH, "fishgen.school.run", "fishgen.school.simulate", "fishgen.school.bake",
                       "fishgen.school.scene_file"],
-           "clouds": ["fishgen.clouds.parser", "fishgen.clouds.fill", "fishgen.clouds.export", "fishgen.clouds.scene",
-                      "numpy.random"]}
+           "clouds": ["fishgen.clouds.parser", "fishgen.clouds.fill", "fishgen.clouds.export",
+                      "fishgen.clouds.scene", "numpy.random"]}
 
 
 def preload(kinds: set[str]) -> list[str]:
     """The modules the jobs of these kinds need, in import order."""
-    jobs = [m for kind in sorted(kinds) for m in PRELOAD[kind]]
-    return list(dict.fromkeys(["fishgen.batch.jobs", *jobs, "fishgen.exchange.gltf"]))
+    from fishgen.commands import MODULES
+
+    jobs = [m for kind in sorted(kinds) for m in (MODULES[kind], *PRELOAD[kind])]
+    return list(dict.fromkeys(["fishgen.batch.jobs", "fishgen.commands.paths", *jobs,
+                               "fishgen.exchange.gltf"]))
 
 
 def run_jobs(jobs: Sequence[Job], done: Done, *, workers: int = 1, scheduler: str | None = None,
@@ -64,8 +69,8 @@ def _here(jobs: Sequence[Job], done: Done) -> None:
             return
 
 
-def _failed(job: Job, message: str, kind: str = "worker") -> Result:
-    return Result(job.name, "failed", error={"message": message, "file": None, "line": None, "kind": kind})
+def _failed(job: Job, message: str) -> Result:
+    return Result(job.name, "failed", error=WorkerLost(message))
 
 
 def _context(kinds: set[str]):
@@ -134,8 +139,9 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int, fail_fast: bool = False
         # per pool: a worker of a broken pool may have set it before its failed job's result came
         # back; that job runs again in the next pool, which must not start stopped
         failed = context.RawValue("b", 0)  # a job failed under --fail-fast: start no other
+        pids = context.SimpleQueue()  # each worker says who it is, so an interrupted batch can stop it
         pool = ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
-                                   initializer=init_worker, initargs=(os.getpid(), failed))
+                                   initializer=init_worker, initargs=(os.getpid(), failed, pids))
         running: dict[Future, tuple[Job, ...]] = {}
         broken = clean = False
         try:
@@ -165,7 +171,7 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int, fail_fast: bool = False
                     failed.value = 1  # the chunks already handed out start no further job
             clean = True
         finally:
-            _close(pool, clean)
+            _close(pool, clean, pids)
 
 
 def _broken(chunk: tuple[Job, ...], lost: set[str], struck: set[str],
@@ -183,22 +189,41 @@ def _broken(chunk: tuple[Job, ...], lost: set[str], struck: set[str],
     return (), []
 
 
-def _close(pool, clean: bool) -> None:
+def _close(pool, clean: bool, pids) -> None:
     """Shut the pool down; when interrupted, stop its workers first and wait for them to unwind.
-    (A forked worker inherits the command's SIGTERM handler until its initializer replaces it.)"""
+    (A forked worker inherits the command's SIGTERM handler until its initializer replaces it.)
+    The executor names no workers before Python 3.14 (``terminate_workers``), so each worker put
+    its pid on ``pids`` when it started."""
     if clean:
         pool.shutdown(wait=True)
         return
-    procs = list((getattr(pool, "_processes", None) or {}).values())  # the executor has no public handle
-    for proc in procs:
-        if proc.is_alive():
-            proc.terminate()  # SIGTERM: the worker raises, its atomic writer removes the temp file
-    for proc in procs:
-        proc.join(timeout=10)
-        if proc.is_alive():
-            proc.kill()
-            proc.join(timeout=5)
+    workers = []
+    while not pids.empty():
+        workers.append(pids.get())
+    for pid in workers:
+        _signal(pid, signal.SIGTERM)  # the worker raises, its atomic writer removes the temp file
+    for pid, patience in ((pid, 10.0) for pid in workers):
+        if not _gone(pid, patience):
+            _signal(pid, signal.SIGKILL)
+            _gone(pid, 5.0)
     pool.shutdown(wait=False, cancel_futures=True)
+
+
+def _signal(pid: int, signum: int) -> None:
+    try:
+        os.kill(pid, signum)
+    except ProcessLookupError:
+        pass
+
+
+def _gone(pid: int, seconds: float) -> bool:
+    """Wait up to ``seconds`` for ``pid`` to end (it may be the forkserver's child, not ours)."""
+    deadline = time.monotonic() + seconds
+    while alive(pid):
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.02)
+    return True
 
 
 def _dask(jobs: Sequence[Job], done: Done, address: str) -> None:
@@ -206,13 +231,13 @@ def _dask(jobs: Sequence[Job], done: Done, address: str) -> None:
     try:
         from distributed import Client, as_completed
     except ImportError:
-        raise FishgenError("expected Dask distributed for --scheduler, found it not installed "
-                           "(pip install 'fishgen[cluster]')") from None
+        raise MissingDependency("--scheduler needs Dask distributed, which is not installed; install it "
+                                "with pip install 'fishgen[cluster]'") from None
 
     try:
         client = Client(address, timeout=30, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as err:
-        raise FishgenError(f"expected a Dask scheduler at {address}, found none reachable ({err})") from None
+        raise SystemFailure(f"cannot reach a Dask scheduler at {address} ({err})") from None
     futures = {}
     try:
         for index, job in enumerate(jobs):

@@ -1,12 +1,12 @@
-"""Command-line entry point: a thin, lazily-loaded layer over the library API.
+"""Command-line entry point: a thin adapter over the use-case layer (:mod:`fishgen.commands`).
 
-Subcommands live in their own modules and are imported only when invoked, so
-``fishgen --help`` stays instant (no numpy/trimesh import).
+Each command's click command is made from its declaration (:mod:`fishgen.cli.adapter`) when it is
+invoked, and the declarations import nothing heavy, so ``fishgen --help`` stays instant (no
+numpy/trimesh import).
 """
 from __future__ import annotations
 
 import atexit
-import importlib
 import os
 import signal
 import sys
@@ -15,44 +15,23 @@ import threading
 import click
 
 from fishgen.cli.common import add_common_options, error_line, json_errors, reset
-
-# name -> (module, attribute, one-line help shown by `fishgen --help`)
-COMMANDS = {
-    "build": ("fishgen.cli.build", "build", "Build a species file into a textured, fin-animated fish asset."),
-    "clouds": ("fishgen.cli.clouds", "clouds",
-               "Fill cloud cube files (.awn) with particles and export them."),
-    "preview": ("fishgen.cli.preview", "preview",
-                "Render inputs or assets to PNG, contact sheets or swim loops."),
-    "view": ("fishgen.cli.view", "view", "Open an asset in a self-contained three.js viewer page."),
-    "school": ("fishgen.cli.school", "school",
-               "Simulate a fish school and bake it into an animated glb, tracks and measures."),
-    "batch": ("fishgen.cli.batch", "batch",
-              "Regenerate an asset set from a manifest or folder, incrementally and in parallel."),
-    "texture": ("fishgen.cli.texture", "texture",
-                "Make a species from a side photo of a fish: texture, texture points, fin mask."),
-    "species": ("fishgen.cli.species", "species",
-                "Sample plausible new species (shape, fins, motion) with painted textures."),
-}
+from fishgen.commands import MODULES, command
 
 
 class LazyGroup(click.Group):
     def list_commands(self, ctx):
-        return sorted(COMMANDS)
+        return sorted(MODULES)
 
     def get_command(self, ctx, name):
-        if name not in COMMANDS:
+        if name not in MODULES:
             return None
-        module, attr, _ = COMMANDS[name]
-        try:
-            command = getattr(importlib.import_module(module), attr)
-        except ModuleNotFoundError as err:
-            if err.name == module:
-                return None
-            raise
-        return add_common_options(command)  # --quiet, --verbose, --json: every command, declared once
+        from fishgen.cli.adapter import click_command
+
+        cmd = command(name)
+        return add_common_options(click_command(cmd))  # --quiet, --verbose, --json: every command, once
 
     def format_commands(self, ctx, formatter):
-        rows = [(name, COMMANDS[name][2]) for name in self.list_commands(ctx)]
+        rows = [(name, command(name).summary) for name in self.list_commands(ctx)]
         with formatter.section("Commands"):
             formatter.write_dl(rows)
 
@@ -99,9 +78,10 @@ def main(argv: list[str] | None = None) -> None:
     try:
         cli.main(args=args, prog_name="fishgen", standalone_mode=False)
     except FishgenError as err:
-        status = getattr(err, "status", 2)
-        _fail(f"fishgen: {err}" if err.file is None else str(err), status, err.file, err.line,
-              getattr(err, "kind", "input"))
+        from fishgen.errors import SystemFailure
+
+        plain = err.file is None or isinstance(err, SystemFailure)  # a system's refusal names its path
+        _fail(f"fishgen: {err}" if plain else str(err), err.status, err.file, err.line, err.kind)
     except click.exceptions.Abort:
         _fail("fishgen: interrupted", 130, kind="interrupted")  # the shell's ^C ends the line before ours
     except click.UsageError as err:  # one line, like every other error (`--help` shows the usage)
@@ -114,8 +94,9 @@ def main(argv: list[str] | None = None) -> None:
         _fail(err.format_message(), err.exit_code, kind="usage")
     except (KeyboardInterrupt, Interrupted) as err:
         _fail("fishgen: interrupted", err.status if isinstance(err, Interrupted) else 130, kind="interrupted")
-    except OSError as err:
-        _fail(f"fishgen: {err.filename or ''}: {err.strerror or err}", 1, err.filename, kind="os")
+    except OSError as err:  # one no layer below turned into a SystemFailure with its path
+        where = f"{err.filename}: " if err.filename else ""
+        _fail(f"fishgen: {where}{err.strerror or err}", 1, err.filename, kind="os")
 
 
 def run() -> None:

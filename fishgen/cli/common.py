@@ -57,10 +57,11 @@ def _options() -> list[click.Option]:
     return [
         click.Option(["-q", "--quiet"], is_flag=True, expose_value=False, is_eager=True,
                      callback=_set("verbosity", QUIET),
-                     help="Print nothing on stdout (no summary, no progress); errors still go to stderr."),
+                     help="Print nothing on stdout (no summary, no progress); errors still go to stderr.  "
+                          "[default: off]"),
         click.Option(["-v", "--verbose"], is_flag=True, expose_value=False, is_eager=True,
                      callback=_set("verbosity", VERBOSE),
-                     help="Also print each file written and the time taken, on stderr."),
+                     help="Also print each file written and the time taken, on stderr.  [default: off]"),
         click.Option(["--json"], is_flag=True, expose_value=False, is_eager=True, callback=_set("json", True),
                      help='Print an error as one JSON object on stderr: {"error", "file", "line", "exit", '
                           '"kind"}.'),

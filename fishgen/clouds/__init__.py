@@ -15,7 +15,7 @@ import importlib
 _API = {
     "FORMATS": "fishgen.clouds.export", "check_output": "fishgen.clouds.export",
     "export_cloud": "fishgen.clouds.export",
-    "METHODS": "fishgen.clouds.fill", "fill_cloud": "fishgen.clouds.fill",
+    "METHODS": "fishgen.clouds.model", "fill_cloud": "fishgen.clouds.fill",
     "merge_clouds": "fishgen.clouds.fill",
     "DEFAULT_MAX_PARTICLES": "fishgen.clouds.model", "Cloud": "fishgen.clouds.model",
     "Cube": "fishgen.clouds.model", "CubeFile": "fishgen.clouds.model",

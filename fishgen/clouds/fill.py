@@ -20,10 +20,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from fishgen.clouds.model import Cloud, CubeFile
+from fishgen.clouds.model import METHODS, Cloud, CubeFile
 from fishgen.errors import FishgenError
 
-METHODS = ("paper", "uniform")
 CHUNK = 1 << 16
 CLUMP = 0.25
 """Phase shifts (radians, |P| <= 3*pi/2) move a particle by CLUMP*P/pi half-extents: at most 37.5 %."""

@@ -9,6 +9,8 @@ if TYPE_CHECKING:  # numpy stays out of the import path of the parser and the CL
 
 DEFAULT_MAX_PARTICLES = 50_000_000
 """Refuse larger clouds before allocating (about 31 bytes per particle in memory)."""
+METHODS = ("paper", "uniform")
+"""How cubes are filled: the report's sine phase shifts with rejection, or plain uniform."""
 
 
 @dataclass(frozen=True)

@@ -75,10 +75,11 @@ class Report:
 def _worker(conn, progress, corpus: str, budget: int, workdir: str, quiet: bool = True) -> None:
     # Import everything a case may need before the memory limit, as a long-lived tool would.
     import fishgen.assembly.fish  # noqa: F401
-    import fishgen.cli.build  # noqa: F401
-    import fishgen.cli.clouds  # noqa: F401
-    import fishgen.cli.preview  # noqa: F401
+    import fishgen.cli.adapter  # noqa: F401
     import fishgen.clouds.fill  # noqa: F401
+    import fishgen.commands.build  # noqa: F401
+    import fishgen.commands.clouds  # noqa: F401
+    import fishgen.commands.preview  # noqa: F401
     import fishgen.exchange.gltf_reader  # noqa: F401
     import fishgen.exchange.mesh_reader  # noqa: F401
     import fishgen.preview.inputs  # noqa: F401

@@ -24,7 +24,9 @@
     inertia = 0.7
 
 Every mistake is one ``FILE:LINE: expected ..., found ...`` line; absurd sizes are refused
-before anything is allocated.
+before anything is allocated. The keys that are also `fishgen school` options (frames, fps, seed,
+model, a species' count) are declared once, here, and checked exactly as the options are.
+Leaf module (no numpy): `fishgen school --help` and batch manifests read the declarations.
 """
 from __future__ import annotations
 
@@ -34,7 +36,10 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
+import click
+
 from fishgen.errors import FishgenError, describe
+from fishgen.options import SEED, FiniteRange, Option, check_value
 from fishgen.school.model import MODELS, PsoParams, TargetPath
 from fishgen.tomlfile import Where as _Where
 from fishgen.tomlfile import loads as _loads
@@ -46,12 +51,22 @@ MAX_FISH_FRAMES = 2 * 10**8
 MAX_SCENE_BYTES = 1 << 20
 LAYOUTS = ("sphere", "box", "line")
 PATHS = ("circle", "figure8", "spline", "none")
+DEFAULT_COUNT = 50
+
+# Keys that are also options of `fishgen school` (and of its batch jobs): one declaration each.
+COUNT = Option(click.IntRange(1, MAX_FISH), "Fish per species.", DEFAULT_COUNT)
+FRAMES = Option(click.IntRange(2, MAX_FRAMES), "Frames to simulate and bake.", 300)
+FPS = Option(FiniteRange(1, 1000), "Frames per second.", 30.0)
+SEED_KEY = Option(SEED, "Random seed; the same seed gives byte-identical files.", 0)
+MODEL = Option(click.Choice(MODELS), "boids: VRFish's brain (thesis 7.2); pso: the particle swarm following "
+               "a target (2017 report).", "boids")
+SPEED = Option(FiniteRange(0.05, 20), "Cruising speed, body lengths per second.", 1.0)
 
 
 @dataclass(frozen=True)
 class SpeciesEntry:
     file: Path
-    count: int
+    count: int = DEFAULT_COUNT
     speed: float = 1.0
 
 
@@ -60,15 +75,16 @@ class SceneFile:
     """What a scene file (or the command line alone) asks for; the CLI's flags override it."""
 
     species: tuple[SpeciesEntry, ...] = ()
-    model: str = "boids"
-    frames: int = 300
-    fps: float = 30.0
-    seed: int = 0
+    model: str = MODEL.default
+    frames: int = FRAMES.default
+    fps: float = FPS.default
+    seed: int = SEED_KEY.default
     bounds: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
     layout: str = "sphere"
     target: TargetPath = TargetPath()
     predator: TargetPath | None = None
     pso: PsoParams = PsoParams()
+    read: tuple[Path, ...] = ()      # the files it named and were read: path CSVs
 
 
 def with_options(scene: SceneFile, *, count: int | None = None, frames: int | None = None,
@@ -100,13 +116,20 @@ def _number(where: _Where, value: Any, key: str, low: float, high: float, table:
     return value
 
 
+def _declared(where: _Where, spec: Option, value: Any, key: str, table: str | None = None,
+              nth: int = 0) -> Any:
+    """A key that is also an option, checked by the option's own declaration."""
+    return check_value(spec, value, lambda what: where.fail(f"{key} as {what}", value, key, table, nth))
+
+
 def _triple(where: _Where, value: Any, key: str, table: str | None = None) -> tuple[float, float, float]:
     if not (isinstance(value, list) and len(value) == 3):
         raise where.fail(f"{key} as [x, y, z]", value, key, table)
     return tuple(float(_number(where, v, key, -1e4, 1e4, table)) for v in value)  # type: ignore[return-value]
 
 
-def _path(where: _Where, data: Any, table: str, folder: Path) -> TargetPath:
+def _path(where: _Where, data: Any, table: str, folder: Path) -> tuple[TargetPath, Path | None]:
+    """The path of [target] or [predator], and the CSV file it was read from (if any)."""
     if not isinstance(data, dict):
         raise where.fail(f"a [{table}] table", data, table)
     kind = data.get("path", "circle")
@@ -115,10 +138,12 @@ def _path(where: _Where, data: Any, table: str, folder: Path) -> TargetPath:
         if key not in known:
             raise where.fail(f"one of {', '.join(sorted(known))} in [{table}]", key, key, table)
     path = TargetPath()
+    csv = None
     if not isinstance(kind, str):
         raise where.fail(f"path as one of {', '.join(PATHS)} or a CSV file", kind, "path", table)
     if kind not in PATHS:
-        path = replace(path, kind="points", points=_csv_points(where, folder / kind, table))
+        csv = folder / kind
+        path = replace(path, kind="points", points=_csv_points(where, csv, table))
     else:
         path = replace(path, kind=kind)  # type: ignore[arg-type]
     if "centre" in data:
@@ -128,8 +153,8 @@ def _path(where: _Where, data: Any, table: str, folder: Path) -> TargetPath:
     if "period" in data:
         path = replace(path, period=float(_number(where, data["period"], "period", 0.1, 1e6, table)))
     if "seed" in data:
-        path = replace(path, seed=int(_number(where, data["seed"], "seed", 0, 2**32 - 1, table, whole=True)))
-    return path
+        path = replace(path, seed=_declared(where, SEED_KEY, data["seed"], "seed", table))
+    return path, csv
 
 
 def _csv_points(where: _Where, path: Path, table: str) -> tuple[tuple[float, float, float, float], ...]:
@@ -181,17 +206,9 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
         if key not in known:
             raise where.fail(f"one of {', '.join(sorted(known))}", key, key)
     scene = SceneFile()
-    if "model" in data:
-        if data["model"] not in MODELS:
-            raise where.fail(f"model as one of {', '.join(MODELS)}", data["model"], "model")
-        scene = replace(scene, model=data["model"])
-    if "frames" in data:
-        frames = _number(where, data["frames"], "frames", 2, MAX_FRAMES, whole=True)
-        scene = replace(scene, frames=int(frames))
-    if "fps" in data:
-        scene = replace(scene, fps=float(_number(where, data["fps"], "fps", 1, 1000)))
-    if "seed" in data:
-        scene = replace(scene, seed=int(_number(where, data["seed"], "seed", 0, 2**32 - 1, whole=True)))
+    for key, spec in (("model", MODEL), ("frames", FRAMES), ("fps", FPS), ("seed", SEED_KEY)):
+        if key in data:
+            scene = replace(scene, **{key: _declared(where, spec, data[key], key)})
     if "layout" in data:
         if data["layout"] not in LAYOUTS:
             raise where.fail(f"layout as one of {', '.join(LAYOUTS)}", data["layout"], "layout")
@@ -216,14 +233,16 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
         if not isinstance(name, str):
             raise where.fail("file as a species file name", "no file" if name is None else name, "file",
                              "species", k)
-        count = int(_number(where, entry.get("count", 50), "count", 1, MAX_FISH, "species", k, whole=True))
-        speed = float(_number(where, entry.get("speed", 1.0), "speed", 0.05, 20, "species", k))
+        count = _declared(where, COUNT, entry.get("count", COUNT.default), "count", "species", k)
+        speed = _declared(where, SPEED, entry.get("speed", SPEED.default), "speed", "species", k)
         species.append(SpeciesEntry(path.parent / name, count, speed))
     scene = replace(scene, species=tuple(species))
     if "target" in data:
-        scene = replace(scene, target=_path(where, data["target"], "target", path.parent))
+        target, csv = _path(where, data["target"], "target", path.parent)
+        scene = replace(scene, target=target, read=scene.read + ((csv,) if csv else ()))
     if "predator" in data:
-        scene = replace(scene, predator=_path(where, data["predator"], "predator", path.parent))
+        predator, csv = _path(where, data["predator"], "predator", path.parent)
+        scene = replace(scene, predator=predator, read=scene.read + ((csv,) if csv else ()))
     if "pso" in data:
         pso = data["pso"]
         if not isinstance(pso, dict):

@@ -1,18 +1,10 @@
 """Manifests: typed jobs, every option as the commands take it, one-line FILE:LINE errors."""
 from __future__ import annotations
 
-import click
 import pytest
 
-from fishgen.batch.manifest import (
-    CLOUD_METHODS,
-    DEFAULT_MAX_PARTICLES,
-    FIN_MODES,
-    SCHOOL_MODELS,
-    derived_seed,
-    load_manifest,
-    scan_folder,
-)
+from fishgen.batch.manifest import derived_seed, load_manifest, scan_folder
+from fishgen.commands.build import BuildOptions
 from fishgen.errors import FishgenError
 from tests.conftest import PARAMS
 
@@ -49,13 +41,12 @@ output = "seeded.ply"
 seed = 5
 """), out=tmp_path / "o")
     build, clouds, seeded = manifest.jobs
-    assert build.options == {"fins": None, "length": None, "fps": 30.0, "swim": "body", "speed": 1.0,
-                             "textures": None}
+    assert build.options == BuildOptions()  # the command's own defaults, every one
     assert build.output == tmp_path / "o" / "a.glb" and build.inputs == (tmp_path / "a.txt",)
-    assert clouds.options["seed"] == derived_seed("sky/c.ply") and clouds.options["method"] == "paper"
-    assert clouds.options["offset"] == [[0, 0, 0], [1, 2, 3]]
+    assert clouds.options.seed == derived_seed("sky/c.ply") and clouds.options.method == "paper"
+    assert clouds.options.offset == ((0, 0, 0), (1, 2, 3))
     assert clouds.where == f"{tmp_path / 'm.toml'}:7"
-    assert seeded.options["seed"] == 5
+    assert seeded.options.seed == 5
     assert derived_seed("a.ply") != derived_seed("b.ply")
 
 
@@ -68,8 +59,8 @@ output = "reef.glb"
 inputs = ["a.txt", "b.txt"]
 output = "ab.glb"
 """))
-    assert manifest.jobs[0].options["seed"] is None  # the scene file's, as `fishgen school` does
-    assert manifest.jobs[1].options["seed"] == derived_seed("ab.glb")
+    assert manifest.jobs[0].options.seed is None  # the scene file's, as `fishgen school` does
+    assert manifest.jobs[1].options.seed == derived_seed("ab.glb")
 
 
 @pytest.mark.parametrize("text,line,message", [
@@ -110,29 +101,26 @@ def test_a_folder_scan_makes_one_default_job_per_species_and_cube_file(tmp_path)
         scan_folder(tmp_path / "empty", tmp_path / "o2")
 
 
-def test_the_mirrored_constants_agree_with_the_library():
-    from fishgen.assembly.fin_modes import FIN_MODES as LIBRARY_FIN_MODES
-    from fishgen.clouds import DEFAULT_MAX_PARTICLES as LIBRARY_MAX
-    from fishgen.clouds import METHODS
-    from fishgen.school.model import MODELS
-
-    assert FIN_MODES == LIBRARY_FIN_MODES and tuple(SCHOOL_MODELS) == tuple(MODELS)
-    assert tuple(CLOUD_METHODS) == tuple(METHODS) and DEFAULT_MAX_PARTICLES == LIBRARY_MAX
-
-
-# Options a manifest job spells differently or leaves to the command: the output is `output`, a
-# build job's format is its output's extension, and a school's side outputs are `fishgen school`'s.
-NOT_IN_MANIFESTS = {"output", "format", "tracks", "metrics", "plot"}
-
-
 @pytest.mark.parametrize("kind", ["build", "school", "clouds"])
-def test_a_job_takes_every_option_of_its_command(kind):
-    """When a command gains an option, a batch job must take it too (and jobs.py pass it on)."""
-    from fishgen.batch.manifest import OPTIONS
-    from fishgen.cli import cli
+def test_a_job_takes_every_option_of_its_command_that_a_manifest_may_set(kind):
+    """Both come from one declaration: the command's options record."""
+    import click
 
-    command = cli.get_command(None, kind)  # type: ignore[arg-type]
-    names = {opt.lstrip("-") for p in command.params if isinstance(p, click.Option) for opt in p.opts
+    from fishgen.cli import cli
+    from fishgen.commands import command
+    from fishgen.options import manifest_options
+
+    click_command = cli.get_command(None, kind)  # type: ignore[arg-type]
+    names = {opt.lstrip("-") for p in click_command.params if isinstance(p, click.Option) for opt in p.opts
              if opt.startswith("--")}
-    names -= {"quiet", "verbose", "json", "help"} | NOT_IN_MANIFESTS
-    assert names == set(OPTIONS[kind])
+    local = {"output", "quiet", "verbose", "json", "help"}  # -o is a manifest's `output`
+    declared = manifest_options(command(kind).options)
+    assert set(declared) <= names - local
+    assert all(not spec.manifest for f, spec in manifest_options.__globals__["declared"](command(kind).options)
+               if f.name.replace("_", "-") in names - local - set(declared))
+
+
+def test_a_seed_the_command_line_takes_a_manifest_takes_too(tmp_path):
+    """Issue 19: `--seed 1099511627776` worked on the command line and was refused in a manifest."""
+    manifest = load_manifest(write(tmp_path, '[[clouds]]\ninput = "a.awn"\noutput = "a.ply"\nseed = 1099511627776\n'))
+    assert manifest.jobs[0].options.seed == 1099511627776

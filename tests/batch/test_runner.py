@@ -134,7 +134,7 @@ def fake_pool(tmp_path, monkeypatch, names: list[str], fail_fast: bool = False) 
     reported: dict[str, list] = {}
 
     def done(job, result) -> bool:
-        reported.setdefault(job.name, []).append((result.status, (result.error or {}).get("message")))
+        reported.setdefault(job.name, []).append((result.status, result.error.message if result.error else None))
         return fail_fast and result.status == "failed"
 
     _pool([Job("build", name, (), tmp_path / f"{name}.glb") for name in names], done, 2, fail_fast)

@@ -36,7 +36,7 @@ def test_help_documents_every_option():
     assert result.returncode == 0
     for option in ("--output", "--fins", "--length", "--fps", "--textures"):
         assert option in result.stdout
-    assert "default" in result.stdout and "30.0" in result.stdout
+    assert "[default: 30]" in result.stdout
 
 
 def test_top_level_help_is_light():
@@ -103,7 +103,7 @@ def test_batch_builds_every_good_file_and_reports_each_bad_one(tmp_path):
     bad = tmp_path / "bad.txt"
     bad.write_text("nothing like a species\n")
     out = tmp_path / "assets"
-    result = run_cli("build", PARAMS / "bonybream.txt", bad, PARAMS / "pineapplefish.txt", "-o", out,
+    result = run_cli("build", PARAMS / "bonybream.txt", bad, PARAMS / "pineapplefish.txt", "-o", f"{out}/",
                      "--format", "gltf")
     assert result.returncode == 2
     assert sorted(p.name for p in out.glob("*.gltf")) == ["bonybream.gltf", "pineapplefish.gltf"]
@@ -117,7 +117,7 @@ def test_batch_refuses_two_files_that_would_write_one_output(tmp_path):
     for sub in ("a", "b"):
         (tmp_path / sub).mkdir()
         shutil.copy(PARAMS / "bonybream.txt", tmp_path / sub / "fish.txt")
-    result = run_cli("build", tmp_path / "a" / "fish.txt", tmp_path / "b" / "fish.txt", "-o", tmp_path / "out")
+    result = run_cli("build", tmp_path / "a" / "fish.txt", tmp_path / "b" / "fish.txt", "-o", f"{tmp_path}/out/")
     assert result.returncode == 2 and "distinct names" in result.stderr
     assert not (tmp_path / "out").exists()
 
@@ -132,7 +132,7 @@ def test_damaged_texture_is_reported_at_the_texture_line_and_the_batch_goes_on(t
     species = _species_copy(tmp_path)
     png = (ROOT / "textures" / "bonybream.png").read_bytes()
     (tmp_path / "bonybream.png").write_bytes(png[: len(png) // 3])
-    result = run_cli("build", species, PARAMS / "centroberyx.txt", "-o", tmp_path / "batch")
+    result = run_cli("build", species, PARAMS / "centroberyx.txt", "-o", f"{tmp_path}/batch/")
     assert result.returncode == 2
     line = next(i for i, l in enumerate(species.read_text().splitlines(), 1) if l.startswith("bonybream.png"))
     assert f"{species}:{line}: expected a readable texture image, found 'bonybream.png' damaged" in result.stderr
@@ -145,11 +145,32 @@ def test_output_names_that_need_percent_encoding(tmp_path):
     assert_valid_gltf(out)
 
 
-def test_output_onto_a_folder_leaves_nothing_behind(tmp_path):
+def test_an_existing_folder_is_a_folder_whatever_its_name(tmp_path):
     (tmp_path / "x.glb").mkdir()
     result = run_cli("build", PARAMS / "bonybream.txt", "-o", tmp_path / "x.glb")
-    assert result.returncode == 2 and "found a folder at" in result.stderr
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["x.glb"]
+    assert result.returncode == 0 and (tmp_path / "x.glb" / "bonybream.glb").is_file()
+
+
+@pytest.mark.parametrize("output,message", [
+    ("fish", "expected an output file with an extension, or a folder (an existing one, or a name ending in /), "
+             "found"),
+    ("fish.txt", "expected an output ending in .glb, .gltf, .obj, .ply"),
+])
+def test_o_never_turns_silently_into_a_folder(tmp_path, output, message):
+    """Issue 19: `-o out/fish` made a folder `fish/`; a folder must exist or end in /."""
+    result = run_cli("build", PARAMS / "bonybream.txt", "-o", tmp_path / output)
+    assert result.returncode == 2 and message in result.stderr and result.stderr.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_name_ending_in_a_slash_is_a_folder(tmp_path):
+    result = run_cli("build", PARAMS / "bonybream.txt", "-o", f"{tmp_path}/fish/")
+    assert result.returncode == 0 and (tmp_path / "fish" / "bonybream.glb").is_file()
+
+
+def test_o_dev_null_is_not_a_regular_file(tmp_path):
+    result = run_cli("build", PARAMS / "bonybream.txt", "-o", "/dev/null")
+    assert result.returncode == 2 and "expected a regular file or no file as the output" in result.stderr
 
 
 def test_special_files_are_refused_without_reading(tmp_path):

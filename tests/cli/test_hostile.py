@@ -43,7 +43,7 @@ def test_absurd_fin_step_size_is_refused_at_its_line(tmp_path, step):
 
 def test_one_bad_species_does_not_abort_the_others(tmp_path):
     bad = species_file(tmp_path, "bad.txt", BONY.replace("3.0 10.0 1.0\n", "3.0 10.0 1e-320\n"))
-    result = run_cli("build", bad, PARAMS / "centroberyx.txt", "-o", tmp_path / "out")
+    result = run_cli("build", bad, PARAMS / "centroberyx.txt", "-o", f"{tmp_path}/out/")
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert (tmp_path / "out" / "centroberyx.glb").is_file() and not (tmp_path / "out" / "bad.glb").exists()
 

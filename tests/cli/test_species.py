@@ -22,10 +22,17 @@ def test_same_seed_same_files(tmp_path, cli):
 
 
 def test_count_writes_a_folder(tmp_path, cli):
-    r = cli("species", "--random", "--seed", "10", "--count", "3", "-o", tmp_path / "reef")
+    r = cli("species", "--random", "--seed", "10", "--count", "3", "-o", f"{tmp_path}/reef/")
     assert r.returncode == 0, r.stderr
     assert sorted(p.name for p in (tmp_path / "reef").glob("*.txt")) == \
         ["species_10.txt", "species_11.txt", "species_12.txt"]
+
+
+def test_several_species_need_a_folder_not_a_file_name(tmp_path, cli):
+    """Issue 19: `--count 2 -o out/sp2.txt` made a folder named sp2.txt."""
+    r = cli("species", "--random", "--count", "2", "-o", tmp_path / "sp2.txt")
+    assert r.returncode == 2 and "expected a folder for --count 2" in r.stderr
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_mistakes_are_one_line(tmp_path, cli):

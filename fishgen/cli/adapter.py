@@ -1,0 +1,113 @@
+"""A command's declaration (:class:`fishgen.commands.Command`) as a click command.
+
+Nothing here knows what a command does: its arguments, ``-o`` and options come from the
+declaration, its work from the use-case function, and this module only turns the function's
+:class:`~fishgen.commands.Made` and events into what a person at a terminal sees.
+"""
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import click
+
+from fishgen.cli.common import QUIET, VERBOSE, error_line, verbosity
+from fishgen.commands import Command, Events, Progress
+from fishgen.options import click_params, from_values
+
+
+def click_command(cmd: Command) -> click.Command:
+    """The click command of ``cmd``: its inputs, ``-o``, and every declared option with its default."""
+    params: list[click.Parameter] = []
+    if cmd.inputs is not None:
+        kind = click.Path(path_type=Path, exists=cmd.inputs.must_exist) if cmd.inputs.path else None
+        params.append(click.Argument(["inputs"], nargs=-1 if cmd.inputs.many else 1, required=True, type=kind,
+                                     metavar=cmd.inputs.metavar))
+    if cmd.output is not None:
+        shown = f"  [default: {cmd.output.shown_default}]" if cmd.output.shown_default else ""
+        # a str, not a Path: `-o out/` keeps the slash that makes it a folder
+        params.append(click.Option(["-o", "--output"], type=click.Path(), default=None,
+                                   required=cmd.output.required, metavar=cmd.output.metavar,
+                                   help=cmd.output.help + shown))
+    params += click_params(cmd.options)
+
+    def callback(inputs: Any = (), output: str | None = None, **values: Any) -> None:
+        given = tuple(inputs) if cmd.inputs is not None and cmd.inputs.many else (inputs,) if inputs else ()
+        execute(cmd, given, output, from_values(cmd.options, values))
+
+    return click.Command(cmd.name, params=params, callback=callback, help=cmd.help, short_help=cmd.summary,
+                         context_settings={"help_option_names": ["-h", "--help"]})
+
+
+def execute(cmd: Command, inputs: tuple[Path, ...], output: str | None, options: Any) -> None:
+    """Run the command's function and show what it made: the summary on stdout, notes and each
+    failed input on stderr, a bar on a terminal; serve its server until Ctrl-C."""
+    from fishgen.commands import run
+
+    events = TerminalEvents()
+    made = run(cmd, inputs, output, options, events.as_events())
+    for line in made.lines:
+        click.echo(line)
+    if made.verdict is not None:
+        raise made.verdict
+    if made.failed:
+        raise SystemExit(max(err.status for err in made.failed))
+    if made.server is not None:
+        sys.stdout.flush()
+        try:
+            made.server.serve_forever()
+        except KeyboardInterrupt:
+            pass
+        finally:
+            made.server.server_close()
+
+
+class TerminalEvents:
+    """Notes and failures on stderr; a progress bar when a person watches (stderr is a terminal and
+    not --quiet), else one plain line per step on stdout, with the reason under --verbose."""
+
+    def __init__(self) -> None:
+        self.bars = 0
+
+    def as_events(self) -> Events:
+        return Events(note=lambda text: click.echo(text, err=True), failed=self.failed,
+                      progress=self.progress,
+                      line=self.line)
+
+    def failed(self, err: Any) -> None:
+        if self.bars:
+            click.echo("", err=True)  # off the bar's line
+        click.echo(error_line(str(err), err.status, file=err.file, line=err.line, kind=err.kind,
+                              **({"job": err.job} if err.job else {})), err=True)
+        detail = getattr(err, "detail", "")
+        if detail and verbosity() >= VERBOSE:
+            click.echo(detail, err=True)
+
+    def line(self, text: str, detail: str | None) -> None:
+        if self.bars or verbosity() <= QUIET:
+            return
+        click.echo(text + (f": {detail}" if detail and verbosity() >= VERBOSE else ""))
+
+    @contextmanager
+    def progress(self, label: str, total: int) -> Iterator[Progress]:
+        if not (sys.stderr.isatty() and verbosity() == 1) or total <= 0:
+            yield Progress()
+            return
+        bar = click.progressbar(length=total, label=label, file=sys.stderr)
+        self.bars += 1
+        try:
+            with bar:
+                yield _Bar(bar)
+        finally:
+            self.bars -= 1
+
+
+class _Bar(Progress):
+    def __init__(self, bar: Any):
+        self.bar = bar
+
+    def update(self, n: int) -> None:
+        self.bar.update(n)

@@ -1,0 +1,159 @@
+"""The use-case layer: one module per command, each holding one library function.
+
+    from fishgen.commands.build import BuildOptions, build
+    made = build([Path("params/bonybream.txt")], Path("out/bonybream.glb"), BuildOptions(fps=60))
+    made.written, made.read, made.facts      # what it wrote, what it read, what it built
+
+Each module declares its :class:`Command`: the options record (whose fields are the option
+declarations, :mod:`fishgen.commands.options`), its inputs and output, its help, and the function.
+The command line (:mod:`fishgen.cli`) and batch jobs (:mod:`fishgen.batch.jobs`) are thin adapters
+over these; neither knows what a command does.
+
+The modules import nothing heavy at the top (numpy loads inside the functions), so ``fishgen
+--help`` and a batch run where nothing changed stay fast.
+"""
+from __future__ import annotations
+
+import importlib
+import os
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager as ContextManager
+from contextlib import contextmanager, nullcontext
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fishgen.errors import FishgenError
+
+#: Every command, by name -> the module that declares it (``COMMAND``), in `fishgen --help` order.
+MODULES = {
+    "batch": "fishgen.commands.batch",
+    "build": "fishgen.commands.build",
+    "clouds": "fishgen.commands.clouds",
+    "preview": "fishgen.commands.preview",
+    "school": "fishgen.commands.school",
+    "species": "fishgen.commands.species",
+    "texture": "fishgen.commands.texture",
+    "view": "fishgen.commands.view",
+}
+
+
+@dataclass(frozen=True)
+class Inputs:
+    """A command's positional arguments."""
+
+    metavar: str
+    many: bool = True                   # one or more (else exactly one)
+    path: bool = True                   # file paths (else plain strings)
+    must_exist: bool = False
+
+
+@dataclass(frozen=True)
+class Output:
+    """A command's ``-o``."""
+
+    help: str
+    required: bool = True
+    metavar: str = "PATH"
+    shown_default: str | None = None
+    holds: tuple[str, ...] = ()         # what its format must hold, in the registry's words
+
+
+@dataclass(frozen=True)
+class Command:
+    """What a command is: the adapters build the CLI command and the batch job from this."""
+
+    name: str
+    summary: str                        # one line, in `fishgen --help`
+    help: str                           # the command's --help text (click docstring conventions)
+    options: type                       # the frozen options record
+    run: str                            # "module:function" of the use-case function
+    inputs: Inputs | None = None
+    output: Output | None = None
+    batch: bool = False                 # a batch manifest may list jobs of this command
+    cli: str | None = None              # "module:function" of a command-specific CLI adapter
+
+    @property
+    def holds(self) -> tuple[str, ...]:
+        """What the command's output format must hold (nothing when it writes no -o)."""
+        return self.output.holds if self.output is not None else ()
+
+    def function(self) -> Callable[..., Made]:
+        module, name = self.run.split(":")
+        return getattr(importlib.import_module(module), name)
+
+
+def command(name: str) -> Command:
+    """The declaration of command ``name``."""
+    return importlib.import_module(MODULES[name]).COMMAND
+
+
+@dataclass(frozen=True)
+class Made:
+    """What a command did: files written and read (absolute or as given), the summary lines it
+    prints on stdout, its typed facts, and how many of several inputs failed (each reported
+    through :attr:`Events.failed` as it happened)."""
+
+    written: tuple[Path, ...] = ()
+    read: tuple[Path, ...] = ()
+    lines: tuple[str, ...] = ()
+    facts: Any = None
+    failed: tuple[FishgenError, ...] = ()
+    verdict: FishgenError | None = None  # how the command ends once its summary is out (jobs failed)
+    server: Any = None                  # a bound local server the caller serves until Ctrl-C
+
+
+class Progress:
+    """A progress bar's counter: ``update(n)`` adds ``n`` done."""
+
+    def update(self, n: int) -> None:
+        pass
+
+
+def _no_bar(label: str, total: int) -> ContextManager[Progress]:
+    return nullcontext(Progress())
+
+
+def _ignore(text: str) -> None:
+    pass
+
+
+def _ignore_line(text: str, detail: str | None) -> None:
+    pass
+
+
+@dataclass(frozen=True)
+class Events:
+    """How a running command talks to whoever runs it. The CLI prints notes on stderr and draws
+    bars on a terminal; a batch job keeps the notes and draws nothing."""
+
+    note: Callable[[str], None] = _ignore                              # a warning, one line
+    failed: Callable[[FishgenError], None] | None = None                # one of several inputs failed
+    progress: Callable[[str, int], ContextManager[Progress]] = field(default=_no_bar)
+    line: Callable[[str, str | None], None] = _ignore_line             # a step done (a batch's job), and
+                                                                       # why it ran (said with --verbose)
+    summary: bool = True    # the caller shows Made.lines; without, a command skips what only they need
+
+
+QUIET = Events()
+
+
+def run(cmd: Command, inputs: tuple[Path, ...], output: str | os.PathLike | None, options: Any,
+        events: Events = QUIET) -> Made:
+    """Run a command as the CLI and batch jobs do: no file it writes may be one of its inputs."""
+    from fishgen.atomic import protecting
+
+    with protecting(inputs):
+        return cmd.function()(inputs, output, options, events)
+
+
+@contextmanager
+def each_input(events: Events, errors: list[FishgenError], several: bool) -> Iterator[None]:
+    """Run one input's work; with several inputs, its bad input is reported and the rest go on."""
+    try:
+        yield
+    except FishgenError as err:
+        if not several or events.failed is None or err.status != 2:
+            raise
+        events.failed(err)
+        errors.append(err)

@@ -1,0 +1,150 @@
+"""`fishgen batch`: a manifest (or a folder) of build, school and clouds jobs, brought up to date."""
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from contextlib import ExitStack
+from dataclasses import dataclass
+from pathlib import Path
+
+import click
+
+from fishgen.commands import QUIET, Command, Events, Inputs, Made, Progress
+from fishgen.errors import FishgenError
+from fishgen.options import FILE, FOLDER, option
+
+
+@dataclass(frozen=True)
+class BatchOptions:
+    out: Path | None = option(FOLDER, "Folder for the outputs and the record (.fishgen-batch.json). Required "
+                              "with DIR.", shown_default="the manifest's `out`, else ./out")
+    jobs: int | None = option(click.IntRange(1, 1024), "Jobs at once, each in its own process (1: in this "
+                              "process).", shown_default="the number of cores", short="-j")
+    force: bool = option(click.BOOL, "Rebuild every job, even those the record says are up to date.", False,
+                         flag=True)
+    fail_fast: bool = option(click.BOOL,
+                             "Start no new job after the first failure (the jobs running finish).",
+                             False, flag=True)
+    scheduler: str | None = option(click.STRING, "Run the jobs on this Dask distributed scheduler "
+                                   "(tcp://host:8786) instead of local processes; outputs must be on a "
+                                   "path the "
+                                   "workers share. Needs `pip install 'fishgen[cluster]'`.",
+                                   shown_default="local processes", metavar="ADDRESS")
+    report: Path | None = option(FILE,
+                                 "Also write a JSON report: per job its inputs and their hashes, options, "
+                                 "output and its hash, seconds, status and error.", shown_default="none")
+
+
+COMMAND = Command(
+    name="batch",
+    summary="Regenerate an asset set from a manifest or folder, incrementally and in parallel.",
+    help="""Bring every output of a MANIFEST.toml (or of every species and cube file under DIR) up to date.
+
+    A manifest lists [[build]], [[school]] and [[clouds]] jobs with their inputs, the options of
+    those commands and an output (see params/assets.toml). A job runs only when a file it reads
+    (textures and a school's species included), its options or fishgen's version changed, or
+    its output is not the one recorded. Seeds come from each job's output name unless set, so
+    outputs are byte-identical across runs, -j values and machines. A bad input fails only its
+    own job; the exit status is then non-zero. Outputs are written atomically: an interrupted
+    batch leaves whole old or whole new files, and the next run does only what is missing.
+
+    \b
+    Examples:
+      fishgen batch params/assets.toml
+      fishgen batch params --out out/all -j 2 --report out/all/report.json
+    """,
+    options=BatchOptions,
+    run="fishgen.commands.batch:batch",
+    inputs=Inputs("MANIFEST.toml|DIR", many=False, must_exist=True),
+)
+
+
+@dataclass(frozen=True)
+class BatchFacts:
+    outcomes: tuple          # one fishgen.batch.Outcome per job, in manifest order
+    seconds: float
+    workers: int
+
+
+def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOptions(),
+          events: Events = QUIET) -> Made:
+    """Run every job that is not up to date; each finished job is told through ``events``."""
+    import time
+
+    from fishgen.batch import run_batch
+    from fishgen.batch.manifest import load_manifest, scan_folder
+    from fishgen.commands.paths import needs
+    from fishgen.errors import JobsFailed, UsageError
+
+    start = time.perf_counter()
+    (source,) = inputs
+    if options.scheduler is not None:
+        needs("distributed", "cluster", "--scheduler")
+    if source.is_dir():
+        if options.out is None:
+            raise UsageError("expected --out FOLDER with a folder of inputs, found none", source)
+        manifest = scan_folder(source, options.out)
+    else:
+        manifest = load_manifest(source, options.out)
+    workers = options.jobs or os.cpu_count() or 1
+    with ExitStack() as stack:
+        bar: list[Progress] = []
+
+        def started(count: int) -> None:
+            if count:
+                bar.append(stack.enter_context(events.progress("building", count)))
+
+        def finished(outcome) -> None:
+            _tell(outcome, events, bar[0] if bar else None)
+
+        outcomes = run_batch(manifest, workers=workers, force=options.force, fail_fast=options.fail_fast,
+                             scheduler=options.scheduler, started=started, finished=finished)
+    seconds = time.perf_counter() - start
+    written = []
+    if options.report is not None:
+        from fishgen.batch.report import report, write_report
+
+        write_report(options.report, report(manifest, outcomes, seconds, workers, options.scheduler))
+        written.append(options.report)
+    counts = {s: sum(o.status == s for o in outcomes) for s in ("built", "skipped", "failed", "not run")}
+    where = options.scheduler or f"-j {workers}"
+    line = (f"{_shown(manifest.out)}: {len(outcomes)} jobs, {counts['built']} built, "
+            f"{counts['skipped']} skipped, {counts['failed']} failed"
+            + (f", {counts['not run']} not run" if counts["not run"] else "")
+            + f" in {seconds:.2f} s ({where})")
+    errors = tuple(_job_error(o) for o in outcomes if o.status == "failed")
+    verdict = None
+    if errors:
+        verdict = JobsFailed(f"{len(errors)} of {len(outcomes)} jobs failed (each said why above)",
+                             any(e.status == 2 for e in errors))
+    written += [manifest.out / p for o in outcomes if o.status == "built" for p in o.outputs]
+    return Made(tuple(written), (manifest.file,) if manifest.file else (), (line,),
+                BatchFacts(tuple(outcomes), seconds, workers), errors, verdict)
+
+
+def _job_error(outcome) -> FishgenError:
+    return (outcome.error or FishgenError("failed")).of_job(outcome.job.name)
+
+
+def _tell(outcome, events: Events, bar: Progress | None) -> None:
+    """One finished job: its error and notes on stderr, its line (or the bar's step) on stdout."""
+    if outcome.status == "failed" and events.failed is not None:
+        events.failed(_job_error(outcome))
+    for note in outcome.notes:
+        events.note(note)
+    if bar is not None and outcome.status != "skipped":
+        bar.update(1)
+    if outcome.status != "failed":
+        text = f"{outcome.status:<8} {outcome.job.name}"
+        if outcome.status == "built":
+            text += f" ({outcome.seconds:.2f} s)"
+        events.line(text, outcome.reason)
+
+
+def _shown(path: Path) -> str:
+    """The out folder as the user would type it: relative below the current folder, else absolute."""
+    try:
+        shown = os.path.relpath(path)
+    except ValueError:  # another drive (Windows)
+        return os.fspath(path)
+    return os.fspath(path) if shown.startswith("..") else shown

@@ -1,0 +1,112 @@
+"""`fishgen build`: species files -> textured, fin-animated fish assets."""
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import click
+
+from fishgen.assembly.swim_modes import DEFAULT_SPEED
+from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output, each_input
+from fishgen.exchange.registry import MESHES, extensions, formats
+from fishgen.options import FiniteRange, fins_option, option, swim_option, textures_option
+
+FISH_FORMATS = formats(writable=True, holding=[MESHES])
+
+
+@dataclass(frozen=True)
+class BuildOptions:
+    format: str = option(click.Choice([f.name for f in FISH_FORMATS]), "Format of each file written into "
+                         "a folder (-o FOLDER/).", "glb", manifest=False)
+    fins: str | None = fins_option("mask if the file says masked, else blend")
+    length: float | None = option(FiniteRange(0.001, 1e4), "Nose-to-tail length in metres.",
+                                  shown_default="world scale x scaleX x 0.05 m for the body",
+                                  metavar="METRES")
+    fps: float = option(FiniteRange(1, 1000), "Frames per second; fins move step size degrees per frame.",
+                        30.0)
+    swim: str = swim_option("body: a travelling body wave (carangiform, tail-beat frequency from --speed) "
+                            "under the fin swings; fins: a rigid body, only the fins move (VRFish's fish).")
+    speed: float = option(FiniteRange(0.01, 100), "Cruising speed of the swim loop in body lengths per "
+                          "second; the tail beats at Strouhal number 0.3, rounded to a whole number of beats "
+                          "in the loop.", DEFAULT_SPEED, metavar="BL/S")
+    textures: Path | None = textures_option("the species file's folder, then the textures/ folder beside it")
+
+
+COMMAND = Command(
+    name="build",
+    summary="Build a species file into a textured, fin-animated fish asset.",
+    help="""Build SPECIES_FILE (VRFish parameter files) into game-ready fish.
+
+    glTF outputs carry the node hierarchy, materials, textures and a looping
+    `swim` clip; OBJ and PLY carry the rest pose. Axes: +Y up, head towards +Z,
+    metres. Outputs are written atomically: a failed run leaves no file. With
+    several species every good file is built, each bad one is reported on its
+    own line, and the exit status is non-zero if any failed.
+
+    \b
+    Examples:
+      fishgen build params/bonybream.txt -o out/bonybream.glb
+      fishgen build params/*.txt -o out/fish/ --format gltf
+    """,
+    options=BuildOptions,
+    run="fishgen.commands.build:build",
+    inputs=Inputs("SPECIES_FILE..."),
+    output=Output(f"Output file for one species (its extension picks the format: "
+                  f"{', '.join(extensions(FISH_FORMATS))}), or a folder: an existing one, or a name "
+                  "ending in /.", required=False, shown_default="out/<species file stem>.<format>",
+                  holds=(MESHES,)),
+    batch=True,
+)
+
+
+def build(inputs: Sequence[Path], output: str | os.PathLike | None, options: BuildOptions = BuildOptions(),
+          events: Events = QUIET) -> Made:
+    """Build each species file into a fish asset; with several inputs, a bad one is reported
+    through ``events.failed`` and the others are built."""
+    from fishgen.assembly.fish import make_fish
+    from fishgen.commands.paths import check_inputs, check_targets, targets
+    from fishgen.exchange import export
+    from fishgen.exchange.registry import FORMATS
+    from fishgen.species.parser import load_species
+
+    check_inputs(inputs, "build", [FORMATS["species"]], default=FORMATS["species"])
+    outputs = targets(inputs, output, fmt=options.format, holding=[MESHES], noun="species file")
+    check_targets(outputs, inputs)
+    written: list[Path] = []
+    read: list[Path] = []
+    lines: list[str] = []
+    facts = []
+    errors: list = []
+    for source, target in zip(inputs, outputs, strict=True):
+        with each_input(events, errors, len(inputs) > 1):
+            species = load_species(source, options.textures)
+            check_targets([target], species.side_files)
+            fish = make_fish(species, fins=options.fins, length=options.length, fps=options.fps,
+                             swim=options.swim, speed=options.speed)
+            files = export(fish.scene, target, require=[MESHES])
+            read += [source, *species.side_files]
+            written += files
+            facts.append(fish.facts)
+            lines.append(summary(fish, target, files))
+    return Made(tuple(written), tuple(read), tuple(lines), tuple(facts), tuple(errors))
+
+
+def summary(fish, target: Path, written: list[Path]) -> str:
+    """One line: what was built, and what the format could not keep (said once)."""
+    from fishgen.exchange.registry import by_extension, lost
+
+    scene, facts = fish.scene, fish.facts
+    fmt = by_extension(target)
+    dropped = lost(fmt, scene) if fmt is not None else []
+    animated = facts.clip_seconds is not None and "node animation" not in dropped
+    motion = (f"swim loop {facts.clip_seconds:.2f} s" if animated
+              else "rest pose only" if facts.clip_seconds is not None else "no animation")
+    if animated and facts.tail_beat_hz is not None:
+        motion += f", body wave {facts.tail_beat_hz:.2f} Hz"
+    listed = ", ".join(dropped[:-1]) + (" or " if len(dropped) > 1 else "") + dropped[-1] if dropped else ""
+    note = f" ({fmt.extensions[0][1:].upper()} holds no {listed})" if dropped and fmt else ""
+    return (f"{target}: {scene.name}, {scene.counts()['triangles']} triangles, "
+            f"{facts.body_length:.3f} m long, fins {facts.fin_mode}, {motion}{note}"
+            + (f" (+{len(written) - 1} files)" if len(written) > 1 else ""))

@@ -1,0 +1,181 @@
+"""`fishgen school`: simulate a fish school and bake it into one animated asset, tracks and measures."""
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
+from fishgen.exchange.registry import MESHES, NODE_ANIMATION
+from fishgen.options import FILE, FiniteRange, declare, fins_option, option, swim_option, textures_option
+from fishgen.school.scene_file import COUNT, FPS, FRAMES, MODEL, SEED_KEY
+
+SIDE_OUTPUTS = {"tracks": (".csv", ".npz"), "metrics": (".json",), "plot": (".png",)}
+
+
+@dataclass(frozen=True)
+class SchoolOptions:
+    count: int | None = declare(COUNT, default=None, shown_default=f"the scene file's counts, else "
+                                                                   f"{COUNT.default}")
+    frames: int | None = declare(FRAMES, default=None, shown_default=f"the scene file's, else "
+                                                                     f"{FRAMES.default}")
+    fps: float | None = declare(FPS, default=None, shown_default=f"the scene file's, else {FPS.default:g}")
+    seed: int | None = declare(SEED_KEY, default=None,
+                               shown_default="the scene file's, else 0; in a batch, derived from the "
+                                             "output's name")
+    model: str | None = declare(MODEL, default=None, shown_default=f"the scene file's, else {MODEL.default}")
+    tolerance: float = option(FiniteRange(0, 1),
+                              "How far thinned keyframes may stray from the simulated path.",
+                              0.002, metavar="METRES")
+    tracks: Path | None = option(FILE, "Also write raw tracks: .csv or .npz (frame, time, fish, species, "
+                                 "position, quaternion, velocity).", shown_default="none", manifest=False)
+    metrics: Path | None = option(FILE, "Also write the per-frame measures as JSON.", shown_default="none",
+                                  manifest=False)
+    plot: Path | None = option(FILE,
+                               "Also draw the measures over time beside a top view of the tracks (.png; "
+                               "needs matplotlib, `pip install 'fishgen[plot]'`).", shown_default="none",
+                               manifest=False)
+    fins: str | None = fins_option("from each species file")
+    swim: str = swim_option("body: every fish's body waves, its tail beating faster the faster it swims; "
+                            "fins: rigid bodies, only the fins move.")
+    textures: Path | None = textures_option("as `fishgen build` resolves them")
+
+
+COMMAND = Command(
+    name="school",
+    summary="Simulate a fish school and bake it into an animated glb, tracks and measures.",
+    help="""Simulate a school of SPECIES files (or a SCENE.toml) and bake it into an animated glb.
+
+    Every fish of a species shares its meshes; each fish is a node with translation and
+    rotation keys for the whole run, its body wave follows its own speed, and its fins beat
+    phase-shifted in the same clip.
+    A scene file holds species and counts, model parameters, bounds, the target path,
+    a predator and the start layout; the options here override it.
+
+    \b
+    Examples:
+      fishgen school params/bonybream.txt --count 200 -o out/school.glb
+      fishgen school params/reef.toml -o out/reef.glb --metrics out/reef.json --tracks out/reef.npz
+    """,
+    options=SchoolOptions,
+    run="fishgen.commands.school:school",
+    inputs=Inputs("SPECIES|SCENE.toml..."),
+    output=Output("Animated asset to write (.glb or .gltf: the only formats that hold node animation).",
+                  holds=(MESHES, NODE_ANIMATION)),
+    batch=True,
+)
+
+
+@dataclass(frozen=True)
+class SchoolFacts:
+    species: tuple[tuple[str, int], ...]   # (name, count)
+    frames: int
+    fps: float
+    model: str
+    bytes: int
+    warmup_frames: int
+    table: str                             # the summary of the measures after the warm-up
+
+
+def school(inputs: Sequence[Path], output: str | os.PathLike, options: SchoolOptions = SchoolOptions(),
+           events: Events = QUIET) -> Made:
+    """Simulate, bake and write the school; the side outputs (tracks, metrics, plot) are written
+    only when the glb was, and every target is checked before the simulation starts."""
+    output = Path(output)
+    from fishgen.commands.paths import check_inputs, check_targets, needs, suffix_of
+    from fishgen.errors import UsageError
+    from fishgen.exchange.registry import FORMATS, MESHES, NODE_ANIMATION, output_format
+    from fishgen.school.scene_file import SceneFile, SpeciesEntry, check_size, load_scene_file, with_options
+
+    output_format(output, [MESHES, NODE_ANIMATION])
+    kinds = check_inputs(inputs, "school", [FORMATS["school scene"], FORMATS["species"]],
+                         default=FORMATS["species"])
+    scene_files = [p for p, kind in zip(inputs, kinds, strict=True) if kind is FORMATS["school scene"]]
+    if scene_files and len(inputs) > 1:
+        raise UsageError(f"expected one scene file alone or species files, found {len(inputs)} inputs "
+                         f"with {scene_files[0]}")
+    sides = {name: getattr(options, name) for name in SIDE_OUTPUTS if getattr(options, name) is not None}
+    for name, path in sides.items():
+        suffix_of(path, SIDE_OUTPUTS[name], f"--{name}")
+    if "plot" in sides:
+        needs("matplotlib", "plot", "--plot")
+    if scene_files:
+        scene = load_scene_file(scene_files[0])
+    else:
+        scene = SceneFile(species=tuple(SpeciesEntry(p) for p in inputs))
+    scene = with_options(scene, count=options.count, frames=options.frames, fps=options.fps,
+                         seed=options.seed,
+                         model=options.model)
+    check_size(scene)  # before anything is built
+    species_files = [e.file for e in scene.species]
+    check_targets([output, *sides.values()], [*inputs, *species_files, *scene.read])
+
+    from fishgen.school import run_school
+
+    with events.progress("simulating", scene.frames) as bar:
+        run = run_school(scene, fins=options.fins, swim=options.swim, tolerance=options.tolerance,
+                         textures_dir=options.textures, progress=bar.update)
+    warmup = min(scene.frames // 3, int(3 * scene.fps))
+    per_frame: dict = {}
+    numbers: dict = {}
+    table = ""
+    measured = events.summary or "metrics" in sides or "plot" in sides  # else nobody reads the measures
+    if measured:
+        from fishgen.school.metrics import format_table, measures, summary, summary_table
+
+        per_frame = measures(run.tracks, run.group_lengths)
+        numbers = summary(per_frame, warmup)
+        table = format_table(summary_table(per_frame, warmup, run.species_names),
+                             f"after {warmup / scene.fps:.1f} s warm-up")
+    files = _write_all(output, run, sides, per_frame, numbers, warmup)
+    size = sum(p.stat().st_size for p in files if p not in sides.values())
+    kinds_line = ", ".join(f"{e.count} {Path(e.file).stem}" for e in scene.species)
+    line = (f"{output}: {kinds_line}; {scene.frames} frames ({scene.frames / scene.fps:.1f} s), "
+            f"{scene.model}, {size / 1e6:.2f} MB")
+    facts = SchoolFacts(tuple((Path(e.file).stem, e.count) for e in scene.species), scene.frames, scene.fps,
+                        scene.model, size, warmup, table)
+    read = tuple(dict.fromkeys([*inputs, *scene.read, *run.read]))
+    return Made(tuple(files), read, (line, table) if measured else (line,), facts)
+
+
+def _write_all(output: Path, run, sides: dict[str, Path], per_frame: dict, numbers: dict,
+               warmup: int) -> list[Path]:
+    """The glb and every side output, all or none."""
+    from fishgen.atomic import together, write_bytes
+    from fishgen.exchange import export
+    from fishgen.exchange.registry import MESHES, NODE_ANIMATION
+
+    with together():
+        files = export(run.scene, output, require=[MESHES, NODE_ANIMATION])
+        if "tracks" in sides:
+            from fishgen.school.tracks import write_tracks
+            files.append(write_tracks(run.tracks, sides["tracks"], run.species_names))
+        if "metrics" in sides:
+            write_bytes(sides["metrics"], _metrics_json(run, per_frame, numbers, warmup))
+            files.append(sides["metrics"])
+        if "plot" in sides:
+            from fishgen.school.plot import plot_school
+            files.append(plot_school(sides["plot"], run, per_frame))
+    return files
+
+
+def _metrics_json(run, per_frame: dict, numbers: dict, warmup: int) -> bytes:
+    import json
+
+    import numpy as np
+
+    def plain(value: Any) -> Any:
+        if isinstance(value, dict):
+            return {str(k): plain(v) for k, v in value.items()}
+        if isinstance(value, np.ndarray):
+            return np.round(value.astype(float), 6).tolist()
+        if isinstance(value, (np.floating, np.integer)):
+            return value.item()
+        return value
+
+    doc = {"species": run.species_names, "fps": run.config.fps, "frames": run.config.frames,
+           "model": run.config.model, "warmup_frames": warmup, "summary": plain(numbers),
+           "per_frame": plain(per_frame)}
+    return json.dumps(doc, indent=1, sort_keys=True).encode("utf-8")

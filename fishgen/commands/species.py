@@ -1,0 +1,63 @@
+"""`fishgen species`: sample plausible new species, painted and ready to build."""
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import click
+
+from fishgen.commands import QUIET, Command, Events, Made, Output
+from fishgen.options import option
+
+
+@dataclass(frozen=True)
+class SpeciesOptions:
+    random: bool = option(click.BOOL,
+                          "Sample species at random (the only mode so far; say it so a typo never "
+                          "samples).", False, flag=True, required=True)
+    seed: int = option(click.IntRange(0, 2**63 - 1), "Seed of the first species.", 0)
+    count: int = option(click.IntRange(1, 10_000), "Species to write; more than one go into the folder -o "
+                        "names, seeds seed..seed+K-1.", 1)
+
+
+COMMAND = Command(
+    name="species",
+    summary="Sample plausible new species (shape, fins, motion) with painted textures.",
+    help="""Write new VRFish species: body shape and profile, level of detail, fins and their
+    sizes, fin technique and swimming, all within the ranges the thesis' and the
+    shipped species span (docs/decisions.md), with a painted skin.
+
+    \b
+    Examples:
+      fishgen species --random --seed 7 -o out/reef/fish7.txt
+      fishgen species --random --seed 100 --count 16 -o out/reef/
+    """,
+    options=SpeciesOptions,
+    run="fishgen.commands.species:species",
+    output=Output("Species file (.txt) for one species, or a folder (an existing one, or a name ending in /) "
+                  "for any count. Textures (NAME.png, NAME_mask.png) are written beside each species file.",
+                  metavar="OUT"),
+)
+
+
+def species(inputs: Sequence[Path], output: str | os.PathLike, options: SpeciesOptions = SpeciesOptions(),
+            events: Events = QUIET) -> Made:
+    """Sample ``count`` species from ``seed`` on and write them, each all or nothing."""
+    from fishgen.authoring.species_files import write_samples
+    from fishgen.commands.paths import names_folder
+    from fishgen.errors import UsageError
+
+    if not options.random:
+        raise UsageError("expected --random (the only way to make species so far), found none")
+    folder = names_folder(output)
+    path = Path(output)
+    if not folder and options.count > 1:
+        raise UsageError(f"expected a folder for --count {options.count} (an existing folder, or a name "
+                         f"ending in /), found {os.fspath(output)!r}")
+    if not folder and path.suffix.lower() != ".txt":
+        raise UsageError(f"expected -o to name a species file (.txt) or a folder (an existing one, or a name "
+                         f"ending in /), found {os.fspath(output)!r}")
+    written = write_samples(options.seed, options.count, path, folder=folder)
+    return Made(tuple(written), (), tuple(f"wrote {p}" for p in written))

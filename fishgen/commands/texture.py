@@ -1,0 +1,95 @@
+"""`fishgen texture`: Fixel's texture points, measured on a side photo of a fish."""
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import click
+
+from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
+from fishgen.options import FILE, option
+
+SPACINGS = ("projected", "even")   # fishgen.authoring.photo.points.SPACINGS, without numpy
+
+
+@dataclass(frozen=True)
+class TextureCommandOptions:
+    species: Path = option(FILE, "Species file whose geometry (body, fins, level of detail) the new species "
+                           "starts from.", None, required=True, short="-s", metavar="BASE.txt")
+    mask: Path | None = option(FILE, "Hand-made silhouette (white fish on black), the photo's size, for hard "
+                               "photos.", shown_default="the photo's alpha, else a model of the background",
+                               metavar="MASK.png")
+    fit_shape: bool = option(click.BOOL,
+                             "Also fit the body profile, its proportions and the fin sizes to the "
+                             "photo.", False, flag=True)
+    body_sections: int | None = option(click.IntRange(3, 256), "BodySections of the new species.",
+                                       shown_default="the base species'", metavar="N")
+    circle_sections: int | None = option(click.IntRange(3, 256), "CircleSections of the new species.",
+                                         shown_default="the base species'", metavar="M")
+    spacing: str = option(click.Choice(SPACINGS), "Points on each vertical line: where a side view shows the "
+                          "ring's points, or evenly spaced as in the thesis' BonyBream listing.", "projected")
+    compare: Path | None = option(FILE,
+                                  "Also write the photo beside the rebuilt fish, rendered the same way.",
+                                  shown_default="none", metavar="OUT.png")
+    fxl_in: Path | None = option(FILE, "Take the parts a Fixel .FXL file holds from it instead of measuring "
+                                 "them.", shown_default="none", metavar="POINTS.FXL")
+    fxl_out: Path | None = option(FILE, "Also write the points as a Fixel .FXL file.", shown_default="none",
+                                  metavar="POINTS.FXL")
+
+
+COMMAND = Command(
+    name="texture",
+    summary="Make a species from a side photo of a fish: texture, texture points, fin mask.",
+    help="""Make a species from PHOTO, a side view of one fish on a plain or transparent background.
+
+    The head may point left or right and the fish may lie up to about 10 degrees
+    off level. fishgen finds the silhouette, the body under the fins, the nose
+    and the tail base, and places every texture point Fixel's user would have
+    clicked (thesis chapter 6, Appendix B). The photo becomes the texture, stored
+    upside down as VRFish expects.
+
+    \\b
+    Examples:
+      fishgen texture params/photos/bream-side.png -s params/centroberyx.txt -o out/bream.txt
+      fishgen texture params/photos/bream-side.png -s params/centroberyx.txt -o out/bream.txt \\
+        --fit-shape --compare out/cmp.png
+    """,
+    options=TextureCommandOptions,
+    run="fishgen.commands.texture:texture",
+    inputs=Inputs("PHOTO", many=False),
+    output=Output("New species file; NEW.png (texture) and NEW_mask.png (fin mask) are written beside it.",
+                  metavar="NEW.txt"),
+)
+
+
+def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureCommandOptions,
+            events: Events = QUIET) -> Made:
+    """Measure the photo and write the new species, its texture and mask (and the extras asked)."""
+    output = Path(output)
+    from fishgen.authoring.photo.run import TextureOptions, make_texture
+    from fishgen.commands.paths import check_targets
+    from fishgen.errors import UsageError
+    from fishgen.species.parser import load_species
+
+    (photo,) = inputs
+    if options.species is None:
+        raise UsageError("expected -s/--species BASE.txt, the species to start from, found none")
+    sides = [options.mask, options.fxl_in]
+    outputs = [output, output.with_suffix(".png"), output.with_name(f"{output.stem}_mask.png"),
+               options.compare, options.fxl_out]
+    check_targets(outputs, [photo, options.species, *(p for p in sides if p is not None)])
+    species = load_species(options.species)
+    settings = TextureOptions(mask=options.mask, fit_shape=options.fit_shape,
+                              body_sections=options.body_sections,
+                              circle_sections=options.circle_sections, spacing=options.spacing,
+                              compare=options.compare, fxl_in=options.fxl_in, fxl_out=options.fxl_out)
+    result = make_texture(photo, species, output, settings, on_note=events.note)
+    turned = (["head on the right"] if result.mirrored else []) + (
+        [f"turned {result.angle:+.1f} degrees"] if result.angle else [])
+    events.note(f"silhouette from the {result.source}" + (f" ({', '.join(turned)})" if turned else ""))
+    if result.iou is not None:
+        events.note(f"silhouette IoU of the rebuilt fish: {result.iou:.3f}")
+    read = [photo, options.species, *species.side_files, *(p for p in sides if p is not None)]
+    return Made(tuple(result.written), tuple(read), tuple(f"wrote {p}" for p in result.written), result)

@@ -1,0 +1,298 @@
+"""Options declared once: an options record's fields *are* the declarations.
+
+    @dataclass(frozen=True)
+    class BuildOptions:
+        fps: float = option(FiniteRange(1, 1000), "Frames per second.", 30.0)
+
+One such field gives the command line its ``--fps`` (type, range, default and help, checked by
+click before any work), the batch manifest its ``fps = 30`` key (the same type checks on the TOML
+value, with the manifest's ``FILE:LINE``), and the library function its ``options.fps``. Scene
+files check their keys against the same declarations.
+
+Leaf module: click and the standard library only, so ``fishgen --help`` never loads numpy.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import MISSING, Field, dataclass, field, fields
+from pathlib import Path
+from typing import Any, TypeVar
+
+import click
+
+from fishgen.errors import FishgenError
+
+OPTION = "fishgen.option"
+FLOAT32_MAX = 3.4028234663852886e38  # mirrors fishgen.numeric without importing numpy at --help time
+SEED_MAX = 2**63 - 1
+"""The largest seed: every command takes 0 .. 2^63 - 1 (a TOML integer holds no more)."""
+
+T = TypeVar("T")
+
+
+# -- types click checks (and manifests reuse) -------------------------------------------------
+
+class Triple(click.ParamType):
+    """``X,Y,Z``: three finite numbers within float32 range (where particles and nodes live)."""
+
+    name = "X,Y,Z"
+    what = "[x, y, z] of finite numbers within float32 range"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, (tuple, list)):
+            numbers = tuple(value)
+        else:
+            try:
+                numbers = tuple(float(part) for part in str(value).replace(" ", "").split(","))
+            except ValueError:
+                numbers = ()
+        if len(numbers) != 3 or not all(_finite_number(v) and abs(v) <= FLOAT32_MAX for v in numbers):
+            self.fail(f"expected X,Y,Z with three finite numbers within float32 range, found {value!r}",
+                      param, ctx)
+        return tuple(float(v) for v in numbers)
+
+
+class FiniteRange(click.FloatRange):
+    """click's FloatRange, refusing NaN too (it compares false with both bounds, so it passes them)."""
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number.", param, ctx)
+        return number
+
+
+class Size(click.ParamType):
+    """``WxH`` in pixels, each side within ``low`` .. ``high``."""
+
+    name = "WxH"
+
+    def __init__(self, low: int = 16, high: int = 8192):
+        self.low, self.high = low, high
+        self.what = f"WxH with {low} to {high} pixels a side"
+
+    def convert(self, value, param, ctx):
+        import re
+
+        if isinstance(value, tuple):
+            return value
+        m = re.fullmatch(r"\s*(\d{1,6})\s*[xX×]\s*(\d{1,6})\s*", str(value))
+        if not m or not all(self.low <= int(v) <= self.high for v in m.groups()):
+            self.fail(f"expected {self.what}, found {value!r}", param, ctx)
+        return int(m[1]), int(m[2])
+
+
+class Colour(click.ParamType):
+    """A CSS colour (``#8cadcc``, ``#rrggbbaa``, ``white``) or ``transparent``, as sRGB 0-255 RGBA."""
+
+    name = "COLOUR"
+    what = "a colour (#8cadcc, white) or transparent"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, tuple):
+            return value
+        from PIL import ImageColor
+
+        text = str(value).strip()
+        if text.lower() in ("transparent", "none"):
+            return (0, 0, 0, 0)
+        try:
+            rgba = ImageColor.getcolor(text, "RGBA")
+        except ValueError:
+            self.fail(f"expected {self.what}, found {value!r}", param, ctx)
+        r, g, b, a = rgba if isinstance(rgba, tuple) else (rgba, rgba, rgba, 255)
+        return int(r), int(g), int(b), int(a)
+
+
+def _finite_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+SEED = click.IntRange(0, SEED_MAX)
+FOLDER = click.Path(file_okay=False, path_type=Path)
+FILE = click.Path(dir_okay=False, path_type=Path)
+
+
+# -- the declaration ------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Option:
+    """What one option is: its type (a click ParamType, which checks it), help, default, how
+    ``--help`` shows the default, and where it may be set."""
+
+    type: click.ParamType
+    help: str
+    default: Any = None
+    shown_default: str | None = None  # for --help when the default alone does not say (None: computed)
+    short: str | None = None          # e.g. "-j"
+    metavar: str | None = None
+    flag: bool = False
+    multiple: bool = False
+    manifest: bool = True             # a batch manifest may set it
+    required: bool = False            # on the command line
+    path: bool = False                # a file or folder: relative to the manifest in a manifest
+
+    def default_text(self) -> str:
+        if self.shown_default is not None:
+            return self.shown_default
+        if self.flag:
+            return "on" if self.default else "off"
+        if self.multiple and not self.default:
+            return "none"
+        if isinstance(self.default, tuple):
+            return ",".join(f"{v:g}" if isinstance(v, float) else str(v) for v in self.default)
+        if isinstance(self.default, float):
+            return f"{self.default:g}"
+        return str(self.default)
+
+
+def option(type: click.ParamType, help: str, default: Any = None, **kwargs: Any) -> Any:
+    """A field of an options record, declaring its option (see the module's docstring)."""
+    return declare(Option(type, help, default, **kwargs))
+
+
+def declare(spec: Option, **changes: Any) -> Any:
+    """A field of an options record from a declaration made elsewhere (a scene file's key that is
+    also an option), with ``changes`` (another default, how --help shows it)."""
+    from dataclasses import replace
+
+    spec = replace(spec, **changes)
+    return field(default=spec.default, metadata={OPTION: spec})
+
+
+def declared(record: type | Any) -> Iterator[tuple[Field, Option]]:
+    """Each field of an options record with its declaration, in declaration order."""
+    for f in fields(record):
+        spec = f.metadata.get(OPTION)
+        if spec is not None:
+            yield f, spec
+
+
+def long_name(f: Field) -> str:
+    """The option's name on the command line and in manifests: ``max_particles`` -> ``max-particles``."""
+    return f.name.replace("_", "-")
+
+
+# -- the command line -----------------------------------------------------------------------------
+
+def click_params(record: type) -> list[click.Parameter]:
+    """The click options of an options record, each documenting its default."""
+    params: list[click.Parameter] = []
+    for f, spec in declared(record):
+        decls = [f"--{long_name(f)}", *([spec.short] if spec.short else []), f.name]
+        help_text = f"{spec.help}  [default: {spec.default_text()}]" if not spec.required else spec.help
+        if spec.flag:
+            params.append(click.Option(decls, is_flag=True, default=bool(spec.default), help=help_text))
+        else:
+            params.append(click.Option(decls, type=spec.type, default=spec.default, multiple=spec.multiple,
+                                       metavar=spec.metavar, help=help_text, show_default=False,
+                                       required=spec.required))
+    return params
+
+
+def from_values(record: type[T], values: Mapping[str, Any]) -> T:
+    """The options record from click's values (keyed by field name); unknown keys are a bug."""
+    names = {f.name for f, _ in declared(record)}
+    unknown = set(values) - names
+    if unknown:
+        raise TypeError(f"{record.__name__} has no option {', '.join(sorted(unknown))}")
+    given = {k: (tuple(v) if isinstance(v, list) else v) for k, v in values.items()}
+    return record(**given)
+
+
+# -- manifests and scene files --------------------------------------------------------------------
+
+def what(spec: Option) -> str:
+    """The words a manifest's error uses for what a value must be."""
+    t = spec.type
+    if spec.flag:
+        text = "true or false"
+    elif hasattr(t, "what"):
+        text = str(t.what)
+    elif isinstance(t, click.Choice):
+        text = "one of " + ", ".join(map(str, t.choices))
+    elif isinstance(t, (click.IntRange, click.FloatRange)):
+        kind = "a whole number" if isinstance(t, click.IntRange) else "a number"
+        if t.min is not None and t.max is not None:
+            text = f"{kind} from {t.min:g} to {t.max:g}" if isinstance(t, click.FloatRange) else \
+                f"{kind} from {t.min} to {t.max}"
+        elif t.min is not None:
+            text = f"{kind} of {t.min} or more"
+        else:
+            text = kind
+    elif isinstance(t, click.Path):
+        text = "a folder name" if not t.file_okay else "a file name"
+    else:
+        text = f"a {t.name}"
+    return f"a list of {text}" if spec.multiple else text
+
+
+def _toml_kind_ok(spec: Option, value: Any) -> bool:
+    """TOML values come typed: a number where a number is declared, text where a name is."""
+    t = spec.type
+    if spec.flag:
+        return isinstance(value, bool)
+    if isinstance(value, bool):
+        return False
+    if isinstance(t, click.IntRange) or t is click.INT:
+        return isinstance(value, int)
+    if isinstance(t, click.FloatRange) or t is click.FLOAT:
+        return isinstance(value, (int, float))
+    if isinstance(t, Triple):
+        return isinstance(value, list)
+    return isinstance(value, str)
+
+
+def check_value(spec: Option, value: Any, fail: Callable[[str], FishgenError]) -> Any:
+    """A manifest's or scene file's value, checked exactly as the command line checks it.
+    ``fail(what)`` makes the error at the value's line."""
+    items = value if spec.multiple else [value]
+    if spec.multiple and not isinstance(value, list):
+        raise fail(what(spec))
+    converted = []
+    for item in items:
+        if not _toml_kind_ok(spec, item):
+            raise fail(what(spec))
+        if spec.flag:
+            converted.append(item)
+            continue
+        try:
+            converted.append(spec.type.convert(item, None, None))
+        except click.BadParameter:
+            raise fail(what(spec)) from None
+    return tuple(converted) if spec.multiple else converted[0]
+
+
+def manifest_options(record: type) -> dict[str, tuple[Field, Option]]:
+    """The keys a manifest may set for a command: long name -> (field, declaration)."""
+    return {long_name(f): (f, spec) for f, spec in declared(record) if spec.manifest}
+
+
+def field_default(f: Field) -> Any:
+    return None if f.default is MISSING else f.default
+
+
+# -- options several commands share (each call declares one field) -----------------------------
+
+def fins_option(shown_default: str) -> Any:
+    from fishgen.assembly.fin_modes import FIN_MODES
+
+    return option(click.Choice(FIN_MODES), "Fin technique (thesis ch. 5): translucent, mask cut-out or "
+                  "opaque.", shown_default=shown_default)
+
+
+def swim_option(help_text: str) -> Any:
+    from fishgen.assembly.swim_modes import SWIM_MODES
+
+    return option(click.Choice(SWIM_MODES), help_text, "body")
+
+
+def textures_option(shown_default: str) -> Any:
+    return option(FOLDER, "Folder texture names resolve in (and may not leave).", shown_default=shown_default,
+                  metavar="DIR", path=True)
+
+
+def seed_option(help_text: str, default: int | None = 0, shown_default: str | None = None) -> Any:
+    return option(SEED, f"Random seed (0 to 2^63-1); the same seed gives byte-identical files. {help_text}",
+                  default, shown_default=shown_default)

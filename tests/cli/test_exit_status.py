@@ -1,0 +1,139 @@
+"""The README's exit-status table, row by row, for every command that writes: 1 when the system
+refuses (a full disk, a read-only folder, a port taken, a missing optional package), 2 for bad
+input, each one line naming the path, and nothing left behind. (130 and 143: test_interrupt.py.)"""
+from __future__ import annotations
+
+import json
+import os
+import resource
+import shutil
+import socket
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import PARAMS, ROOT
+
+FISH = PARAMS / "bonybream.txt"
+CUBES = PARAMS / "clouds" / "table_4_3.awn"
+PHOTO = PARAMS / "photos" / "bonybream-side.png"
+
+
+def writers(out: Path) -> dict[str, list[str]]:
+    """Every command that writes files, writing into ``out``, with the file it names."""
+    return {
+        "build": ["build", str(FISH), "-o", str(out / "fish.glb")],
+        "clouds": ["clouds", str(CUBES), "-o", str(out / "cloud.ply")],
+        "school": ["school", str(FISH), "--count", "4", "--frames", "10", "-o", str(out / "school.glb")],
+        "preview": ["preview", str(FISH), "-o", str(out / "fish.png"), "--size", "64x48"],
+        "view": ["view", str(ROOT / "tests" / "fixtures" / "tiny.glb"), "--no-serve", "-o", str(out / "page.html")],
+        "texture": ["texture", str(PHOTO), "-s", str(FISH), "-o", str(out / "new.txt")],
+        "species": ["species", "--random", "-o", str(out / "sp.txt")],
+        "batch": ["batch", str(PARAMS / "clouds"), "--out", str(out / "all"), "-j", "1"],
+    }
+
+
+def run(args: list[str], limit: int | None = None, env: dict | None = None) -> subprocess.CompletedProcess:
+    def cap() -> None:  # a file size limit: every write past it fails as a full disk does
+        if limit is not None:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    return subprocess.run([sys.executable, "-m", "fishgen", "--json", *args], cwd=ROOT, capture_output=True,
+                          text=True, preexec_fn=cap, env=env)
+
+
+def one_error(result: subprocess.CompletedProcess) -> dict:
+    lines = result.stderr.strip().splitlines()
+    assert lines and "Traceback" not in result.stderr, result.stderr
+    return json.loads(lines[-1])
+
+
+@pytest.mark.parametrize("name", sorted(writers(Path("."))))
+def test_a_write_the_system_refuses_exits_1_naming_the_file(tmp_path, name):
+    """A full disk (a file-size limit here) is not bad input: status 1, kind os, the path named."""
+    out = tmp_path / "out"
+    out.mkdir()
+    result = run(writers(out)[name], limit=4096)
+    error = one_error(result)
+    assert result.returncode == 1 and error["exit"] == 1 and error["kind"] in ("os", "jobs"), result.stderr
+    assert str(out) in result.stderr and ": : " not in result.stderr
+    leftovers = [p for p in out.rglob("*") if p.is_file() and p.name != ".fishgen-batch.lock"]
+    assert [p for p in leftovers if p.name.endswith(".tmp")] == []
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A real 64 KiB file system, and a read-only one (root only: mount)."""
+    if os.geteuid() != 0 or shutil.which("mount") is None:
+        pytest.skip("mounting a small file system needs root")
+    full, readonly = tmp_path / "full", tmp_path / "ro"
+    full.mkdir(), readonly.mkdir()
+    for where, opts in ((full, "size=64k"), (readonly, "ro,size=64k")):
+        if subprocess.run(["mount", "-t", "tmpfs", "-o", opts, "tmpfs", str(where)],
+                          capture_output=True).returncode:
+            pytest.skip("this machine refuses to mount a tmpfs")
+    yield full, readonly
+    for where in (full, readonly):
+        subprocess.run(["umount", str(where)], capture_output=True)
+
+
+@pytest.mark.parametrize("name", ["build", "clouds", "school", "species"])
+def test_a_full_disk_and_a_read_only_folder_exit_1_with_the_path(small_disk, name):
+    full, readonly = small_disk
+    for folder, reason in ((full, "No space left on device"), (readonly, "Read-only file system")):
+        args = writers(folder)[name]
+        if name == "clouds":  # big enough to fill 64 KiB
+            args = ["clouds", str(PARAMS / "clouds" / "table_4_4.awn"), "-o", str(folder / "cloud.csv")]
+        result = run(args)
+        error = one_error(result)
+        assert result.returncode == 1 and error["kind"] == "os" and reason in error["error"], result.stderr
+        assert str(folder) in error["error"] and error["file"] is not None
+        assert list(folder.iterdir()) == []
+
+
+def test_a_port_already_taken_exits_1(tmp_path):
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        result = run(["view", str(ROOT / "tests" / "fixtures" / "tiny.glb"), "-o", str(tmp_path / "p.html"),
+                      "--port", str(port)])
+    error = one_error(result)
+    assert result.returncode == 1 and error["kind"] == "os" and f"port {port}" in error["error"]
+
+
+BLOCK = "import sys; sys.modules[{name!r}] = None; from fishgen.cli import run; sys.argv[0] = 'fishgen'; run()"
+
+
+@pytest.mark.parametrize("module,args", [
+    ("matplotlib", ["school", str(FISH), "--count", "400", "--frames", "600", "-o", "{out}/s.glb", "--plot",
+                    "{out}/s.png"]),
+    ("distributed", ["batch", str(PARAMS / "clouds"), "--out", "{out}/all", "--scheduler", "tcp://127.0.0.1:9"]),
+])
+def test_a_missing_optional_package_exits_1_before_any_work(tmp_path, module, args):
+    """Issue 19: `--plot` on a core install simulated for seconds, wrote the glb, then failed."""
+    filled = [a.format(out=tmp_path) for a in args]
+    result = subprocess.run([sys.executable, "-c", BLOCK.format(name=module), "--json", *filled], cwd=ROOT,
+                            capture_output=True, text=True, timeout=60)
+    error = one_error(result)
+    assert result.returncode == 1 and error["kind"] == "dependency" and f"fishgen[" in error["error"]
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name", sorted(writers(Path("."))))
+def test_bad_input_exits_2_in_one_line_and_writes_nothing(tmp_path, name):
+    bad = tmp_path / "bad"
+    bad.write_bytes(b"\x89PNG\r\n\x1a\nnot really")
+    args = [a if a not in (str(FISH), str(CUBES), str(PHOTO), str(PARAMS / "clouds"),
+                           str(ROOT / "tests" / "fixtures" / "tiny.glb")) else str(bad)
+            for a in writers(tmp_path / "out")[name]]
+    if name == "species":
+        args = ["species", "--random", "--count", "2", "-o", str(tmp_path / "out" / "two.txt")]
+    if name == "batch":
+        args = ["batch", str(bad), "--out", str(tmp_path / "out")]
+    result = run(args)
+    error = one_error(result)
+    assert result.returncode == 2 and error["exit"] == 2 and error["kind"] in ("input", "usage"), result.stderr
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.*"))

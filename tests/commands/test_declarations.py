@@ -1,0 +1,81 @@
+"""One declaration per option: the command line, batch manifests and the library function all
+take it from the options record (issue 19)."""
+from __future__ import annotations
+
+import pytest
+from click.testing import CliRunner
+
+from fishgen.commands import MODULES, Made, command
+from tests.commands import toy
+
+
+@pytest.fixture
+def with_toy(monkeypatch):
+    monkeypatch.setitem(MODULES, "toy", "tests.commands.toy")
+    toy.SEEN.clear()
+    return toy
+
+
+def test_an_option_declared_once_is_in_help_in_a_manifest_and_in_the_function(with_toy, tmp_path):
+    from fishgen.batch import run_batch
+    from fishgen.batch.manifest import load_manifest
+    from fishgen.cli import cli
+
+    help_text = CliRunner().invoke(cli, ["toy", "--help"]).output
+    assert "--brightness" in help_text and "How bright the toy shines.  [default: 2.5]" in help_text
+
+    (tmp_path / "in.txt").write_text("x")
+    ran = CliRunner().invoke(cli, ["toy", str(tmp_path / "in.txt"), "-o", str(tmp_path / "a"), "--brightness", "7"])
+    assert ran.exit_code == 0 and ran.output == "toy 7.0\n"
+    bad = CliRunner().invoke(cli, ["toy", str(tmp_path / "in.txt"), "-o", str(tmp_path / "a"), "--brightness", "11"])
+    assert bad.exit_code == 2
+
+    manifest = tmp_path / "m.toml"
+    manifest.write_text('[[toy]]\ninput = "in.txt"\noutput = "b"\nbrightness = 4\n')
+    outcomes = run_batch(load_manifest(manifest, tmp_path / "out"))
+    assert [o.status for o in outcomes] == ["built"] and (tmp_path / "out" / "b").read_text() == "4.0 red\n"
+    assert [o.brightness for o in toy.SEEN] == [7.0, 4.0]
+
+    manifest.write_text('[[toy]]\ninput = "in.txt"\noutput = "b"\n\nbrightness = 11\n')
+    from fishgen.errors import FishgenError
+    with pytest.raises(FishgenError) as caught:
+        load_manifest(manifest)
+    assert str(caught.value) == f"{manifest}:5: expected brightness as a number from 0 to 10, found '11'"
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_every_option_of_every_command_says_its_default(name):
+    """`--help` shows the default of every option, flags and optional outputs included."""
+    import click
+
+    from fishgen.cli import cli
+
+    click_command = cli.get_command(None, name)  # type: ignore[arg-type]
+    for param in click_command.params:
+        if isinstance(param, click.Option) and param.name != "help":
+            text = param.help or ""
+            assert "[default: " in text or param.required, f"fishgen {name} {param.opts[0]}: {text!r}"
+
+
+def test_the_school_scene_file_checks_its_keys_with_the_options_declarations(tmp_path):
+    """The scene file's ranges are the options' own: a seed the command line takes, it takes."""
+    from fishgen.commands.school import SchoolOptions
+    from fishgen.errors import FishgenError
+    from fishgen.options import declared
+    from fishgen.school.scene_file import FRAMES, load_scene_file
+
+    frames = next(spec for f, spec in declared(SchoolOptions) if f.name == "frames")
+    assert frames.type is FRAMES.type
+    scene = tmp_path / "s.toml"
+    scene.write_text('seed = 1099511627776\n[[species]]\nfile = "a.txt"\n')
+    assert load_scene_file(scene).seed == 1099511627776
+    scene.write_text('frames = 1\n[[species]]\nfile = "a.txt"\n')
+    with pytest.raises(FishgenError, match=r":1: expected frames as a whole number from 2 to 100000, found '1'"):
+        load_scene_file(scene)
+
+
+def test_the_library_function_is_what_the_cli_and_a_batch_job_run():
+    for name in MODULES:
+        declared = command(name)
+        assert declared.function().__name__ == name
+        assert declared.function().__annotations__["return"] in ("Made", Made)
