@@ -183,7 +183,8 @@ def click_params(record: type) -> list[click.Parameter]:
         decls = [f"--{long_name(f)}", *([spec.short] if spec.short else []), f.name]
         help_text = f"{spec.help}  [default: {spec.default_text()}]" if not spec.required else spec.help
         if spec.flag:
-            params.append(click.Option(decls, is_flag=True, default=bool(spec.default), help=help_text))
+            params.append(click.Option(decls, is_flag=True, default=bool(spec.default), help=help_text,
+                                       required=spec.required))
         else:
             params.append(click.Option(decls, type=spec.type, default=spec.default, multiple=spec.multiple,
                                        metavar=spec.metavar, help=help_text, show_default=False,

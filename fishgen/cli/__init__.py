@@ -122,6 +122,8 @@ def run() -> None:
     for signum in (signal.SIGINT, signal.SIGTERM):  # too late to interrupt: nothing is left to stop
         if signal.getsignal(signum) is _interrupt:
             signal.signal(signum, signal.SIG_DFL)
+    # Private, and on purpose: no public API runs the exit handlers (a library's log flush, a Dask
+    # client's close) without also tearing the interpreter down, which is what this exit skips.
     atexit._run_exitfuncs()
     for stream in (sys.stdout, sys.stderr):
         try:

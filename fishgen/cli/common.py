@@ -64,7 +64,7 @@ def _options() -> list[click.Option]:
                      help="Also print each file written and the time taken, on stderr.  [default: off]"),
         click.Option(["--json"], is_flag=True, expose_value=False, is_eager=True, callback=_set("json", True),
                      help='Print an error as one JSON object on stderr: {"error", "file", "line", "exit", '
-                          '"kind"}.'),
+                          '"kind"}.  [default: off]'),
     ]
 
 

@@ -69,6 +69,7 @@ class BatchFacts:
 def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOptions(),
           events: Events = QUIET) -> Made:
     """Run every job that is not up to date; each finished job is told through ``events``."""
+    inputs = tuple(Path(p) for p in inputs)
     import time
 
     from fishgen.batch import run_batch

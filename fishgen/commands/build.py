@@ -61,10 +61,12 @@ COMMAND = Command(
 )
 
 
-def build(inputs: Sequence[Path], output: str | os.PathLike | None, options: BuildOptions = BuildOptions(),
+def build(inputs: Sequence[Path], output: str | os.PathLike | None,
+          options: BuildOptions = BuildOptions(),
           events: Events = QUIET) -> Made:
     """Build each species file into a fish asset; with several inputs, a bad one is reported
     through ``events.failed`` and the others are built."""
+    inputs = tuple(Path(p) for p in inputs)
     from fishgen.assembly.fish import make_fish
     from fishgen.commands.paths import check_inputs, check_targets, targets
     from fishgen.exchange import export

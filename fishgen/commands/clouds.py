@@ -53,9 +53,11 @@ COMMAND = Command(
 )
 
 
-def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOptions = CloudsOptions(),
+def clouds(inputs: Sequence[Path], output: str | os.PathLike,
+           options: CloudsOptions = CloudsOptions(),
            events: Events = QUIET) -> Made:
     """Fill every cube file and write them as one scene; input i is filled with seed + i."""
+    inputs = tuple(Path(p) for p in inputs)
     output = Path(output)
     from fishgen.clouds.export import check_output, export_cloud
     from fishgen.clouds.fill import fill_cloud, merge_clouds

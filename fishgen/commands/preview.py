@@ -74,6 +74,7 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
             options: PreviewCommandOptions = PreviewCommandOptions(),
             events: Events = QUIET) -> Made:
     """Render the inputs to one image or loop."""
+    inputs = tuple(Path(p) for p in inputs)
     output = Path(output)
     from fishgen.commands.paths import check_inputs, check_targets
     from fishgen.preview.inputs import input_formats

@@ -79,10 +79,12 @@ class SchoolFacts:
     table: str                             # the summary of the measures after the warm-up
 
 
-def school(inputs: Sequence[Path], output: str | os.PathLike, options: SchoolOptions = SchoolOptions(),
+def school(inputs: Sequence[Path], output: str | os.PathLike,
+           options: SchoolOptions = SchoolOptions(),
            events: Events = QUIET) -> Made:
     """Simulate, bake and write the school; the side outputs (tracks, metrics, plot) are written
     only when the glb was, and every target is checked before the simulation starts."""
+    inputs = tuple(Path(p) for p in inputs)
     output = Path(output)
     from fishgen.commands.paths import check_inputs, check_targets, needs, suffix_of
     from fishgen.errors import UsageError

@@ -67,6 +67,7 @@ COMMAND = Command(
 def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureCommandOptions,
             events: Events = QUIET) -> Made:
     """Measure the photo and write the new species, its texture and mask (and the extras asked)."""
+    inputs = tuple(Path(p) for p in inputs)
     output = Path(output)
     from fishgen.authoring.photo.run import TextureOptions, make_texture
     from fishgen.commands.paths import check_targets

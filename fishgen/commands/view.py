@@ -42,9 +42,11 @@ COMMAND = Command(
 )
 
 
-def view(inputs: Sequence[Path], output: str | os.PathLike | None, options: ViewOptions = ViewOptions(),
+def view(inputs: Sequence[Path], output: str | os.PathLike | None,
+         options: ViewOptions = ViewOptions(),
          events: Events = QUIET) -> Made:
     """Write the page; unless ``no_serve``, also bind its server (the caller serves it)."""
+    inputs = tuple(Path(p) for p in inputs)
     output = Path(output) if output is not None else None
     from fishgen.errors import SystemFailure
     from fishgen.viewer.page import write_page

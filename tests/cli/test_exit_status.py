@@ -27,7 +27,7 @@ def writers(out: Path) -> dict[str, list[str]]:
         "build": ["build", str(FISH), "-o", str(out / "fish.glb")],
         "clouds": ["clouds", str(CUBES), "-o", str(out / "cloud.ply")],
         "school": ["school", str(FISH), "--count", "4", "--frames", "10", "-o", str(out / "school.glb")],
-        "preview": ["preview", str(FISH), "-o", str(out / "fish.png"), "--size", "64x48"],
+        "preview": ["preview", str(FISH), "-o", str(out / "fish.png"), "--size", "320x240"],
         "view": ["view", str(ROOT / "tests" / "fixtures" / "tiny.glb"), "--no-serve", "-o", str(out / "page.html")],
         "texture": ["texture", str(PHOTO), "-s", str(FISH), "-o", str(out / "new.txt")],
         "species": ["species", "--random", "-o", str(out / "sp.txt")],
@@ -85,7 +85,7 @@ def test_a_full_disk_and_a_read_only_folder_exit_1_with_the_path(small_disk, nam
     for folder, reason in ((full, "No space left on device"), (readonly, "Read-only file system")):
         args = writers(folder)[name]
         if name == "clouds":  # big enough to fill 64 KiB
-            args = ["clouds", str(PARAMS / "clouds" / "table_4_4.awn"), "-o", str(folder / "cloud.csv")]
+            args = ["clouds", str(PARAMS / "clouds" / "table_4_2.awn"), "-o", str(folder / "cloud.csv")]
         result = run(args)
         error = one_error(result)
         assert result.returncode == 1 and error["kind"] == "os" and reason in error["error"], result.stderr

@@ -25,18 +25,20 @@ def test_an_option_declared_once_is_in_help_in_a_manifest_and_in_the_function(wi
     assert "--brightness" in help_text and "How bright the toy shines.  [default: 2.5]" in help_text
 
     (tmp_path / "in.txt").write_text("x")
-    ran = CliRunner().invoke(cli, ["toy", str(tmp_path / "in.txt"), "-o", str(tmp_path / "a"), "--brightness", "7"])
+    ran = CliRunner().invoke(cli, ["toy", str(tmp_path / "in.txt"), "-o", str(tmp_path / "a.csv"), "--brightness",
+                                   "7"])
     assert ran.exit_code == 0 and ran.output == "toy 7.0\n"
-    bad = CliRunner().invoke(cli, ["toy", str(tmp_path / "in.txt"), "-o", str(tmp_path / "a"), "--brightness", "11"])
+    bad = CliRunner().invoke(cli, ["toy", str(tmp_path / "in.txt"), "-o", str(tmp_path / "a.csv"), "--brightness",
+                                   "11"])
     assert bad.exit_code == 2
 
     manifest = tmp_path / "m.toml"
-    manifest.write_text('[[toy]]\ninput = "in.txt"\noutput = "b"\nbrightness = 4\n')
+    manifest.write_text('[[toy]]\ninput = "in.txt"\noutput = "b.csv"\nbrightness = 4\n')
     outcomes = run_batch(load_manifest(manifest, tmp_path / "out"))
-    assert [o.status for o in outcomes] == ["built"] and (tmp_path / "out" / "b").read_text() == "4.0 red\n"
+    assert [o.status for o in outcomes] == ["built"] and (tmp_path / "out" / "b.csv").read_text() == "4.0 red\n"
     assert [o.brightness for o in toy.SEEN] == [7.0, 4.0]
 
-    manifest.write_text('[[toy]]\ninput = "in.txt"\noutput = "b"\n\nbrightness = 11\n')
+    manifest.write_text('[[toy]]\ninput = "in.txt"\noutput = "b.csv"\n\nbrightness = 11\n')
     from fishgen.errors import FishgenError
     with pytest.raises(FishgenError) as caught:
         load_manifest(manifest)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import random
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -21,17 +22,19 @@ from fishgen.fuzz import TARGETS, load_seeds, make_case, run
 from fishgen.fuzz.cases import DEFAULT_CORPUS, Case, classify, run_case
 from fishgen.fuzz.mutate import NUMBERS, pack_glb, unpack_glb
 
-ROOT = Path(__file__).resolve().parents[2]
 CI_SEED = 20240601
 #: Inputs per target (the seed corpus comes first). About 30 s on 2 cores; rates in docs/fuzzing.md.
 CI_COUNTS = {"species": 4000, "cubes": 10000, "gltf": 3000, "obj": 2000, "ply": 3000, "cli": 600}
-FINDINGS_DIR = ROOT / "out" / "fuzz-findings-ci"
+#: The test command writes nothing into the user's out/: findings and work files go to a temporary
+#: folder (FISHGEN_FUZZ_FINDINGS keeps CI's findings where a CI job can collect them).
+WORK = Path(tempfile.mkdtemp(prefix="fishgen-fuzz-"))
 
 
 @pytest.fixture(scope="module")
 def ci_report():
+    findings = Path(os.environ.get("FISHGEN_FUZZ_FINDINGS", WORK / "findings"))
     return run(list(TARGETS), seed=CI_SEED, counts=CI_COUNTS, jobs=min(2, os.cpu_count() or 1),
-               findings_dir=FINDINGS_DIR)
+               findings_dir=findings)
 
 
 @pytest.mark.parametrize("target", TARGETS)
@@ -89,7 +92,7 @@ def test_the_judge_flags_what_it_should():
     except FishgenError as err:
         assert classify(err).key.startswith("budget overrun (memory)")
     bad_cli = Case("cli", 0, argv=["build", "missing.txt", "--fps", "nan"])
-    assert run_case(bad_cli, ROOT / "out" / "fuzz-selftest").status == "error"
+    assert run_case(bad_cli, WORK / "selftest").status == "error"
 
 
 # Property-based generation (hypothesis) over the two text parsers, in-process: records of
@@ -108,7 +111,7 @@ def test_species_parser_hypothesis(data):
     i = data.draw(st.integers(0, len(tokens) - 1))
     tokens[i] = data.draw(_token)
     lines[k] = " ".join(tokens)
-    outcome = run_case(Case("species", 0, text="\n".join(lines)), ROOT / "out" / "fuzz-selftest")
+    outcome = run_case(Case("species", 0, text="\n".join(lines)), WORK / "selftest")
     assert outcome.status != "finding", outcome.detail
 
 
@@ -117,5 +120,5 @@ def test_species_parser_hypothesis(data):
        st.sampled_from([", ", " ", ","]))
 def test_cubes_parser_hypothesis(rows, sep):
     text = "\n".join(sep.join(r) for r in rows)
-    outcome = run_case(Case("cubes", 0, data=text.encode("utf-8", "surrogatepass")), ROOT / "out")
+    outcome = run_case(Case("cubes", 0, data=text.encode("utf-8", "surrogatepass")), WORK / "cubes")
     assert outcome.status != "finding", outcome.detail
