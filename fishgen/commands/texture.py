@@ -50,10 +50,10 @@ COMMAND = Command(
     clicked (thesis chapter 6, Appendix B). The photo becomes the texture, stored
     upside down as VRFish expects.
 
-    \\b
+    \b
     Examples:
-      fishgen texture params/photos/bream-side.png -s params/centroberyx.txt -o out/bream.txt
-      fishgen texture params/photos/bream-side.png -s params/centroberyx.txt -o out/bream.txt \\
+      fishgen texture params/photos/bonybream-side.png -s params/centroberyx.txt -o out/bream.txt
+      fishgen texture params/photos/bonybream-side.png -s params/centroberyx.txt -o out/bream.txt \\
         --fit-shape --compare out/cmp.png
     """,
     options=TextureCommandOptions,

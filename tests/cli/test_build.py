@@ -176,3 +176,10 @@ def test_o_dev_null_is_not_a_regular_file(tmp_path):
 def test_special_files_are_refused_without_reading(tmp_path):
     result = run_cli("build", "/dev/zero", "-o", tmp_path / "x.glb")
     assert result.returncode == 2 and "expected a regular species file" in result.stderr
+
+
+def test_a_batch_manifest_given_to_build_points_to_batch(tmp_path):
+    """Issue 19: it was taken for a school scene ("use fishgen school")."""
+    result = run_cli("build", PARAMS / "assets.toml", "-o", tmp_path / "x.glb")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1
+    assert "found a batch manifest; use `fishgen batch` for it" in result.stderr

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image, ImageDraw, ImageFilter
 
-from tests.conftest import PARAMS, assert_valid_gltf
+from tests.conftest import PARAMS, assert_valid_gltf, run_cli
 
 SMALL = (640, 320)
 
@@ -154,3 +154,21 @@ def test_bad_mask_and_fxl(tmp_path, cli, bream_photo):
 def test_help_is_fast_and_lists_both_commands(cli):
     r = cli("--help")
     assert r.returncode == 0 and "texture" in r.stdout and "species" in r.stdout
+
+
+def test_an_output_that_is_one_of_the_inputs_is_refused_and_nothing_is_written(tmp_path):
+    """Issue 19: `-o base.txt` replaced the base species file silently."""
+    import shutil
+
+    base = tmp_path / "base.txt"
+    shutil.copy(PARAMS / "bonybream.txt", base)
+    before = base.read_bytes()
+    result = run_cli("texture", PARAMS / "photos" / "bonybream-side.png", "-s", base, "-o", base)
+    assert result.returncode == 2 and "is the input" in result.stderr and base.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["base.txt"]
+
+
+def test_the_help_examples_read_as_one_command_each():
+    lines = run_cli("texture", "--help").stdout.splitlines()
+    example = [line.strip() for line in lines if line.strip().startswith("fishgen texture")]
+    assert len(example) == 2 and example[1].endswith("\\")
