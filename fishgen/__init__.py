@@ -5,7 +5,7 @@ The public API is imported lazily so that ``import fishgen`` (and the CLI's
 """
 from __future__ import annotations
 
-import importlib
+from fishgen.lazy import lazy_exports
 
 __version__ = "0.1.0"
 
@@ -22,10 +22,4 @@ _API = {
     "export_cloud": "fishgen.clouds",
 }
 
-__all__ = sorted(_API)
-
-
-def __getattr__(name: str):
-    if name in _API:
-        return getattr(importlib.import_module(_API[name]), name)
-    raise AttributeError(f"module 'fishgen' has no attribute {name!r}")
+__getattr__, __all__ = lazy_exports(__name__, _API)

@@ -10,7 +10,7 @@ names load their modules when first used.
 """
 from __future__ import annotations
 
-import importlib
+from fishgen.lazy import lazy_exports
 
 _API = {
     "FORMATS": "fishgen.clouds.export", "check_output": "fishgen.clouds.export",
@@ -22,10 +22,4 @@ _API = {
     "CubeFileWarning": "fishgen.clouds.parser", "load_cubes": "fishgen.clouds.parser",
     "parse_cubes": "fishgen.clouds.parser",
 }
-__all__ = sorted(_API)
-
-
-def __getattr__(name: str):
-    if name in _API:
-        return getattr(importlib.import_module(_API[name]), name)
-    raise AttributeError(f"module 'fishgen.clouds' has no attribute {name!r}")
+__getattr__, __all__ = lazy_exports(__name__, _API)

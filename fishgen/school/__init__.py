@@ -10,14 +10,8 @@ names load their modules when first used.
 """
 from __future__ import annotations
 
-import importlib
+from fishgen.lazy import lazy_exports
 
 _API = {"SchoolRun": "fishgen.school.run", "run_school": "fishgen.school.run",
         "brain_of": "fishgen.school.run", "DEFAULT_BOUNDS_BODY_LENGTHS": "fishgen.school.run"}
-__all__ = sorted(_API)
-
-
-def __getattr__(name: str):
-    if name in _API:
-        return getattr(importlib.import_module(_API[name]), name)
-    raise AttributeError(f"module 'fishgen.school' has no attribute {name!r}")
+__getattr__, __all__ = lazy_exports(__name__, _API)
