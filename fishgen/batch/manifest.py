@@ -35,7 +35,10 @@ from fishgen.exchange.registry import output_format
 from fishgen.options import check_value, manifest_options
 from fishgen.tomlfile import Where, loads
 
-KINDS = tuple(name for name in MODULES if command(name).batch)
+def kinds() -> tuple[str, ...]:
+    """The commands a manifest may list jobs of (their tables' names)."""
+    return tuple(name for name in MODULES if command(name).batch)
+
 MAX_MANIFEST_BYTES = 16 << 20
 
 
@@ -84,8 +87,9 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None)
     data = loads(text, file)
     where = Where(text, file)
     for key in data:
-        if key not in ("out", *KINDS):  # a misspelt key, or a misspelt [[table]] (its header line)
-            raise FishgenError(f"expected one of out, {', '.join(f'[[{k}]]' for k in KINDS)}, found {key!r}",
+        if key not in ("out", *kinds()):  # a misspelt key, or a misspelt [[table]] (its header line)
+            tables = ", ".join(f"[[{k}]]" for k in kinds())
+            raise FishgenError(f"expected one of out, {tables}, found {key!r}",
                                file, where.line(key) or where.line("", key))
     folder = path.resolve().parent
     if out is None and "out" in data:
@@ -95,7 +99,7 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None)
     out_dir = Path(os.path.abspath(out if out is not None else "out"))
     jobs: list[Job] = []
     seen: dict[str, str] = {}
-    for kind in KINDS:
+    for kind in kinds():
         entries = data.get(kind, [])
         if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
             raise where.fail(f"[[{kind}]] tables", entries, kind)
@@ -107,7 +111,8 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None)
             seen[job.name] = job.where
             jobs.append(job)
     if not jobs:
-        raise FishgenError("expected at least one [[build]], [[school]] or [[clouds]] job, found none", file)
+        tables = ", ".join(f"[[{k}]]" for k in kinds())
+        raise FishgenError(f"expected at least one job ({tables}), found none", file)
     return Manifest(path, out_dir, tuple(jobs))
 
 

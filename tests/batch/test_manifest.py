@@ -81,7 +81,7 @@ output = "ab.glb"
      "one job per output, the first at"),
     ('[[bild]]\ninput = "a.txt"\n', 1, "expected one of out, [[build]]"),
     ('[[build]\ninput = "a.txt"\n', 1, "expected TOML"),
-    ('out = "o"\n', None, "expected at least one [[build]]"),
+    ('out = "o"\n', None, "expected at least one job ([[build]], [[clouds]], [[school]])"),
 ])
 def test_every_mistake_is_one_line_at_its_place(tmp_path, text, line, message):
     path = write(tmp_path, text)

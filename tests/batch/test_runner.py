@@ -16,6 +16,7 @@ import pytest
 from fishgen.batch.jobs import Result
 from fishgen.batch.manifest import Job
 from fishgen.batch.runner import MAX_CHUNK, chunk_size
+from fishgen.errors import FishgenError
 from tests.batch.conftest import batch, hashes, record, statuses
 from tests.conftest import ROOT, run_cli
 
@@ -115,7 +116,7 @@ def fake_run_job(job: Job) -> Result:
         waited = time.monotonic()
         while "slow" in job.name and not started.exists() and time.monotonic() - waited < 2:
             time.sleep(0.001)  # fails once the other worker is on kills-on-failure
-        return Result(job.name, "failed", error={"message": "bad", "file": None, "line": None, "kind": "input"},
+        return Result(job.name, "failed", error=FishgenError("bad"),
                       notes=[SlowToSend()] if "slow" in job.name else [])
     time.sleep(0.01)
     return Result(job.name, "built")

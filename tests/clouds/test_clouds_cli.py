@@ -103,7 +103,8 @@ def test_total_mismatch_is_a_warning_on_stderr(cli, write_awn, tmp_path):
     (["--offset", "1,2"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z with three finite "
                           "numbers within float32 range, found '1,2'"),
     (["--offset", "0,0,0", "--offset", "1,1,1"], "fishgen: expected one --offset per input (1), found 2"),
-    (["--seed", "-4"], "fishgen clouds: Invalid value for '--seed': -4 is not in the range x>=0."),
+    (["--seed", "-4"], "fishgen clouds: Invalid value for '--seed': -4 is not in the range "
+                       "0<=x<=9223372036854775807."),
     (["--offset", "1e300,0,0"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z with three "
                                 "finite numbers within float32 range, found '1e300,0,0'"),
     (["--offset", "0,-1e39,0"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z"),
@@ -130,14 +131,15 @@ def test_help_documents_every_option_with_its_default(cli):
     assert result.returncode == 0
     text = " ".join(result.stdout.split())
     for option, default in (("--output", "[required]"), ("--offset", "[default: 0,0,0"),
-                            ("--seed", "[default: 0; x>=0]"), ("--method", "[default: paper]"),
-                            ("--billboards", "[default: off"),
-                            ("--max-particles", "[default: 50000000; x>=1]")):
+                            ("--seed", "[default: 0; in a batch, derived from the output's name]"),
+                            ("--method", "[default: paper]"), ("--billboards", "[default: off"),
+                            ("--max-particles", "[default: 50000000] [x>=1]")):
         assert option in text and default in text, option
 
 
 def test_command_module_does_not_import_numpy():
-    code = "import sys, fishgen.cli.clouds; print('numpy' in sys.modules)"
+    code = ("import sys, fishgen.commands.clouds, fishgen.cli.adapter as a; "
+            "a.click_command(fishgen.commands.clouds.COMMAND); print('numpy' in sys.modules)")
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           check=True).stdout.strip() == "False"
 

@@ -14,7 +14,7 @@ from PIL import Image
 from fishgen.clouds import export_cloud, fill_cloud, load_cubes
 from fishgen.clouds.scene import cloud_scene
 from fishgen.exchange import particles
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, SystemFailure
 
 from cloud_tables import TABLES
 
@@ -222,7 +222,7 @@ def test_failed_export_leaves_no_file_and_keeps_the_old_one(cloud, tmp_path, mon
 
     monkeypatch.setattr("fishgen.exchange.ply.particle_chunks", broken)
     for target in (old, tmp_path / "new.ply"):
-        with pytest.raises(OSError):
+        with pytest.raises(SystemFailure, match=f"cannot write {target}: disk full"):  # the path named
             export_cloud(cloud, target)
     assert old.read_bytes() == b"previous good output"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.ply"]
