@@ -35,6 +35,7 @@ from fishgen.exchange.registry import output_format
 from fishgen.options import check_value, manifest_options
 from fishgen.tomlfile import Where, loads
 
+
 def kinds() -> tuple[str, ...]:
     """The commands a manifest may list jobs of (their tables' names)."""
     return tuple(name for name in MODULES if command(name).batch)
