@@ -1,0 +1,1 @@
+"""fishgen's local web pages: the server they share."""

@@ -1,0 +1,177 @@
+"""A local web server for fishgen's pages (`view`, `edit`, `fly`), safe to leave running.
+
+- It binds 127.0.0.1 only, never another interface.
+- It answers only requests addressed to ``127.0.0.1:PORT`` or ``localhost:PORT``: a web page
+  elsewhere cannot reach it through a DNS name rebound to 127.0.0.1.
+- Every request carries the random token of this run (``?token=`` in the URL, or the
+  ``X-Fishgen-Token`` header that the pages' own requests send), compared in constant time: another
+  local user's or another site's guess is refused.
+- Request bodies are capped before they are read, and a client that sends too slowly is cut off.
+- It serves only the routes a command gives it: no folder, no directory listing, no file by name.
+"""
+from __future__ import annotations
+
+import hmac
+import json
+import secrets
+from collections.abc import Callable
+from dataclasses import dataclass
+from http import HTTPStatus
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from typing import Any
+from urllib.parse import parse_qs, urlsplit
+
+HOST = "127.0.0.1"
+MAX_BODY = 16 << 20
+"""Largest request body any route takes (a cube file of 100,000 cubes is about 8 MB)."""
+TIMEOUT = 10.0
+"""Seconds a client may take to send its request: a slow sender is cut off, not waited for."""
+
+
+@dataclass(frozen=True)
+class Request:
+    method: str
+    path: str
+    query: dict[str, str]
+    body: bytes
+
+    def json(self) -> Any:
+        """The body as JSON; a malformed body is a :class:`Refused` (400), never a traceback."""
+        try:
+            return json.loads(self.body.decode("utf-8"))
+        except (UnicodeDecodeError, json.JSONDecodeError) as err:
+            raise Refused(HTTPStatus.BAD_REQUEST, f"expected a JSON body, found {type(err).__name__}") from None
+
+
+@dataclass(frozen=True)
+class Response:
+    status: int = 200
+    body: bytes = b""
+    type: str = "application/octet-stream"
+
+    @classmethod
+    def of_json(cls, value: Any, status: int = 200) -> Response:
+        return cls(status, json.dumps(value).encode("utf-8"), "application/json")
+
+    @classmethod
+    def of_html(cls, text: str) -> Response:
+        return cls(200, text.encode("utf-8"), "text/html; charset=utf-8")
+
+
+class Refused(Exception):
+    """A request answered with an error status and a one-line reason (sent as JSON)."""
+
+    def __init__(self, status: int, message: str):
+        super().__init__(message)
+        self.status = int(status)
+        self.message = message
+
+
+Route = Callable[[Request], Response]
+
+
+class LocalServer(ThreadingHTTPServer):
+    """Loopback, Host-checked, token-checked routes: ``{("GET", "/"): page, ("POST", "/api/save"): save}``."""
+
+    daemon_threads = True
+
+    def __init__(self, routes: dict[tuple[str, str], Route], port: int = 0, max_body: int = MAX_BODY,
+                 token: str | None = None, timeout: float = TIMEOUT):
+        self.routes = dict(routes)
+        self.max_body = max_body
+        self.timeout_seconds = timeout
+        self.token = token or secrets.token_urlsafe(24)
+        super().__init__((HOST, port), _Handler)
+
+    def handle_error(self, request, client_address) -> None:  # a dropped client is not news
+        pass
+
+    @property
+    def port(self) -> int:
+        return int(self.server_address[1])
+
+    def url(self, path: str = "/") -> str:
+        """The address a user opens: the route and this run's token."""
+        return f"http://{HOST}:{self.port}{path}?token={self.token}"
+
+    def allowed_hosts(self) -> set[str]:
+        return {f"{HOST}:{self.port}", f"localhost:{self.port}"}
+
+
+class _Handler(BaseHTTPRequestHandler):
+    server: LocalServer
+    server_version = "fishgen"
+    sys_version = ""
+
+    def setup(self) -> None:
+        self.timeout = self.server.timeout_seconds  # a slow sender is cut off after this many seconds
+        super().setup()
+
+    def log_message(self, format, *args):  # one line per request would bury the URL
+        pass
+
+    def do_GET(self):
+        self._answer("GET")
+
+    def do_HEAD(self):
+        self._answer("HEAD")
+
+    def do_POST(self):
+        self._answer("POST")
+
+    def do_PUT(self):
+        self._answer("PUT")
+
+    def do_DELETE(self):
+        self._answer("DELETE")
+
+    def _answer(self, method: str) -> None:
+        from fishgen.errors import FishgenError
+
+        try:
+            response = self._route(method)
+        except Refused as refused:
+            response = Response.of_json({"error": refused.message}, refused.status)
+        except FishgenError as err:  # bad input from the page: its one line, as the CLI says it
+            response = Response.of_json({"error": str(err), "line": err.line}, HTTPStatus.UNPROCESSABLE_ENTITY)
+        except TimeoutError:
+            self.close_connection = True
+            return
+        self.send_response(response.status)
+        self.send_header("Content-Type", response.type)
+        self.send_header("Content-Length", str(len(response.body)))
+        self.send_header("Cache-Control", "no-store")
+        self.send_header("X-Content-Type-Options", "nosniff")
+        self.send_header("Referrer-Policy", "no-referrer")
+        self.send_header("Cross-Origin-Resource-Policy", "same-origin")
+        self.end_headers()
+        if method != "HEAD":
+            self.wfile.write(response.body)
+
+    def _route(self, method: str) -> Response:
+        host = (self.headers.get("Host") or "").strip().lower()
+        if host not in self.server.allowed_hosts():
+            raise Refused(HTTPStatus.FORBIDDEN, "only 127.0.0.1 and localhost may ask")
+        parts = urlsplit(self.path)
+        query = {k: v[-1] for k, v in parse_qs(parts.query, keep_blank_values=True).items()}
+        given = self.headers.get("X-Fishgen-Token") or query.get("token") or ""
+        if not hmac.compare_digest(given.encode("utf-8", "replace"), self.server.token.encode()):
+            raise Refused(HTTPStatus.FORBIDDEN, "expected this run's token, found none or another")
+        route = self.server.routes.get(("GET" if method == "HEAD" else method, parts.path))
+        if route is None:
+            raise Refused(HTTPStatus.NOT_FOUND, f"no {method} {parts.path}")
+        return route(Request(method, parts.path, query, self._body()))
+
+    def _body(self) -> bytes:
+        length = self.headers.get("Content-Length")
+        if length is None:
+            if self.headers.get("Transfer-Encoding"):
+                raise Refused(HTTPStatus.LENGTH_REQUIRED, "expected a Content-Length, found a chunked body")
+            return b""
+        if not length.isdigit():
+            raise Refused(HTTPStatus.BAD_REQUEST, f"expected a Content-Length, found {length[:20]!r}")
+        size = int(length)
+        if size > self.server.max_body:
+            raise Refused(HTTPStatus.REQUEST_ENTITY_TOO_LARGE,
+                          f"expected a body of at most {self.server.max_body:,} bytes, found {size:,}")
+        return self.rfile.read(size)

@@ -1,0 +1,93 @@
+"""The local server every page of fishgen's uses: loopback, Host and token checked, bodies capped,
+slow clients cut off, only the routes given."""
+from __future__ import annotations
+
+import http.client
+import socket
+import threading
+import time
+
+import pytest
+
+from fishgen.errors import FishgenError
+from fishgen.web.server import LocalServer, Request, Response
+
+
+@pytest.fixture
+def server():
+    def echo(request: Request) -> Response:
+        return Response.of_json({"got": request.json()})
+
+    def bad(request: Request) -> Response:
+        raise FishgenError("expected a cube, found none", "x.awn", 3)
+
+    server = LocalServer({("GET", "/"): lambda r: Response.of_html("<p>hi</p>"), ("POST", "/echo"): echo,
+                          ("POST", "/bad"): bad}, max_body=1000, timeout=1.0)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield server
+    server.shutdown()
+    server.server_close()
+
+
+def ask(server, method="GET", path="/", body=None, host=None, token="", headers=None):
+    conn = http.client.HTTPConnection("127.0.0.1", server.port, timeout=5)
+    query = f"?token={token}" if token else ""
+    conn.putrequest(method, path + query, skip_host=True)
+    conn.putheader("Host", host or f"127.0.0.1:{server.port}")
+    for k, v in (headers or {}).items():
+        conn.putheader(k, v)
+    if body is not None:
+        conn.putheader("Content-Length", str(len(body)))
+    conn.endheaders(body)
+    response = conn.getresponse()
+    return response.status, response.read()
+
+
+def test_it_binds_loopback_only_and_its_url_carries_the_token(server):
+    assert server.server_address[0] == "127.0.0.1"
+    assert server.url("/") == f"http://127.0.0.1:{server.port}/?token={server.token}"
+    assert len(server.token) >= 32 and LocalServer({}, 0).token != server.token
+
+
+def test_the_right_token_and_host_get_the_page(server):
+    assert ask(server, token=server.token) == (200, b"<p>hi</p>")
+    assert ask(server, token=server.token, host=f"localhost:{server.port}")[0] == 200
+    assert ask(server, headers={"X-Fishgen-Token": server.token})[0] == 200
+
+
+@pytest.mark.parametrize("case", ["no token", "wrong token", "foreign host", "rebound name"])
+def test_a_request_without_the_token_or_from_another_host_is_refused(server, case):
+    token = {"no token": "", "wrong token": server.token[:-1] + "x"}.get(case, server.token)
+    host = {"foreign host": "evil.example:80", "rebound name": f"evil.example:{server.port}"}.get(case)
+    status, body = ask(server, token=token, host=host)
+    assert status == 403 and b"<p>hi</p>" not in body
+
+
+def test_bodies_are_capped_before_they_are_read_and_must_be_json(server):
+    assert ask(server, "POST", "/echo", b'{"a": 1}', token=server.token) == (200, b'{"got": {"a": 1}}')
+    status, body = ask(server, "POST", "/echo", b"x" * 1001, token=server.token)
+    assert status == 413 and b"at most 1,000 bytes" in body
+    status, body = ask(server, "POST", "/echo", b"{not json", token=server.token)
+    assert status == 400 and b"expected a JSON body" in body
+
+
+def test_bad_input_from_the_page_is_one_line_with_its_place(server):
+    status, body = ask(server, "POST", "/bad", b"{}", token=server.token)
+    assert status == 422 and b"x.awn:3: expected a cube, found none" in body
+
+
+def test_only_the_routes_given_are_served(server):
+    for path in ("/../etc/passwd", "/index.html", "/api"):
+        assert ask(server, path=path, token=server.token)[0] == 404
+
+
+def test_a_slow_client_is_cut_off(server):
+    with socket.create_connection(("127.0.0.1", server.port)) as sock:
+        sock.sendall(f"POST /echo?token={server.token} HTTP/1.1\r\nHost: 127.0.0.1:{server.port}\r\n"
+                     "Content-Length: 100\r\n\r\n{".encode())
+        start = time.monotonic()
+        sock.settimeout(10)
+        assert sock.recv(100) == b""  # closed, not waiting for the other 99 bytes
+        assert time.monotonic() - start < 5
+    assert ask(server, token=server.token)[0] == 200  # and the server goes on
