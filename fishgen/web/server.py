@@ -40,7 +40,8 @@ class Request:
         try:
             return json.loads(self.body.decode("utf-8"))
         except (UnicodeDecodeError, json.JSONDecodeError) as err:
-            raise Refused(HTTPStatus.BAD_REQUEST, f"expected a JSON body, found {type(err).__name__}") from None
+            raise Refused(HTTPStatus.BAD_REQUEST,
+                          f"expected a JSON body, found {type(err).__name__}") from None
 
 
 @dataclass(frozen=True)
@@ -104,8 +105,8 @@ class _Handler(BaseHTTPRequestHandler):
     sys_version = ""
 
     def setup(self) -> None:
-        self.timeout = self.server.timeout_seconds  # a slow sender is cut off after this many seconds
         super().setup()
+        self.connection.settimeout(self.server.timeout_seconds)  # a slow sender is cut off
 
     def log_message(self, format, *args):  # one line per request would bury the URL
         pass
@@ -133,7 +134,8 @@ class _Handler(BaseHTTPRequestHandler):
         except Refused as refused:
             response = Response.of_json({"error": refused.message}, refused.status)
         except FishgenError as err:  # bad input from the page: its one line, as the CLI says it
-            response = Response.of_json({"error": str(err), "line": err.line}, HTTPStatus.UNPROCESSABLE_ENTITY)
+            response = Response.of_json({"error": str(err), "line": err.line},
+                                        HTTPStatus.UNPROCESSABLE_ENTITY)
         except TimeoutError:
             self.close_connection = True
             return
