@@ -19,17 +19,16 @@ from __future__ import annotations
 
 import base64
 import binascii
-import io
 import json
 import math
 import struct
-import warnings
 from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
 
 from fishgen.errors import FishgenError, describe
+from fishgen.exchange.guards import check_picture, one_line, size_text
 from fishgen.exchange.sidefiles import side_file
 from fishgen.scene.model import (
     INTERPOLATIONS,
@@ -57,10 +56,6 @@ MAX_DATA_URI_CHARS = 64 * 2**20
 """Longest ``data:`` URI (buffer or image), checked before decoding."""
 MAX_ELEMENTS = 2**26
 """Most accessor components (count x components, summed over every accessor) in one file."""
-MAX_IMAGE_SIDE = 8192
-"""Widest or tallest texture image, read from its header before any decoding."""
-MAX_IMAGE_PIXELS = 2**26
-"""Most pixels of one texture image (256 MiB as RGBA)."""
 
 SUPPORTED_EXTENSIONS = frozenset({"KHR_materials_unlit"})
 """Extensions the reader understands; a file that requires any other one is refused."""
@@ -102,19 +97,6 @@ def read_gltf(path: str | Path | None = None, *, data: bytes | None = None,
     except Exception as err:  # a fault the checks above missed: still one line, never a traceback
         raise FishgenError(f"expected a well-formed glTF 2.0 asset, found {type(err).__name__}: "
                            f"{one_line(err)}", where) from None
-
-
-def one_line(err: BaseException, limit: int = 200) -> str:
-    """A library's error message squeezed onto one short line for ours."""
-    text = " ".join(str(err).split())
-    return text if len(text) <= limit else text[: limit - 1] + "…"
-
-
-def size_text(n: int) -> str:
-    """A byte count for a message: ``564 bytes``, ``2.0 GiB``."""
-    if n < 2**20:
-        return f"{n:,} bytes"
-    return f"{n / 2**30:.1f} GiB" if n >= 2**30 else f"{n / 2**20:.1f} MiB"
 
 
 def _fail(what: str, found: str) -> FishgenError:
@@ -757,7 +739,7 @@ class _Reader:
         else:
             data = self._side(img["uri"]).read_bytes()
         if i in self.textured:
-            _check_picture(data, f"images[{i}] ({_name(img, 'unnamed')!r})")
+            check_picture(data, f"images[{i}] ({_name(img, 'unnamed')!r})")
         return data
 
     # -- scene ------------------------------------------------------------------
@@ -869,32 +851,6 @@ class _Reader:
                 if a is not None and len(a) and int(a.max()) >= joints:
                     raise _fail(f"JOINTS_0 values below {joints} (the joints of skins[{node.skin}]) "
                                 f"in meshes[{node.mesh}] on nodes[{i}]", str(int(a.max())))
-
-
-def _check_picture(data: bytes, name: str) -> None:
-    """Refuse a texture too big to decode, or damaged, from its header and a cheap verify."""
-    from PIL import Image as PILImage
-
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", PILImage.DecompressionBombWarning)
-            with PILImage.open(io.BytesIO(data)) as img:
-                width, height = img.size
-    except PILImage.DecompressionBombError:
-        raise _fail(f"an image of at most {MAX_IMAGE_PIXELS:,} pixels at {name}",
-                    f"more than {2 * (PILImage.MAX_IMAGE_PIXELS or 0):,}") from None
-    except Exception as err:  # Pillow raises anything from OSError to SyntaxError
-        raise _fail(f"a PNG or JPEG image at {name}", f"unreadable data ({type(err).__name__})") from None
-    if width > MAX_IMAGE_SIDE or height > MAX_IMAGE_SIDE or width * height > MAX_IMAGE_PIXELS:
-        raise _fail(f"an image of at most {MAX_IMAGE_SIDE} px a side and {MAX_IMAGE_PIXELS:,} pixels "
-                    f"at {name}", f"{width}x{height}")
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            with PILImage.open(io.BytesIO(data)) as img:
-                img.verify()
-    except Exception as err:
-        raise _fail(f"an undamaged image at {name}", f"{type(err).__name__}: {one_line(err, 80)}") from None
 
 
 def _triangles(flat: np.ndarray, mode: int) -> np.ndarray:
