@@ -17,19 +17,16 @@ reading ``expected ..., found ...``.
 """
 from __future__ import annotations
 
-import base64
-import binascii
 import json
 import math
-import struct
 from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
 
 from fishgen.errors import FishgenError, describe
-from fishgen.exchange.guards import check_picture, one_line, size_text
-from fishgen.exchange.sidefiles import side_file
+from fishgen.exchange.gltf_container import data_uri, read_capped, side_path, sized_uri, unpack
+from fishgen.exchange.guards import check_picture, one_line
 from fishgen.scene.model import (
     INTERPOLATIONS,
     PATHS,
@@ -46,14 +43,6 @@ from fishgen.scene.model import (
     Skin,
 )
 
-MAX_FILE_BYTES = 512 * 2**20
-"""Largest .glb/.gltf file, and largest buffer or image side file, checked by stat before reading."""
-MAX_JSON_BYTES = 128 * 2**20
-"""Largest JSON part (a .gltf file, or a GLB's JSON chunk)."""
-MAX_JSON_ITEMS = 2_000_000
-"""Most JSON arrays, objects and commas: a few hundred MB of Python objects at worst."""
-MAX_DATA_URI_CHARS = 64 * 2**20
-"""Longest ``data:`` URI (buffer or image), checked before decoding."""
 MAX_ELEMENTS = 2**26
 """Most accessor components (count x components, summed over every accessor) in one file."""
 
@@ -69,8 +58,6 @@ _UNORM = (5121, 5123)   # unsigned byte / short, used normalized
 _PATH_TYPES = {"translation": "VEC3", "rotation": "VEC4", "scale": "VEC3", "weights": "SCALAR"}
 _PATH_COMPONENTS = {"translation": (_FLOAT,), "scale": (_FLOAT,),
                     "rotation": (_FLOAT, 5120, 5121, 5122, 5123), "weights": (_FLOAT, 5120, 5121, 5122, 5123)}
-_GLB_MAGIC, _CHUNK_JSON, _CHUNK_BIN = b"glTF", 0x4E4F534A, 0x004E4942
-_NOT_GLTF = "a glTF 2.0 file (JSON, or GLB with a 12-byte header)"
 _IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
 
 
@@ -82,8 +69,8 @@ def read_gltf(path: str | Path | None = None, *, data: bytes | None = None,
         if data is None:
             if path is None:
                 raise FishgenError("expected a file or GLB bytes to read, found neither")
-            data = _read_capped(Path(path), where)
-        doc, blob = _split(data, where)
+            data = read_capped(Path(path), where)
+        doc, blob = unpack(data)
         del data  # the BIN chunk is a view; a .gltf's text is no longer needed
         reader = _Reader(doc, blob, Path(path) if path is not None else None, where)
         return reader.scene(label if label is not None else (Path(path).stem if path else ""))
@@ -101,78 +88,6 @@ def read_gltf(path: str | Path | None = None, *, data: bytes | None = None,
 
 def _fail(what: str, found: str) -> FishgenError:
     return FishgenError(f"expected {what}, found {found}")
-
-
-def _read_capped(path: Path, where: str) -> bytes:
-    try:
-        size = path.stat().st_size
-    except OSError as err:
-        raise FishgenError(f"expected a readable file, found {type(err).__name__}", where) from None
-    if size > MAX_FILE_BYTES:
-        raise _fail(f"a glTF file of at most {size_text(MAX_FILE_BYTES)}", size_text(size))
-    if size > MAX_JSON_BYTES:  # only a GLB may be this big: its bulk is binary
-        with path.open("rb") as f:
-            if f.read(4) != _GLB_MAGIC:
-                raise _fail(f"a glTF JSON file of at most {size_text(MAX_JSON_BYTES)} "
-                            "(keep big data in .bin files or a .glb)", size_text(size))
-    return path.read_bytes()
-
-
-def _split(data: bytes, where: str) -> tuple[dict, memoryview | None]:
-    """The JSON document and the GLB BIN chunk (None for a .gltf)."""
-    if bytes(data[:4]) != _GLB_MAGIC:
-        return _parse_json(data), None
-    if len(data) < 12:
-        raise _fail(_NOT_GLTF, f"{len(data)} bytes")
-    _, version, length = struct.unpack_from("<4sII", data)
-    if version != 2:
-        raise _fail("a GLB of version 2", f"version {version}")
-    if length != len(data):
-        raise _fail(f"a GLB of {length:,} bytes, as its header says", f"{len(data):,} bytes")
-    view = memoryview(data)
-    chunks: list[tuple[int, memoryview]] = []
-    offset = 12
-    while offset < length:
-        if offset + 8 > length:
-            raise _fail("an 8-byte GLB chunk header", f"{length - offset} bytes at byte {offset}")
-        clen, ctype = struct.unpack_from("<II", data, offset)
-        if offset + 8 + clen > length:
-            raise _fail(f"a GLB chunk of {clen:,} bytes within the file",
-                        f"{length - offset - 8:,} bytes left at byte {offset}")
-        chunks.append((ctype, view[offset + 8: offset + 8 + clen]))
-        offset += 8 + clen
-    if not chunks or chunks[0][0] != _CHUNK_JSON:
-        raise _fail("a JSON chunk first in the GLB",
-                    "none" if not chunks else f"chunk type {chunks[0][0]:#x}")
-    if len(chunks[0][1]) > MAX_JSON_BYTES:
-        raise _fail(f"a JSON chunk of at most {size_text(MAX_JSON_BYTES)}", size_text(len(chunks[0][1])))
-    blob = chunks[1][1] if len(chunks) > 1 and chunks[1][0] == _CHUNK_BIN else None
-    return _parse_json(bytes(chunks[0][1])), blob
-
-
-def _no_constant(name: str) -> Any:
-    raise _fail("finite JSON numbers", name)
-
-
-def _parse_json(raw: bytes) -> dict:
-    if len(raw) > MAX_JSON_BYTES:
-        raise _fail(f"a glTF JSON document of at most {size_text(MAX_JSON_BYTES)}", size_text(len(raw)))
-    items = raw.count(b",") + raw.count(b"[") + raw.count(b"{")
-    if items > MAX_JSON_ITEMS:
-        raise _fail(f"a JSON document of at most {MAX_JSON_ITEMS:,} items", f"{items:,}")
-    try:
-        text = bytes(raw).decode("utf-8-sig")
-    except UnicodeDecodeError as err:
-        raise _fail(_NOT_GLTF, f"bytes that are not UTF-8 at byte {err.start}") from None
-    try:
-        doc = json.loads(text, parse_constant=_no_constant)
-    except json.JSONDecodeError as err:
-        raise _fail(_NOT_GLTF, f"invalid JSON at line {err.lineno} column {err.colno} ({err.msg})") from None
-    except RecursionError:
-        raise _fail(_NOT_GLTF, "JSON nested too deeply") from None
-    if not isinstance(doc, dict):
-        raise _fail(f"{_NOT_GLTF} holding a JSON object", f"a JSON {type(doc).__name__}")
-    return doc
 
 
 # -- JSON shape checks ---------------------------------------------------------------
@@ -359,30 +274,9 @@ class _Reader:
         self._files[k] = target
 
     def _sized_uri(self, uri: Any, where: str, what: str) -> tuple[Path, int] | None:
-        """Check a buffer's or image's URI against the caps by its length or its file's stat size,
-        before anything is read: (side file, size), or None for an inline data: URI."""
         if not isinstance(uri, str):
             raise _fail(f"a URI string at {where}.uri", _show(uri))
-        if uri.strip().startswith("data:"):
-            if len(uri) > MAX_DATA_URI_CHARS:
-                raise _fail(f"a data URI of at most {size_text(MAX_DATA_URI_CHARS)} at {where}",
-                            size_text(len(uri)))
-            return None
-        target = self._side(uri)
-        size = target.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise _fail(f"{what} file of at most {size_text(MAX_FILE_BYTES)} at {where}",
-                        f"{describe(uri)} of {size_text(size)}")
-        return target, size
-
-    def _side(self, uri: str) -> Path:
-        if self.asset is None:  # GLB bytes from memory have no folder to take side files from
-            raise _fail("only embedded data", f"a reference to {describe(uri)}")
-        # Only files in the asset's folder (glTF URIs are percent-encoded: "my%20skin.png").
-        target = side_file(self.asset, uri, uri=True)
-        if not target.is_file():
-            raise _fail("a file beside the asset", f"no {uri!r}")
-        return target
+        return sized_uri(self.asset, uri, where, what)
 
     def _check_view(self, k: int, v: dict) -> None:
         where = f"bufferViews[{k}]"
@@ -664,14 +558,6 @@ class _Reader:
                             f"{out['count']:,} (accessor {smp['output']})")
 
     # -- raw data -------------------------------------------------------------
-    def _data_uri(self, uri: str, where: str) -> bytes:
-        head, _, payload = uri.strip().partition(",")
-        try:
-            return base64.b64decode(payload, validate=True) if head.endswith(";base64") else \
-                payload.encode("latin-1")
-        except (binascii.Error, ValueError, UnicodeEncodeError):
-            raise _fail(f"base64 data in the data URI at {where}", "other characters") from None
-
     def buffer(self, i: int) -> bytes | memoryview:
         if i not in self._buffers:
             buf = self.lists["buffers"][i]
@@ -683,7 +569,7 @@ class _Reader:
                 if len(data) != buf["byteLength"]:  # changed since the check
                     raise _fail(f"{buf['byteLength']:,} bytes in {describe(buf['uri'])}", f"{len(data):,}")
             else:
-                data = self._data_uri(buf["uri"], where)
+                data = data_uri(buf["uri"], where)
                 if len(data) != buf["byteLength"]:
                     raise _fail(f"{buf['byteLength']:,} bytes in the data URI of {where}", f"{len(data):,}")
             self._buffers[i] = data
@@ -735,9 +621,9 @@ class _Reader:
             raw, offset = self._view(img["bufferView"])
             data = bytes(raw[offset: offset + self.lists["bufferViews"][img["bufferView"]]["byteLength"]])
         elif img["uri"].strip().startswith("data:"):
-            data = self._data_uri(img["uri"], f"images[{i}]")
+            data = data_uri(img["uri"], f"images[{i}]")
         else:
-            data = self._side(img["uri"]).read_bytes()
+            data = side_path(self.asset, img["uri"]).read_bytes()
         if i in self.textured:
             check_picture(data, f"images[{i}] ({_name(img, 'unnamed')!r})")
         return data
