@@ -17,18 +17,16 @@ reading ``expected ..., found ...``.
 """
 from __future__ import annotations
 
-import json
-import math
 from pathlib import Path
-from typing import Any, cast
+from typing import cast
 
 import numpy as np
 
 from fishgen.errors import FishgenError, describe
-from fishgen.exchange.gltf_container import data_uri, read_capped, side_path, sized_uri, unpack
+from fishgen.exchange.gltf_checks import COMPONENT_DTYPES, TYPE_WIDTHS, Document, check_document, item_name
+from fishgen.exchange.gltf_container import data_uri, read_capped, side_path, unpack
 from fishgen.exchange.guards import check_picture, one_line
 from fishgen.scene.model import (
-    INTERPOLATIONS,
     PATHS,
     Channel,
     Clip,
@@ -43,21 +41,7 @@ from fishgen.scene.model import (
     Skin,
 )
 
-MAX_ELEMENTS = 2**26
-"""Most accessor components (count x components, summed over every accessor) in one file."""
-
-SUPPORTED_EXTENSIONS = frozenset({"KHR_materials_unlit"})
-"""Extensions the reader understands; a file that requires any other one is refused."""
-
-_DTYPES: dict[int, type[np.number]] = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16,
-           5125: np.uint32, 5126: np.float32}
-_WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
 _MODES: dict[int, PrimitiveMode] = {0: "POINTS", 4: "TRIANGLES", 5: "TRIANGLES", 6: "TRIANGLES"}
-_FLOAT = 5126
-_UNORM = (5121, 5123)   # unsigned byte / short, used normalized
-_PATH_TYPES = {"translation": "VEC3", "rotation": "VEC4", "scale": "VEC3", "weights": "SCALAR"}
-_PATH_COMPONENTS = {"translation": (_FLOAT,), "scale": (_FLOAT,),
-                    "rotation": (_FLOAT, 5120, 5121, 5122, 5123), "weights": (_FLOAT, 5120, 5121, 5122, 5123)}
 _IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
 
 
@@ -72,7 +56,7 @@ def read_gltf(path: str | Path | None = None, *, data: bytes | None = None,
             data = read_capped(Path(path), where)
         doc, blob = unpack(data)
         del data  # the BIN chunk is a view; a .gltf's text is no longer needed
-        reader = _Reader(doc, blob, Path(path) if path is not None else None, where)
+        reader = _Reader(check_document(doc, blob, Path(path) if path is not None else None), where)
         return reader.scene(label if label is not None else (Path(path).stem if path else ""))
     except FishgenError as err:
         if err.file is None:
@@ -90,472 +74,20 @@ def _fail(what: str, found: str) -> FishgenError:
     return FishgenError(f"expected {what}, found {found}")
 
 
-# -- JSON shape checks ---------------------------------------------------------------
-def _show(value: Any) -> str:
-    """A JSON value for a message, short."""
-    if isinstance(value, bool) or value is None:
-        return json.dumps(value)
-    if isinstance(value, str):
-        return describe(value)
-    if isinstance(value, (int, float)):
-        return repr(value)
-    if isinstance(value, list):
-        if len(value) <= 6 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-            return json.dumps(value)
-        return f"a list of {len(value)} items"
-    return "an object" if isinstance(value, dict) else type(value).__name__
-
-
-def _is_int(v: Any) -> bool:
-    return isinstance(v, int) and not isinstance(v, bool)
-
-
-def _is_num(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-
-
-def _obj(value: Any, where: str) -> dict:
-    if not isinstance(value, dict):
-        raise _fail(f"an object at {where}", _show(value))
-    return value
-
-
-def _list(d: dict, key: str, where: str) -> list:
-    value = d.get(key, [])
-    if not isinstance(value, list):
-        raise _fail(f"a list at {where}.{key}", _show(value))
-    return value
-
-
-def _int(d: dict, key: str, where: str, default: int | None = None, lo: int = 0,
-         hi: int | None = None) -> int:
-    value: Any = d.get(key, default)
-    if not _is_int(value) or value < lo or (hi is not None and value > hi):
-        span = f"from {lo} to {hi}" if hi is not None else f"of at least {lo}"
-        raise _fail(f"an integer {span} at {where}.{key}", "none" if value is None else _show(value))
-    return cast(int, value)
-
-
-def _index(d: dict, key: str, where: str, kind: str, count: int, required: bool = False) -> int | None:
-    value = d.get(key)
-    if value is None and not required:
-        return None
-    return _ref(value, f"{where}.{key}", kind, count)
-
-
-def _ref(value: Any, where: str, kind: str, count: int) -> int:
-    if not _is_int(value) or not 0 <= value < count:
-        span = f"from 0 to {count - 1}" if count else f"(the file has no {kind}s)"
-        raise _fail(f"a {kind} index {span} at {where}", "none" if value is None else _show(value))
-    return cast(int, value)
-
-
-def _numbers(d: dict, key: str, where: str, n: int | None) -> list[float] | None:
-    value = d.get(key)
-    if value is None:
-        return None
-    if not isinstance(value, list) or (n is not None and len(value) != n) or not all(map(_is_num, value)):
-        what = f"{n} finite numbers" if n is not None else "a list of finite numbers"
-        if isinstance(value, list) and n is not None and len(value) != n:
-            found = f"{len(value)} numbers"
-        else:
-            found = _show(value)
-        raise _fail(f"{what} at {where}.{key}", found)
-    return [float(v) for v in value]
-
-
-def _enum(d: dict, key: str, where: str, choices: tuple[str, ...], default: str) -> str:
-    value = d.get(key, default)
-    if value not in choices:
-        raise _fail(f"one of {', '.join(choices)} at {where}.{key}", _show(value))
-    return cast(str, value)
-
-
-def _bool(d: dict, key: str, where: str) -> bool:
-    value = d.get(key, False)
-    if not isinstance(value, bool):
-        raise _fail(f"true or false at {where}.{key}", _show(value))
-    return value
-
-
 def _mime(img: dict) -> str:
     mime = img.get("mimeType")
     return mime if isinstance(mime, str) else "image/png"
 
 
-def _name(d: dict, fallback: str) -> str:
-    name = d.get("name")
-    return name if isinstance(name, str) and name else fallback
-
-
 class _Reader:
-    """Checks the document, then builds the scene from it."""
+    """Builds the scene from a checked document."""
 
-    def __init__(self, doc: dict, blob: memoryview | None, asset: Path | None, where: str):
-        self.doc, self.blob, self.asset, self.where = doc, blob, asset, where
+    def __init__(self, document: Document, where: str):
+        self.document, self.where = document, where
+        self.doc, self.lists = document.doc, document.lists
+        self.blob, self.asset = document.blob, document.asset
+        self._files, self.textured, self.parent = document.files, document.textured, document.parent
         self._buffers: dict[int, bytes | memoryview] = {}
-        self._files: dict[int, Path] = {}
-        self.lists: dict[str, list[dict]] = {}
-        self.elements = 0
-        self.targets: list[int] = []   # morph target count of each mesh
-        self.textured: set[int] = set()  # images the renderer decodes (base colour textures)
-        self._check()
-
-    def count(self, kind: str) -> int:
-        return len(self.lists[kind])
-
-    # -- checks of the document --------------------------------------------------
-    def _check(self) -> None:
-        doc = self.doc
-        asset = _obj(doc.get("asset"), "asset")
-        version = asset.get("version")
-        if not isinstance(version, str) or version.split(".")[0] != "2":
-            raise _fail('asset.version "2.0"', "none" if version is None else _show(version))
-        required = _list(doc, "extensionsRequired", "document")
-        unknown = [e for e in required if e not in SUPPORTED_EXTENSIONS]
-        if unknown:
-            raise _fail("no required extension but " + ", ".join(sorted(SUPPORTED_EXTENSIONS)),
-                        _show(unknown[0]) if len(unknown) == 1 else ", ".join(map(_show, unknown)))
-        for kind in ("accessors", "animations", "buffers", "bufferViews", "images", "materials", "meshes",
-                     "nodes", "samplers", "scenes", "skins", "textures", "cameras"):
-            items = _list(doc, kind, "document")
-            for k, item in enumerate(items):
-                _obj(item, f"{kind}[{k}]")
-            self.lists[kind] = items
-        for k, b in enumerate(self.lists["buffers"]):
-            self._check_buffer(k, b)
-        for k, v in enumerate(self.lists["bufferViews"]):
-            self._check_view(k, v)
-        for k, a in enumerate(self.lists["accessors"]):
-            self._check_accessor(k, a)
-        for k, img in enumerate(self.lists["images"]):
-            self._check_image_ref(k, img)
-        for k, t in enumerate(self.lists["textures"]):
-            _index(t, "source", f"textures[{k}]", "image", self.count("images"))
-            _index(t, "sampler", f"textures[{k}]", "sampler", self.count("samplers"))
-        for k, m in enumerate(self.lists["materials"]):
-            self._check_material(k, m)
-        for k, m in enumerate(self.lists["meshes"]):
-            self._check_mesh(k, m)
-        self._check_nodes()
-        for k, s in enumerate(self.lists["skins"]):
-            self._check_skin(k, s)
-        for k, s in enumerate(self.lists["scenes"]):
-            where = f"scenes[{k}]"
-            nodes = [_ref(n, f"{where}.nodes[{j}]", "node", self.count("nodes"))
-                     for j, n in enumerate(_list(s, "nodes", where))]
-            if len(set(nodes)) != len(nodes):
-                raise _fail(f"each node once at {where}.nodes", "a node listed twice")
-            for n in nodes:
-                if n in self.parent:
-                    raise _fail(f"only root nodes at {where}.nodes",
-                                f"node {n}, a child of node {self.parent[n]}")
-        if self.lists["scenes"]:
-            _index(doc, "scene", "document", "scene", self.count("scenes"))
-        for k, a in enumerate(self.lists["animations"]):
-            self._check_animation(k, a)
-
-    def _check_buffer(self, k: int, b: dict) -> None:
-        where = f"buffers[{k}]"
-        length = _int(b, "byteLength", where, lo=1)
-        uri = b.get("uri")
-        if uri is None:
-            if k != 0 or self.blob is None:
-                raise _fail(f"a uri at {where} (only a GLB's first buffer may omit it)", "none")
-            if not length <= len(self.blob) <= length + 3:
-                raise _fail(f"a GLB BIN chunk of {length:,} bytes for {where}", f"{len(self.blob):,} bytes")
-            return
-        found = self._sized_uri(uri, where, "a buffer")
-        if found is None:
-            return
-        target, size = found
-        if size != length:
-            raise _fail(f"{length:,} bytes in {describe(uri)} ({where}.byteLength)", f"{size:,} bytes")
-        self._files[k] = target
-
-    def _sized_uri(self, uri: Any, where: str, what: str) -> tuple[Path, int] | None:
-        if not isinstance(uri, str):
-            raise _fail(f"a URI string at {where}.uri", _show(uri))
-        return sized_uri(self.asset, uri, where, what)
-
-    def _check_view(self, k: int, v: dict) -> None:
-        where = f"bufferViews[{k}]"
-        buf = _index(v, "buffer", where, "buffer", self.count("buffers"), required=True)
-        offset = _int(v, "byteOffset", where, 0)
-        length = _int(v, "byteLength", where, lo=1)
-        stride = v.get("byteStride")
-        if stride is not None and (not _is_int(stride) or not 4 <= stride <= 252 or stride % 4):
-            raise _fail(f"a byteStride from 4 to 252, a multiple of 4, at {where}", _show(stride))
-        size = self.lists["buffers"][cast(int, buf)]["byteLength"]
-        if offset + length > size:
-            raise _fail(f"{where} (bytes {offset:,} to {offset + length:,}) within buffer {buf} "
-                        f"of {size:,} bytes", f"{offset + length - size:,} bytes past its end")
-
-    def _check_accessor(self, k: int, a: dict) -> None:
-        where = f"accessors[{k}]"
-        ctype = a.get("componentType")
-        if ctype not in _DTYPES:
-            raise _fail(f"a componentType of {', '.join(map(str, _DTYPES))} at {where}", _show(ctype))
-        kind = _enum(a, "type", where, tuple(_WIDTH), "")
-        count = _int(a, "count", where, lo=1)
-        _bool(a, "normalized", where)
-        width = _WIDTH[kind]
-        view = _index(a, "bufferView", where, "bufferView", self.count("bufferViews"))
-        if view is not None:
-            item = np.dtype(_DTYPES[ctype]).itemsize * width
-            self._fits(where, view, _int(a, "byteOffset", where, 0), count, item, strided=True)
-        self.elements += count * width
-        if self.elements > MAX_ELEMENTS:
-            raise _fail(f"at most {MAX_ELEMENTS:,} accessor components in the file",
-                        f"more by {where} (count {count:,} of {kind})")
-        sparse = a.get("sparse")
-        if sparse is not None:
-            sw = f"{where}.sparse"
-            _obj(sparse, sw)
-            n = _int(sparse, "count", sw, lo=1, hi=count)
-            self.elements += n * (1 + width)
-            if self.elements > MAX_ELEMENTS:
-                raise _fail(f"at most {MAX_ELEMENTS:,} accessor components in the file", f"more by {sw}")
-            idx = _obj(sparse.get("indices"), f"{sw}.indices")
-            if idx.get("componentType") not in (5121, 5123, 5125):
-                raise _fail(f"a componentType of 5121, 5123 or 5125 at {sw}.indices",
-                            _show(idx.get("componentType")))
-            for part, item in ((idx, np.dtype(_DTYPES[idx["componentType"]]).itemsize),
-                               (_obj(sparse.get("values"), f"{sw}.values"),
-                                np.dtype(_DTYPES[ctype]).itemsize * width)):
-                pw = f"{sw}.{'indices' if part is idx else 'values'}"
-                pv = _index(part, "bufferView", pw, "bufferView", self.count("bufferViews"), required=True)
-                self._fits(pw, cast(int, pv), _int(part, "byteOffset", pw, 0), n, item, strided=False)
-
-    def _fits(self, where: str, view: int, offset: int, count: int, item: int, strided: bool) -> None:
-        v = self.lists["bufferViews"][view]
-        stride = (v.get("byteStride") if strided else None) or item
-        if stride < item:
-            raise _fail(f"a byteStride of at least {item} (one element) for {where}",
-                        f"{stride} in bufferView {view}")
-        end = offset + stride * (count - 1) + item
-        if end > v["byteLength"]:
-            raise _fail(f"{where} ({count:,} elements of {item} bytes from byte {offset:,}) "
-                        f"within bufferView {view} of {v['byteLength']:,} bytes",
-                        f"{end:,} bytes needed")
-
-    def _check_image_ref(self, k: int, img: dict) -> None:
-        where = f"images[{k}]"
-        uri, view = img.get("uri"), _index(img, "bufferView", where, "bufferView", self.count("bufferViews"))
-        if (uri is None) == (view is None):
-            raise _fail(f"either a uri or a bufferView at {where}", "both" if view is not None else "neither")
-        if uri is not None:
-            self._sized_uri(uri, where, "an image")
-
-    def _texture_ref(self, info: Any, where: str) -> int | None:
-        if info is None:
-            return None
-        _obj(info, where)
-        t = cast(int, _index(info, "index", where, "texture", self.count("textures"), required=True))
-        _int(info, "texCoord", where, 0)
-        return t
-
-    def _check_material(self, k: int, m: dict) -> None:
-        where = f"materials[{k}]"
-        pbr = m.get("pbrMetallicRoughness")
-        if pbr is not None:
-            pw = f"{where}.pbrMetallicRoughness"
-            _obj(pbr, pw)
-            _numbers(pbr, "baseColorFactor", pw, 4)
-            for key in ("metallicFactor", "roughnessFactor"):
-                if key in pbr and not _is_num(pbr[key]):
-                    raise _fail(f"a finite number at {pw}.{key}", _show(pbr[key]))
-            t = self._texture_ref(pbr.get("baseColorTexture"), f"{pw}.baseColorTexture")
-            if t is not None:
-                source = self.lists["textures"][t].get("source")
-                if source is not None:
-                    self.textured.add(source)
-            self._texture_ref(pbr.get("metallicRoughnessTexture"), f"{pw}.metallicRoughnessTexture")
-        for key in ("normalTexture", "occlusionTexture", "emissiveTexture"):
-            self._texture_ref(m.get(key), f"{where}.{key}")
-        _numbers(m, "emissiveFactor", where, 3)
-        _enum(m, "alphaMode", where, ("OPAQUE", "MASK", "BLEND"), "OPAQUE")
-        cutoff = m.get("alphaCutoff")
-        if cutoff is not None and (not _is_num(cutoff) or cutoff < 0):
-            raise _fail(f"a finite alphaCutoff of at least 0 at {where}", _show(cutoff))
-        _bool(m, "doubleSided", where)
-        if not isinstance(m.get("extensions", {}), dict):
-            raise _fail(f"an object at {where}.extensions", _show(m["extensions"]))
-
-    def _acc(self, i: int) -> dict:
-        return self.lists["accessors"][i]
-
-    def _check_semantic(self, name: str, i: int, where: str, n: int | None) -> None:
-        a = self._acc(i)
-        kind, ctype, norm = a["type"], a["componentType"], a.get("normalized", False)
-        ok = True
-        want = ""
-        if name in ("POSITION", "NORMAL"):
-            ok, want = kind == "VEC3" and ctype == _FLOAT, "VEC3 of floats (5126)"
-        elif name == "TANGENT":
-            ok, want = kind == "VEC4" and ctype == _FLOAT, "VEC4 of floats (5126)"
-        elif name.startswith("TEXCOORD_"):
-            ok = kind == "VEC2" and (ctype == _FLOAT or (ctype in _UNORM and norm))
-            want = "VEC2 of floats, or of normalized unsigned bytes or shorts"
-        elif name.startswith("COLOR_"):
-            ok = kind in ("VEC3", "VEC4") and (ctype == _FLOAT or (ctype in _UNORM and norm))
-            want = "VEC3 or VEC4 of floats, or of normalized unsigned bytes or shorts"
-        elif name.startswith("JOINTS_"):
-            ok, want = kind == "VEC4" and ctype in _UNORM and not norm, "VEC4 of unsigned bytes or shorts"
-        elif name.startswith("WEIGHTS_"):
-            ok = kind == "VEC4" and (ctype == _FLOAT or (ctype in _UNORM and norm))
-            want = "VEC4 of floats, or of normalized unsigned bytes or shorts"
-        elif name in ("_RADIUS", "_DENSITY"):
-            ok, want = kind == "SCALAR", "SCALAR"
-        if not ok:
-            raise _fail(f"{name} as {want} at {where}",
-                        f"accessor {i}: {kind} of componentType {ctype}{' normalized' if norm else ''}")
-        if n is not None and a["count"] != n:
-            raise _fail(f"{n:,} {name} values (one per POSITION) at {where}",
-                        f"{a['count']:,} (accessor {i})")
-
-    def _check_mesh(self, k: int, m: dict) -> None:
-        where = f"meshes[{k}]"
-        prims = _list(m, "primitives", where)
-        if not prims:
-            raise _fail(f"at least one primitive at {where}", "none")
-        counts = []
-        for j, p in enumerate(prims):
-            pw = f"{where}.primitives[{j}]"
-            _obj(p, pw)
-            attrs = _obj(p.get("attributes"), f"{pw}.attributes")
-            for name, i in attrs.items():
-                _ref(i, f"{pw}.attributes.{name}", "accessor", self.count("accessors"))
-            _int(p, "mode", pw, 4, 0, 6)
-            _index(p, "material", pw, "material", self.count("materials"))
-            indices = _index(p, "indices", pw, "accessor", self.count("accessors"))
-            n = self._acc(attrs["POSITION"])["count"] if "POSITION" in attrs else None
-            for name, i in attrs.items():
-                self._check_semantic(name, i, f"{pw}.attributes", n)
-            if indices is not None:
-                a = self._acc(indices)
-                if a["type"] != "SCALAR" or a["componentType"] not in (5121, 5123, 5125):
-                    raise _fail(f"indices as SCALAR unsigned bytes, shorts or ints at {pw}",
-                                f"accessor {indices}: {a['type']} of componentType {a['componentType']}")
-            targets = _list(p, "targets", pw)
-            for t, target in enumerate(targets):
-                tw = f"{pw}.targets[{t}]"
-                for name, i in _obj(target, tw).items():
-                    i = _ref(i, f"{tw}.{name}", "accessor", self.count("accessors"))
-                    a = self._acc(i)
-                    if name in ("POSITION", "NORMAL", "TANGENT") and (a["type"] != "VEC3"
-                                                                     or a["componentType"] != _FLOAT):
-                        raise _fail(f"{name} displacements as VEC3 of floats at {tw}",
-                                    f"accessor {i}: {a['type']} of componentType {a['componentType']}")
-                    if n is not None and a["count"] != n:
-                        raise _fail(f"{n:,} {name} displacements (one per POSITION) at {tw}",
-                                    f"{a['count']:,} (accessor {i})")
-            counts.append(len(targets))
-        if len(set(counts)) > 1:
-            raise _fail(f"the same number of morph targets in every primitive of {where}",
-                        ", ".join(map(str, counts)))
-        self.targets.append(counts[0])
-        weights = _numbers(m, "weights", where, None)
-        if weights is not None and len(weights) != counts[0]:
-            raise _fail(f"{counts[0]} default weights (one per morph target) at {where}.weights",
-                        f"{len(weights)}")
-
-    def _check_nodes(self) -> None:
-        nodes = self.lists["nodes"]
-        self.parent: dict[int, int] = {}
-        for i, n in enumerate(nodes):
-            where = f"nodes[{i}]"
-            children = [_ref(c, f"{where}.children[{j}]", "node", len(nodes))
-                        for j, c in enumerate(_list(n, "children", where))]
-            for c in children:
-                if c == i:
-                    raise _fail(f"children other than the node itself at {where}",
-                                f"node {i} as its own child")
-                if c in self.parent:
-                    raise _fail(f"one parent for node {c}",
-                                f"nodes {self.parent[c]} and {i}" if self.parent[c] != i
-                                else f"it listed twice at {where}.children")
-                self.parent[c] = i
-            mesh = _index(n, "mesh", where, "mesh", self.count("meshes"))
-            _index(n, "skin", where, "skin", self.count("skins"))
-            _index(n, "camera", where, "camera", self.count("cameras"))
-            _numbers(n, "matrix", where, 16)
-            _numbers(n, "translation", where, 3)
-            _numbers(n, "rotation", where, 4)
-            _numbers(n, "scale", where, 3)
-            weights = _numbers(n, "weights", where, None)
-            if weights is not None and (mesh is None or len(weights) != self.targets[mesh]):
-                raise _fail(f"{0 if mesh is None else self.targets[mesh]} weights (one per morph target "
-                            f"of its mesh) at {where}.weights", str(len(weights)))
-        # With one parent each, a node that no walk from the roots reaches sits on a cycle.
-        seen: set[int] = set()
-        stack = [i for i in range(len(nodes)) if i not in self.parent]
-        while stack:
-            i = stack.pop()
-            seen.add(i)
-            stack.extend(nodes[i].get("children", []))
-        if len(seen) != len(nodes):
-            first = min(set(range(len(nodes))) - seen)
-            raise _fail("a node hierarchy without cycles", f"node {first} among its own ancestors")
-
-    def _check_skin(self, k: int, s: dict) -> None:
-        where = f"skins[{k}]"
-        joints = [_ref(j, f"{where}.joints[{n}]", "node", self.count("nodes"))
-                  for n, j in enumerate(_list(s, "joints", where))]
-        if not joints:
-            raise _fail(f"at least one joint at {where}.joints", "none")
-        _index(s, "skeleton", where, "node", self.count("nodes"))
-        ibm = _index(s, "inverseBindMatrices", where, "accessor", self.count("accessors"))
-        if ibm is not None:
-            a = self._acc(ibm)
-            if a["type"] != "MAT4" or a["componentType"] != _FLOAT:
-                raise _fail(f"inverseBindMatrices as MAT4 of floats at {where}",
-                            f"accessor {ibm}: {a['type']} of componentType {a['componentType']}")
-            if a["count"] != len(joints):
-                raise _fail(f"{len(joints)} inverseBindMatrices (one per joint) at {where}",
-                            f"{a['count']:,} (accessor {ibm})")
-
-    def _check_animation(self, k: int, anim: dict) -> None:
-        where = f"animations[{k}]"
-        samplers = _list(anim, "samplers", where)
-        for j, smp in enumerate(samplers):
-            sw = f"{where}.samplers[{j}]"
-            _obj(smp, sw)
-            i = cast(int, _index(smp, "input", sw, "accessor", self.count("accessors"), required=True))
-            _index(smp, "output", sw, "accessor", self.count("accessors"), required=True)
-            _enum(smp, "interpolation", sw, INTERPOLATIONS, "LINEAR")
-            a = self._acc(i)
-            if a["type"] != "SCALAR" or a["componentType"] != _FLOAT:
-                raise _fail(f"keyframe times as SCALAR floats at {sw}.input",
-                            f"accessor {i}: {a['type']} of componentType {a['componentType']}")
-        for j, ch in enumerate(_list(anim, "channels", where)):
-            cw = f"{where}.channels[{j}]"
-            _obj(ch, cw)
-            smp = samplers[cast(int, _index(ch, "sampler", cw, "sampler", len(samplers), required=True))]
-            target = _obj(ch.get("target"), f"{cw}.target")
-            node = _index(target, "node", f"{cw}.target", "node", self.count("nodes"))
-            path = target.get("path")
-            if not isinstance(path, str):
-                raise _fail(f"a path at {cw}.target", _show(path))
-            if node is None or path not in PATHS:
-                continue  # another extension's target (KHR_animation_pointer): not previewed
-            out = self._acc(smp["output"])
-            if out["type"] != _PATH_TYPES[path] or out["componentType"] not in _PATH_COMPONENTS[path]:
-                raise _fail(f"{path} keyframes as {_PATH_TYPES[path]} at {cw}", f"accessor {smp['output']}: "
-                            f"{out['type']} of componentType {out['componentType']}")
-            per_key = 3 if smp.get("interpolation") == "CUBICSPLINE" else 1
-            if path == "weights":
-                mesh = self.lists["nodes"][node].get("mesh")
-                targets = 0 if mesh is None else self.targets[mesh]
-                if not targets:
-                    raise _fail(f"a node with morph targets for the weights channel {cw}",
-                                f"node {node} without any")
-                per_key *= targets
-            times = self._acc(smp["input"])["count"]
-            if out["count"] != times * per_key:
-                factor = f" x {per_key}" if per_key > 1 else ""
-                raise _fail(f"{times * per_key:,} output values ({times:,} keyframes{factor}) for {cw}",
-                            f"{out['count']:,} (accessor {smp['output']})")
 
     # -- raw data -------------------------------------------------------------
     def buffer(self, i: int) -> bytes | memoryview:
@@ -581,8 +113,9 @@ class _Reader:
 
     def accessor(self, i: int) -> np.ndarray:
         """The accessor's values, (count, components); normalized integers as float32."""
-        acc = self._acc(i)
-        dtype, width, count = np.dtype(_DTYPES[acc["componentType"]]), _WIDTH[acc["type"]], acc["count"]
+        acc = self.lists["accessors"][i]
+        dtype = np.dtype(COMPONENT_DTYPES[acc["componentType"]])
+        width, count = TYPE_WIDTHS[acc["type"]], acc["count"]
         if acc.get("bufferView") is None:
             out = np.zeros((count, width), dtype)
         else:
@@ -601,7 +134,7 @@ class _Reader:
             out = out.copy()
             n, idx_part, val_part = sparse["count"], sparse["indices"], sparse["values"]
             raw, offset = self._view(idx_part["bufferView"])
-            idx = np.frombuffer(raw, _DTYPES[idx_part["componentType"]], n,
+            idx = np.frombuffer(raw, COMPONENT_DTYPES[idx_part["componentType"]], n,
                                 offset + idx_part.get("byteOffset", 0))
             if int(idx.max()) >= count:
                 raise _fail(f"sparse indices below {count:,} at accessors[{i}]", str(int(idx.max())))
@@ -625,7 +158,7 @@ class _Reader:
         else:
             data = side_path(self.asset, img["uri"]).read_bytes()
         if i in self.textured:
-            check_picture(data, f"images[{i}] ({_name(img, 'unnamed')!r})")
+            check_picture(data, f"images[{i}] ({item_name(img, 'unnamed')!r})")
         return data
 
     # -- scene ------------------------------------------------------------------
@@ -638,7 +171,7 @@ class _Reader:
         factor = pbr.get("baseColorFactor") or [1, 1, 1, 1]
         base_color = cast(tuple[float, float, float, float], tuple(float(v) for v in factor))
         cutoff = m.get("alphaCutoff")
-        return Material(name=_name(m, f"material{k}"), base_color=base_color,
+        return Material(name=item_name(m, f"material{k}"), base_color=base_color,
                         texture=texture, alpha_mode=m.get("alphaMode", "OPAQUE"),
                         alpha_cutoff=None if cutoff is None else float(cutoff),
                         double_sided=bool(m.get("doubleSided", False)),
@@ -676,13 +209,13 @@ class _Reader:
         scene = Scene(name=label, source=self.where)
         for k, m in enumerate(lists["meshes"]):
             prims = [self.primitive(p, f"meshes[{k}].primitives[{j}]") for j, p in enumerate(m["primitives"])]
-            scene.meshes.append(Mesh(_name(m, f"mesh{k}"), [p for p in prims if p is not None],
+            scene.meshes.append(Mesh(item_name(m, f"mesh{k}"), [p for p in prims if p is not None],
                                      [float(w) for w in m.get("weights", [])]))
-        scene.images = [Image(_name(img, f"image{k}"), self.image_bytes(k), _mime(img))
+        scene.images = [Image(item_name(img, f"image{k}"), self.image_bytes(k), _mime(img))
                         for k, img in enumerate(lists["images"])]
         scene.materials = [self.material(k) for k in range(len(lists["materials"]))]
         for i, n in enumerate(lists["nodes"]):
-            node = Node(name=_name(n, f"node{i}"), children=list(n.get("children", [])),
+            node = Node(name=item_name(n, f"node{i}"), children=list(n.get("children", [])),
                         mesh=n.get("mesh"), skin=n.get("skin"))
             if n.get("matrix") is not None and list(n["matrix"]) != _IDENTITY:
                 node.matrix = np.asarray(n["matrix"], float).reshape(4, 4).T  # column-major
@@ -700,7 +233,7 @@ class _Reader:
                        .reshape(-1, 4, 4).transpose(0, 2, 1))
             else:
                 ibm = np.repeat(np.eye(4)[None], len(joints), axis=0)
-            scene.skins.append(Skin(_name(skin, f"skin{k}"), joints, ibm, skin.get("skeleton")))
+            scene.skins.append(Skin(item_name(skin, f"skin{k}"), joints, ibm, skin.get("skeleton")))
         self._check_joints(scene)
         # Only nodes reachable from the default scene are drawn, as an engine would.
         scenes = lists["scenes"]
@@ -723,7 +256,7 @@ class _Reader:
                 if path == "weights":
                     values = values.reshape(len(times) * (3 if interp == "CUBICSPLINE" else 1), -1)
                 channels.append(Channel(node, path, Sampler(times, values, interp)))
-            scene.clips.append(Clip(_name(a, f"clip{k}"), channels))
+            scene.clips.append(Clip(item_name(a, f"clip{k}"), channels))
         return scene
 
     def _check_joints(self, scene: Scene) -> None:
