@@ -22,7 +22,7 @@ import numpy as np
 from trimesh.resolvers import Resolver
 
 from fishgen.errors import FishgenError, describe, expected
-from fishgen.exchange.gltf_reader import _check_picture, one_line, size_text
+from fishgen.exchange.guards import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_picture, one_line, size_text
 from fishgen.exchange.sidefiles import side_file
 from fishgen.numeric import srgb_to_linear
 from fishgen.scene.model import Image, Material, Mesh, Node, Primitive, Scene
@@ -222,7 +222,7 @@ _MAP_KEYS = {"map_ka", "map_kd", "map_ks", "map_ke", "map_ns", "map_d", "map_bum
 
 def _check_texture(image: Path, where: Path, line: int | None = None) -> None:
     try:
-        _check_picture(image.read_bytes(), repr(image.name))
+        check_picture(image.read_bytes(), repr(image.name))
     except FishgenError as err:
         raise FishgenError(err.message, where, line) from None
 
@@ -330,9 +330,7 @@ def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path, scene: Scene) -
 
 
 def _check_size(image, path: Path) -> None:
-    """A texture trimesh opened (lazily) is refused over the glTF reader's caps before decoding."""
-    from fishgen.exchange.gltf_reader import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE
-
+    """A texture trimesh opened (lazily) is refused over the readers' image caps before decoding."""
     width, height = image.size
     if width > MAX_IMAGE_SIDE or height > MAX_IMAGE_SIDE or width * height > MAX_IMAGE_PIXELS:
         raise expected(f"a texture of at most {MAX_IMAGE_SIDE} px a side and {MAX_IMAGE_PIXELS:,} pixels",

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from fishgen.errors import FishgenError
-from fishgen.exchange import gltf_reader
+from fishgen.exchange import gltf_container
 from fishgen.exchange.gltf_reader import read_gltf
 from fishgen.scene.pose import bounds, pose
 from tests.conftest import run_cli
@@ -343,7 +343,7 @@ def test_data_uri_over_the_cap_is_refused_before_decoding(tmp_path, monkeypatch)
     path = tmp_path / "inline.gltf"
     path.write_text(json.dumps(d))
     assert read_gltf(path).counts()["triangles"] == 1
-    monkeypatch.setattr(gltf_reader, "MAX_DATA_URI_CHARS", 64)
+    monkeypatch.setattr(gltf_container, "MAX_DATA_URI_CHARS", 64)
     refused(path, r"a data URI of at most 64 bytes at buffers\[0\]")
     monkeypatch.undo()
     d["buffers"][0]["byteLength"] += 4
@@ -355,7 +355,7 @@ def test_data_uri_over_the_cap_is_refused_before_decoding(tmp_path, monkeypatch)
 def test_too_many_json_items_are_refused_before_parsing(tmp_path, monkeypatch):
     doc = Doc()
     doc.d["extras"] = [0] * 1000
-    monkeypatch.setattr(gltf_reader, "MAX_JSON_ITEMS", 500)
+    monkeypatch.setattr(gltf_container, "MAX_JSON_ITEMS", 500)
     refused(doc.write(tmp_path), r"a JSON document of at most 500 items")
 
 
