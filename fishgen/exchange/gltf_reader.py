@@ -529,7 +529,7 @@ class _Reader:
         elif name.startswith("WEIGHTS_"):
             ok = kind == "VEC4" and (ctype == _FLOAT or (ctype in _UNORM and norm))
             want = "VEC4 of floats, or of normalized unsigned bytes or shorts"
-        elif name in ("_RADIUS", "_DENSITY"):
+        elif name in ("_RADIUS", "_DENSITY", "_LIGHT"):
             ok, want = kind == "SCALAR", "SCALAR"
         if not ok:
             raise _fail(f"{name} as {want} at {where}",
@@ -838,6 +838,9 @@ class _Reader:
         scenes = lists["scenes"]
         scene.roots = (list(scenes[self.doc.get("scene", 0)].get("nodes", [])) if scenes
                        else [i for i in range(len(lists["nodes"])) if i not in self.parent])
+        extras = scenes[self.doc.get("scene", 0)].get("extras") if scenes else None
+        if isinstance(extras, dict):  # kept as read; whoever uses a member checks it
+            scene.extras = extras
         for k, a in enumerate(lists["animations"]):
             channels = []
             for j, ch in enumerate(a.get("channels", [])):
