@@ -32,6 +32,10 @@ _R3 = np.array([0.8191725133961645, 0.6710436067037893, 0.5497004779019703])
 """Martin Roberts' R3 sequence (2018): fractional parts of k times these are evenly spread in
 the unit cube, so particle k's turn needs no random generator and no seed."""
 QUADS = len(PLANES)
+BILLBOARD_OPACITY = 0.5
+"""Each quad's opacity at its centre, times the particle's density. Half a single billboard's:
+from any side one to three of a particle's quads overlap, and a quad seen almost edge-on (a
+thin needle) shows half as strongly."""
 TRIANGLES_PER_BILLBOARD = 2 * QUADS
 BILLBOARD_BYTES = QUADS * (4 * (12 + 8 + 4 + 4) + 6 * 4)
 """glTF bytes per billboard particle: per quad 4 corners of position, UV, RGBA8 and light,
@@ -72,7 +76,7 @@ def _billboards(cloud: Cloud, scene: Scene) -> Primitive:
     rgba = np.empty((n, 4), np.uint8)
     lin16 = srgb8_to_linear16()[cloud.colors]
     rgba[:, :3] = (lin16.astype(np.uint32) * 255 + 32767) // 65535   # linear, 8 bits
-    rgba[:, 3] = np.round(cloud.density * 255)   # thin parts of the cloud fade more
+    rgba[:, 3] = np.round(cloud.density * (255 * BILLBOARD_OPACITY))   # thin parts of the cloud fade more
     texture = scene.add_image(Image("gaussian sprite", gaussian_sprite_png()))
     material = scene.add_material(Material("cloud particle", texture=texture, alpha_mode="BLEND",
                                            double_sided=True, unlit=True, roughness=1.0))
