@@ -59,9 +59,10 @@ def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
 
     n = int(counts.sum())
     cube_index = np.repeat(np.arange(len(cubes), dtype=np.int32), counts)
+    textures = tuple(c.texture for c in cubes) if any(c.texture for c in cubes) else ()
     out = Cloud(centers=np.empty((n, 3), _F32), radii=np.empty(n, _F32),
                 density=np.empty(n, _F32), colors=np.full((n, 3), UNLIT, np.uint8),
-                cube_index=cube_index, cube_bounds=np.stack([lo, hi], axis=1))
+                cube_index=cube_index, cube_bounds=np.stack([lo, hi], axis=1), textures=textures)
 
     def work(start: int) -> None:
         _fill_chunk(out, tables, start, min(start + CHUNK, n), int(seed), method)
@@ -131,7 +132,9 @@ def merge_clouds(clouds: Sequence[Cloud]) -> Cloud:
         cube_index=np.concatenate([c.cube_index + np.int32(k) for c, k in zip(clouds, shifts, strict=True)]),
         cube_bounds=np.concatenate([c.cube_bounds for c in clouds]),
         light=np.concatenate([c.light for c in clouds if c.light is not None]) if lit else None,
-        lighting=clouds[0].lighting if lit else None)
+        lighting=clouds[0].lighting if lit else None,
+        textures=(tuple(t for c in clouds for t in (c.textures or (None,) * len(c.cube_bounds)))
+                  if any(c.textures for c in clouds) else ()))
 
 
 class _Tables:

@@ -15,13 +15,15 @@ DEFAULT_MAX_PARTICLES = 50_000_000
 
 @dataclass(frozen=True)
 class Cube:
-    """One editor cube: particles to place, x/y/z extents (y up), centre and maximum radius."""
+    """One editor cube: particles (or billboards) to place, x/y/z extents (y up), centre and
+    maximum radius; in a texture cloud (.awa), the texture its billboards carry."""
 
     particles: int
     size: tuple[float, float, float]
     centre: tuple[float, float, float]
     max_radius: float
     line: int = 0  # source line, for messages
+    texture: str | None = None  # .awa: the PNG file, resolved (an absolute path)
 
 
 @dataclass(frozen=True)
@@ -56,6 +58,7 @@ class Cloud:
     cube_bounds: np.ndarray  # (K, 2, 3) float64
     light: np.ndarray | None = None       # (N,) float32 in [0, 1]: sunlight reaching each centre
     lighting: Lighting | None = None      # the light it was lit with
+    textures: tuple[str | None, ...] = ()  # per cube: its billboards' PNG (a texture cloud), else ()
 
     def __post_init__(self) -> None:
         n = len(self.centers)
@@ -67,6 +70,9 @@ class Cloud:
                 raise ValueError(f"Cloud.{name} has shape {value.shape}, expected {shape}")
         if (self.light is None) != (self.lighting is None):
             raise ValueError("Cloud.light and Cloud.lighting go together")
+        if self.textures and len(self.textures) != len(self.cube_bounds):
+            raise ValueError(f"Cloud.textures has {len(self.textures)} entries, expected one per cube "
+                             f"({len(self.cube_bounds)})")
 
     def __len__(self) -> int:
         return len(self.centers)

@@ -52,8 +52,8 @@ def cloud_scene(cloud: Cloud, *, billboards: bool = False, name: str = "cloud") 
     scene = Scene(name=name, info={"kind": "cloud", "particles": len(cloud)})
     if cloud.lighting is not None:
         scene.extras[EXTRAS_KEY] = cloud.lighting.extras()
-    prim = _billboards(cloud, scene) if billboards else _points(cloud)
-    mesh = scene.add_mesh(Mesh(name, [prim]))
+    prims = _billboards(cloud, scene) if billboards else [_points(cloud)]
+    mesh = scene.add_mesh(Mesh(name, prims))
     scene.add_node(Node(name=name, mesh=mesh))
     return scene
 
@@ -67,19 +67,51 @@ def _points(cloud: Cloud) -> Primitive:
     return Primitive(attributes, mode="POINTS")
 
 
-def _billboards(cloud: Cloud, scene: Scene) -> Primitive:
-    """Three crossed quads per particle (``PLANES``), half width = radius, vertex alpha = density."""
-    n = len(cloud)
-    offsets = np.einsum("ck,qkd->qcd", _CORNERS, PLANES)                 # (quads, 4 corners, 3)
-    turned = np.einsum("qcd,nde->nqce", offsets, turns(n))               # (n, quads, 4, 3)
-    corners = cloud.centers[:, None, None, :] + turned * cloud.radii[:, None, None, None]
-    rgba = np.empty((n, 4), np.uint8)
-    lin16 = srgb8_to_linear16()[cloud.colors]
-    rgba[:, :3] = (lin16.astype(np.uint32) * 255 + 32767) // 65535   # linear, 8 bits
-    rgba[:, 3] = np.round(cloud.density * (255 * BILLBOARD_OPACITY))   # thin parts of the cloud fade more
+def _billboards(cloud: Cloud, scene: Scene) -> list[Primitive]:
+    """One primitive per texture: a texture cloud's billboards carry their cube's PNG, the
+    others fishgen's Gaussian sprite."""
+    if not cloud.textures:
+        return [_billboard_primitive(cloud, np.arange(len(cloud)), _sprite_material(scene))]
+    out = []
+    for texture in dict.fromkeys(cloud.textures):     # in cube order, each once
+        cubes = [k for k, t in enumerate(cloud.textures) if t == texture]
+        members = np.flatnonzero(np.isin(cloud.cube_index, cubes))
+        if not len(members):
+            continue
+        material = _sprite_material(scene) if texture is None else _texture_material(scene, texture)
+        out.append(_billboard_primitive(cloud, members, material))
+    return out
+
+
+def _sprite_material(scene: Scene) -> int:
+    for k, m in enumerate(scene.materials):
+        if m.name == "cloud particle":
+            return k
     texture = scene.add_image(Image("gaussian sprite", gaussian_sprite_png()))
-    material = scene.add_material(Material("cloud particle", texture=texture, alpha_mode="BLEND",
-                                           double_sided=True, unlit=True, roughness=1.0))
+    return scene.add_material(Material("cloud particle", texture=texture, alpha_mode="BLEND",
+                                       double_sided=True, unlit=True, roughness=1.0))
+
+
+def _texture_material(scene: Scene, path: str) -> int:
+    """An unlit, alpha-blended material showing the PNG at ``path`` (read as it is)."""
+    from pathlib import Path
+
+    name = Path(path).name
+    texture = scene.add_image(Image(name, Path(path).read_bytes()))
+    return scene.add_material(Material(f"cloud texture {name}", texture=texture, alpha_mode="BLEND",
+                                       double_sided=True, unlit=True, roughness=1.0))
+
+
+def _billboard_primitive(cloud: Cloud, members: np.ndarray, material: int) -> Primitive:
+    """Three crossed quads per particle (``PLANES``), half width = radius, vertex alpha = density."""
+    n = len(members)
+    offsets = np.einsum("ck,qkd->qcd", _CORNERS, PLANES)                 # (quads, 4 corners, 3)
+    turned = np.einsum("qcd,nde->nqce", offsets, turns(len(cloud))[members])   # (n, quads, 4, 3)
+    corners = cloud.centers[members, None, None, :] + turned * cloud.radii[members, None, None, None]
+    rgba = np.empty((n, 4), np.uint8)
+    lin16 = srgb8_to_linear16()[cloud.colors[members]]
+    rgba[:, :3] = (lin16.astype(np.uint32) * 255 + 32767) // 65535   # linear, 8 bits
+    rgba[:, 3] = np.round(cloud.density[members] * (255 * BILLBOARD_OPACITY))  # thin parts fade more
     per = 4 * QUADS                                                       # vertices per particle
     quad_starts = np.arange(n * QUADS, dtype=np.uint32)[:, None, None] * 4
     indices = (quad_starts + _QUAD[None]).reshape(-1, 3)
@@ -87,7 +119,7 @@ def _billboards(cloud: Cloud, scene: Scene) -> Primitive:
                   "TEXCOORD_0": np.broadcast_to(_UVS, (n * QUADS, 4, 2)).reshape(-1, 2),
                   "COLOR_0": np.repeat(rgba, per, axis=0)}
     if cloud.light is not None:
-        attributes["_LIGHT"] = np.repeat(cloud.light, per)
+        attributes["_LIGHT"] = np.repeat(cloud.light[members], per)
     return Primitive(attributes, indices, material)
 
 
@@ -110,8 +142,10 @@ about 2.5 s, and a 46-byte file of 2x10^7 particles took 6.6 GB and 42 s before 
 
 
 def cube_file_scene(path: str | os.PathLike, *, seed: int = 0, most: int = PREVIEW_PARTICLES,
-                    lighting: Lighting | None = None, **_) -> Scene:
-    """A cube file filled and lit as `fishgen clouds` does it, as points (what the preview draws).
+                    lighting: Lighting | None = None, textures_dir: str | os.PathLike | None = None,
+                    **_) -> Scene:
+    """A cube file (.awn) or texture cloud file (.awa) filled and lit as `fishgen clouds` does it,
+    as points or textured billboards (what the preview and the viewer draw).
 
     A file of more than ``most`` particles is filled with every cube's count
     scaled down alike (its shape and density pattern kept), and the scene's
@@ -123,7 +157,7 @@ def cube_file_scene(path: str | os.PathLike, *, seed: int = 0, most: int = PREVI
     from fishgen.clouds import fill_cloud, load_cubes
     from fishgen.clouds.light import light_cloud
 
-    cubes = load_cubes(path)
+    cubes = load_cubes(path, textures_dir=textures_dir)
     note = None
     if cubes.total > most:
         whole = cubes.total
@@ -131,7 +165,9 @@ def cube_file_scene(path: str | os.PathLike, *, seed: int = 0, most: int = PREVI
         cubes = replace(cubes, cubes=tuple(replace(c, particles=max(1, int(c.particles * ratio)))
                                            for c in cubes.cubes))
         note = f"{path}: previewing {cubes.total:,} of its {whole:,} particles"
-    scene = cloud_scene(light_cloud(fill_cloud(cubes, seed=seed), lighting), name=Path(path).stem)
+    # a texture cloud is its textured billboards; a particle cloud is points, drawn as soft discs
+    scene = cloud_scene(light_cloud(fill_cloud(cubes, seed=seed), lighting), name=Path(path).stem,
+                        billboards=bool(cubes.cubes[0].texture))
     if note:
         scene.info["note"] = note
     return scene
