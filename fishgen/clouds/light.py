@@ -44,7 +44,9 @@ from fishgen.clouds.model import Cloud
 from fishgen.clouds.sprite import SIGMA
 
 SLABS = 128
-"""Slabs along the sun axis for a big cloud (more than SMALL particles)."""
+"""Most slabs along the sun axis for a big cloud (more than SMALL particles): one per 2,048
+particles, at least FEW_SLABS (each costs an FFT of the grid, ~1 ms)."""
+FEW_SLABS = 32
 SMALL = 2048
 """Up to this many particles a cloud has a slab per particle."""
 GRID = 96
@@ -105,9 +107,11 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
         return light
     small = n <= SMALL
     frame = _frame(np.array(lighting.sun_unit, np.float64))   # rows: sun, across a, across b
-    depth, across = _project(centers, frame)
-    order = _order(depth, exact=small)
-    del depth
+    middle = _middle(centers)
+    # the depth lives only until it is sorted, the coordinates across the rays only after: a
+    # cloud of 10^7 particles holds 27 bytes of its own per particle, and the sort needs 18
+    order = _order(_project(centers, frame[:1], middle)[0], exact=small)
+    across = _project(centers, frame[1:], middle)
     lo, hi = across.min(axis=1).astype(np.float64), across.max(axis=1).astype(np.float64)
     grid = _Grid(lo, hi, radii, small)
     forward = _F32(lighting.forward_fraction)
@@ -164,7 +168,7 @@ def _slabs(grid: _Grid, order, across, radii, density, extinction, forward, ligh
     the light before its slab passed through half the slab's depth at its centre, less its own.
     """
     n = len(order)
-    slabs = min(n, SLABS)
+    slabs = min(n, SLABS, max(FEW_SLABS, n // 2048))
     bounds = [(k * n) // slabs for k in range(slabs + 1)]
 
     def prepare(k: int):
@@ -270,31 +274,35 @@ def _frame(sun: np.ndarray) -> np.ndarray:
     return np.stack([sun, a, np.cross(sun, a)])
 
 
-def _project(centers: np.ndarray, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Depth along the sun (larger = nearer the sun) and the two coordinates across it, float32,
-    relative to the cloud's middle (so float32 keeps the detail of a cloud far from the origin)."""
+def _middle(centers: np.ndarray) -> np.ndarray:
+    """About the middle of the cloud (float64): coordinates relative to it keep float32's detail
+    for a cloud far from the origin."""
+    sample = centers[::max(1, len(centers) // CHUNK)].astype(np.float64)
+    return (sample.min(axis=0) + sample.max(axis=0)) / 2
+
+
+def _project(centers: np.ndarray, rows: np.ndarray, middle: np.ndarray) -> np.ndarray:
+    """The centres' coordinates along each of ``rows`` (unit vectors), relative to ``middle``,
+    as float32 (len(rows), N)."""
     n = len(centers)
-    sample = centers[::max(1, n // CHUNK)].astype(np.float64)
-    middle = (sample.min(axis=0) + sample.max(axis=0)) / 2
-    depth = np.empty(n, _F32)
-    across = np.empty((2, n), _F32)
+    out = np.empty((len(rows), n), _F32)
     top = float(np.finfo(_F32).max)
     for start in range(0, n, CHUNK):
         x, y, z = (centers[start:start + CHUNK] - middle).T            # float64, chunk-sized
-        for row, out in ((0, depth[start:start + CHUNK]), (1, across[0, start:start + CHUNK]),
-                         (2, across[1, start:start + CHUNK])):
+        for k, row in enumerate(rows):
             # written out: a (65536, 3) x (3, 3) matmul took 40 ms a chunk here (BLAS threads)
-            value = x * frame[row, 0]
-            value += y * frame[row, 1]
-            value += z * frame[row, 2]
+            value = x * row[0]
+            value += y * row[1]
+            value += z * row[2]
             np.clip(value, -top, top, out=value)                      # a cloud spanning all of float32
-            out[:] = value
-    return depth, across
+            out[k, start:start + CHUNK] = value
+    return out
 
 
 def _order(depth: np.ndarray, exact: bool) -> np.ndarray:
     """Particles nearest the sun first, ties in input order: a stable sort on the depth itself
-    (small clouds) or a stable radix sort on a 16-bit depth key (big ones: 7x faster)."""
+    (small clouds) or a stable radix sort on a 16-bit depth key (big ones: 7x faster). The depth
+    is dropped before the big sort (the caller keeps no reference to it)."""
     if exact:
         return np.argsort(-depth, kind="stable")
     top, bottom = float(depth.max()), float(depth.min())
@@ -305,6 +313,7 @@ def _order(depth: np.ndarray, exact: bool) -> np.ndarray:
         part = (_F32(top) - depth[start:start + CHUNK]) * scale
         np.clip(part, 0, KEY_LEVELS, out=part)
         key[start:start + CHUNK] = part + _F32(0.5)
+    del depth
     return np.argsort(key, kind="stable")
 
 
