@@ -241,10 +241,12 @@ def _effective_table(peak: np.ndarray, forward: float) -> np.ndarray:
         return peak
     u = np.linspace(0, CUT * CUT / 2, 513)
     g = np.exp(-u)
-    kept = forward + (1 - forward) * np.exp(-peak[:, None] * g[None, :])
-    e = -np.log(kept)
-    total = ((e[:, 1:] + e[:, :-1]) / 2 * np.diff(u)).sum(axis=1)
-    return total / (1 - math.exp(-CUT * CUT / 2))
+    out = np.empty_like(peak)
+    for start in range(0, len(peak), 256):     # 256 x 513 at a time: the whole table took 300 MB
+        part = peak[start:start + 256, None]
+        e = -np.log(forward + (1 - forward) * np.exp(-part * g[None, :]))
+        out[start:start + 256] = ((e[:, 1:] + e[:, :-1]) / 2 * np.diff(u)).sum(axis=1)
+    return out / (1 - math.exp(-CUT * CUT / 2))
 
 
 def _dilog(x: np.ndarray) -> np.ndarray:
