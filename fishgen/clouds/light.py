@@ -171,25 +171,56 @@ def _slabs(grid: _Grid, order, across, radii, density, extinction, forward, ligh
     slabs = min(n, SLABS, max(FEW_SLABS, n // 2048))
     bounds = [(k * n) // slabs for k in range(slabs + 1)]
 
+    packed = np.empty(n, np.complex64)         # a + ib: one gather a slab instead of two
+    packed.real, packed.imag = across
+    del across
+    width = grid.shape[1]
+    cells = grid.shape[0] * width
+    scale, (x0, y0) = _F32(1 / grid.cell), (_F32(grid.corner[0] / grid.cell + 0.5),
+                                            _F32(grid.corner[1] / grid.cell + 0.5))
+    widths = _F32(SIGMA / grid.cell)
+    rising = np.array(grid.bounds[::-1], _F32)  # class c: sigma under c of the bounds
+    spread = grid.spread
+    table = _peak_table(float(extinction), float(forward))
+
     def prepare(k: int):
-        """Everything of slab k that does not need the light map (run a slab ahead, in a thread)."""
+        """Everything of slab k that does not need the light map (run a slab ahead, in a thread):
+        the corner cells and fractions to read the light at, the nearest cell, and each
+        particle's place in its width class's map, whole depth and own share (``_Grid.splat``)."""
         idx = order[bounds[k]:bounds[k + 1]]
-        gx, gy = grid.coordinates(across[0][idx], across[1][idx])
-        sigma = radii[idx].astype(_F32) * _F32(SIGMA / grid.cell)
-        peak = _peak_depth(density[idx], extinction, forward)
-        return idx, grid.splat_points(gx, gy, sigma, peak), grid.corners(gx, gy)
+        ab = packed[idx]
+        gx = ab.real * scale
+        gx -= x0
+        gy = ab.imag * scale
+        gy -= y0
+        ix, iy = np.floor(gx), np.floor(gy)
+        fx, fy = gx - ix, gy - iy
+        flat = ix.astype(np.intp)
+        flat *= width
+        flat += iy.astype(np.intp)
+        near = flat + width * (fx >= _F32(0.5)) + (fy >= _F32(0.5))
+        sigma = radii[idx] * widths
+        klass = len(rising) - np.searchsorted(rising, sigma, side="right")
+        level = density[idx] * _F32(PEAK_LEVELS)
+        level += _F32(0.5)
+        np.clip(level, 0, PEAK_LEVELS, out=level)
+        mass = table[level.astype(np.intp)]
+        mass *= sigma
+        mass *= sigma
+        points = (near + klass * cells, mass * _F32(2 * math.pi), mass / spread[klass])
+        return idx, points, near, (flat, fx, fy)
 
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(1) as helper:
         ahead = helper.submit(prepare, 0)
         for k in range(slabs):
-            idx, points, (flat, fx, fy) = ahead.result()
+            idx, points, near, (flat, fx, fy) = ahead.result()
             if k + 1 < slabs:
                 ahead = helper.submit(prepare, k + 1)
             depth, own = grid.slab_depth(*points)
-            got = _bilinear(grid.direct.ravel(), flat, fx, fy, grid.shape[1])
-            half = depth.ravel()[points[0] % depth.size]            # at the nearest cell
+            got = _bilinear(grid.direct.ravel(), flat, fx, fy, width)
+            half = depth.ravel()[near]                              # at the nearest cell
             half -= own
             np.maximum(half, 0, out=half)
             half *= _F32(-0.5)
@@ -356,30 +387,11 @@ class _Grid:
         gy = (b - _F32(self.corner[1])) * _F32(1 / self.cell) - _F32(0.5)
         return gx, gy
 
-    def corners(self, gx: np.ndarray, gy: np.ndarray):
-        """The lower corner cell of each point (flat index) and its fractions towards the next."""
-        ix, iy = np.floor(gx), np.floor(gy)
-        flat = ix.astype(np.intp) * self.shape[1] + iy.astype(np.intp)
-        return flat, gx - ix, gy - iy
-
-    def splat_points(self, gx, gy, sigma, peak) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Where each particle of a slab goes (cell nearest its centre, in its width class's
-        map), its whole depth (peak x 2 pi sigma^2) and its own share of the slab's depth at
-        its centre (about the peak x (sigma / class width)^2)."""
-        k = np.zeros(len(sigma), np.intp)
-        for bound in self.bounds:                      # class c: below c of the bounds
-            k += sigma < bound
-        cells = self.shape[0] * self.shape[1]
-        index = np.rint(gx).astype(np.intp)
-        index *= self.shape[1]
-        index += np.rint(gy).astype(np.intp)
-        index += k * cells
-        mass = peak * sigma * sigma
-        return index, mass * _F32(2 * math.pi), mass / self.spread[k]
-
     def slab_depth(self, index, whole, own) -> tuple[np.ndarray, np.ndarray]:
-        """A slab's optical depth map from ``splat_points``: each class map blurred with its
-        Gaussian, and summed."""
+        """A slab's optical depth map: each particle's ``whole`` depth (peak x 2 pi sigma^2) put at
+        ``index`` (the cell nearest its centre, in the map of its width class: sigma_max / 2^c,
+        nearest in log scale), each class map blurred with its Gaussian, and summed; ``own`` (each
+        particle's own share at its centre, about peak x (sigma / class width)^2) passed through."""
         cells = self.shape[0] * self.shape[1]
         layers = np.bincount(index, whole, minlength=CLASSES * cells)
         spectrum = np.fft.rfft2(layers.reshape(CLASSES, *self.shape))
