@@ -111,8 +111,9 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     # the depth lives only until it is sorted, the coordinates across the rays only after: a
     # cloud of 10^7 particles holds 27 bytes of its own per particle, and the sort needs 18
     order = _order(_project(centers, frame[:1], middle)[0], exact=small)
-    across = _project(centers, frame[1:], middle)
-    lo, hi = across.min(axis=1).astype(np.float64), across.max(axis=1).astype(np.float64)
+    across = _project(centers, frame[1:], middle, packed=True)      # a + ib, complex64
+    lo = np.array([across.real.min(), across.imag.min()], np.float64)
+    hi = np.array([across.real.max(), across.imag.max()], np.float64)
     grid = _Grid(lo, hi, radii, small)
     forward = _F32(lighting.forward_fraction)
     run = _one_by_one if small else _slabs
@@ -129,7 +130,7 @@ def _one_by_one(grid: _Grid, order, across, radii, density, extinction, forward,
     stops, of which the forward fraction goes on as scattered light. The footprints are
     computed up front in one go; the loop only reads and multiplies.
     """
-    gx, gy = grid.coordinates(across[0][order], across[1][order])
+    gx, gy = grid.coordinates(across.real[order], across.imag[order])
     sigma = radii[order].astype(_F32) * _F32(SIGMA / grid.cell)
     peak = _peak_depth(density[order], extinction)
     keeps = grid.footprints(gx, gy, sigma, peak)
@@ -171,9 +172,7 @@ def _slabs(grid: _Grid, order, across, radii, density, extinction, forward, ligh
     slabs = min(n, SLABS, max(FEW_SLABS, n // 2048))
     bounds = [(k * n) // slabs for k in range(slabs + 1)]
 
-    packed = np.empty(n, np.complex64)         # a + ib: one gather a slab instead of two
-    packed.real, packed.imag = across
-    del across
+    packed = across                            # a + ib: one gather a slab instead of two
     width = grid.shape[1]
     cells = grid.shape[0] * width
     scale, (x0, y0) = _F32(1 / grid.cell), (_F32(grid.corner[0] / grid.cell + 0.5),
@@ -314,11 +313,13 @@ def _middle(centers: np.ndarray) -> np.ndarray:
     return (sample.min(axis=0) + sample.max(axis=0)) / 2
 
 
-def _project(centers: np.ndarray, rows: np.ndarray, middle: np.ndarray) -> np.ndarray:
+def _project(centers: np.ndarray, rows: np.ndarray, middle: np.ndarray, packed: bool = False) -> np.ndarray:
     """The centres' coordinates along each of ``rows`` (unit vectors), relative to ``middle``,
-    as float32 (len(rows), N)."""
+    as float32 (len(rows), N); with ``packed``, two rows as one complex64 (N,): a slab then
+    gathers both in one go."""
     n = len(centers)
-    out = np.empty((len(rows), n), _F32)
+    store = np.empty(n, np.complex64) if packed else np.empty((len(rows), n), _F32)
+    out: list[np.ndarray] = [store.real, store.imag] if packed else list(store)
     top = float(np.finfo(_F32).max)
     for start in range(0, n, CHUNK):
         x, y, z = (centers[start:start + CHUNK] - middle).T            # float64, chunk-sized
@@ -328,8 +329,8 @@ def _project(centers: np.ndarray, rows: np.ndarray, middle: np.ndarray) -> np.nd
             value += y * row[1]
             value += z * row[2]
             np.clip(value, -top, top, out=value)                      # a cloud spanning all of float32
-            out[k, start:start + CHUNK] = value
-    return out
+            out[k][start:start + CHUNK] = value
+    return store
 
 
 def _order(depth: np.ndarray, exact: bool) -> np.ndarray:
