@@ -1,8 +1,9 @@
-"""Benchmark `fishgen clouds`: fill rate vs. a plain Python loop, whole command, peak memory.
+"""Benchmark `fishgen clouds`: fill rate vs. a plain Python loop, lighting, whole command, peak memory.
 
-    python benchmarks/clouds.py                 # full run (about a minute)
+    python benchmarks/clouds.py                 # full run (a few minutes)
     python benchmarks/clouds.py --quick         # smoke run, small sizes only
     python benchmarks/clouds.py --writers-only  # CSV vs PLY writer, 10^6 particles
+    python benchmarks/clouds.py --light-only    # lighting vs fill, and lit vs unlit whole runs
 
 The cloud shape is the report's Table 4.4 (23 cubes) with every cube's count
 scaled so the total is N. The baseline is the report's algorithm (section 4.5,
@@ -28,7 +29,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from fishgen.clouds import Cube, CubeFile, fill_cloud, load_cubes  # noqa: E402
+from fishgen.clouds import Cube, CubeFile, Lighting, fill_cloud, light_cloud, load_cubes  # noqa: E402
+from fishgen.clouds.light import incident_light  # noqa: E402
 from fishgen.clouds.scene import cloud_scene  # noqa: E402
 from fishgen.exchange.ply import write_ply as _write_ply  # noqa: E402
 from fishgen.exchange.table import write_csv as _write_csv  # noqa: E402
@@ -40,7 +42,7 @@ def write_ply(cloud, path):
 
 def write_csv(cloud, path):
     return _write_csv(cloud_scene(cloud), Path(path))
-from fishgen.clouds.fill import BASE_COLOUR, CLUMP, TOP_COLOUR  # noqa: E402
+from fishgen.clouds.fill import CLUMP  # noqa: E402
 
 TABLE = ROOT / "params" / "clouds" / "table_4_4.awn"
 REPORT = "report: 50,000 particles in ~90 ms on a 3.2 GHz Pentium IV (section 5.2)"
@@ -67,9 +69,6 @@ def plain_fill(cube_file: CubeFile, seed: int) -> list[tuple]:
     """The report's algorithm, one particle at a time: the baseline."""
     rnd = random.Random(seed)
     half_pi, k, norm = math.pi / 2, CLUMP / math.pi, 1 + math.pi / 2 * math.sin(1)
-    y0 = min(c.centre[1] - c.size[1] / 2 for c in cube_file.cubes)
-    y1 = max(c.centre[1] + c.size[1] / 2 for c in cube_file.cubes)
-    base, top = [float(v) for v in BASE_COLOUR], [float(v) for v in TOP_COLOUR]
     out = []
     for cube in cube_file.cubes:
         (cx, cy, cz), (sx, sy, sz) = cube.centre, cube.size
@@ -87,10 +86,7 @@ def plain_fill(cube_file: CubeFile, seed: int) -> list[tuple]:
             u = 1 - rnd.random()
             radius = cube.max_radius * (u + half_pi * math.sin(u)) / norm  # eq. 4.9-4.12
             density = math.exp(-(x * x + y * y + z * z))
-            wy = cy + y * sy / 2
-            h = math.sqrt(min(max((wy - y0) / (y1 - y0), 0.0), 1.0))
-            colour = tuple(int(b + (t - b) * h + 0.5) for b, t in zip(base, top))
-            out.append((cx + x * sx / 2, wy, cz + z * sz / 2, radius, density) + colour)
+            out.append((cx + x * sx / 2, cy + y * sy / 2, cz + z * sz / 2, radius, density))
     return out
 
 
@@ -103,8 +99,28 @@ def median_time(run, repeats: int) -> float:
     return statistics.median(times)
 
 
-def whole_command(n: int, workdir: Path, repeats: int) -> tuple[float, int]:
-    """Median wall time and peak RSS (bytes) of `fishgen clouds big.awn -o big.ply`."""
+COMMANDS = {
+    "fishgen": lambda awn, ply: [sys.executable, "-m", "fishgen", "clouds", str(awn), "-o", str(ply)],
+    "unlit": lambda awn, ply: [sys.executable, __file__, "--run", "unlit", str(awn), str(ply)],
+    "lit": lambda awn, ply: [sys.executable, __file__, "--run", "lit", str(awn), str(ply)],
+}
+"""`fishgen clouds` as the command line runs it today, and the library steps the command runs,
+without and with lighting (load, fill, [light_cloud,] export), each a process of its own."""
+
+
+def run(kind: str, awn: str, ply: str) -> None:
+    """One whole run, as the `--run` child process: what `fishgen clouds AWN -o PLY` does."""
+    from fishgen.clouds import export_cloud
+
+    cloud = fill_cloud(load_cubes(awn), seed=0)
+    if kind == "lit":
+        cloud = light_cloud(cloud, Lighting())
+    export_cloud(cloud, ply)
+
+
+def whole_command(n: int, workdir: Path, repeats: int, kinds=("fishgen",)) -> dict[str, tuple[float, int]]:
+    """Per kind of COMMANDS: median wall time and peak RSS (bytes) of the whole run on a
+    Table 4.4 cloud of n particles to PLY, the kinds interleaved run by run."""
     awn, ply = workdir / f"cloud_{n}.awn", workdir / f"cloud_{n}.ply"
     write_awn(scaled_cubes(n), awn)
     # Each measurement runs in its own wrapper so RUSAGE_CHILDREN sees only that command.
@@ -112,16 +128,51 @@ def whole_command(n: int, workdir: Path, repeats: int) -> tuple[float, int]:
              "t = time.perf_counter()\n"
              "subprocess.run(sys.argv[1:], check=True, stdout=subprocess.DEVNULL)\n"
              "print(time.perf_counter() - t, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)")
-    times, peaks = [], []
+    times: dict[str, list[float]] = {k: [] for k in kinds}
+    peaks: dict[str, list[int]] = {k: [] for k in kinds}
     for _ in range(repeats):
-        out = subprocess.run([sys.executable, "-c", probe, sys.executable, "-m", "fishgen",
-                              "clouds", str(awn), "-o", str(ply)],
-                             cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
-        times.append(float(out[0]))
-        peaks.append(int(out[1]) * 1024)  # ru_maxrss is in KiB on Linux
-    assert ply.stat().st_size > 23 * n
-    ply.unlink()
-    return statistics.median(times), max(peaks)
+        for kind in kinds:
+            out = subprocess.run([sys.executable, "-c", probe, *COMMANDS[kind](awn, ply)],
+                                 cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
+            times[kind].append(float(out[0]))
+            peaks[kind].append(int(out[1]) * 1024)  # ru_maxrss is in KiB on Linux
+            assert ply.stat().st_size > 23 * n
+            ply.unlink()
+    return {k: (statistics.median(times[k]), max(peaks[k])) for k in kinds}
+
+
+def lighting(n: int, repeats: int) -> tuple[float, float]:
+    """Median seconds of fill_cloud and of incident_light for one n-particle cloud, interleaved."""
+    cubes = scaled_cubes(n)
+    cloud = fill_cloud(cubes, seed=1)
+    incident_light(cloud.centers, cloud.radii, cloud.density, Lighting())  # warm-up
+    fills, lights = [], []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fill_cloud(cubes, seed=1)
+        fills.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        incident_light(cloud.centers, cloud.radii, cloud.density, Lighting())
+        lights.append(time.perf_counter() - start)
+    return statistics.median(fills), statistics.median(lights)
+
+
+def light_report(sizes: list[int], command_size: int, repeats: int, workdir: Path) -> None:
+    """The lighting targets (issue 20): lighting <= 3x the fill; a lit whole run < 2x the unlit
+    one; peak memory < 64 bytes per particle."""
+    print("\n| particles | fill (median) | lighting (median) | lighting / fill |")
+    print("|---:|---:|---:|---:|")
+    for n in sizes:
+        fill, light = lighting(n, repeats)
+        print(f"| {n:,} | {fill * 1e3:,.1f} ms | {light * 1e3:,.1f} ms | {light / fill:.2f}x |")
+    runs = whole_command(command_size, workdir, 3, ("fishgen", "unlit", "lit"))
+    print(f"\nwhole run, {command_size:,} particles to PLY, median of 3, interleaved:")
+    for kind, label in (("fishgen", "`fishgen clouds` today (unlit)"), ("unlit", "library steps, unlit"),
+                        ("lit", "library steps, lit")):
+        wall, peak = runs[kind]
+        print(f"  {label:32s} {wall:6.2f} s, peak {peak / 2**20:,.0f} MiB = {peak / command_size:.1f} bytes/particle")
+    print(f"  lit / today's unlit: {runs['lit'][0] / runs['fishgen'][0]:.2f}x "
+          f"(lit / unlit library steps: {runs['lit'][0] / runs['unlit'][0]:.2f}x)")
 
 
 def writers(n: int, workdir: Path, repeats: int) -> None:
@@ -151,13 +202,26 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="small sizes only (smoke test)")
     parser.add_argument("--writers-only", action="store_true",
                         help="only time the CSV and PLY writers at 10^6 particles")
+    parser.add_argument("--light-only", action="store_true",
+                        help="only the lighting figures: vs the fill at --light-sizes, whole runs at --command-size")
+    parser.add_argument("--light-sizes", default="1e5,1e6", help="particle counts to light [default: %(default)s]")
+    parser.add_argument("--run", nargs=3, metavar=("KIND", "AWN", "PLY"), help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.run:
+        run(*args.run)
+        return
+    if args.light_only:
+        with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:
+            light_report([int(float(v)) for v in args.light_sizes.split(",")], int(args.command_size),
+                         args.repeats, Path(tmp))
+        return
     if args.writers_only:
         with tempfile.TemporaryDirectory() as tmp:
             writers(10**6, Path(tmp), 3)
         return
     if args.quick:
         args.sizes, args.baseline_max, args.repeats, args.command_size = "1e4,1e5", 1e4, 3, 1e5
+        args.light_sizes = "1e4,1e5"
     sizes = [int(float(s)) for s in args.sizes.split(",")]
 
     print(f"fishgen clouds benchmark on {os.cpu_count()} cores, Python {sys.version.split()[0]}")
@@ -187,8 +251,8 @@ def main() -> None:
 
     n = int(args.command_size)
     with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:
-        wall, peak = whole_command(n, Path(tmp), 3)
-        _, idle = whole_command(1000, Path(tmp), 1)
+        wall, peak = whole_command(n, Path(tmp), 3)["fishgen"]
+        _, idle = whole_command(1000, Path(tmp), 1)["fishgen"]
     print(f"\nwhole command, {n:,} particles to PLY: {wall:.2f} s median of 3 "
           f"({n / wall / 1e6:.1f} M particles/s end to end)")
     print(f"peak memory: {peak / 2**20:,.0f} MiB = {peak / n:.1f} bytes/particle "
@@ -196,6 +260,8 @@ def main() -> None:
           f"of a 1,000-particle run)")
     with tempfile.TemporaryDirectory() as tmp:
         writers(10**5 if args.quick else 10**6, Path(tmp), 3)
+    with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:
+        light_report([int(float(v)) for v in args.light_sizes.split(",")], n, args.repeats, Path(tmp))
 
 
 if __name__ == "__main__":

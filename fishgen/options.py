@@ -14,6 +14,7 @@ Leaf module: click and the standard library only, so ``fishgen --help`` never lo
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import MISSING, Field, dataclass, field, fields
 from pathlib import Path
@@ -34,10 +35,17 @@ T = TypeVar("T")
 # -- types click checks (and manifests reuse) -------------------------------------------------
 
 class Triple(click.ParamType):
-    """``X,Y,Z``: three finite numbers within float32 range (where particles and nodes live)."""
+    """``X,Y,Z``: three finite numbers, by default within float32 range (where particles and nodes
+    live); ``low``/``high`` bound each (a colour's channels), ``nonzero`` refuses 0,0,0 (a direction)."""
 
     name = "X,Y,Z"
-    what = "[x, y, z] of finite numbers within float32 range"
+
+    def __init__(self, low: float = -FLOAT32_MAX, high: float = FLOAT32_MAX, nonzero: bool = False,
+                 name: str = "X,Y,Z"):
+        self.low, self.high, self.nonzero, self.name = low, high, nonzero, name
+        float32 = (low, high) == (-FLOAT32_MAX, FLOAT32_MAX)
+        within = "within float32 range" if float32 else f"from {low:g} to {high:g}"
+        self.what = f"{name} with three finite numbers {within}" + (", not all 0" if nonzero else "")
 
     def convert(self, value, param, ctx):
         if isinstance(value, (tuple, list)):
@@ -47,9 +55,9 @@ class Triple(click.ParamType):
                 numbers = tuple(float(part) for part in str(value).replace(" ", "").split(","))
             except ValueError:
                 numbers = ()
-        if len(numbers) != 3 or not all(_finite_number(v) and abs(v) <= FLOAT32_MAX for v in numbers):
-            self.fail(f"expected X,Y,Z with three finite numbers within float32 range, found {value!r}",
-                      param, ctx)
+        if (len(numbers) != 3 or not all(_finite_number(v) and self.low <= v <= self.high for v in numbers)
+                or (self.nonzero and not any(numbers))):
+            self.fail(f"expected {self.what}, found {value!r}", param, ctx)
         return tuple(float(v) for v in numbers)
 
 
@@ -131,6 +139,7 @@ class Option:
     multiple: bool = False
     manifest: bool = True             # a batch manifest may set it
     required: bool = False            # on the command line
+    off: str | None = None            # a flag's switch-off name (--no-scattering)
     path: bool = False                # a file or folder: relative to the manifest in a manifest
 
     def default_text(self) -> str:
@@ -161,12 +170,47 @@ def declare(spec: Option, **changes: Any) -> Any:
     return field(default=spec.default, metadata={OPTION: spec})
 
 
+GROUP = "fishgen.option_group"
+
+
+def group(record: type) -> Any:
+    """A field holding a whole options record (a cloud's lighting), whose options the command takes
+    as its own: declared once in ``record``, shared by every command that groups it."""
+    return field(default_factory=record, metadata={GROUP: record})
+
+
 def declared(record: type | Any) -> Iterator[tuple[Field, Option]]:
-    """Each field of an options record with its declaration, in declaration order."""
+    """Each option of an options record with its declaration, in declaration order; the options
+    of its groups take their group's place."""
     for f in fields(record):
         spec = f.metadata.get(OPTION)
         if spec is not None:
             yield f, spec
+        elif GROUP in f.metadata:
+            yield from declared(f.metadata[GROUP])
+
+
+def build(record: type[T], values: Mapping[str, Any]) -> T:
+    """The record from option values keyed by field name (a group's options fill its record)."""
+    given: dict[str, Any] = {}
+    for f in fields(record):
+        if GROUP in f.metadata:
+            given[f.name] = build(f.metadata[GROUP], values)
+        elif f.name in values:
+            given[f.name] = values[f.name]
+    return record(**given)
+
+
+def flat(options: Any) -> dict[str, Any]:
+    """An options record's values keyed by field name, its groups' options among them."""
+    values: dict[str, Any] = {}
+    for f in fields(options):
+        value = getattr(options, f.name)
+        if GROUP in f.metadata:
+            values.update(flat(value))
+        elif OPTION in f.metadata:
+            values[f.name] = value
+    return values
 
 
 def long_name(f: Field) -> str:
@@ -180,7 +224,8 @@ def click_params(record: type) -> list[click.Parameter]:
     """The click options of an options record, each documenting its default."""
     params: list[click.Parameter] = []
     for f, spec in declared(record):
-        decls = [f"--{long_name(f)}", *([spec.short] if spec.short else []), f.name]
+        switch = f"--{long_name(f)}" + (f"/{spec.off}" if spec.off else "")
+        decls = [switch, *([spec.short] if spec.short else []), f.name]
         help_text = f"{spec.help}  [default: {spec.default_text()}]" if not spec.required else spec.help
         if spec.flag:
             params.append(click.Option(decls, is_flag=True, default=bool(spec.default), help=help_text,
@@ -198,8 +243,7 @@ def from_values(record: type[T], values: Mapping[str, Any]) -> T:
     unknown = set(values) - names
     if unknown:
         raise TypeError(f"{record.__name__} has no option {', '.join(sorted(unknown))}")
-    given = {k: (tuple(v) if isinstance(v, list) else v) for k, v in values.items()}
-    return record(**given)
+    return build(record, {k: (tuple(v) if isinstance(v, list) else v) for k, v in values.items()})
 
 
 # -- manifests and scene files --------------------------------------------------------------------
@@ -237,9 +281,9 @@ def _toml_kind_ok(spec: Option, value: Any) -> bool:
     if isinstance(value, bool):
         return False
     if isinstance(t, click.IntRange) or t is click.INT:
-        return isinstance(value, int)
+        return isinstance(value, numbers.Integral)
     if isinstance(t, click.FloatRange) or t is click.FLOAT:
-        return isinstance(value, (int, float))
+        return isinstance(value, numbers.Real)
     if isinstance(t, Triple):
         return isinstance(value, list)
     return isinstance(value, str)

@@ -32,7 +32,7 @@ from typing import Any
 from fishgen.commands import MODULES, command
 from fishgen.errors import FishgenError
 from fishgen.exchange.registry import output_format
-from fishgen.options import check_value, manifest_options
+from fishgen.options import build, check_value, manifest_options
 from fishgen.tomlfile import Where, loads
 
 
@@ -155,7 +155,7 @@ def _job(where: Where, kind: str, nth: int, entry: dict[str, Any], folder: Path,
         if key in entry:
             value = check_value(spec, entry[key], fail_at(key))
             values[f.name] = Path(os.path.abspath(folder / value)) if spec.path else value
-    options = record(**values)
+    options = build(record, values)
     offsets = getattr(options, "offset", None)
     if offsets and len(offsets) != len(inputs):
         raise fail_at("offset")(f"one [x, y, z] per input ({len(inputs)})")

@@ -77,10 +77,11 @@ def _relative(path: str, base: str) -> str:
 def canonical_options(options: Any, base: Path) -> dict[str, Any]:
     """The options a manifest may set, by their long names, as JSON values: folders relative to the
     out folder, so keys match on any machine."""
-    from fishgen.options import manifest_options
+    from fishgen.options import flat, manifest_options
 
-    return {key: _plain(getattr(options, f.name), base)
-            for key, (f, _) in sorted(manifest_options(type(options)).items())}
+    values = flat(options)
+    declared = manifest_options(type(options))
+    return {key: _plain(values[f.name], base) for key, (f, _) in sorted(declared.items())}
 
 
 def _plain(value: Any, base: Path) -> Any:

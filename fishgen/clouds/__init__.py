@@ -2,9 +2,11 @@
 
     cubes = load_cubes("params/clouds/table_4_3.awn")
     cloud = fill_cloud(cubes, seed=7, method="paper", offset=(0, 0, 0))
+    cloud = light_cloud(cloud, Lighting(sun=(1, 0.3, 0)))     # Harris's first pass, baked
     export_cloud(cloud, "cloud.glb", billboards=True)
 
-Several files make one scene with ``merge_clouds([fill_cloud(a, offset=...), ...])``.
+Several files make one scene with ``merge_clouds([fill_cloud(a, offset=...), ...])``, lit after
+merging so the clouds shadow each other.
 The package itself imports nothing heavy (numpy stays out of ``fishgen --help``); its public
 names load their modules when first used.
 """
@@ -21,5 +23,8 @@ _API = {
     "Cube": "fishgen.clouds.model", "CubeFile": "fishgen.clouds.model",
     "CubeFileWarning": "fishgen.clouds.parser", "load_cubes": "fishgen.clouds.parser",
     "parse_cubes": "fishgen.clouds.parser",
+    "Lighting": "fishgen.clouds.lighting",
+    "incident_light": "fishgen.clouds.light", "light_cloud": "fishgen.clouds.light",
+    "lit_colors": "fishgen.clouds.light",
 }
 __getattr__, __all__ = lazy_exports(__name__, _API)

@@ -1,4 +1,4 @@
-"""The randomized fill of report section 4.5, vectorised with numpy.
+"""The randomized fill of report section 4.5, vectorised with numpy: positions, radii, densities.
 
 Particles are produced in fixed chunks of ``CHUNK`` rows; chunk ``j`` draws from
 its own generator seeded with ``(seed, j)``, so the result is byte-identical for
@@ -29,12 +29,10 @@ CLUMP = 0.25
 MAX_ROUNDS = 64
 """Rejection rounds per chunk; about 77 % of paper draws are accepted, so 4-5 rounds suffice."""
 
-BASE_COLOUR = np.array([150, 158, 176], np.float32)   # shadowed, bluish-grey cloud base
-TOP_COLOUR = np.array([255, 255, 255], np.float32)    # sunlit top
+UNLIT = 255
+"""An unlit cloud is white; its colours come from the sun (fishgen.clouds.light.light_cloud)."""
 
 _F32 = np.float32
-_COLOUR_LUT = (BASE_COLOUR + (TOP_COLOUR - BASE_COLOUR) * np.sqrt(np.arange(256) / 255)[:, None]
-               + 0.5).astype(np.uint8)
 _HALF_PI = _F32(math.pi / 2)
 _PI = _F32(math.pi)
 _RADIUS_NORM = _F32(1 + math.pi / 2 * math.sin(1.0))  # eq. 4.12 at the maximum, u = 1
@@ -55,16 +53,15 @@ def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
     centre = centre + np.asarray(offset, np.float64).reshape(1, 3)
     lo, hi = centre - size / 2, centre + size / 2
     lo32, hi32 = _float32_bounds(cube_file, offset, lo, hi)
-    tables = _Tables(
-        centre=centre.astype(_F32), half=(size / 2).astype(_F32), lo=lo32, hi=hi32,
-        rmax=np.array([c.max_radius for c in cubes], np.float32),
-        y_range=(float(lo[:, 1].min()), float(hi[:, 1].max())))
+    tables = _Tables(centre=centre.astype(_F32), half=(size / 2).astype(_F32), lo=lo32, hi=hi32,
+                     rmax=np.array([c.max_radius for c in cubes], np.float32))
 
     n = int(counts.sum())
     cube_index = np.repeat(np.arange(len(cubes), dtype=np.int32), counts)
+    textures = tuple(c.texture for c in cubes) if any(c.texture for c in cubes) else ()
     out = Cloud(centers=np.empty((n, 3), _F32), radii=np.empty(n, _F32),
-                density=np.empty(n, _F32), colors=np.empty((n, 3), np.uint8),
-                cube_index=cube_index, cube_bounds=np.stack([lo, hi], axis=1))
+                density=np.empty(n, _F32), colors=np.full((n, 3), UNLIT, np.uint8),
+                cube_index=cube_index, cube_bounds=np.stack([lo, hi], axis=1), textures=textures)
 
     def work(start: int) -> None:
         _fill_chunk(out, tables, start, min(start + CHUNK, n), int(seed), method)
@@ -115,35 +112,35 @@ def _xyz(values) -> str:
 
 
 def merge_clouds(clouds: Sequence[Cloud]) -> Cloud:
-    """One scene from several clouds; cube indices are renumbered to stay unique."""
+    """One scene from several clouds; cube indices are renumbered to stay unique.
+
+    Light them after merging, so they shadow each other. Clouds lit alike before keep
+    their light; otherwise the merged cloud is unlit (its colours kept).
+    """
     if not clouds:
         raise ValueError("merge_clouds needs at least one cloud")
     if len(clouds) == 1:
         return clouds[0]
     shifts = np.cumsum([0] + [len(c.cube_bounds) for c in clouds[:-1]])
+    lit = all(c.light is not None and c.lighting == clouds[0].lighting for c in clouds)
     return Cloud(
         centers=np.concatenate([c.centers for c in clouds]),
         radii=np.concatenate([c.radii for c in clouds]),
         density=np.concatenate([c.density for c in clouds]),
         colors=np.concatenate([c.colors for c in clouds]),
         cube_index=np.concatenate([c.cube_index + np.int32(k) for c, k in zip(clouds, shifts, strict=True)]),
-        cube_bounds=np.concatenate([c.cube_bounds for c in clouds]))
+        cube_bounds=np.concatenate([c.cube_bounds for c in clouds]),
+        light=np.concatenate([c.light for c in clouds if c.light is not None]) if lit else None,
+        lighting=clouds[0].lighting if lit else None,
+        textures=(tuple(t for c in clouds for t in (c.textures or (None,) * len(c.cube_bounds)))
+                  if any(c.textures for c in clouds) else ()))
 
 
 class _Tables:
     """Per-cube float32 lookup tables shared by the chunk workers."""
 
-    def __init__(self, centre, half, lo, hi, rmax, y_range):
+    def __init__(self, centre, half, lo, hi, rmax):
         self.centre, self.half, self.lo, self.hi, self.rmax = centre, half, lo, hi, rmax
-        # Height-to-colour scale. A y range wider than float32 can hold (up to 6.8e38)
-        # would overflow ``world - y0``, so it is scaled first; a range thinner than one
-        # float32 step at its height gives every particle the base colour.
-        y0, y1 = y_range
-        extent = y1 - y0
-        step = float(np.spacing(_F32(max(abs(y0), abs(y1)))))
-        self.scale_first = extent > float(np.finfo(_F32).max) / 2
-        self.y_scale = _F32(255 / extent if extent >= step else 0.0)
-        self.y_shift = _F32(y0 * (255 / extent) if self.scale_first else y0)
 
 
 def _round_inward(bound: np.ndarray, up: bool) -> np.ndarray:
@@ -185,18 +182,6 @@ def _fill_chunk(out: Cloud, t: _Tables, start: int, stop: int, seed: int, method
     # Gaussian fall-off from the cube centre: 1 at the core, e^-1 at a face centre.
     np.square(s, out=s)
     out.density[start:stop] = np.exp(-s.sum(axis=0))
-
-    # Colour by height in the cloud through a 256-entry table (one gather instead of
-    # per-channel float maths): a grey base brightening to a white top.
-    if t.scale_first:
-        level = world[1] * t.y_scale
-        level -= t.y_shift
-    else:
-        level = world[1] - t.y_shift
-        level *= t.y_scale
-    np.clip(level, 0, 255, out=level)
-    np.take(_COLOUR_LUT, (level + _F32(0.5)).astype(np.uint8), axis=0,
-            out=out.colors[start:stop])
 
 
 def _uniform_offsets(rng: np.random.Generator, m: int) -> np.ndarray:

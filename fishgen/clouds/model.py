@@ -7,6 +7,8 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:  # numpy stays out of the import path of the parser and the CLI help
     import numpy as np
 
+    from fishgen.clouds.lighting import Lighting
+
 DEFAULT_MAX_PARTICLES = 50_000_000
 """Refuse larger clouds before allocating (about 31 bytes per particle in memory)."""
 METHODS = ("paper", "uniform")
@@ -15,13 +17,15 @@ METHODS = ("paper", "uniform")
 
 @dataclass(frozen=True)
 class Cube:
-    """One editor cube: particles to place, x/y/z extents (y up), centre and maximum radius."""
+    """One editor cube: particles (or billboards) to place, x/y/z extents (y up), centre and
+    maximum radius; in a texture cloud (.awa), the texture its billboards carry."""
 
     particles: int
     size: tuple[float, float, float]
     centre: tuple[float, float, float]
     max_radius: float
     line: int = 0  # source line, for messages
+    texture: str | None = None  # .awa: the PNG file, resolved (an absolute path)
 
 
 @dataclass(frozen=True)
@@ -44,6 +48,8 @@ class Cloud:
 
     ``cube_bounds[k]`` is ``(min corner, max corner)`` of cube ``k`` in world
     coordinates (offset applied); ``cube_index`` maps each particle to its cube.
+    A filled cloud is unlit: white, ``light`` and ``lighting`` None. ``light_cloud``
+    (fishgen.clouds.light) sets the sunlight reaching each particle and the colours it gives.
     """
 
     centers: np.ndarray      # (N, 3) float32, world units, y up
@@ -52,14 +58,23 @@ class Cloud:
     colors: np.ndarray       # (N, 3) uint8 sRGB
     cube_index: np.ndarray   # (N,) int32
     cube_bounds: np.ndarray  # (K, 2, 3) float64
+    light: np.ndarray | None = None       # (N,) float32 in [0, 1]: sunlight reaching each centre
+    lighting: Lighting | None = None      # the light it was lit with
+    textures: tuple[str | None, ...] = ()  # per cube: its billboards' PNG (a texture cloud), else ()
 
     def __post_init__(self) -> None:
         n = len(self.centers)
         shapes = {"centers": (n, 3), "radii": (n,), "density": (n,), "colors": (n, 3),
-                  "cube_index": (n,)}
+                  "cube_index": (n,), "light": (n,)}
         for name, shape in shapes.items():
-            if getattr(self, name).shape != shape:
-                raise ValueError(f"Cloud.{name} has shape {getattr(self, name).shape}, expected {shape}")
+            value = getattr(self, name)
+            if value is not None and value.shape != shape:
+                raise ValueError(f"Cloud.{name} has shape {value.shape}, expected {shape}")
+        if (self.light is None) != (self.lighting is None):
+            raise ValueError("Cloud.light and Cloud.lighting go together")
+        if self.textures and len(self.textures) != len(self.cube_bounds):
+            raise ValueError(f"Cloud.textures has {len(self.textures)} entries, expected one per cube "
+                             f"({len(self.cube_bounds)})")
 
     def __len__(self) -> int:
         return len(self.centers)

@@ -1,10 +1,14 @@
-"""Parser for RekAwan cloud cube files (.awn), report section 4.3.4.
+"""Parser for RekAwan cloud cube files (.awn, report section 4.3.4) and texture cloud files (.awa).
 
 Line 1 holds the total particle count, line 2 the cube count, then one line per
 cube: ``particles, x size, y size, z size, centre x, centre y, centre z, max
 radius``. Fields are separated by commas and/or white space, because the
 editor's own Table 4.3 has a line with a missing comma. Blank lines are skipped
 but still counted, so messages point at the real line.
+
+A texture cloud file (.awa, the editor's texture mode; docs/clouds.md) is the same with
+billboards for particles ("Billboards per Box") and a ninth field on each cube line: the
+PNG its billboards carry, found in the file's folder or the ``textures/`` folder beside it.
 """
 from __future__ import annotations
 
@@ -13,6 +17,8 @@ import os
 import re
 import stat
 import warnings
+from collections.abc import Callable
+from pathlib import Path
 
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, Cube, CubeFile
 from fishgen.errors import FishgenError, describe, expected
@@ -44,10 +50,47 @@ class CubeFileWarning(UserWarning):
     """A suspicious but usable cube file (e.g. a declared total that does not add up)."""
 
 
-def load_cubes(path: str | os.PathLike, *, max_particles: int = DEFAULT_MAX_PARTICLES) -> CubeFile:
-    """Read and check a .awn cube file; raise FishgenError naming FILE:LINE on bad input."""
+def load_cubes(path: str | os.PathLike, *, max_particles: int = DEFAULT_MAX_PARTICLES,
+               textures_dir: str | os.PathLike | None = None) -> CubeFile:
+    """Read and check a .awn cube file, or a .awa texture cloud file (by its extension);
+    raise FishgenError naming FILE:LINE on bad input.
+
+    A .awa file's textures are resolved in ``textures_dir`` if given, else in the file's
+    folder and the ``textures/`` folder beside it (``texture_roots``), and must exist.
+    """
     name = os.fspath(path)
-    return parse_cubes(_read_capped(name), name, max_particles=max_particles)
+    data = _read_capped(name)
+    if name.lower().endswith(TEXTURE_SUFFIX):
+        roots = texture_roots(Path(name), textures_dir)
+        return parse_cubes(data, name, max_particles=max_particles,
+                           textures=lambda texture, number: _texture(texture, roots, name, number))
+    return parse_cubes(data, name, max_particles=max_particles)
+
+
+TEXTURE_SUFFIX = ".awa"
+
+
+def texture_roots(path: Path, textures_dir: str | os.PathLike | None = None) -> list[Path]:
+    """Folders a .awa file may read textures from: ``textures_dir`` if given; else its own folder
+    and the ``textures/`` folder beside it, as a species file's (fishgen.species.parser), or,
+    for a file one folder deeper (params/clouds/sky.awa), the one beside that folder's parent."""
+    if textures_dir is not None:
+        return [Path(textures_dir).resolve()]
+    here = path.resolve().parent
+    for level in (here.parent, here.parent.parent):
+        candidate = level / "textures"
+        # as for species: only a textures/ folder that really lies there, not a link elsewhere
+        if candidate.is_dir() and candidate.resolve().is_relative_to(level):
+            return [here, candidate.resolve()]
+    return [here]
+
+
+def _texture(token: str, roots: list[Path], name: str, number: int) -> str:
+    from fishgen.species.parser import resolve_texture
+
+    if not token.lower().endswith(".png"):
+        raise expected("a texture file name ending in .png", describe(token), name, number)
+    return str(resolve_texture(token, roots, name, number))
 
 
 def _read_capped(name: str) -> bytes:
@@ -108,15 +151,18 @@ def _reason(err: OSError) -> str:
 
 
 def parse_cubes(data: bytes, name: str = "<cubes>", *,
-                max_particles: int = DEFAULT_MAX_PARTICLES) -> CubeFile:
-    """Parse the bytes of a cube file; ``name`` is used in messages."""
+                max_particles: int = DEFAULT_MAX_PARTICLES,
+                textures: Callable[[str, int], str] | None = None) -> CubeFile:
+    """Parse the bytes of a cube file; ``name`` is used in messages. With ``textures`` (a .awa
+    file) each cube line ends with a texture name, which ``textures(name, line)`` resolves."""
     text = _decode(data, name)
     rows = [(number, row) for number, line in enumerate(_LINE_END.split(text), 1)
             if (row := line.strip(" \t"))]
+    noun = "particle" if textures is None else "billboard"
     if not rows:
-        raise expected("the total particle count on line 1", "an empty file", name, 1)
+        raise expected(f"the total {noun} count on line 1", "an empty file", name, 1)
 
-    declared_total = _header(rows[0], "total particle count", name)
+    declared_total = _header(rows[0], f"total {noun} count", name)
     if declared_total > max_particles:
         raise _over_limit(declared_total, max_particles, name, rows[0][0])
     if len(rows) < 2:
@@ -141,7 +187,7 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
     cubes: list[Cube] = []
     running = 0
     for number, line in cube_rows:
-        cube = _cube(line, name, number)
+        cube = _cube(line, name, number, textures)
         running += cube.particles
         if running > max_particles:
             raise _over_limit(running, max_particles, name, number)
@@ -149,10 +195,10 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
 
     total = sum(cube.particles for cube in cubes)
     if total == 0:
-        raise expected("at least 1 particle in the cubes", "0", name, cube_rows[0][0])
+        raise expected(f"at least 1 {noun} in the cubes", "0", name, cube_rows[0][0])
     notes: list[str] = []
     if total != declared_total:
-        notes.append(f"{name}:{rows[0][0]}: warning: declared total {declared_total} particles, "
+        notes.append(f"{name}:{rows[0][0]}: warning: declared total {declared_total} {noun}s, "
                      f"but the cubes hold {total}; using the cubes' counts")
         warnings.warn(notes[-1], CubeFileWarning, stacklevel=3)
     return CubeFile(path=name, declared_total=declared_total, cubes=tuple(cubes),
@@ -229,16 +275,21 @@ def _reject_non_number(token: str, what: str, name: str, number: int) -> None:
         raise expected(f"a finite number for the {what}", describe(token), name, number)
 
 
-def _cube(line: str, name: str, number: int) -> Cube:
+def _cube(line: str, name: str, number: int, textures: Callable[[str, int], str] | None = None) -> Cube:
     fields = _fields(line)
-    if len(fields) != len(CUBE_FIELDS):
+    if textures is None and len(fields) != len(CUBE_FIELDS):
         raise expected(f"{len(CUBE_FIELDS)} fields (particles, x y z size, centre x y z, "
                        "maximum radius)", f"{len(fields)} fields", name, number)
-    particles = _count(fields[0], CUBE_FIELDS[0], name, number)
+    if textures is not None and len(fields) != len(CUBE_FIELDS) + 1:
+        raise expected(f"{len(CUBE_FIELDS) + 1} fields (billboards, x y z size, centre x y z, "
+                       "maximum radius, texture)", f"{len(fields)} fields", name, number)
+    what = CUBE_FIELDS[0] if textures is None else "billboard count"
+    particles = _count(fields[0], what, name, number)
     size = tuple(_real(fields[i], CUBE_FIELDS[i], name, number, True) for i in (1, 2, 3))
     centre = tuple(_real(fields[i], CUBE_FIELDS[i], name, number, False) for i in (4, 5, 6))
     radius = _real(fields[7], CUBE_FIELDS[7], name, number, True)
-    return Cube(particles, size, centre, radius, number)  # type: ignore[arg-type]
+    texture = textures(fields[8], number) if textures is not None else None
+    return Cube(particles, size, centre, radius, number, texture)  # type: ignore[arg-type]
 
 
 def _over_limit(count: int, limit: int, name: str, number: int) -> FishgenError:

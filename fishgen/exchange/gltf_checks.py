@@ -388,7 +388,7 @@ class _Checker:
         elif name.startswith("WEIGHTS_"):
             ok = kind == "VEC4" and (ctype == _FLOAT or (ctype in _UNORM and norm))
             want = "VEC4 of floats, or of normalized unsigned bytes or shorts"
-        elif name in ("_RADIUS", "_DENSITY"):
+        elif name in ("_RADIUS", "_DENSITY", "_LIGHT"):
             ok, want = kind == "SCALAR", "SCALAR"
         if not ok:
             raise expected(f"{name} as {want} at {where}",

@@ -60,6 +60,9 @@ def build_scene(document: Document, label: str, source: str) -> Scene:
     scenes = lists["scenes"]
     scene.roots = (list(scenes[document.doc.get("scene", 0)].get("nodes", [])) if scenes
                    else [i for i in range(len(lists["nodes"])) if i not in document.parent])
+    extras = scenes[document.doc.get("scene", 0)].get("extras") if scenes else None
+    if isinstance(extras, dict):  # kept as read; whoever uses a member checks it
+        scene.extras = extras
     scene.clips = [_clip(data, k, a) for k, a in enumerate(lists["animations"])]
     return scene
 

@@ -4,7 +4,11 @@ The context is a headless EGL one; with no GPU, Mesa's llvmpipe rasterises on
 the CPU. Shading mimics a glTF viewer: base colour (factor x texture x vertex
 colour), alpha modes OPAQUE / MASK (cutoff) / BLEND (sorted, drawn after the
 opaque pass without depth writes), double-sided materials lit on both faces,
-and particles drawn as camera-facing soft discs of their world radius.
+and particles drawn as camera-facing soft discs of their world radius, with
+the billboard sprite's Gaussian profile. Transparent parts (BLEND meshes,
+their triangles, particles) are drawn farthest first without depth writes, as
+three.js blends them. A fishgen cloud's particles get Harris's second pass
+from the sunlight baked into the file (``_LIGHT`` and the scene's extras).
 The framebuffer holds premultiplied alpha, so a transparent background works.
 """
 from __future__ import annotations
@@ -14,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from fishgen.clouds.lighting import Lighting, from_extras
 from fishgen.errors import FishgenError
 from fishgen.geometry.mesh import vertex_normals
 from fishgen.numeric import to_linear_float
@@ -26,7 +31,10 @@ SAMPLES = 4
 # sky/ground hemisphere - so the top of anything reads brighter than its belly.
 SUN_DIR = np.array([0.35, 1.0, 0.55]) / np.linalg.norm([0.35, 1.0, 0.55])
 FILL_DIR = np.array([-0.6, 0.1, -0.4]) / np.linalg.norm([-0.6, 0.1, -0.4])
-PARTICLE_OPACITY = 0.55
+PARTICLE_OPACITY = 0.7
+"""A particle's opacity at its centre, times its density, fading out with the billboard sprite's
+Gaussian: about as opaque as one of fishgen's billboard particles, whose one to three quads of
+opacity 0.5 overlap depending on the side it is seen from."""
 POINT_SIZE_FRACTION = 0.004
 """Radius of particles that carry no ``_RADIUS``, as a fraction of the bounding-box diagonal."""
 DEFAULT_MATERIAL = Material("default")
@@ -41,19 +49,37 @@ vec3 to_linear(vec3 c) {
 }
 """
 
+# Harris's second pass (report eq. 3.13): a cloud particle scatters the sunlight that reached it
+# (``light``, the first pass baked into the file) towards the eye by the phase function, on top
+# of the sky's ambient light. ``u_cloud`` is 0 when the scene carries no fishgen lighting.
+_SECOND_PASS = """
+uniform bool u_cloud;
+uniform vec3 u_cloud_sun, u_sun_color, u_sky_color;
+uniform float u_albedo, u_g;
+float phase(float c) {   // Cornette-Shanks; g = 0 is Rayleigh's 3/4 (1 + c^2)
+    float g2 = u_g * u_g;
+    return 1.5 * (1.0 - g2) / (2.0 + g2) * (1.0 + c * c) / pow(1.0 + g2 - 2.0 * u_g * c, 1.5);
+}
+vec3 scattered(float light, vec3 world, vec3 eye) {
+    float c = dot(u_cloud_sun, normalize(world - eye));   // 1: looking towards the sun
+    return u_albedo * (u_sky_color + u_sun_color * light * phase(c));
+}
+"""
+
 MESH_VS = """
 #version 330
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
 uniform mat4 u_viewproj;
-in vec3 in_pos; in vec3 in_normal; in vec2 in_uv; in vec4 in_color;
-out vec3 v_world; out vec3 v_normal; out vec2 v_uv; out vec4 v_color;
+in vec3 in_pos; in vec3 in_normal; in vec2 in_uv; in vec4 in_color; in float in_light;
+out vec3 v_world; out vec3 v_normal; out vec2 v_uv; out vec4 v_color; out float v_light;
 void main() {
     vec4 world = u_model * vec4(in_pos, 1.0);
     v_world = world.xyz;
     v_normal = u_normal_matrix * in_normal;
     v_uv = in_uv;
     v_color = in_color;
+    v_light = in_light;
     gl_Position = u_viewproj * world;
 }
 """
@@ -67,11 +93,12 @@ uniform int u_alpha_mode;   // 0 opaque, 1 mask, 2 blend
 uniform float u_cutoff;
 uniform bool u_unlit;
 uniform vec3 u_eye, u_sun, u_fill;
-in vec3 v_world; in vec3 v_normal; in vec2 v_uv; in vec4 v_color;
+in vec3 v_world; in vec3 v_normal; in vec2 v_uv; in vec4 v_color; in float v_light;
 out vec4 f_color;
-""" + _SRGB + """
+""" + _SRGB + _SECOND_PASS + """
 void main() {
     vec4 base = u_base * v_color;
+    if (u_cloud && v_light >= 0.0) base.rgb = u_base.rgb * scattered(v_light, v_world, u_eye);
     if (u_has_tex) {
         vec4 t = texture(u_tex, v_uv);
         base *= vec4(to_linear(t.rgb), t.a);
@@ -97,45 +124,46 @@ void main() {
 POINT_VS = """
 #version 330
 uniform mat4 u_view, u_proj;
+uniform vec3 u_eye;
 in vec2 in_corner;
-in vec3 in_center; in float in_radius; in vec4 in_color;
+in vec3 in_center; in float in_radius; in vec4 in_color; in float in_light;
 out vec2 v_corner; out vec4 v_color;
+""" + _SECOND_PASS + """
 void main() {
     vec4 c = u_view * vec4(in_center, 1.0);
     c.xy += in_corner * in_radius;   // camera-facing quad of the particle's world radius
     v_corner = in_corner;
     v_color = in_color;
+    if (u_cloud && in_light >= 0.0) v_color.rgb = scattered(in_light, in_center, u_eye);
     gl_Position = u_proj * c;
 }
 """
 
 POINT_FS = """
 #version 330
-uniform vec3 u_sun_view;
 uniform float u_opacity;
 in vec2 v_corner; in vec4 v_color;
 out vec4 f_color;
 """ + _SRGB + """
 void main() {
+    // The billboard sprite's profile (fishgen.clouds.sprite): a Gaussian of sigma 0.4, 0 at the rim.
     float r2 = dot(v_corner, v_corner);
     if (r2 > 1.0) discard;
-    // Shade the disc like a soft sphere so a cloud reads as puffs, not flat stickers.
-    vec3 n = vec3(v_corner, sqrt(1.0 - r2));
-    float light = 0.62 + 0.38 * dot(n, u_sun_view);
-    float a = v_color.a * u_opacity * smoothstep(1.0, 0.35, sqrt(r2));
-    f_color = vec4(to_srgb(v_color.rgb * light) * a, a);
+    float a = v_color.a * u_opacity * max((exp(-r2 / 0.32) - 0.04394) / 0.95606, 0.0);
+    f_color = vec4(to_srgb(v_color.rgb) * a, a);
 }
 """
 
 
-# moderngl objects are typed ``Any``: its bundled stubs lack ``Context.depth_mask`` and type a
-# program's members as a union, of which only ``Uniform`` has the ``value`` / ``write`` used here.
+# moderngl objects are typed ``Any``: its bundled stubs type a program's members as a union, of
+# which only ``Uniform`` has the ``value`` / ``write`` used here.
 @dataclass
 class _GpuMesh:
     node: int
     prim: Primitive
     material: Material
     vbo: Any          # moderngl.Buffer
+    ibo: Any          # moderngl.Buffer; a BLEND mesh's triangles are rewritten back to front each frame
     vao: Any          # moderngl.VertexArray
     texture: Any      # moderngl.Texture or None
     centroid: np.ndarray
@@ -144,6 +172,12 @@ class _GpuMesh:
 
 class Renderer:
     """One headless GL context and framebuffer, reused for every image of a run."""
+
+    sort_triangles = True
+    """Draw a transparent mesh's triangles farthest first (off: in file order, as three.js does)."""
+    transparent_depth_writes = False
+    """Transparent parts write no depth, as in three.js. (On, they hide what is drawn after them:
+    fishgen's preview before issue 20 showed a billboard cloud as hard-edged rectangles.)"""
 
     def __init__(self, width: int, height: int):
         import moderngl
@@ -212,11 +246,12 @@ class Renderer:
                                              and "JOINTS_0" in prim.attributes)
             data = self._vertex_data(prim, *self._local(prim))
             vbo = self.ctx.buffer(data.tobytes(), dynamic=deforms)
-            ibo = self.ctx.buffer(np.asarray(prim.indices, np.uint32).tobytes())
-            vao = self.ctx.vertex_array(self.mesh_prog, [(vbo, "3f 3f 2f 4f", "in_pos", "in_normal",
-                                                          "in_uv", "in_color")], ibo)
+            ibo = self.ctx.buffer(np.asarray(prim.indices, np.uint32).tobytes(),
+                                  dynamic=material.alpha_mode == "BLEND")
+            vao = self.ctx.vertex_array(self.mesh_prog, [(vbo, "3f 3f 2f 4f 1f", "in_pos", "in_normal",
+                                                          "in_uv", "in_color", "in_light")], ibo)
             tex = self._texture(scene, material.texture) if material.texture is not None else None
-            out.append(_GpuMesh(node, prim, material, vbo, vao, tex,
+            out.append(_GpuMesh(node, prim, material, vbo, ibo, vao, tex,
                                 np.asarray(prim.positions, float).mean(0), deforms))
         self._uploaded[key] = out
         return out
@@ -237,7 +272,7 @@ class Renderer:
             if np.asarray(uvs).dtype.kind in "iu" else np.asarray(uvs, np.float32)
         colors = prim.attributes.get("COLOR_0")
         colors = np.ones((n, 4), np.float32) if colors is None else to_linear_float(colors)
-        return np.hstack([positions, normals, uvs, colors]).astype(np.float32)
+        return np.hstack([positions, normals, uvs, colors, _light(prim)[:, None]]).astype(np.float32)
 
     # -- drawing -------------------------------------------------------------
     def render(self, scene: Scene, camera: Camera, t: float | None,
@@ -259,9 +294,14 @@ class Renderer:
         prog["u_eye"].value = tuple(camera.eye)
         prog["u_sun"].value = tuple(SUN_DIR)
         prog["u_fill"].value = tuple(FILL_DIR)
+        cloud = from_extras(scene.extras)
+        for program in (self.mesh_prog, self.point_prog):
+            _set_cloud_light(program, cloud)
 
         meshes = self._upload(scene)
         models: dict[int, np.ndarray] = {}
+        posed_positions: dict[int, np.ndarray] = {}
+        self._posed = posed_positions
         for m in meshes:
             if m.deforms:  # morph targets and skins are posed on the CPU, drawn in world space
                 pos, nrm = deformed(scene, m.node, m.prim, posed)
@@ -269,6 +309,7 @@ class Renderer:
                     nrm = vertex_normals(pos, np.asarray(m.prim.indices, np.int64))
                 data = self._vertex_data(m.prim, pos.astype(np.float32), nrm.astype(np.float32))
                 m.vbo.write(data.tobytes())
+                posed_positions[id(m)] = pos
                 models[id(m)] = np.eye(4)
             else:
                 models[id(m)] = posed.matrix(m.node)
@@ -279,19 +320,35 @@ class Renderer:
             c = view @ models[id(m)] @ np.append(m.centroid, 1.0)
             return float(c[2])  # more negative = farther
 
-        ctx.depth_mask = True
+        self.msaa.depth_mask = True
         for m in opaque:
             self._draw_mesh(m, models[id(m)])
-        ctx.depth_mask = False  # transparent fins must not hide what lies behind them
+        # Transparent parts are blended over what lies behind them, as three.js blends them (its
+        # GLTFLoader turns depth writes off for BLEND materials), and drawn farthest first: whole
+        # meshes, and each mesh's triangles (a billboard cloud's quads, a fin's folds).
+        self.msaa.depth_mask = self.transparent_depth_writes
         for m in sorted(blended, key=depth):
+            if self.sort_triangles:
+                self._sort_triangles(m, view @ models[id(m)])
             self._draw_mesh(m, models[id(m)])
-        self._draw_points(scene, posed, view, proj)
-        ctx.depth_mask = True
+        self._draw_points(scene, posed, view, proj, camera.eye)
+        self.msaa.depth_mask = True
 
         ctx.copy_framebuffer(self.resolved, self.msaa)
         raw = self.resolved.read(components=4, alignment=1)
         img = np.frombuffer(raw, np.uint8).reshape(self.height, self.width, 4)[::-1]
         return unpremultiply(img)
+
+    def _sort_triangles(self, m: _GpuMesh, modelview: np.ndarray) -> None:
+        """Rewrite a transparent mesh's index buffer with its triangles farthest first."""
+        tris = np.asarray(m.prim.indices, np.int64).reshape(-1, 3)
+        if len(tris) < 2:
+            return
+        positions = self._posed.get(id(m), m.prim.positions)
+        centroids = np.asarray(positions, np.float64)[tris].mean(axis=1)
+        depth = centroids @ modelview[2, :3]           # view-space z: more negative = farther
+        order = np.argsort(depth, kind="stable")
+        m.ibo.write(np.ascontiguousarray(tris[order], np.uint32).tobytes())
 
     def _draw_mesh(self, m: _GpuMesh, model: np.ndarray) -> None:
         import moderngl
@@ -316,34 +373,33 @@ class Renderer:
         m.vao.render(moderngl.TRIANGLES)
         self.ctx.disable(moderngl.CULL_FACE)
 
-    def _draw_points(self, scene: Scene, posed: Pose, view: np.ndarray, proj: np.ndarray) -> None:
-        centers: list[np.ndarray] = []
-        radii: list[np.ndarray] = []
-        colors: list[np.ndarray] = []
+    def _draw_points(self, scene: Scene, posed: Pose, view: np.ndarray, proj: np.ndarray,
+                     eye: np.ndarray) -> None:
+        import moderngl
+
+        parts = []
         for node, prim in scene.drawn():
             if prim.mode != "POINTS" or not prim.vertex_count:
                 continue
             c, r, col = particles(scene, node, prim, posed)
-            centers.append(c)
-            radii.append(r)
-            colors.append(col)
-        if not centers:
+            parts.append((c, r, col, _light(prim)))
+        if not parts:
             return
-        c = np.concatenate(centers).astype(np.float32)
-        r = np.concatenate(radii).astype(np.float32)
-        col = np.concatenate(colors).astype(np.float32)
-        order = np.argsort((c @ view[2, :3]) + view[2, 3])  # back to front for "over" blending
-        inst = np.hstack([c[order], r[order, None], col[order]]).astype(np.float32)
+        c = np.concatenate([p[0] for p in parts]).astype(np.float32)
+        r = np.concatenate([p[1] for p in parts]).astype(np.float32)
+        col = np.concatenate([p[2] for p in parts]).astype(np.float32)
+        light = np.concatenate([p[3] for p in parts]).astype(np.float32)
+        order = np.argsort((c @ view[2, :3]) + view[2, 3], kind="stable")  # back to front: "over"
+        inst = np.hstack([c[order], r[order, None], col[order], light[order, None]]).astype(np.float32)
         buf = self.ctx.buffer(inst.tobytes())
         prog = self.point_prog
         prog["u_view"].write(view.T.astype("f4").tobytes())
         prog["u_proj"].write(proj.T.astype("f4").tobytes())
-        prog["u_sun_view"].value = tuple(view[:3, :3] @ SUN_DIR)
+        prog["u_eye"].value = tuple(eye)
         prog["u_opacity"].value = PARTICLE_OPACITY
         vao = self.ctx.vertex_array(prog, [(self.corner_buf, "2f", "in_corner"),
-                                           (buf, "3f 1f 4f/i", "in_center", "in_radius", "in_color")])
-        self.ctx.depth_mask = False
-        import moderngl
+                                           (buf, "3f 1f 4f 1f/i", "in_center", "in_radius", "in_color",
+                                            "in_light")])
         vao.render(moderngl.TRIANGLE_STRIP, instances=len(inst))
         vao.release()
         buf.release()
@@ -375,6 +431,26 @@ def particles(scene: Scene, node: int, prim: Primitive,
     if "_DENSITY" in a:
         rgba[:, 3] *= np.clip(np.asarray(a["_DENSITY"], np.float32).ravel(), 0, 1)
     return centers, radii, rgba
+
+
+def _light(prim: Primitive) -> np.ndarray:
+    """Per vertex: the baked sunlight of a fishgen cloud particle (``_LIGHT``), else -1 (none)."""
+    light = prim.attributes.get("_LIGHT")
+    if light is None or len(light) != prim.vertex_count:
+        return np.full(prim.vertex_count, -1.0, np.float32)
+    return np.clip(np.nan_to_num(np.asarray(light, np.float32).ravel(), nan=0.0), 0, 1)
+
+
+def _set_cloud_light(program: Any, lighting: Lighting | None) -> None:
+    """The second pass's uniforms: the lighting a cloud file records, or off."""
+    program["u_cloud"].value = lighting is not None
+    if lighting is None:
+        return
+    program["u_cloud_sun"].value = lighting.sun_unit
+    program["u_sun_color"].value = lighting.sun_color
+    program["u_sky_color"].value = lighting.sky_color
+    program["u_albedo"].value = lighting.albedo
+    program["u_g"].value = lighting.anisotropy
 
 
 def unpremultiply(img: np.ndarray) -> np.ndarray:

@@ -10,7 +10,7 @@ rotations as (x, y, z, w) quaternions. Nothing here knows a file format.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 if TYPE_CHECKING:  # numpy stays out of `fishgen --help`
     import numpy as np
@@ -164,7 +164,9 @@ class Scene:
     """A whole asset. ``roots`` are the top-level nodes. ``source`` is the file a reader read it
     from, and ``note`` what a reader wants the user told (a subsampled cloud); writers ignore both.
     What a builder knows about what it built travels beside the scene, typed
-    (:class:`fishgen.assembly.fish.FishFacts`), never inside it."""
+    (:class:`fishgen.assembly.fish.FishFacts`), never inside it. ``extras`` is application data the
+    file keeps, as JSON values (a cloud's sunlight, a school's warm-up): glTF writes it as the scene's
+    ``extras``."""
 
     name: str = ""
     nodes: list[Node] = field(default_factory=list)
@@ -176,6 +178,7 @@ class Scene:
     clips: list[Clip] = field(default_factory=list)
     source: str | None = None
     note: str | None = None
+    extras: dict[str, Any] = field(default_factory=dict)
 
     # -- building ------------------------------------------------------------------
     def add_node(self, node: Node, parent: int | None = None) -> int:

@@ -9,7 +9,7 @@ import { MTLLoader } from 'three/addons/loaders/MTLLoader.js';
 
 const state = window.fishgenViewer = {
 	loaded: false, error: null, time: 0, clip: null, clips: [], playing: false,
-	counts: { vertices: 0, triangles: 0, particles: 0 },
+	counts: { vertices: 0, triangles: 0, particles: 0 }, cloudLight: null,
 };
 const $ = ( id ) => document.getElementById( id );
 const fail = ( err ) => {
@@ -53,46 +53,160 @@ const fill = new THREE.DirectionalLight( 0x6b7f95, 0.7 );
 fill.position.set( - 0.6, 0.1, - 0.4 );
 scene.add( fill );
 
-// Particles: each a soft disc of its world radius (`_radius`, fishgen's _RADIUS / PLY radius).
+// A fishgen cloud's sunlight (the first pass of Harris's method) is baked into the file: each
+// particle's `_LIGHT` and the scene's extras.fishgen_light. The viewer does the second pass:
+// the light scattered towards the eye by the phase function, over the sky's ambient light.
+const SECOND_PASS = /* glsl */`
+	uniform bool cloudLit;
+	uniform vec3 cloudSun, sunColor, skyColor;
+	uniform float albedo, g;
+	float phase( float c ) {
+		float g2 = g * g;
+		return 1.5 * ( 1.0 - g2 ) / ( 2.0 + g2 ) * ( 1.0 + c * c ) / pow( 1.0 + g2 - 2.0 * g * c, 1.5 );
+	}
+	vec3 scattered( float light, vec3 world ) {
+		float c = dot( cloudSun, normalize( world - cameraPosition ) );   // 1: looking towards the sun
+		return albedo * ( skyColor + sunColor * light * phase( c ) );
+	}`;
+const cloudUniforms = {
+	cloudLit: { value: false }, cloudSun: { value: new THREE.Vector3( 0, 1, 0 ) },
+	sunColor: { value: new THREE.Vector3( 1, 1, 1 ) }, skyColor: { value: new THREE.Vector3() },
+	albedo: { value: 1 }, g: { value: 0 },
+};
+
+function readCloudLight( extras ) {
+	const l = extras && extras.fishgen_light;
+	const triple = ( v ) => Array.isArray( v ) && v.length === 3 && v.every( Number.isFinite );
+	if ( ! l || ! triple( l.sun ) || ! triple( l.sun_color ) || ! triple( l.sky_color ) ) return null;
+	if ( ! Number.isFinite( l.albedo ) || ! Number.isFinite( l.anisotropy ) || Math.abs( l.anisotropy ) > 0.9 ) return null;
+	const sun = new THREE.Vector3( ...l.sun );
+	if ( sun.lengthSq() === 0 ) return null;
+	cloudUniforms.cloudLit.value = true;
+	cloudUniforms.cloudSun.value.copy( sun.normalize() );
+	cloudUniforms.sunColor.value.set( ...l.sun_color );
+	cloudUniforms.skyColor.value.set( ...l.sky_color );
+	cloudUniforms.albedo.value = l.albedo;
+	cloudUniforms.g.value = l.anisotropy;
+	return { sun: sun.toArray() };
+}
+
+// Particles: each a soft disc of its world radius (`_radius`, fishgen's _RADIUS / PLY radius),
+// with the billboard sprite's Gaussian profile, drawn farthest first.
 const particleMaterial = new THREE.ShaderMaterial( {
-	uniforms: { viewportHeight: { value: 1 } },
+	uniforms: { viewportHeight: { value: 1 }, ...cloudUniforms },
 	vertexColors: true, transparent: true, depthWrite: false,
 	vertexShader: /* glsl */`
 		attribute float _radius;
 		attribute float _density;
+		attribute float _light;
 		uniform float viewportHeight;
 		varying vec3 vColor;
 		varying float vAlpha;
+		${ SECOND_PASS }
 		void main() {
-			vec4 mv = modelViewMatrix * vec4( position, 1.0 );
+			vec4 world = modelMatrix * vec4( position, 1.0 );
+			vec4 mv = viewMatrix * world;
 			gl_Position = projectionMatrix * mv;
 			gl_PointSize = 2.0 * _radius * projectionMatrix[ 1 ][ 1 ] * 0.5 * viewportHeight / max( - mv.z, 1e-4 );
-			vColor = color;
-			vAlpha = clamp( _density, 0.0, 1.0 );
+			vColor = ( cloudLit && _light >= 0.0 ) ? scattered( _light, world.xyz ) : color;
+			vAlpha = 0.7 * clamp( _density, 0.0, 1.0 );
 		}`,
 	fragmentShader: /* glsl */`
 		varying vec3 vColor;
 		varying float vAlpha;
 		void main() {
 			vec2 p = gl_PointCoord * 2.0 - 1.0;
-			p.y = - p.y;
 			float r2 = dot( p, p );
 			if ( r2 > 1.0 ) discard;
-			vec3 n = vec3( p, sqrt( 1.0 - r2 ) );
-			float light = 0.62 + 0.38 * dot( n, normalize( vec3( 0.3, 0.9, 0.4 ) ) );
-			float a = 0.55 * vAlpha * smoothstep( 1.0, 0.35, sqrt( r2 ) );
-			gl_FragColor = vec4( vColor * light, a );
+			float a = vAlpha * max( ( exp( - r2 / 0.32 ) - 0.04394 ) / 0.95606, 0.0 );
+			gl_FragColor = vec4( vColor, a );
 			#include <colorspace_fragment>
 		}`,
 } );
+
+// fishgen's billboards (three crossed quads a particle, or a texture cloud's): the second pass
+// too, the texture's colour and alpha times the vertex alpha, their triangles drawn farthest first.
+const WHITE = new THREE.DataTexture( new Uint8Array( [ 255, 255, 255, 255 ] ), 1, 1 );
+WHITE.needsUpdate = true;
+
+function billboardMaterial( source ) {
+	return new THREE.ShaderMaterial( {
+		uniforms: { map: { value: source.map || WHITE }, ...cloudUniforms },
+		vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide,
+		vertexShader: /* glsl */`
+			attribute float _light;
+			varying vec2 vUv;
+			varying vec4 vColor;
+			${ SECOND_PASS }
+			void main() {
+				vec4 world = modelMatrix * vec4( position, 1.0 );
+				gl_Position = projectionMatrix * viewMatrix * world;
+				vUv = uv;
+				vColor = vec4( ( cloudLit && _light >= 0.0 ) ? scattered( _light, world.xyz ) : color.rgb, color.a );
+			}`,
+		fragmentShader: /* glsl */`
+			uniform sampler2D map;
+			varying vec2 vUv;
+			varying vec4 vColor;
+			void main() {
+				vec4 t = texture2D( map, vUv );
+				gl_FragColor = vec4( vColor.rgb * t.rgb, vColor.a * t.a );
+				#include <colorspace_fragment>
+			}`,
+	} );
+}
+
+const sorted = [];   // [object, centroids (Float32Array xyz per primitive), base index (Uint32Array), size]
+
+function sortable( object, size ) {
+	const g = object.geometry, pos = g.getAttribute( 'position' );
+	const index = g.index ? g.index.array.slice() : Uint32Array.from( { length: pos.count }, ( _, i ) => i );
+	const n = index.length / size, centroids = new Float32Array( n * 3 );
+	for ( let k = 0; k < n; k ++ ) for ( let j = 0; j < size; j ++ ) {
+		const v = index[ k * size + j ];
+		centroids[ 3 * k ] += pos.getX( v ) / size; centroids[ 3 * k + 1 ] += pos.getY( v ) / size; centroids[ 3 * k + 2 ] += pos.getZ( v ) / size;
+	}
+	if ( ! g.index ) g.setIndex( new THREE.BufferAttribute( index.slice(), 1 ) );
+	sorted.push( { object, centroids, index, size, keys: new Float32Array( n ), order: new Uint32Array( n ) } );
+}
+
+const _dir = new THREE.Vector3(), _m = new THREE.Matrix4();
+function sortAll() {
+	camera.getWorldDirection( _dir );
+	for ( const s of sorted ) {
+		_m.copy( s.object.matrixWorld );
+		const e = _m.elements, c = s.centroids, n = s.keys.length;
+		for ( let k = 0; k < n; k ++ ) {
+			const x = c[ 3 * k ], y = c[ 3 * k + 1 ], z = c[ 3 * k + 2 ];
+			const wx = e[ 0 ] * x + e[ 4 ] * y + e[ 8 ] * z + e[ 12 ], wy = e[ 1 ] * x + e[ 5 ] * y + e[ 9 ] * z + e[ 13 ];
+			const wz = e[ 2 ] * x + e[ 6 ] * y + e[ 10 ] * z + e[ 14 ];
+			s.keys[ k ] = - ( wx * _dir.x + wy * _dir.y + wz * _dir.z );   // farther: smaller key
+			s.order[ k ] = k;
+		}
+		s.order.sort( ( a, b ) => s.keys[ a ] - s.keys[ b ] );
+		const out = s.object.geometry.index.array;
+		for ( let k = 0; k < n; k ++ ) for ( let j = 0; j < s.size; j ++ ) out[ k * s.size + j ] = s.index[ s.order[ k ] * s.size + j ];
+		s.object.geometry.index.needsUpdate = true;
+	}
+}
 
 function prepareParticles( points, diagonal ) {
 	const g = points.geometry;
 	const n = g.getAttribute( 'position' ).count;
 	if ( ! g.getAttribute( '_radius' ) ) g.setAttribute( '_radius', new THREE.BufferAttribute( new Float32Array( n ).fill( 0.004 * diagonal ), 1 ) );
 	if ( ! g.getAttribute( '_density' ) ) g.setAttribute( '_density', new THREE.BufferAttribute( new Float32Array( n ).fill( 1 ), 1 ) );
+	if ( ! g.getAttribute( '_light' ) ) g.setAttribute( '_light', new THREE.BufferAttribute( new Float32Array( n ).fill( - 1 ), 1 ) );
 	if ( ! g.getAttribute( 'color' ) ) g.setAttribute( 'color', new THREE.BufferAttribute( new Float32Array( n * 3 ).fill( 1 ), 3 ) );
 	points.material = particleMaterial;
+	sortable( points, 1 );
+}
+
+function prepareBillboards( mesh ) {
+	const g = mesh.geometry, n = g.getAttribute( 'position' ).count;
+	if ( ! g.getAttribute( '_light' ) ) g.setAttribute( '_light', new THREE.BufferAttribute( new Float32Array( n ).fill( - 1 ), 1 ) );
+	if ( ! g.getAttribute( 'color' ) ) g.setAttribute( 'color', new THREE.BufferAttribute( new Float32Array( n * 4 ).fill( 1 ), 4 ) );
+	mesh.material = billboardMaterial( mesh.material );
+	sortable( mesh, 3 );
 }
 
 async function load() {
@@ -100,11 +214,12 @@ async function load() {
 	const kind = embedded.kind;
 	if ( kind === 'glb' || kind === 'gltf' ) {
 		const gltf = await new GLTFLoader( manager ).loadAsync( url );
+		state.cloudLight = readCloudLight( gltf.scene.userData );   // GLTFLoader: the scene's extras
 		return { root: gltf.scene, clips: gltf.animations };
 	}
 	if ( kind === 'ply' ) {
 		const loader = new PLYLoader( manager );
-		loader.setCustomPropertyNameMapping( { _radius: [ 'radius' ], _density: [ 'density' ] } );
+		loader.setCustomPropertyNameMapping( { _radius: [ 'radius' ], _density: [ 'density' ], _light: [ 'light' ] } );
 		const geometry = await loader.loadAsync( url );
 		const root = new THREE.Group();
 		if ( geometry.index ) {
@@ -125,17 +240,21 @@ async function load() {
 	return { root: await loader.loadAsync( url ), clips: [] };
 }
 
-// `fishgen clouds --billboards` writes a cloud as one mesh of camera-facing quads, one per
-// particle (4 vertices, 2 triangles), with the material "cloud particle" and the texture
-// "gaussian sprite". Such a mesh is counted as particles, one per quad, and not as vertices
-// and triangles: the same cloud then reads the same exported as points or as billboards.
-// Anything that does not have exactly that shape is counted as an ordinary mesh.
-const CLOUD_MATERIAL = 'cloud particle', CLOUD_SPRITE = 'gaussian sprite';
+// `fishgen clouds --billboards` writes a cloud as meshes of three crossed quads per particle
+// (12 vertices, 6 triangles), with the material "cloud particle" (texture "gaussian sprite") or,
+// for a texture cloud, "cloud texture NAME". Such a mesh is counted as particles, one per three
+// quads, and not as vertices and triangles: the same cloud then reads the same exported as points
+// or as billboards. Anything that does not have exactly that shape is counted as an ordinary mesh.
+const CLOUD_MATERIAL = 'cloud particle', CLOUD_SPRITE = 'gaussian sprite', CLOUD_TEXTURE = 'cloud texture ';
+
+function isBillboards( o ) {
+	return [].concat( o.material ).some( ( m ) => m && ( m.name === CLOUD_MATERIAL || m.name.startsWith( CLOUD_TEXTURE )
+		|| ( m.map && m.map.name === CLOUD_SPRITE ) ) );
+}
 
 function billboardQuads( o, g, n ) {
-	const sprite = [].concat( o.material ).some( ( m ) => m && ( m.name === CLOUD_MATERIAL || ( m.map && m.map.name === CLOUD_SPRITE ) ) );
-	if ( ! sprite || n === 0 || n % 4 !== 0 || ! g.index || g.index.count !== n / 4 * 6 ) return 0;
-	return n / 4;
+	if ( ! o.userData.fishgenBillboards || n === 0 || n % 12 !== 0 || ! g.index || g.index.count !== n / 12 * 18 ) return 0;
+	return n / 12;
 }
 
 function count( root ) {
@@ -194,12 +313,18 @@ function setPlaying( on ) {
 	$( 'play' ).textContent = state.playing ? 'Pause' : 'Play';
 }
 
+// A frame is drawn only when something changed (the camera, the size, the clip's time, the
+// wireframe): a big cloud on a software renderer takes seconds a frame.
+let dirty = true;
+const redraw = () => { dirty = true; };
+
 function resize() {
 	const w = canvas.clientWidth, h = canvas.clientHeight;
 	if ( canvas.width !== Math.floor( w * renderer.getPixelRatio() ) || canvas.height !== Math.floor( h * renderer.getPixelRatio() ) ) {
 		renderer.setSize( w, h, false );
 		camera.aspect = w / Math.max( h, 1 );
 		camera.updateProjectionMatrix();
+		dirty = true;
 	}
 	particleMaterial.uniforms.viewportHeight.value = h * renderer.getPixelRatio();
 }
@@ -212,17 +337,31 @@ function tick( now ) {
 		mixer.update( dt );
 		state.time = duration > 0 ? mixer.time % duration : 0;
 		slider.value = String( state.time );
+		dirty = true;
 	}
 	$( 'clock' ).textContent = mixer ? `${ state.time.toFixed( 2 ) } / ${ duration.toFixed( 2 ) } s` : '';
 	controls.update();
-	renderer.render( scene, camera );
+	if ( dirty ) {
+		dirty = false;
+		renderer.render( scene, camera );
+	}
 	requestAnimationFrame( tick );
 }
 
 load().then( ( { root, clips } ) => {
 	scene.add( root );
 	const diagonal = frameCamera( root );
-	root.traverse( ( o ) => { if ( o.isPoints ) prepareParticles( o, diagonal ); } );
+	root.updateMatrixWorld( true );
+	root.traverse( ( o ) => {
+		if ( o.isPoints ) prepareParticles( o, diagonal );
+		else if ( o.isMesh && isBillboards( o ) ) {
+			o.userData.fishgenBillboards = true;
+			prepareBillboards( o );
+		}
+	} );
+	sortAll();
+	controls.addEventListener( 'change', () => { sortAll(); redraw(); } );
+	redraw();
 	state.counts = count( root );
 	const c = state.counts;
 	$( 'counts' ).textContent = `${ c.vertices } vertices · ${ c.triangles } triangles · ${ c.particles } particles`;
@@ -247,10 +386,12 @@ slider.addEventListener( 'input', () => {
 	setPlaying( false );
 	mixer.setTime( Number( slider.value ) );
 	state.time = Number( slider.value );
+	redraw();
 } );
 $( 'wireframe' ).addEventListener( 'change', ( e ) => {
 	scene.traverse( ( o ) => {
 		if ( o.isMesh ) for ( const m of [].concat( o.material ) ) m.wireframe = e.target.checked;
 	} );
+	redraw();
 } );
 requestAnimationFrame( tick );

@@ -12,7 +12,7 @@ import trimesh
 from PIL import Image
 
 from fishgen.clouds import export_cloud, fill_cloud, load_cubes
-from fishgen.clouds.scene import cloud_scene
+from fishgen.clouds.scene import TRIANGLES_PER_BILLBOARD, cloud_scene, turns
 from fishgen.exchange import particles
 from fishgen.errors import FishgenError, SystemFailure
 
@@ -94,17 +94,38 @@ def test_glb_billboards(cloud, tmp_path, gltf_validator):
     material = doc["materials"][0]
     assert material["alphaMode"] == "BLEND" and "KHR_materials_unlit" in doc["extensionsUsed"]
     prim = doc["meshes"][0]["primitives"][0]
-    corners = accessor_array(doc, blob, prim["attributes"]["POSITION"], "<f4", 3).reshape(-1, 4, 3)
-    np.testing.assert_allclose(corners.mean(axis=1), cloud.centers, atol=1e-5)
-    np.testing.assert_allclose(corners[:, 2, 0] - corners[:, 0, 0], 2 * cloud.radii, rtol=1e-5)
-    np.testing.assert_array_equal(corners[:, :, 2], np.repeat(cloud.centers[:, 2:], 4, axis=1))
+    # three crossed quads per particle, each a square of half width = radius around its centre
+    quads = accessor_array(doc, blob, prim["attributes"]["POSITION"], "<f4", 3).reshape(-1, 3, 4, 3)
+    assert len(quads) == len(cloud)
+    np.testing.assert_allclose(quads.mean(axis=2), np.repeat(cloud.centers[:, None], 3, axis=1), atol=1e-5)
+    right, up = quads[:, :, 1] - quads[:, :, 0], quads[:, :, 3] - quads[:, :, 0]
+    r2 = np.repeat(cloud.radii[:, None], 3, axis=1)
+    np.testing.assert_allclose(np.linalg.norm(right, axis=-1), 2 * r2, rtol=1e-4)
+    np.testing.assert_allclose(np.linalg.norm(up, axis=-1), 2 * r2, rtol=1e-4)
+    normals = np.cross(right, up)
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    gram = np.einsum("nqd,npd->nqp", normals, normals)  # the three quads are mutually perpendicular
+    np.testing.assert_allclose(gram, np.broadcast_to(np.eye(3), gram.shape), atol=1e-4)
     image = doc["images"][0]
     view = doc["bufferViews"][image["bufferView"]]
     sprite = Image.open(io.BytesIO(blob[view["byteOffset"]:view["byteOffset"] + view["byteLength"]]))
     alpha = np.asarray(sprite.convert("RGBA"))[..., 3]
     assert alpha[sprite.height // 2, sprite.width // 2] > 240 and alpha[0, 0] == 0
     mesh = trimesh.load(path, force="mesh")
-    assert len(mesh.faces) == 2 * len(cloud)
+    assert len(mesh.faces) == TRIANGLES_PER_BILLBOARD * len(cloud) == 6 * len(cloud)
+
+
+def test_billboards_are_turned_alike_whatever_the_cloud(tmp_path):
+    """Particle k's quads are turned by the k-th rotation of a fixed sequence: no seed, no
+    randomness, and no view direction sees every particle's quads edge-on."""
+    rot = turns(4000).astype(np.float64)
+    np.testing.assert_allclose(np.einsum("nij,nkj->nik", rot, rot), np.broadcast_to(np.eye(3), rot.shape),
+                               atol=1e-5)
+    np.testing.assert_array_equal(turns(10), turns(4000)[:10])
+    normals = np.einsum("qd,nde->nqe", np.array([[0, 0, 1], [1, 0, 0], [0, 1, 0]], float), rot)
+    for view in ([0, 0, 1], [1, 0, 0], [0, 1, 0], [1, 1, 1]):
+        edge_on = np.abs(normals @ (np.array(view) / np.linalg.norm(view))) < 0.05   # within 3 degrees
+        assert edge_on.mean() < 0.06, view
 
 
 @pytest.mark.parametrize("billboards", [False, True])

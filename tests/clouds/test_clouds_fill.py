@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from fishgen.clouds import Cube, CubeFile, fill_cloud, load_cubes, merge_clouds
+from fishgen.clouds import Cube, CubeFile, Lighting, fill_cloud, light_cloud, load_cubes, merge_clouds
 
 from cloud_tables import TABLES
 
@@ -109,11 +109,10 @@ def test_density_is_the_gaussian_fall_off_from_the_cube_centre():
     np.testing.assert_allclose(cloud.density, np.exp(-(s ** 2).sum(axis=1)), rtol=1e-4)
 
 
-def test_colour_is_darker_at_the_base_than_at_the_top():
+def test_a_filled_cloud_is_unlit_and_white():
+    """The fill places particles; their colour comes from the sun (tests/clouds/test_light.py)."""
     cloud = fill_cloud(load_cubes(TABLES["4.4"]), seed=3)
-    brightness = cloud.colors.astype(int).sum(axis=1)
-    y = cloud.centers[:, 1]
-    assert brightness[y < np.quantile(y, 0.2)].mean() + 60 < brightness[y > np.quantile(y, 0.8)].mean()
+    assert (cloud.colors == 255).all() and cloud.light is None and cloud.lighting is None
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -210,8 +209,10 @@ def test_cubes_at_the_ends_of_float32_fill_without_overflow_warnings():
         warnings.simplefilter("error")
         cloud = fill_cloud(cubes, seed=1)
     assert np.isfinite(cloud.centers).all()
-    assert (cloud.colors[:200] >= 250).all()          # top of the scene: white
-    assert (cloud.colors[200:, 0] < 200).all()        # bottom: towards the grey base
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lit = light_cloud(cloud, Lighting(sun=(0, 1, 0)))
+    assert np.isfinite(lit.light).all() and (lit.light >= 0).all() and (lit.light <= 1).all()
     for k in range(2):
         lo, hi = cloud.cube_bounds[k]
         part = cloud.centers[cloud.cube_index == k].astype(np.float64)

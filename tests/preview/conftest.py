@@ -6,9 +6,9 @@ import pytest
 
 @pytest.fixture(scope="session")
 def assets(tmp_path_factory):
-    """bonybream in every asset format fishgen writes, and table 4.3 as glb and ply clouds."""
+    """bonybream in every asset format fishgen writes, and table 4.3 as lit glb and ply clouds."""
     import fishgen
-    from fishgen.clouds import export_cloud, fill_cloud, load_cubes
+    from fishgen.clouds import export_cloud, fill_cloud, light_cloud, load_cubes
     from tests.conftest import PARAMS
 
     folder = tmp_path_factory.mktemp("assets")
@@ -17,7 +17,7 @@ def assets(tmp_path_factory):
     for ext in ("glb", "gltf", "obj", "ply"):
         out[f"fish.{ext}"] = folder / f"fish.{ext}"
         fishgen.export(fish, out[f"fish.{ext}"])
-    cloud = fill_cloud(load_cubes(PARAMS / "clouds" / "table_4_3.awn"), seed=0)
+    cloud = light_cloud(fill_cloud(load_cubes(PARAMS / "clouds" / "table_4_3.awn"), seed=0))  # as `clouds` does
     for ext in ("glb", "ply"):
         out[f"cloud.{ext}"] = folder / f"cloud.{ext}"
         export_cloud(cloud, out[f"cloud.{ext}"])

@@ -245,3 +245,40 @@ def test_a_school_plays_and_its_fish_move_in_three_js(browser, served, tmp_path)
         _assert_offline(requests)
     finally:
         page.close()
+
+
+def _lit_cloud_page(folder, sun, billboards):
+    from fishgen.clouds import Lighting, export_cloud, fill_cloud, light_cloud, load_cubes
+    from fishgen.viewer.page import write_page
+
+    cloud = light_cloud(fill_cloud(load_cubes(ROOT / "params" / "clouds" / "table_4_4.awn"), seed=0),
+                        Lighting(sun=sun))
+    asset = folder / f"lit_{'billboards' if billboards else 'points'}_{sun[0]:+g}.glb"
+    export_cloud(cloud, asset, billboards=billboards)
+    return write_page(asset).as_uri(), len(cloud)
+
+
+@pytest.mark.parametrize("billboards", [False, True], ids=["points", "billboards"])
+def test_a_lit_cloud_gets_the_second_pass_and_follows_its_sun(browser, tmp_path, billboards):
+    """The viewer reads the sun from the file and scatters each particle's baked light towards the
+    eye: the same cloud lit from the left or from the right looks brighter on that side."""
+    sides = {}
+    for sun in ((-1, 0.2, 0.3), (1, 0.2, 0.3)):
+        url, particles = _lit_cloud_page(tmp_path, sun, billboards)
+        page, problems, _ = _open(browser, url)
+        try:
+            state = page.evaluate("window.fishgenViewer")
+            assert state["cloudLight"] is not None and state["counts"]["particles"] == particles
+            page.evaluate("() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))")
+            img = _canvas(page)
+            _assert_not_blank(img)
+            lum = img @ np.array([0.2126, 0.7152, 0.0722])
+            background = np.median(lum)
+            cloud = np.abs(lum - background) > 8
+            xs = np.nonzero(cloud)[1]
+            left = np.arange(img.shape[1])[None, :] < (xs.min() + xs.max()) / 2
+            sides[sun[0]] = lum[cloud & left].mean() / lum[cloud & ~left].mean()
+            assert problems == []
+        finally:
+            page.close()
+    assert sides[-1] > sides[1] + 0.03

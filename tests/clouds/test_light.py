@@ -1,0 +1,329 @@
+"""Sunlight baked into a cloud (Harris's first pass): checked against brute force and by invariants.
+
+The particle model the light is computed for: particle j's optical depth across the sun's
+rays is a Gaussian of width sigma_j = 0.4 radius_j, cut at 3 sigma, with peak
+Li2(1 - exp(-extinction x density_j)) (the shadow of SkyWorks' splat). With scattering off
+a particle's light is exp(-tau), tau summed over the particles nearer the sun; with
+scattering on, each particle passes on F (1 - e^-depth) of the light at its own centre
+(Harris's recurrence, report eq. 3.12).
+"""
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+from scipy import special, stats
+
+import fishgen.clouds.light as light_module
+from fishgen.clouds import Cloud, Lighting, export_cloud, fill_cloud, light_cloud, load_cubes, merge_clouds
+from fishgen.clouds.light import incident_light, lit_colors, peak_optical_depth
+from fishgen.clouds.lighting import EXTRAS_KEY, from_extras
+from fishgen.errors import FishgenError
+
+from cloud_tables import TABLES
+
+SUNS = {"above": (0.35, 1.0, 0.55), "side": (1.0, 0.2, 0.0), "below": (0.2, -1.0, 0.3)}
+
+
+def random_cloud(n=300, seed=3, radii=(1.0, 2.0), box=(8.0, 4.0, 6.0)):
+    """Particles whose widths the light grid resolves (radii within a factor 2)."""
+    rng = np.random.default_rng(seed)
+    return (rng.random((n, 3)) * box).astype(np.float32), \
+        rng.uniform(*radii, n).astype(np.float32), rng.uniform(0.05, 1, n).astype(np.float32)
+
+
+def brute_force(centers, radii, density, lighting):
+    """(light, tau) per particle by Harris's recurrence over every pair, in float64."""
+    sun = np.array(lighting.sun_unit)
+    p = centers.astype(np.float64)
+    order = np.argsort(-(p @ sun), kind="stable")
+    p, sigma = p[order], 0.4 * radii[order].astype(np.float64)
+    peak = special.spence(np.exp(-density[order].astype(np.float64) * lighting.extinction))  # Li2(1 - e^-x)
+    f = lighting.forward_fraction
+    n = len(p)
+    got, tau = np.empty(n), np.empty(n)
+    for i in range(n):
+        q = p[i] - p[:i]
+        q -= np.outer(q @ sun, sun)
+        r2 = (q * q).sum(axis=1)
+        depth = np.where(r2 <= 9 * sigma[:i] ** 2, peak[:i] * np.exp(-r2 / (2 * sigma[:i] ** 2)), 0.0)
+        keep = np.exp(-depth)
+        after = np.append(np.cumprod(keep[::-1])[::-1][1:], 1.0) if i else np.ones(0)
+        got[i] = keep.prod() + (f * (1 - keep) * got[:i] * after).sum()
+        tau[i] = depth.sum()
+    out_light, out_tau = np.empty(n), np.empty(n)
+    out_light[order], out_tau[order] = got, tau
+    return out_light, out_tau
+
+
+def luminance(colors: np.ndarray) -> np.ndarray:
+    from fishgen.numeric import srgb_to_linear
+
+    return srgb_to_linear(colors / 255.0) @ np.array([0.2126, 0.7152, 0.0722])
+
+
+# -- against brute force ----------------------------------------------------------------------
+
+def test_peak_depth_is_the_shadow_of_skyworks_splat():
+    d = np.linspace(0, 1, 101)
+    np.testing.assert_allclose(peak_optical_depth(d, 80.0), special.spence(np.exp(-80 * d)), atol=1e-12)
+    assert peak_optical_depth([1.0], 80.0)[0] == pytest.approx(math.pi**2 / 6)       # opaque: Li2(1)
+    assert peak_optical_depth([0.5], 1e-3)[0] == pytest.approx(0.5e-3, rel=1e-3)     # faint: ext x density
+
+
+@pytest.mark.parametrize("sun", sorted(SUNS))
+@pytest.mark.parametrize("extinction", [80.0, 2.0])
+def test_scattering_off_gives_exp_minus_tau_exactly(sun, extinction):
+    centers, radii, density = random_cloud()
+    lighting = Lighting(sun=SUNS[sun], extinction=extinction, scattering=False)
+    got = incident_light(centers, radii, density, lighting)
+    _, tau = brute_force(centers, radii, density, lighting)
+    err = got - np.exp(-tau)
+    assert np.abs(err).max() < 0.03 and np.sqrt((err**2).mean()) < 0.005   # the grid's interpolation
+
+
+def test_a_finer_grid_converges_on_the_reference(monkeypatch):
+    centers, radii, density = random_cloud()
+    lighting = Lighting(sun=SUNS["above"], scattering=False)
+    _, tau = brute_force(centers, radii, density, lighting)
+    errors = []
+    for cells in (2.5, 6.0):
+        monkeypatch.setattr(light_module, "CELLS_PER_SIGMA", cells)
+        monkeypatch.setattr(light_module, "FINE_GRID", 1024)
+        err = incident_light(centers, radii, density, lighting) - np.exp(-tau)
+        errors.append(np.sqrt((err**2).mean()))
+    assert errors[1] < errors[0] / 2
+
+
+@pytest.mark.parametrize("sun", sorted(SUNS))
+def test_scattering_on_follows_harris_recurrence(sun):
+    centers, radii, density = random_cloud()
+    lighting = Lighting(sun=SUNS[sun])
+    got = incident_light(centers, radii, density, lighting)
+    want, _ = brute_force(centers, radii, density, lighting)
+    err = got - want
+    assert np.abs(err).max() < 0.05 and np.sqrt((err**2).mean()) < 0.01
+
+
+# -- invariants -------------------------------------------------------------------------------
+
+def test_a_lone_particle_and_particles_side_by_side_get_the_full_sun():
+    one = incident_light(np.zeros((1, 3), np.float32), np.ones(1, np.float32), np.ones(1, np.float32))
+    assert one.tolist() == [1.0]
+    # a row across the sun's rays, 3 radii apart: nobody shadows anybody
+    row = np.stack([np.arange(20) * 3.0, np.zeros(20), np.zeros(20)], axis=1).astype(np.float32)
+    lit = incident_light(row, np.ones(20, np.float32), np.ones(20, np.float32), Lighting(sun=(0, 1, 0)))
+    assert (lit == 1).all()
+
+
+@pytest.mark.parametrize("small", [True, False], ids=["one by one", "slabs"])
+def test_input_order_changes_nothing(small, monkeypatch):
+    if not small:
+        monkeypatch.setattr(light_module, "SMALL", 0)
+    centers, radii, density = random_cloud(n=2000, box=(20, 10, 15))
+    lighting = Lighting(sun=SUNS["side"])
+    a = incident_light(centers, radii, density, lighting)
+    shuffle = np.random.default_rng(1).permutation(len(a))
+    b = incident_light(centers[shuffle], radii[shuffle], density[shuffle], lighting)
+    if small:
+        np.testing.assert_array_equal(b, a[shuffle])
+    else:  # the slabs' sums run in another order: float32 rounding only
+        np.testing.assert_allclose(b, a[shuffle], atol=1e-5)
+
+
+def _rotation(axis, angle):
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * k @ k
+
+
+def test_moving_cloud_and_sun_together_changes_nothing():
+    centers, radii, density = random_cloud()
+    sun = np.array(SUNS["above"])
+    base = incident_light(centers, radii, density, Lighting(sun=tuple(sun)))
+    moved = incident_light(centers + np.float32([100, -40, 7]), radii, density, Lighting(sun=tuple(sun)))
+    np.testing.assert_allclose(moved, base, atol=1e-4)
+    for axis, angle in (((0, 0, 1), 0.7), ((1, 2, 3), 2.1)):
+        r = _rotation(axis, angle)
+        turned = incident_light((centers @ r.T).astype(np.float32), radii, density, Lighting(sun=tuple(r @ sun)))
+        err = turned - base   # the grid turns with the sun, not with the cloud: interpolation only
+        assert np.abs(err).max() < 0.05 and np.sqrt((err**2).mean()) < 0.01
+
+
+@pytest.mark.parametrize("small", [True, False], ids=["one by one", "slabs"])
+def test_scattering_only_adds_light_and_light_never_exceeds_the_sun(small, monkeypatch):
+    if not small:
+        monkeypatch.setattr(light_module, "SMALL", 0)
+    cloud = fill_cloud(load_cubes(TABLES["4.2"]), seed=5)
+    for sun in SUNS.values():
+        for albedo, extinction in ((0.9, 80.0), (1.0, 1000.0), (0.3, 0.5)):
+            kw = dict(sun=sun, albedo=albedo, extinction=extinction)
+            off = incident_light(cloud.centers, cloud.radii, cloud.density, Lighting(**kw, scattering=False))
+            on = incident_light(cloud.centers, cloud.radii, cloud.density, Lighting(**kw))
+            assert (on >= off).all()
+            assert (off >= 0).all() and (on <= 1).all()
+            assert on.mean() > off.mean() or Lighting(**kw).forward_fraction == 0
+
+
+@pytest.mark.parametrize("sun", sorted(SUNS))
+def test_luminance_falls_with_optical_depth_towards_the_sun(sun):
+    """Colour is light: under a sun from above, the side or below, the particles deeper in the
+    cloud as the sun sees it are darker (the height gradient this replaced ranked at 0.37).
+
+    The colour's luminance is taken in linear light, before it is stored as sRGB bytes: the
+    bytes keep the order but tie the particles deep in shadow (light 1e-3 is a tenth of a byte)."""
+    cloud = fill_cloud(load_cubes(TABLES["4.4"]), seed=0)
+    lighting = Lighting(sun=SUNS[sun])
+    lit = light_cloud(cloud, lighting)
+    _, tau = brute_force(cloud.centers, cloud.radii, cloud.density, lighting)
+    linear = lighting.albedo * (np.array(lighting.sky_color) + np.array(lighting.sun_color) * lit.light[:, None])
+    assert stats.spearmanr(linear @ [0.2126, 0.7152, 0.0722], tau).statistic < -0.8
+    order = np.argsort(lit.light)
+    assert (np.diff(luminance(lit.colors)[order]) >= 0).all()      # the bytes never invert it
+
+
+def test_a_high_sun_leaves_the_base_darker_than_the_top():
+    lit = light_cloud(fill_cloud(load_cubes(TABLES["4.4"]), seed=3), Lighting(sun=(0, 1, 0)))
+    y = lit.centers[:, 1]
+    bright = luminance(lit.colors)
+    assert bright[y < np.quantile(y, 0.2)].mean() + 0.2 < bright[y > np.quantile(y, 0.8)].mean()
+
+
+def test_a_big_cloud_in_slabs_agrees_with_the_exact_recurrence(monkeypatch):
+    cloud = fill_cloud(load_cubes(TABLES["4.2"]), seed=1)
+    lighting = Lighting(sun=SUNS["side"])
+    exact = incident_light(cloud.centers, cloud.radii, cloud.density, lighting)
+    monkeypatch.setattr(light_module, "SMALL", 0)
+    slabs = incident_light(cloud.centers, cloud.radii, cloud.density, lighting)
+    assert stats.spearmanr(slabs, exact).statistic > 0.8
+    assert abs(slabs.mean() - exact.mean()) < 0.25 * exact.mean()
+
+
+def test_same_bytes_whatever_the_thread_count(monkeypatch):
+    cubes = load_cubes(TABLES["4.4"])
+    big = fill_cloud(cubes.__class__(cubes.path, 200_000, tuple(
+        c.__class__(c.particles * 300, c.size, c.centre, c.max_radius, c.line) for c in cubes.cubes)), seed=2)
+    one = fill_cloud(cubes, seed=2, workers=1)
+    two = fill_cloud(cubes, seed=2, workers=2)
+    assert light_cloud(one).light.tobytes() == light_cloud(two).light.tobytes()
+    assert light_cloud(big).light.tobytes() == light_cloud(big).light.tobytes()
+
+
+# -- the lit cloud and its files --------------------------------------------------------------
+
+def test_light_cloud_sets_light_lighting_and_colours():
+    cloud = fill_cloud(load_cubes(TABLES["4.3"]), seed=0)
+    lighting = Lighting(sun=(1, 0.3, 0), sky_color=(0.2, 0.3, 0.5))
+    lit = light_cloud(cloud, lighting)
+    assert cloud.light is None and (cloud.colors == 255).all()      # the input is left alone
+    assert lit.lighting == lighting and lit.light.dtype == np.float32
+    np.testing.assert_array_equal(lit.colors, lit_colors(lit.light, lighting))
+    ends = lit_colors(np.array([0.0, 1.0], np.float32), lighting)
+    from fishgen.numeric import linear_to_srgb
+    np.testing.assert_array_equal(ends[0], np.round(linear_to_srgb(0.9 * np.array([0.2, 0.3, 0.5])) * 255))
+    np.testing.assert_array_equal(ends[1], np.round(linear_to_srgb(0.9 * np.array([0.92, 1.0, 1.16])) * 255))
+    assert (lit_colors(np.ones(1, np.float32), Lighting()) >= 250).all()   # by default full sun is white
+    with pytest.raises(ValueError, match="go together"):
+        Cloud(cloud.centers, cloud.radii, cloud.density, cloud.colors, cloud.cube_index, cloud.cube_bounds,
+              light=lit.light)
+
+
+def test_merge_keeps_light_only_when_lit_alike():
+    a = light_cloud(fill_cloud(load_cubes(TABLES["4.3"]), seed=1))
+    b = light_cloud(fill_cloud(load_cubes(TABLES["4.4"]), seed=2, offset=(40, 0, 0)))
+    both = merge_clouds([a, b])
+    np.testing.assert_array_equal(both.light, np.concatenate([a.light, b.light]))
+    mixed = merge_clouds([a, light_cloud(b, Lighting(sun=(1, 0, 0)))])
+    assert mixed.light is None and mixed.lighting is None
+
+
+def test_glb_carries_the_light_and_the_sun(tmp_path, gltf_validator):
+    from fishgen.exchange.gltf_reader import read_gltf
+    from tests.clouds.test_clouds_export import accessor_array, glb_parts
+
+    lighting = Lighting(sun=(2, 0.6, 0))
+    lit = light_cloud(fill_cloud(load_cubes(TABLES["4.4"]), seed=0), lighting)
+    for billboards in (False, True):
+        path = tmp_path / f"lit{billboards}.glb"
+        export_cloud(lit, path, billboards=billboards)
+        gltf_validator(path)
+        doc, blob = glb_parts(path)
+        prim = doc["meshes"][0]["primitives"][0]
+        stored = accessor_array(doc, blob, prim["attributes"]["_LIGHT"], "<f4", 1)[:, 0]
+        np.testing.assert_array_equal(stored, np.repeat(lit.light, 12) if billboards else lit.light)
+        record = doc["scenes"][0]["extras"][EXTRAS_KEY]
+        np.testing.assert_allclose(record["sun"], np.array([2, 0.6, 0]) / math.hypot(2, 0.6), atol=1e-12)
+        back = from_extras(read_gltf(path).extras)   # what the preview and the viewer use
+        assert back == Lighting(sun=lighting.sun_unit)
+
+
+def test_unlit_files_stay_as_they_were(tmp_path):
+    """No light: no _LIGHT and no extras (fishgen clouds without lighting writes what it wrote)."""
+    cloud = fill_cloud(load_cubes(TABLES["4.3"]), seed=0)
+    export_cloud(cloud, tmp_path / "plain.glb")
+    from tests.clouds.test_clouds_export import glb_parts
+
+    doc, _ = glb_parts(tmp_path / "plain.glb")
+    assert "_LIGHT" not in doc["meshes"][0]["primitives"][0]["attributes"] and "extras" not in doc["scenes"][0]
+
+
+# -- the lighting parameters ------------------------------------------------------------------
+
+def test_defaults_are_skyworks_constants():
+    lighting = Lighting()
+    assert (lighting.albedo, lighting.extinction, lighting.solid_angle) == (0.9, 80.0, 0.09)
+    assert lighting.phase(1.0) == lighting.phase(-1.0) == pytest.approx(1.5)         # Rayleigh
+    assert lighting.forward_fraction == pytest.approx(0.9 * 80 * 1.5 * 0.09 / (4 * math.pi))
+    assert Lighting(scattering=False).forward_fraction == 0
+    for g in (0.0, 0.5, -0.3):  # the phase function averages 1 over the sphere
+        c = np.linspace(-1, 1, 20001)
+        values = [Lighting(anisotropy=g).phase(v) for v in c]
+        assert np.trapezoid(values, c) / 2 == pytest.approx(1.0, rel=1e-4)
+    sun = Lighting().sun_unit
+    assert sun[1] > 0.8 and math.isclose(sum(v * v for v in sun), 1.0)
+
+
+@pytest.mark.parametrize("kwargs,message", [
+    (dict(sun=(0, 0, 0)), "expected sun as X,Y,Z with three finite numbers within float32 range, not all 0, "
+                          "found (0, 0, 0)"),
+    (dict(sun=(1, float("nan"), 0)), "expected sun as X,Y,Z with three finite numbers"),
+    (dict(sun=(1, 2)), "expected sun as X,Y,Z with three finite numbers within float32 range, not all 0, "
+                       "found (1, 2)"),
+    (dict(albedo=1.5), "expected albedo as a number from 0 to 1, found 1.5"),
+    (dict(extinction=-1), "expected extinction as a number from 0 to 1000, found -1"),
+    (dict(solid_angle=0), "expected solid angle as a number from 0 to 12.5664, found 0"),
+    (dict(anisotropy=0.95), "expected anisotropy as a number from -0.9 to 0.9, found 0.95"),
+    (dict(sun_color=(1, 1, -1)), "expected sun color as R,G,B with three finite numbers from 0 to 10, found"),
+])
+def test_bad_lighting_is_one_line(kwargs, message):
+    with pytest.raises(FishgenError) as err:
+        Lighting(**kwargs)
+    assert str(err.value).startswith(message) and "\n" not in str(err.value)
+
+
+def test_every_field_is_an_option_declared_once():
+    from fishgen.options import declared
+
+    names = {f.name for f, _ in declared(Lighting)}
+    assert names == {"sun", "sun_color", "sky_color", "albedo", "extinction", "solid_angle", "anisotropy",
+                     "scattering"}
+    assert all(spec.help and spec.default == f.default for f, spec in declared(Lighting))
+
+
+def test_the_parameters_module_imports_no_numpy():
+    import subprocess
+    import sys
+
+    code = "import sys, fishgen.clouds.lighting; sys.exit('numpy' in sys.modules)"
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+
+
+def test_lighting_warns_about_nothing():
+    cloud = fill_cloud(load_cubes(TABLES["4.2"]), seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for sun in SUNS.values():
+            light_cloud(cloud, Lighting(sun=sun, extinction=0.0))
+            light_cloud(cloud, Lighting(sun=sun))
