@@ -193,7 +193,7 @@ def declared(record: type | Any) -> Iterator[tuple[Field, Option]]:
 def build(record: type[T], values: Mapping[str, Any]) -> T:
     """The record from option values keyed by field name (a group's options fill its record)."""
     given: dict[str, Any] = {}
-    for f in fields(record):
+    for f in fields(record):  # type: ignore[arg-type]  # an options record is a dataclass
         if GROUP in f.metadata:
             given[f.name] = build(f.metadata[GROUP], values)
         elif f.name in values:

@@ -155,7 +155,7 @@ def _job(where: Where, kind: str, nth: int, entry: dict[str, Any], folder: Path,
         if key in entry:
             value = check_value(spec, entry[key], fail_at(key))
             values[f.name] = Path(os.path.abspath(folder / value)) if spec.path else value
-    options = build(record, values)
+    options: Any = build(record, values)
     offsets = getattr(options, "offset", None)
     if offsets and len(offsets) != len(inputs):
         raise fail_at("offset")(f"one [x, y, z] per input ({len(inputs)})")
@@ -172,8 +172,14 @@ def _seeded(kind: str, options: Any, inputs: tuple[Path, ...], name: str) -> Any
 
 
 def scan_folder(folder: str | os.PathLike, out: str | os.PathLike) -> Manifest:
-    """Every species file (.txt) and cube file (.awn) under ``folder``, default options, as ``.glb``
-    in ``out`` at the same relative place. Hidden folders and ``out`` itself are not searched."""
+    """Every species file (.txt), cube file (.awn) and texture cloud (.awa) under ``folder``, default
+    options, as ``.glb`` in ``out`` at the same relative place. Hidden folders and ``out`` itself are
+    not searched."""
+    from fishgen.exchange.registry import FORMATS
+
+    # the source formats a single file makes an asset from: species files, cube and texture clouds
+    scanned = {ext: fmt.command for fmt in FORMATS.values() if fmt.command in ("build", "clouds")
+               for ext in fmt.extensions}
     root = Path(os.path.abspath(folder))
     out_dir = Path(os.path.abspath(out))
     jobs: list[Job] = []
@@ -184,7 +190,7 @@ def scan_folder(folder: str | os.PathLike, out: str | os.PathLike) -> Manifest:
         for filename in sorted(filenames):
             source = here / filename
             suffix = source.suffix.lower()
-            kind = {".txt": "build", ".awn": "clouds"}.get(suffix)
+            kind = scanned.get(suffix)
             if kind is None or filename.startswith("."):
                 continue
             name = source.relative_to(root).with_suffix(".glb").as_posix()
@@ -195,6 +201,7 @@ def scan_folder(folder: str | os.PathLike, out: str | os.PathLike) -> Manifest:
             options = _seeded(kind, command(kind).options(), (source,), name)
             jobs.append(Job(kind, name, (source,), out_dir / name, options, os.fspath(source)))
     if not jobs:
-        raise FishgenError("expected species files (.txt) or cube files (.awn) in the folder, found none",
+        raise FishgenError(f"expected species files or cube files ({', '.join(scanned)}) in the folder, "
+                           "found none",
                            folder)
     return Manifest(None, out_dir, tuple(jobs))

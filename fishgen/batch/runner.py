@@ -36,7 +36,7 @@ PRELOAD = {"build": _FISH,
            "school": [*_FISH, "fishgen.school.run", "fishgen.school.simulate", "fishgen.school.bake",
                       "fishgen.school.scene_file"],
            "clouds": ["fishgen.clouds.parser", "fishgen.clouds.fill", "fishgen.clouds.export",
-                      "fishgen.clouds.scene", "numpy.random"]}
+                      "fishgen.clouds.scene", "fishgen.clouds.light", "numpy.random", "numpy.fft"]}
 
 
 def preload(kinds: set[str]) -> list[str]:

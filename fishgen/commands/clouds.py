@@ -1,4 +1,4 @@
-"""`fishgen clouds`: cube files (.awn) to one particle cloud scene."""
+"""`fishgen clouds`: cube files (.awn) and texture clouds (.awa) to one lit cloud scene."""
 from __future__ import annotations
 
 import os
@@ -9,10 +9,13 @@ from pathlib import Path
 
 import click
 
+from fishgen.clouds.lighting import Lighting
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, METHODS
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
 from fishgen.exchange.registry import POINTS, extensions, formats
-from fishgen.options import Triple, option, seed_option
+from fishgen.options import Triple, group, option, seed_option, textures_option
+
+BILLBOARD_TRIANGLES = 6  # fishgen.clouds.scene.TRIANGLES_PER_BILLBOARD, without numpy (a test checks)
 
 
 @dataclass(frozen=True)
@@ -24,50 +27,73 @@ class CloudsOptions:
                                    shown_default="0; in a batch, derived from the output's name")
     method: str = option(click.Choice(METHODS), "paper: the report's sine phase shifts with rejection "
                          "(clumped); uniform: plain uniform positions and radii.", "paper")
-    billboards: bool = option(click.BOOL, "glTF only: one textured quad per particle (Gaussian alpha sprite, "
-                              "alpha blended) instead of points.", False, flag=True)
+    billboards: bool = option(click.BOOL,
+                              f"glTF only: three crossed quads per particle ({BILLBOARD_TRIANGLES} "
+                              "triangles, 12 vertices), an alpha-blended Gaussian sprite, instead of points; "
+                              "a texture cloud (.awa) is always billboards, with its PNGs.", False, flag=True)
     max_particles: int = option(click.IntRange(min=1), "Refuse scenes with more particles than this, "
                                 "before allocating anything.", DEFAULT_MAX_PARTICLES)
+    textures: Path | None = textures_option("a .awa file's folder, then the textures/ folder beside it (or "
+                                            "beside its parent)")
+    lighting: Lighting = group(Lighting)
 
 
 COMMAND = Command(
     name="clouds",
-    summary="Fill cloud cube files (.awn) with particles and export them.",
-    help="""Fill cloud cube files (.awn) with particles and export them.
+    summary="Fill cloud cube files (.awn, .awa) with particles, lit by the sun, and export them.",
+    help="""Fill cloud cube files (.awn, or texture clouds .awa) with particles, light them and export them.
 
     Each CUBES.awn file (RekAwan editor format: total particles, number of cubes,
     then per cube: particles, x y z size, centre x y z, maximum radius) becomes
-    one cloud; several files with --offset make one scene.
+    one cloud; several files with --offset make one scene. The scene is lit by the
+    sun as RekAwan's renderer lit it (Harris's multiple forward scattering, baked
+    into each particle's colour and its _LIGHT attribute). A texture cloud (.awa:
+    each cube line also names its PNG) becomes textured billboards.
 
     \b
     Examples:
       fishgen clouds params/clouds/table_4_3.awn -o out/cloud.ply
       fishgen clouds a.awn b.awn --offset 0,0,0 --offset 25,3,-10 -o out/sky.glb --billboards
+      fishgen clouds params/clouds/table_4_4.awn -o out/cloud.glb --billboards --sun 1,0.3,0
+      fishgen clouds params/clouds/sky.awa -o out/texture-sky.glb
     """,
     options=CloudsOptions,
     run="fishgen.commands.clouds:clouds",
-    inputs=Inputs("CUBES.awn..."),
+    inputs=Inputs("CUBES.awn|CLOUD.awa..."),
     output=Output(f"Output file; the extension picks the format: "
                   f"{', '.join(extensions(formats(writable=True, holding=[POINTS])))}.", holds=(POINTS,)),
     batch=True,
 )
 
 
-def clouds(inputs: Sequence[Path], output: str | os.PathLike,
-           options: CloudsOptions = CloudsOptions(),
+@dataclass(frozen=True)
+class CloudFacts:
+    particles: int
+    cubes: int
+    files: int
+    billboards: bool
+    lighting: Lighting
+
+
+def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOptions = CloudsOptions(),
            events: Events = QUIET) -> Made:
-    """Fill every cube file and write them as one scene; input i is filled with seed + i."""
-    inputs = tuple(Path(p) for p in inputs)
-    output = Path(output)
+    """Fill every cube file, light them together (so clouds shadow each other) and write them as one
+    scene; input i is filled with seed + i. A texture cloud (.awa) becomes textured billboards."""
     from fishgen.clouds.export import check_output, export_cloud
     from fishgen.clouds.fill import fill_cloud, merge_clouds
+    from fishgen.clouds.light import light_cloud
     from fishgen.clouds.parser import CubeFileWarning, load_cubes
     from fishgen.commands.paths import check_inputs, check_targets
     from fishgen.errors import UsageError
     from fishgen.exchange.registry import FORMATS
 
-    check_inputs(inputs, "clouds", [FORMATS["cubes"]], default=FORMATS["cubes"])
-    check_output(output, options.billboards)
+    inputs = tuple(Path(p) for p in inputs)
+    output = Path(output)
+    kinds = check_inputs(inputs, "clouds", [FORMATS["cubes"], FORMATS["texture cubes"]],
+                         default=FORMATS["cubes"])
+    textured = any(kind is FORMATS["texture cubes"] for kind in kinds)
+    billboards = options.billboards or (textured and output.suffix.lower() in (".glb", ".gltf"))
+    check_output(output, billboards)
     check_targets([output], inputs)
     if options.offset and len(options.offset) != len(inputs):
         raise UsageError(f"expected one --offset per input ({len(inputs)}), found {len(options.offset)}")
@@ -77,21 +103,30 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike,
     for path in inputs:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", CubeFileWarning)
-            files.append(load_cubes(path, max_particles=limit))
+            files.append(load_cubes(path, max_particles=limit, textures_dir=options.textures))
         for note in caught:
             events.note(str(note.message))
+    textures = list(dict.fromkeys(Path(c.texture) for f in files for c in f.cubes if c.texture))
+    if textures and not billboards:
+        events.note(f"{output}: {output.suffix.upper()[1:]} holds no textures; the billboards' centres are "
+                    "written as particles")
+    check_targets([output], textures)
     total = sum(f.total for f in files)
     if total > limit:
         raise UsageError(f"expected at most {limit:,} particles in the scene (raise the limit with "
                          f"--max-particles), found {total:,} in {len(files)} files")
-    check_output(output, options.billboards, particles=total)  # before filling: a glTF buffer holds 4 GiB
+    check_output(output, billboards, particles=total)  # before filling: a glTF buffer holds 4 GiB
     seed = options.seed or 0
     cloud = merge_clouds([fill_cloud(f, seed=seed + i, method=options.method, offset=place)
                           for i, (f, place) in enumerate(zip(files, places, strict=True))])
-    written = export_cloud(cloud, output, billboards=options.billboards)
-    line = (f"{output}: {len(cloud):,} particles in {_plural(len(cloud.cube_bounds), 'cube')} "
-            f"from {_plural(len(files), 'file')} ({options.method} fill, seed {seed})")
-    return Made(tuple(written), tuple(inputs), (line,), cloud)
+    cloud = light_cloud(cloud, options.lighting)
+    written = export_cloud(cloud, output, billboards=billboards)
+    sun = ",".join(f"{v:g}" for v in options.lighting.sun)
+    noun = "billboard" if textured else "particle"
+    line = (f"{output}: {_plural(len(cloud), noun)} in {_plural(len(cloud.cube_bounds), 'cube')} "
+            f"from {_plural(len(files), 'file')} ({options.method} fill, seed {seed}, sun {sun})")
+    facts = CloudFacts(len(cloud), len(cloud.cube_bounds), len(files), billboards, options.lighting)
+    return Made(tuple(written), (*inputs, *textures), (line,), facts)
 
 
 def _plural(count: int, noun: str) -> str:

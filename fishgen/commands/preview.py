@@ -9,8 +9,9 @@ from pathlib import Path
 
 import click
 
+from fishgen.clouds.lighting import Lighting
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
-from fishgen.options import Colour, FiniteRange, Size, option, seed_option, textures_option
+from fishgen.options import Colour, FiniteRange, Size, group, option, seed_option, textures_option
 
 VIEW_NAMES = ("side", "top", "front", "three-quarter")  # fishgen.preview.camera.VIEWS, without numpy
 
@@ -42,6 +43,7 @@ class PreviewCommandOptions:
                                  shown_default="about a square grid", metavar="N")
     seed: int = seed_option("Fills .awn cube files as `fishgen clouds` does.")
     textures: Path | None = textures_option("as `fishgen build` resolves them")
+    lighting: Lighting = group(Lighting)
     ortho: bool = option(click.BOOL,
                          "Orthographic camera: no perspective, e.g. a side view to use as a photo "
                          "for `fishgen texture`.", False, flag=True)
@@ -87,7 +89,8 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
     settings = PreviewOptions(view=options.view, width=width, height=height, time=options.time,
                               background=options.background, frames=options.frames, fps=options.fps,
                               duration=options.duration, columns=options.columns, clip=options.clip,
-                              seed=options.seed, textures_dir=options.textures, ortho=options.ortho)
+                              seed=options.seed, textures_dir=options.textures, ortho=options.ortho,
+                              lighting=options.lighting)
     with ExitStack() as stack:
         bar: list = []
 

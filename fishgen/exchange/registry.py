@@ -60,8 +60,9 @@ class Format:
 
 
 FORMATS: dict[str, Format] = {}
-READER_OPTIONS = ("textures_dir", "seed")
-"""What a caller may offer readers: a species file's texture folder, a cube file's fill seed."""
+READER_OPTIONS = ("textures_dir", "seed", "lighting")
+"""What a caller may offer readers: a species file's (or texture cloud's) texture folder, a cube
+file's fill seed, and the sunlight a cloud is lit with (:class:`fishgen.clouds.lighting.Lighting`)."""
 
 
 def register_format(fmt: Format) -> Format:
@@ -194,4 +195,9 @@ register_format(Format("school scene", (".toml",), "a school scene file", frozen
 register_format(Format("batch manifest", (".toml",), "a batch manifest", command="batch",
                        sniff="fishgen.tomlfile:is_batch_manifest"))
 register_format(Format("cubes", (".awn",), "a RekAwan cloud cube file", frozenset({POINTS}),
-                       reader="fishgen.clouds.scene:cube_file_scene", command="clouds", reads_with=("seed",)))
+                       reader="fishgen.clouds.scene:cube_file_scene", command="clouds",
+                       reads_with=("seed", "lighting")))
+register_format(Format("texture cubes", (".awa",), "a RekAwan texture cloud file", frozenset({MESHES,
+                                                                                             TEXTURES}),
+                       reader="fishgen.clouds.scene:cube_file_scene", command="clouds",
+                       reads_with=("seed", "lighting", "textures_dir")))

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 from fishgen.errors import FishgenError
 from fishgen.exchange.registry import formats, input_format
@@ -15,7 +16,7 @@ def input_formats():
 
 
 def load_input(path: str | os.PathLike, *, textures_dir: str | os.PathLike | None = None,
-               seed: int = 0) -> Scene:
+               seed: int = 0, lighting: Any = None) -> Scene:
     """Load a species file, a cube file or an asset; species and cube files are built in memory."""
     path = Path(path)
     fmt = input_format(path, kinds=input_formats(), command="preview")
@@ -23,4 +24,4 @@ def load_input(path: str | os.PathLike, *, textures_dir: str | os.PathLike | Non
         raise FishgenError("expected a file, found a directory", path)
     if not path.is_file():
         raise FishgenError("expected an existing file, found none", path)
-    return fmt.read(path, textures_dir=textures_dir, seed=seed)
+    return fmt.read(path, textures_dir=textures_dir, seed=seed, lighting=lighting)

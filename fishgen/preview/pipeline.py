@@ -12,12 +12,16 @@ import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from fishgen.errors import FishgenError
 from fishgen.preview.camera import VIEWS, frame, turned
 from fishgen.scene.model import Scene
+
+if TYPE_CHECKING:
+    from fishgen.clouds.lighting import Lighting
 
 OUTPUTS = (".png", ".webp", ".gif", ".jpg", ".jpeg")
 ANIMATED = (".gif", ".webp")
@@ -53,6 +57,7 @@ class PreviewOptions:
     seed: int = 0
     textures_dir: str | os.PathLike | None = None
     ortho: bool = False                # orthographic camera (no perspective)
+    lighting: Lighting | None = None   # the sun cube files are lit by (None: the default sun)
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -255,7 +260,8 @@ def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options
     if not inputs:
         raise FishgenError("expected at least one input, found none")
     frames = check_output(out, options, len(inputs))
-    scenes = [load_input(p, textures_dir=options.textures_dir, seed=options.seed) for p in inputs]
+    scenes = [load_input(p, textures_dir=options.textures_dir, seed=options.seed, lighting=options.lighting)
+              for p in inputs]
     for scene in scenes:  # e.g. a cloud previewed with fewer particles than it holds
         if on_note and scene.note:
             on_note(scene.note)

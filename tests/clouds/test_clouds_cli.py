@@ -7,8 +7,9 @@ import sys
 import numpy as np
 import pytest
 import trimesh
-
 from cloud_tables import TABLES, TOTALS
+
+from tests.conftest import PARAMS
 
 
 def assert_one_line_error(result, startswith):
@@ -169,3 +170,36 @@ def test_glb_too_large_for_4_gib_is_refused_before_filling(cli, tmp_path, billbo
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert "4 GiB buffer limit" in result.stderr and f"found {count:,}" in result.stderr
     assert list(tmp_path.iterdir()) == [cubes]
+
+
+def test_the_sun_option_moves_the_light(cli, tmp_path):
+    """Issue 20: lit from the side, the side towards the sun is the bright one."""
+    import numpy as np
+
+    for name, sun in (("right.npy", "1,0.2,0"), ("left.npy", "-1,0.2,0")):
+        assert cli("clouds", TABLES["4.4"], "-o", tmp_path / name, "--sun", sun).returncode == 0
+    for name, sign in (("right.npy", 1), ("left.npy", -1)):
+        cloud = np.load(tmp_path / name)
+        luminance = cloud["red"].astype(float) + cloud["green"] + cloud["blue"]
+        facing = sign * cloud["x"] > np.median(sign * cloud["x"])
+        assert luminance[facing].mean() > luminance[~facing].mean() + 20
+
+
+def test_a_texture_cloud_makes_textured_billboards_and_says_what_ply_drops(cli, tmp_path, gltf_validator):
+    sky = PARAMS / "clouds" / "sky.awa"
+    made = cli("clouds", sky, "-o", tmp_path / "sky.glb")
+    assert made.returncode == 0 and "60 billboards in 6 cubes" in made.stdout
+    gltf_validator(tmp_path / "sky.glb")
+    from fishgen.exchange.gltf_reader import read_gltf
+
+    scene = read_gltf(tmp_path / "sky.glb")
+    assert len(scene.images) == 3 and scene.counts()["triangles"] == 60 * 6
+    flat = cli("clouds", sky, "-o", tmp_path / "sky.ply")
+    assert flat.returncode == 0 and "PLY holds no textures" in flat.stderr
+
+
+def test_the_billboard_help_says_its_triangles():
+    from fishgen.clouds.scene import TRIANGLES_PER_BILLBOARD
+    from fishgen.commands.clouds import BILLBOARD_TRIANGLES
+
+    assert BILLBOARD_TRIANGLES == TRIANGLES_PER_BILLBOARD
