@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
-"""Bundle the viewer (fishgen/viewer/app.js + the parts of three.js it uses) into one minified file.
+"""Bundle each of fishgen's pages (its app.js + the parts of three.js it uses) into one minified file.
 
-Run after `npm ci` whenever app.js or package.json (three's or esbuild's version) changes:
+Run after `npm ci` whenever a page's app.js or package.json (three's or esbuild's version) changes:
 
-    python tools/bundle_viewer.py                 # writes fishgen/viewer/static/
+    python tools/bundle_viewer.py                 # every page: writes fishgen/<page>/static/
+    python tools/bundle_viewer.py --page viewer   # one page
     python tools/bundle_viewer.py --check         # exit 1 unless a rebuild gives the committed bytes
-    python tools/bundle_viewer.py --check-hashes  # no node needed: exit 1 if the committed bundle
-                                                  # or app.js differ from what manifest.json records
+    python tools/bundle_viewer.py --check-hashes  # no node needed: exit 1 if a committed bundle
+                                                  # or its app.js differ from what manifest.json records
+
+The pages are listed in PAGES: a new page is one line there.
 
 esbuild (pinned in package.json) resolves app.js's imports (`three`,
 `three/addons/...`) in node_modules, drops what the viewer never calls, and
@@ -29,9 +32,11 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 NODE_MODULES = ROOT / "node_modules"
-STATIC = ROOT / "fishgen" / "viewer" / "static"
-ENTRY = "fishgen/viewer/app.js"
-BUNDLE = "viewer.min.js"
+#: page -> (its entry module, the folder its bundle is committed in, the bundle's file name)
+PAGES = {
+    "viewer": ("fishgen/viewer/app.js", ROOT / "fishgen" / "viewer" / "static", "viewer.min.js"),
+}
+STATIC = PAGES["viewer"][1]
 LICENSE = "THREE-LICENSE"
 # Fixed options, so the same inputs and esbuild version give the same bytes.
 OPTIONS = ["--bundle", "--format=esm", "--minify", "--target=es2022", "--charset=ascii",
@@ -48,12 +53,13 @@ def _version(package: str) -> str:
     return json.loads((NODE_MODULES / package / "package.json").read_text())["version"]
 
 
-def build() -> dict[str, bytes]:
-    """File name in static/ -> contents: the bundle, three's licence and the manifest."""
+def build(page: str = "viewer") -> dict[str, bytes]:
+    """File name in the page's static/ -> contents: the bundle, three's licence and the manifest."""
+    entry, _, bundle_name = PAGES[page]
     esbuild = NODE_MODULES / ".bin" / "esbuild"
     with tempfile.TemporaryDirectory() as tmp:
-        out, meta = Path(tmp) / BUNDLE, Path(tmp) / "meta.json"
-        run = subprocess.run([str(esbuild), ENTRY, *OPTIONS, f"--outfile={out}", f"--metafile={meta}"],
+        out, meta = Path(tmp) / bundle_name, Path(tmp) / "meta.json"
+        run = subprocess.run([str(esbuild), entry, *OPTIONS, f"--outfile={out}", f"--metafile={meta}"],
                              cwd=ROOT, capture_output=True, text=True)
         if run.returncode != 0:
             raise SystemExit(f"esbuild failed:\n{run.stderr}")
@@ -66,14 +72,14 @@ def build() -> dict[str, bytes]:
         raise SystemExit(f"the bundle contains {unsafe[0]!r}, which cannot sit inside a <script> element")
     licence = (NODE_MODULES / "three" / "LICENSE").read_bytes()
     manifest = {
-        "bundle": {"file": BUNDLE, "bytes": len(bundle), "sha256": _sha256(bundle)},
-        "entry": ENTRY,
+        "bundle": {"file": bundle_name, "bytes": len(bundle), "sha256": _sha256(bundle)},
+        "entry": entry,
         "tools": {"esbuild": _version("esbuild"), "three": _version("three")},
         "options": OPTIONS,
         "inputs": {name: _sha256((ROOT / name).read_bytes()) for name in inputs},
         "license": {"file": LICENSE, "from": "node_modules/three/LICENSE", "sha256": _sha256(licence)},
     }
-    return {BUNDLE: bundle, LICENSE: licence,
+    return {bundle_name: bundle, LICENSE: licence,
             "manifest.json": (json.dumps(manifest, indent=1) + "\n").encode()}
 
 
@@ -109,34 +115,47 @@ def main() -> int:
                       help="rebuild in memory and compare with the committed files (needs npm ci)")
     mode.add_argument("--check-hashes", action="store_true",
                       help="compare the committed files and app.js with manifest.json (no node needed)")
-    parser.add_argument("--static", type=Path, default=STATIC, help=argparse.SUPPRESS)  # for tests
+    parser.add_argument("--page", choices=sorted(PAGES), action="append", help="a page (default: every page)")
+    parser.add_argument("--static", type=Path, default=None, help=argparse.SUPPRESS)  # for tests: one page
     args = parser.parse_args()
-    if args.check_hashes:
-        problems = check_hashes(args.static)
+    pages = args.page or sorted(PAGES)
+    if args.static is not None and len(pages) != 1:
+        pages = ["viewer"]
+    status = 0
+    for page in pages:
+        static = args.static or PAGES[page][1]
+        status = max(status, _one(page, static, args.check, args.check_hashes))
+    return status
+
+
+def _one(page: str, static: Path, check: bool, hashes_only: bool) -> int:
+    if hashes_only:
+        problems = check_hashes(static)
         for problem in problems:
-            print(f"stale: {problem}", file=sys.stderr)
+            print(f"stale: {page}: {problem}", file=sys.stderr)
         return 1 if problems else 0
     if not (NODE_MODULES / ".bin" / "esbuild").exists() or not (NODE_MODULES / "three").is_dir():
         print("node_modules/esbuild or node_modules/three is missing: run `npm ci` in the project root",
               file=sys.stderr)
         return 2
-    files = build()
-    if args.check:
-        problems = check_hashes(args.static)
+    files = build(page)
+    if check:
+        problems = check_hashes(static)
         problems += [f"{name} is not what a rebuild gives" for name, data in files.items()
-                     if not (args.static / name).is_file() or (args.static / name).read_bytes() != data]
+                     if not (static / name).is_file() or (static / name).read_bytes() != data]
         for problem in problems:
-            print(f"stale: {problem}", file=sys.stderr)
+            print(f"stale: {page}: {problem}", file=sys.stderr)
         return 1 if problems else 0
-    args.static.mkdir(parents=True, exist_ok=True)
-    for old in args.static.iterdir():
+    static.mkdir(parents=True, exist_ok=True)
+    for old in static.iterdir():
         if old.is_file() and old.name not in files:
             old.unlink()  # modules of an older layout, say
     for name, data in files.items():
-        (args.static / name).write_bytes(data)
+        (static / name).write_bytes(data)
     manifest = json.loads(files["manifest.json"])
-    print(f"bundled {ENTRY} with three {manifest['tools']['three']} (esbuild {manifest['tools']['esbuild']}): "
-          f"{len(files[BUNDLE]):,} bytes in {args.static.relative_to(ROOT) if args.static.is_relative_to(ROOT) else args.static}")
+    shown = static.relative_to(ROOT) if static.is_relative_to(ROOT) else static
+    print(f"bundled {PAGES[page][0]} with three {manifest['tools']['three']} (esbuild "
+          f"{manifest['tools']['esbuild']}): {len(files[PAGES[page][2]]):,} bytes in {shown}")
     return 0
 
 
