@@ -14,12 +14,12 @@ from __future__ import annotations
 import hmac
 import json
 import secrets
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from typing import Any
-from urllib.parse import parse_qs, urlsplit
+from urllib.parse import parse_qs, unquote, urlsplit
 
 HOST = "127.0.0.1"
 MAX_BODY = 16 << 20
@@ -76,7 +76,7 @@ class LocalServer(ThreadingHTTPServer):
 
     daemon_threads = True
 
-    def __init__(self, routes: dict[tuple[str, str], Route], port: int = 0, max_body: int = MAX_BODY,
+    def __init__(self, routes: Mapping[tuple[str, str], Route], port: int = 0, max_body: int = MAX_BODY,
                  token: str | None = None, timeout: float = TIMEOUT):
         self.routes = dict(routes)
         self.max_body = max_body
@@ -159,10 +159,11 @@ class _Handler(BaseHTTPRequestHandler):
         given = self.headers.get("X-Fishgen-Token") or query.get("token") or ""
         if not hmac.compare_digest(given.encode("utf-8", "replace"), self.server.token.encode()):
             raise Refused(HTTPStatus.FORBIDDEN, "expected this run's token, found none or another")
-        route = self.server.routes.get(("GET" if method == "HEAD" else method, parts.path))
+        path = unquote(parts.path)  # routes are exact names: a decoded `..` matches none
+        route = self.server.routes.get(("GET" if method == "HEAD" else method, path))
         if route is None:
-            raise Refused(HTTPStatus.NOT_FOUND, f"no {method} {parts.path}")
-        return route(Request(method, parts.path, query, self._body()))
+            raise Refused(HTTPStatus.NOT_FOUND, f"no {method} {path[:100]}")
+        return route(Request(method, path, query, self._body()))
 
     def _body(self) -> bytes:
         length = self.headers.get("Content-Length")

@@ -88,8 +88,9 @@ def test_inline_subfolder_and_percent_encoded_references_are_embedded(nest):
 class _Served:
     """Where a running `fishgen view` listens."""
 
-    def __init__(self, port: int):
+    def __init__(self, port: int, token: str):
         self.server_address = ("127.0.0.1", port)
+        self.token = token
 
 
 @pytest.fixture
@@ -112,14 +113,16 @@ def server(tmp_path, viewer_assets):
                 url = line.split()[1]
                 break
         assert url is not None, proc.stderr.read()
-        yield _Served(int(url.split(":")[2].split("/")[0])), page
+        yield _Served(int(url.split(":")[2].split("/")[0]), url.split("token=")[1]), page
     finally:
         proc.terminate()
         proc.wait(timeout=10)
 
 
-def _get(srv, path, host=None, method="GET"):
+def _get(srv, path, host=None, method="GET", token=True):
     conn = http.client.HTTPConnection("127.0.0.1", srv.server_address[1], timeout=10)
+    if token:
+        path += ("&" if "?" in path else "?") + f"token={srv.token}"
     try:
         conn.putrequest(method, path, skip_host=True)
         if host is not False:
@@ -148,6 +151,13 @@ def test_server_serves_nothing_else_from_the_folder(server, path):
     srv, _ = server
     status, body = _get(srv, path)
     assert status == 404 and SECRET not in body and b"Directory listing" not in body
+
+
+def test_server_refuses_a_request_without_this_runs_token(server):
+    srv, page = server
+    for path in ("/", "/?token=", "/?token=" + srv.token[:-1] + "A"):
+        status, body = _get(srv, path, token=False)
+        assert status == 403 and page.read_bytes()[:200] not in body, path
 
 
 @pytest.mark.parametrize("host", ["evil.example:{port}", "127.0.0.1", "localhost:1", "127.0.0.1.nip.io:{port}",
