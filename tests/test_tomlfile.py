@@ -46,3 +46,13 @@ def test_loads_reports_the_line_of_a_syntax_error():
     with pytest.raises(FishgenError) as err:
         loads('a = 1\nb = = 2\n', "bad.toml")
     assert str(err.value).startswith("bad.toml:2: expected TOML, found ")
+
+
+def test_an_integer_of_thousands_of_digits_is_one_line_at_its_place():
+    """Issue 26, fault 6: Python's int-string limit raised a traceback from inside tomllib."""
+    from fishgen.errors import FishgenError
+    from fishgen.tomlfile import loads
+
+    with pytest.raises(FishgenError) as caught:
+        loads('out = "o"\n\nframes = ' + "9" * 5000 + "\n", "m.toml")
+    assert str(caught.value) == "m.toml:3: expected a number of at most a few hundred digits, found one of 5000 digits"

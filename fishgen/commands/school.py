@@ -165,19 +165,24 @@ def _write_all(output: Path, run, sides: dict[str, Path], per_frame: dict, numbe
 
 def _metrics_json(run, per_frame: dict, numbers: dict, warmup: int) -> bytes:
     import json
+    import math
 
     import numpy as np
 
     def plain(value: Any) -> Any:
+        """JSON values; a measure that has no value (NaN: a one-fish species' neighbour distance) or
+        none finite is null, since strict JSON parsers refuse NaN and Infinity."""
         if isinstance(value, dict):
             return {str(k): plain(v) for k, v in value.items()}
         if isinstance(value, np.ndarray):
-            return np.round(value.astype(float), 6).tolist()
-        if isinstance(value, (np.floating, np.integer)):
-            return value.item()
+            rounded = np.round(value.astype(float), 6)
+            return np.where(np.isfinite(rounded), rounded, None).tolist()
+        if isinstance(value, (np.floating, np.integer, float)):
+            number = float(value)
+            return number if math.isfinite(number) else None
         return value
 
     doc = {"species": run.species_names, "fps": run.config.fps, "frames": run.config.frames,
            "model": run.config.model, "warmup_frames": warmup, "summary": plain(numbers),
            "per_frame": plain(per_frame)}
-    return json.dumps(doc, indent=1, sort_keys=True).encode("utf-8")
+    return json.dumps(doc, indent=1, sort_keys=True, allow_nan=False).encode("utf-8")

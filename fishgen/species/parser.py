@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import stat
 import unicodedata
 from collections.abc import Callable, Sequence
@@ -114,11 +115,20 @@ def _found_values(line: _Line) -> str:
     return f"{len(tokens)} value{'s' if len(tokens) != 1 else ''} {shown!r}{hint}"
 
 
+# The number forms the thesis' files use, ASCII only: Python's float() also takes "1_0.0",
+# full-width digits ("８") and "nan", which a species file never holds (as the cube parser does).
+_REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+_BLOCK = re.compile(r"[0-9eE+\-. ]*")
+
+
+def _real(token: str) -> float | None:
+    """The number a token writes in the file's number forms, else None."""
+    return float(token) if _REAL.fullmatch(token) else None
+
+
 def _is_number(token: str) -> bool:
-    try:
-        return math.isfinite(float(token))
-    except ValueError:
-        return False
+    value = _real(token)
+    return value is not None and math.isfinite(value)
 
 
 class _Fields:
@@ -134,10 +144,9 @@ class _Fields:
 
     def number(self, i: int, low: float = -MAX_MAGNITUDE, high: float = MAX_MAGNITUDE,
                open_low: bool = False) -> float:
-        try:
-            value = float(self.tokens[i])
-        except ValueError:
-            raise self._fail(i, "a number") from None
+        value = _real(self.tokens[i])
+        if value is None:
+            raise self._fail(i, "a finite number" if self.tokens[i].lower() in _NOT_WORDS else "a number")
         if not math.isfinite(value):
             raise self._fail(i, "a finite number")
         if value < low or (open_low and value == low) or value > high:
@@ -146,11 +155,8 @@ class _Fields:
         return value
 
     def whole(self, i: int, low: int = 0, high: int | None = None, what: str = "a whole number") -> int:
-        try:
-            value = float(self.tokens[i])
-        except ValueError:
-            raise self._fail(i, what) from None
-        if not math.isfinite(value) or value != int(value):
+        value = _real(self.tokens[i])
+        if value is None or not math.isfinite(value) or value != int(value):
             raise self._fail(i, what)
         value = int(value)
         if value < low or (high is not None and value > high):
@@ -247,8 +253,11 @@ def _body_points_fast(reader: _Reader, bodies: int, circles: int):
     block = reader.lines[reader.pos:reader.pos + n]
     if len(block) < n:
         return None
+    joined = " ".join(line.text for line in block)
+    if not _BLOCK.fullmatch(joined):  # numpy reads "1_0" and full-width digits too: the slow path says where
+        return None
     try:
-        values = np.array(" ".join(line.text for line in block).split(), dtype=np.float64)
+        values = np.array(joined.split(), dtype=np.float64)
     except ValueError:
         return None
     if values.size != 4 * n:
@@ -401,7 +410,7 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
 
 
 def _check_motion(reader: _Reader, line: _Line, f: _Fields, angle: int, step: int) -> None:
-    if float(f.tokens[angle]) > 0 and float(f.tokens[step]) <= 0:
+    if float(f.tokens[angle]) > 0 and float(f.tokens[step]) <= 0:  # both checked numbers above
         raise f._fail(step, "a step size > 0 (the fin has a movement angle)")
 
 

@@ -69,3 +69,19 @@ def test_absurd_sizes_are_refused_before_anything_is_built(tmp_path):
 def test_a_scene_file_given_to_build_names_the_school_command(tmp_path):
     result = run_cli("build", PARAMS / "reef.toml", "-o", tmp_path / "x.glb")
     assert result.returncode == 2 and "use `fishgen school` for it" in result.stderr
+
+
+def test_metrics_are_strict_json_even_when_a_measure_has_no_value(tmp_path):
+    """Issue 26, fault 2: a one-fish school has no nearest neighbour; the file held NaN."""
+    import json
+
+    out = tmp_path / "one.json"
+    result = run_cli("school", PARAMS / "bonybream.txt", "--count", "1", "--frames", "20", "-o", tmp_path / "one.glb",
+                     "--metrics", out)
+    assert result.returncode == 0, result.stderr
+
+    def refuse(constant):
+        raise ValueError(f"not strict JSON: {constant}")
+
+    doc = json.loads(out.read_text(), parse_constant=refuse)
+    assert doc["summary"]["nearest_neighbour"] is None  # no neighbour: no distance, said as null

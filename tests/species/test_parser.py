@@ -251,3 +251,26 @@ def test_body_point_split_across_lines_is_still_a_value_count_error(tmp_path):
                           "1 0 0.064453125\n0.32421875 1 1 0.064453125 0.296875\n")
     err = error_of(tmp_path, text)
     assert err.line == line_number(text, "1 0 0.064453125") and "(4 values), found 3 values" in str(err)
+
+
+@pytest.mark.parametrize("token", ["1_0.0", "１０", "nan", "0x10", "1e5e5"])
+def test_only_the_number_forms_the_thesis_files_use_are_numbers(tmp_path, token):
+    """Issue 26, fault 13: Python's float() reads "1_0.0" and full-width digits; the format has
+    neither. In a record and in the block of body texture points (the fast path) alike."""
+    from fishgen.species.parser import load_species
+
+    text = (PARAMS / "bonybream.txt").read_text()
+    lines = text.splitlines()
+    header = next(i for i, line in enumerate(lines) if line.startswith("bonybream "))
+    record = lines.copy()
+    record[header] = " ".join(lines[header].split()[:-1] + [token])
+    points = lines.copy()
+    first_point = next(i for i, line in enumerate(lines) if line.split()[:2] == ["0", "0"] and len(line.split()) == 4)
+    parts = lines[first_point].split()
+    points[first_point] = " ".join(parts[:2] + [token, parts[3]])
+    for name, changed, line in (("record.txt", record, header + 1), ("points.txt", points, first_point + 1)):
+        path = tmp_path / name
+        path.write_text("\n".join(changed) + "\n")
+        with pytest.raises(FishgenError) as caught:
+            load_species(path, textures_dir=ROOT / "textures")
+        assert caught.value.line == line and repr(token) in str(caught.value), str(caught.value)
