@@ -25,7 +25,7 @@ def loads(text: str, file: str) -> dict[str, Any]:
     except ValueError as err:
         if not isinstance(err, tomllib.TOMLDecodeError):  # Python's limit on an integer's digits
             limit = getattr(sys, "get_int_max_str_digits", lambda: 4300)() or 4300
-            run = re.search(r"[0-9_]{%d,}" % limit, text)
+            run = re.search(f"[0-9_]{{{limit},}}", text)
             line = text.count("\n", 0, run.start()) + 1 if run else None
             raise FishgenError("expected a number of at most a few hundred digits, found one of "
                                f"{len(run[0]) if run else 'thousands of'} digits", file, line) from None

@@ -52,6 +52,10 @@ MAX_SCENE_BYTES = 1 << 20
 LAYOUTS = ("sphere", "box", "line")
 PATHS = ("circle", "figure8", "spline", "none")
 DEFAULT_COUNT = 50
+MAX_COORDINATE = 1e4
+"""Metres from the origin a scene's bounds, centres and path points may lie (a school is far
+smaller; a point at 1e308 overflowed the neighbour search)."""
+MAX_PATH_SECONDS = 1e7
 
 # Keys that are also options of `fishgen school` (and of its batch jobs): one declaration each.
 COUNT = Option(click.IntRange(1, MAX_FISH), "Fish per species.", DEFAULT_COUNT)
@@ -125,7 +129,8 @@ def _declared(where: _Where, spec: Option, value: Any, key: str, table: str | No
 def _triple(where: _Where, value: Any, key: str, table: str | None = None) -> tuple[float, float, float]:
     if not (isinstance(value, list) and len(value) == 3):
         raise where.fail(f"{key} as [x, y, z]", value, key, table)
-    return tuple(float(_number(where, v, key, -1e4, 1e4, table)) for v in value)  # type: ignore[return-value]
+    return tuple(float(_number(where, v, key, -MAX_COORDINATE, MAX_COORDINATE, table))  # type: ignore[return-value]
+                 for v in value)
 
 
 def _path(where: _Where, data: Any, table: str, folder: Path) -> tuple[TargetPath, Path | None]:
@@ -178,6 +183,10 @@ def _csv_points(where: _Where, path: Path, table: str) -> tuple[tuple[float, flo
             raise FishgenError(f"expected t,x,y,z numbers, found {describe(line)}", path, number) from None
         if len(values) != 4 or not all(math.isfinite(v) for v in values):
             raise FishgenError(f"expected 4 finite numbers t,x,y,z, found {describe(line)}", path, number)
+        if not (abs(values[0]) <= MAX_PATH_SECONDS and all(abs(v) <= MAX_COORDINATE for v in values[1:])):
+            raise FishgenError(f"expected t within {MAX_PATH_SECONDS:g} s and x,y,z within "
+                               f"{MAX_COORDINATE:g} m, as a scene's bounds are, found {describe(line)}",
+                               path, number)
         if rows and values[0] <= rows[-1][0]:
             raise FishgenError(f"expected increasing times, found {values[0]:g} after {rows[-1][0]:g}", path,
                                number)
