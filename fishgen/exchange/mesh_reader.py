@@ -15,11 +15,16 @@ from __future__ import annotations
 
 import io
 import math
+import logging
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
 from trimesh.resolvers import Resolver
+
+logging.getLogger("trimesh").addHandler(logging.NullHandler())  # its log is not the user's
+logging.getLogger("trimesh").propagate = False
 
 from fishgen.errors import FishgenError, describe, expected
 from fishgen.exchange.guards import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_picture, one_line, size_text
@@ -50,7 +55,11 @@ def read_mesh_file(path: str | Path) -> Scene:
     path = Path(path)
     kind = path.suffix[1:].upper()
     try:
-        return _read(path)
+        # a library's own warnings (numpy's overflow, trimesh's log) never reach the user's stderr:
+        # what matters about the file becomes this reader's one line
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            return _read(path)
     except FishgenError:
         raise
     except MemoryError:
@@ -227,6 +236,14 @@ def _check_texture(image: Path, where: Path, line: int | None = None) -> None:
         raise FishgenError(err.message, where, line) from None
 
 
+def _named_texture(path: Path, name: str, line: int) -> None:
+    """A texture a PLY names (``comment TextureFile``) is read as an OBJ's or a glTF's is: from the
+    asset's folder only, and it must be there (trimesh's loader would log a traceback and go on)."""
+    target = side_file(path, name)
+    if not target.is_file():
+        raise FishgenError(f"expected the texture {name!r} the PLY names, in its folder, found none", path, line)
+
+
 def _check_ply_header(path: Path) -> None:
     """Element counts x property sizes must fit in the file, checked before trimesh allocates."""
     with path.open("rb") as f:
@@ -243,6 +260,8 @@ def _check_ply_header(path: Path) -> None:
     lines = head[: end.end()].decode("latin-1").splitlines()
     for number, line in enumerate(lines, 1):
         words = line.split()
+        if len(words) >= 3 and words[:2] == ["comment", "TextureFile"]:
+            _named_texture(path, line.split(None, 2)[2].strip(), number)
         if not words or words[0] in ("ply", "comment", "obj_info", "end_header"):
             continue
         if words[0] == "format":
@@ -341,6 +360,9 @@ def _points(cloud, path: Path) -> Primitive:
     positions = np.asarray(cloud.vertices, np.float32)
     _finite(positions, path)
     columns = _ply_columns(cloud.metadata.get("_ply_raw", {}).get("vertex", {}).get("data"))
+    for name in ("radius", "red", "green", "blue", "density"):
+        if name in columns and not np.isfinite(columns[name].astype(np.float64)).all():
+            raise expected(f"finite {name} values", "NaN or infinity", path)
     attributes = {"POSITION": positions}
     if "radius" in columns:
         attributes["_RADIUS"] = columns["radius"].astype(np.float32)
