@@ -60,18 +60,28 @@ class BabylonClient(HarnessPage):
         self.page.wait_for_timeout(50)  # let late console messages and responses land
         return result
 
+    def screenshot(self, path: Path, alpha: float, beta: float) -> None:
+        """The asset inspected last, seen from (alpha, beta) radians about its centre, as a PNG."""
+        self.page.evaluate("([a, b]) => window.viewFrom(a, b)", [alpha, beta])
+        self.page.locator("#view").screenshot(path=str(path))
+
     def check(self, asset: Asset) -> str:
         result = self.inspect(asset)
         expect("error" not in result, f"loader error: {result.get('error')}")
         problems = self._problems()
         expect(not problems, "; ".join(problems[:3]))
+        note = judge(asset, result)
         never = self._never_fetched(asset)
         expect(not never, f"{', '.join(never)} never requested")
-        return judge(asset, result)
+        return note
 
 
 def judge(asset: Asset, r: dict) -> str:
-    """Compare babylon_harness.js's report of one file with what fishgen made (module docstring)."""
+    """Compare babylon_harness.js's report of one file with what fishgen made (module docstring).
+
+    Counts, bounds and the clip come first, materials last: a known limit of a loader's
+    materials (KNOWN_LIMITS) must not hide a wrong number.
+    """
     notes: list[str] = []
     meshes = r["meshes"]
     expect(bool(meshes), "no meshes")
@@ -86,26 +96,8 @@ def judge(asset: Asset, r: dict) -> str:
     expect_counts(counts, asset.expected)
     if "quads" in asset.expected:
         expect(counts["triangles"] == 2 * asset.expected["quads"], "quads != particles")
-    expect(r["settled"], "textures never became ready")
-
-    textured = asset.fmt.kind in ("fish", "school") or "--billboards" in asset.fmt.flags
-    for m in meshes:
-        mat = m["material"]
-        if textured:
-            expect(mat is not None and mat["albedo"] is not None, f"{m['name']}: material has no texture")
-            expect(mat["albedo"]["ready"] and mat["albedo"]["width"] > 0, f"{m['name']}: texture did not arrive")
-        if m in points:
-            expect("color" in m["kinds"], f"{m['name']}: particle colours missing")
     if points:
         notes.append("drops radius/density" + ("/_CUBE" if asset.fmt.ext != "ply" else ""))
-    if asset.fmt.kind in ("fish", "school") and asset.fmt.ext != "ply":
-        fins = [m["material"] for m in meshes if m["material"] and m["material"]["name"] == "fins"]
-        expect(bool(fins), "no fins material")
-        if asset.fmt.ext == "obj":
-            expect(all(f["opacity"] and f["opacity"]["ready"] for f in fins), "fins: map_d mask not loaded")
-        else:
-            expect(all(f["transparencyMode"] == ALPHATEST and abs(f["alphaCutOff"] - 0.5) < 1e-6
-                       and not f["backFaceCulling"] for f in fins), "fins lost MASK 0.5/double-sided")
 
     expected = asset.bounds
     assert expected is not None
@@ -120,6 +112,27 @@ def judge(asset: Asset, r: dict) -> str:
                 expect(box_close(a, b, tol), f"{m['path']}: morph target {k} bounds {show(a)}, fishgen's {show(b)}")
     if asset.clip:
         notes += _judge_clip(asset, r, tol)
+
+    # every texture arrives, and the materials say what fishgen's say
+    expect(r["settled"], "textures never became ready")
+    textured = asset.fmt.kind in ("fish", "school") or "--billboards" in asset.fmt.flags
+    for m in meshes:
+        mat = m["material"]
+        if textured:
+            expect(mat is not None and mat["albedo"] is not None, f"{m['name']}: material has no texture")
+            expect(mat["albedo"]["ready"] and mat["albedo"]["width"] > 0, f"{m['name']}: texture did not arrive")
+        if asset.fmt.kind == "cloud":
+            expect("color" in m["kinds"] and m["useVertexColors"], f"{m['name']}: particle colours not used")
+        if "--billboards" in asset.fmt.flags:
+            expect(mat["unlit"], f"{m['name']}: KHR_materials_unlit ignored (particles lit)")
+    if asset.fmt.kind in ("fish", "school") and asset.fmt.ext != "ply":
+        fins = [m["material"] for m in meshes if m["material"] and m["material"]["name"] == "fins"]
+        expect(bool(fins), "no fins material")
+        if asset.fmt.ext == "obj":
+            expect(all(f["opacity"] and f["opacity"]["ready"] for f in fins), "fins: map_d mask not loaded")
+        else:
+            expect(all(f["transparencyMode"] == ALPHATEST and abs(f["alphaCutOff"] - 0.5) < 1e-6
+                       and not f["backFaceCulling"] for f in fins), "fins lost MASK 0.5/double-sided")
     return "; ".join(notes)
 
 

@@ -8,8 +8,9 @@
 
 const SAMPLES = 32;
 const TEXTURE_WAIT_MS = 5000;
-const engine = new BABYLON.Engine(document.getElementById('view'), false, { preserveDrawingBuffer: false });
+const engine = new BABYLON.Engine(document.getElementById('view'), true, { preserveDrawingBuffer: true });
 let scene = null;
+let camera = null;
 
 // A node's path of names below the loader's root (glTF's __root__, which turns the right-handed
 // file into Babylon's left-handed world), as the file names it.
@@ -57,6 +58,7 @@ function materialInfo(m) {
     useAlphaFromAlbedo: !!(m.useAlphaFromAlbedoTexture || (m.diffuseTexture && m.diffuseTexture.hasAlpha)),
     backFaceCulling: m.backFaceCulling,
     points: m.fillMode === BABYLON.Material.PointFillMode || !!m.pointsCloud,
+    unlit: !!m.unlit || !!m.disableLighting,
   };
 }
 
@@ -78,7 +80,8 @@ function meshInfo(mesh) {
     name: mesh.name, path: pathOf(mesh), class: mesh.getClassName(), root: !!root,
     instance: mesh !== source, geometry: source.geometry ? source.geometry.uniqueId : null,
     vertices: source.getTotalVertices(), indices: source.getTotalIndices(),
-    kinds: source.getVerticesDataKinds(), enabled: mesh.isEnabled(), visible: mesh.isVisible,
+    kinds: source.getVerticesDataKinds(), useVertexColors: source.useVertexColors,
+    enabled: mesh.isEnabled(), visible: mesh.isVisible,
     world: boxOf(positions, world), local: boxOf(positions, null), targets,
     morphManager: mtm ? mtm.uniqueId : null,
     material: materialInfo(mesh.material),
@@ -156,11 +159,9 @@ window.inspectAsset = async (url, options = {}) => {
   try {
     if (scene) scene.dispose();
     scene = new BABYLON.Scene(engine);
-    const camera = new BABYLON.ArcRotateCamera('camera', 1, 1.2, 2, BABYLON.Vector3.Zero(), scene);
+    camera = new BABYLON.ArcRotateCamera('camera', 1, 1.2, 2, BABYLON.Vector3.Zero(), scene);
     new BABYLON.HemisphericLight('light', new BABYLON.Vector3(0, 1, 0), scene);
-    const t0 = performance.now();
     const container = await BABYLON.LoadAssetContainerAsync(url, scene, options);
-    const t1 = performance.now();
     container.addAllToScene();
     for (const g of container.animationGroups) g.stop();
     const meshes = scene.meshes.filter((m) => m.getTotalVertices() > 0 || (m.sourceMesh && m.sourceMesh.getTotalVertices() > 0));
@@ -169,20 +170,18 @@ window.inspectAsset = async (url, options = {}) => {
     // frame it and draw once: shaders compile, textures upload
     const box = BABYLON.Mesh.MinMax(meshes);
     camera.setTarget(box.min.add(box.max).scale(0.5));
-    camera.radius = Math.max(0.1, box.max.subtract(box.min).length() * 1.5);
+    camera.radius = Math.max(0.1, box.max.subtract(box.min).length() * 1.2);
+    camera.minZ = camera.radius / 100;   // the default near plane (1 m) would cut a fish away
     scene.render();
-    const t2 = performance.now();
     const morphOwner = new Map();
     for (const m of meshes) {
       const mtm = m.morphTargetManager;
       if (mtm) for (let i = 0; i < mtm.numTargets; i++) morphOwner.set(mtm.getTarget(i).uniqueId, { mesh: m, index: i });
     }
     const infos = meshes.map(meshInfo);
-    const t3 = performance.now();
     const groups = container.animationGroups.map((g) => groupInfo(g, morphOwner));
-    const t4 = performance.now();
     return {
-      version: BABYLON.Engine.Version, settled, timings: [t1 - t0, t2 - t1, t3 - t2, t4 - t3],
+      version: BABYLON.Engine.Version, settled,
       meshes: infos,
       groups,
       morphManagers: new Set(meshes.filter((m) => m.morphTargetManager).map((m) => m.morphTargetManager.uniqueId)).size,
@@ -190,5 +189,11 @@ window.inspectAsset = async (url, options = {}) => {
   } catch (e) {
     return { error: String(e && e.message ? e.message : e) };
   }
+};
+// Look at the last asset from (alpha, beta) radians around its centre, for a screenshot.
+window.viewFrom = (alpha, beta) => {
+  camera.alpha = alpha;
+  camera.beta = beta;
+  scene.render();
 };
 window.harnessReady = true;

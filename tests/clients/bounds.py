@@ -92,6 +92,12 @@ def scene_bounds(scene: Scene) -> Bounds:
     return Bounds(tuple(prims), _union([b.world for b in prims]), _clip_bounds(scene, clip) if clip else None, scene)
 
 
+def merged(bounds: Bounds, name: str) -> Bounds:
+    """The bounds of a format that writes every part as one mesh at rest (PLY)."""
+    one = PrimitiveBounds(name, bounds.primitives[0].mode, bounds.world, bounds.world, ())
+    return Bounds((one,), bounds.world, None, bounds.scene)
+
+
 def _clip_bounds(scene: Scene, clip) -> ClipBounds:
     paths = [ch.path for ch in clip.channels]
     targets = 0

@@ -31,7 +31,7 @@ from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from tests.clients.bounds import Bounds, scene_bounds
+from tests.clients.bounds import Bounds, merged, scene_bounds
 
 if TYPE_CHECKING:
     from fishgen.scene.model import Scene
@@ -90,9 +90,14 @@ APPLIES = {  # Godot 3 has no PLY importer; Babylon.js reads PLY through its spl
 # (format label, client) -> (substring of the failure it must show, short reason for the table)
 KNOWN_LIMITS: dict[tuple[str, str], tuple[str, str]] = {
     ("fish ply", "three.js"): ("never requested", "PLYLoader ignores `comment TextureFile`: no texture"),
-    ("fish ply", "Babylon.js"): ("never requested",
+    ("fish ply", "Babylon.js"): ("material has no texture",
                                  "the splat loader's PLY mesh ignores `comment TextureFile` and s/t: no texture"),
     ("fish obj", "Godot 3"): ("map_d", "the OBJ importer ignores `map_d`: fins opaque and one-sided"),
+    ("cloud glb points", "Godot 3"): ("COLOR_0 imported but not shown",
+                                      "COLOR_0 kept but not shown (the importer uses vertex colours only for "
+                                      "materials named `…-vcol`): particles white"),
+    ("cloud glb billboards", "Godot 3"): ("COLOR_0 imported but not shown, KHR_materials_unlit ignored",
+                                          "COLOR_0 not shown, KHR_materials_unlit ignored: particles white and lit"),
     ("fish obj", "trimesh"): ("map_d", "trimesh ignores map_d (fins keep the skin png's alpha)"),
 }
 
@@ -177,6 +182,8 @@ def make_assets(folder: Path) -> dict[str, Asset]:
                 raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, the scene has {fish['triangles']} triangles")
             a.expected = {"vertices": fish["vertices"], "triangles": a.reported["triangles"], "particles": 0}
             a.bounds = scene_bounds(scenes["fish"])
+            if a.fmt.ext == "ply":  # one mesh of every part
+                a.bounds = merged(a.bounds, "fish")
             if a.fmt.ext in ("glb", "gltf"):
                 a.clip = ("swim", SWIM_TRACKS)
         elif a.fmt.kind == "school":
@@ -643,6 +650,11 @@ class ThreeClient(HarnessPage):
             expect(not unbound, f"tracks target no node: {unbound}")
             fins = [m for o in meshes for m in o["materials"] if m["name"] == "fins"]
             expect(all(m["alphaTest"] == 0.5 and m["side"] == 2 for m in fins), "fins lost MASK/double-sided")
+        if asset.fmt.kind == "cloud" and asset.fmt.ext == "glb":  # COLOR_0 shown; billboards unlit
+            materials = [m for o in objects for m in o["materials"]]
+            expect(all(m["vertexColors"] for m in materials), "particle colours (COLOR_0) not used")
+            if "--billboards" in asset.fmt.flags:
+                expect(all(m["type"] == "MeshBasicMaterial" for m in materials), "KHR_materials_unlit ignored")
         if points:
             want = {"color", "_radius", "_density", "_cube"} if asset.fmt.ext == "glb" else {"color", "radius", "density"}
             have = set().union(*(o["attributes"] for o in points))

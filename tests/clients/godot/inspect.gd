@@ -92,6 +92,7 @@ func material_info(m):
 		info["cull_mode"] = m.params_cull_mode
 		info["vertex_color_use_as_albedo"] = m.vertex_color_use_as_albedo
 		info["use_point_size"] = m.flags_use_point_size
+		info["unshaded"] = m.flags_unshaded
 	return info
 
 
