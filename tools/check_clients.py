@@ -187,7 +187,7 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="fishgen-clients-") as tmp:
         folder = args.out or Path(tmp)
-        matrix = Matrix(folder)
+        matrix = Matrix(folder, godot_now=not args.blender)
         try:
             if args.blender:
                 bpy_python = _bpy_python(args.bpy_python)

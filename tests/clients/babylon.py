@@ -150,6 +150,7 @@ def _judge_clip(asset: Asset, r: dict, tol: float) -> list[str]:
     expect(not unbound, f"tracks target nothing in the scene: {unbound[:3]}")
     length = (group["to"] - group["from"]) / group["fps"]
     expect(abs(length - clip.duration) < 1e-3, f"{name} lasts {length:.4f} s, fishgen's {clip.duration:.4f} s")
+    assert asset.bounds.scene is not None
     truth = ClipTruth(asset.bounds.scene, name)
     tracks = [{"node": t["node"], "kind": "weight" if t["property"] == "influence" else "trs",
                "target": t["target"], "keys": t["keys"]} for t in group["tracks"]]

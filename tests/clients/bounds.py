@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     import numpy as np
 
-    from fishgen.scene.model import Scene
+    from fishgen.scene.model import Channel, Scene
 
 Box = tuple[tuple[float, float, float], tuple[float, float, float]]
 
@@ -121,7 +121,7 @@ class ClipTruth:
         self.scene = scene
         clip = scene.clip(clip_name)
         assert clip is not None, f"no clip {clip_name}"
-        self.channels = {(ch.node, ch.path): ch for ch in clip.channels}
+        self.channels: dict[tuple[int, str], Channel] = {(ch.node, ch.path): ch for ch in clip.channels}
         self.paths: dict[str, int] = {}
         stack = [(i, scene.nodes[i].name) for i in scene.roots]
         while stack:

@@ -41,7 +41,7 @@ from tests.clients.bounds import (
     show,
     tolerance,
 )
-from tests.clients.matrix import HERE, Asset, expect, expect_counts
+from tests.clients.matrix import HERE, Asset, CellFailure, expect, expect_counts
 
 TEMPLATE = HERE / "godot"
 GODOT = next((p for p in (os.environ.get("FISHGEN_GODOT"), shutil.which("godot3-server"))
@@ -69,11 +69,6 @@ def godot_unavailable() -> str | None:
     if GODOT is None:
         return "no godot3-server (apt-get install godot3-server)"
     return None
-
-
-def godot_version() -> str:
-    out = subprocess.run([GODOT, "--version"], capture_output=True, text=True, env=_env(Path("/tmp")), timeout=60)
-    return out.stdout.strip().splitlines()[-1] if out.stdout.strip() else "?"
 
 
 def _env(home: Path) -> dict[str, str]:
@@ -122,6 +117,8 @@ class GodotRun:
     def start(cls, folder: Path, assets: dict[str, Asset]) -> GodotRun:
         """Copy each asset's folder into a fresh project under ``folder``; import and inspect them all."""
         import time
+
+        assert GODOT is not None, godot_unavailable()
 
         project = folder / "project"
         if folder.exists():
@@ -172,8 +169,8 @@ class GodotRun:
         run.inspect_seconds = time.perf_counter() - start
         (folder / "godot.log").write_text(log + inspected.stdout + inspected.stderr, encoding="utf-8")
         run.messages = _messages(log)
-        for path, found in _messages(inspected.stdout + inspected.stderr).items():
-            run.messages.setdefault(path, []).extend(found)
+        for where, found in _messages(inspected.stdout + inspected.stderr).items():
+            run.messages.setdefault(where, []).extend(found)
         for line in inspected.stdout.splitlines():
             if line.startswith("FISHGEN_JSON "):
                 result = json.loads(line.split(" ", 1)[1])
@@ -282,12 +279,14 @@ def _judge_clip(asset: Asset, animations: list[dict], tol: float) -> list[str]:
     unbound = [t["path"] for t in anim["tracks"] if not t["bound"] or t.get("property_exists") is False]
     expect(not unbound, f"tracks target nothing: {unbound[:3]}")
     expect(abs(anim["length"] - clip.duration) < 1e-3, f"{name} lasts {anim['length']} s, fishgen's {clip.duration:.4f} s")
+    assert asset.bounds.scene is not None
     truth = ClipTruth(asset.bounds.scene, name)
     keys = [{"node": t["path"], "kind": "trs", "keys": t["keys"]} for t in transform]
     for t in value:
         node, prop = t["path"].split(":", 1)
         m = re.fullmatch(r"blend_shapes/morph_(\d+)", prop)
-        expect(m is not None, f"{t['path']}: not a blend shape track")
+        if m is None:
+            raise CellFailure(f"{t['path']}: not a blend shape track")
         keys.append({"node": node, "kind": "weight", "target": int(m[1]), "keys": t["keys"]})
     expect_same_keys(key_errors(truth, keys), tol)
     # as the player plays it: Godot's importer resamples node tracks at 15 fps and drops keys

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from functools import partial
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from tests.clients.bounds import Bounds, merged, scene_bounds
 
@@ -102,8 +102,12 @@ KNOWN_LIMITS: dict[tuple[str, str], tuple[str, str]] = {
 }
 
 
+# The order cells run in: Godot's last, since its import runs in the background meanwhile.
+RUN_ORDER = ("three.js", "Babylon.js", "trimesh", "pygltflib", "plyfile", "numpy", "Godot 3")
+
+
 def cells() -> list[tuple[str, str]]:
-    return [(f.label, c) for f in FORMATS for c in CLIENTS if c in APPLIES[f.ext]]
+    return [(f.label, c) for c in RUN_ORDER for f in FORMATS if c in APPLIES[f.ext]]
 
 
 # --------------------------------------------------------------------------- assets
@@ -477,8 +481,8 @@ class _Chromium:
     once (playwright's sync API allows one instance per thread); closed with the last of them."""
 
     users = 0
-    playwright = None
-    browser = None
+    playwright: Any = None
+    browser: Any = None
 
     @classmethod
     def acquire(cls):
@@ -667,7 +671,7 @@ class ThreeClient(HarnessPage):
 # --------------------------------------------------------------------------- running
 
 class Matrix:
-    def __init__(self, asset_dir: Path):
+    def __init__(self, asset_dir: Path, godot_now: bool = True):
         self.asset_dir = asset_dir
         self.assets = make_assets(asset_dir)
         self.results: dict[tuple[str, str], Cell] = {}
@@ -678,6 +682,10 @@ class Matrix:
         self._godot: GodotRun | None = None
         self._godot_error: str | None = None        # not installed: the cells are skipped
         self._godot_failure: str | None = None      # the import or the inspection failed: the cells fail
+        self._godot_thread: threading.Thread | None = None
+        if godot_now:  # Godot imports in its own process while the other clients run
+            self._godot_thread = threading.Thread(target=self._start_godot, daemon=True)
+            self._godot_thread.start()
 
     def three(self) -> ThreeClient | None:
         if self._three is None and self._three_error is None:
@@ -697,18 +705,24 @@ class Matrix:
 
     def godot(self) -> GodotRun | None:
         """Every file Godot reads, and the extra files of the Godot tests, imported in one run."""
-        if self._godot is None and self._godot_error is None and self._godot_failure is None:
-            from tests.clients.godot import GodotRun, extra_assets, godot_unavailable
-
-            self._godot_error = godot_unavailable()
-            if self._godot_error is None:
-                chosen = {label: a for label, a in self.assets.items() if "Godot 3" in APPLIES[a.fmt.ext]}
-                chosen.update(extra_assets(self.assets, self.asset_dir / "godot-extra"))
-                try:
-                    self._godot = GodotRun.start(self.asset_dir / "godot", chosen)
-                except (RuntimeError, subprocess.TimeoutExpired) as err:
-                    self._godot_failure = str(err)
+        if self._godot_thread is not None:
+            self._godot_thread.join()
+        elif self._godot is None and self._godot_error is None and self._godot_failure is None:
+            self._start_godot()
         return self._godot
+
+    def _start_godot(self) -> None:
+        from tests.clients.godot import GodotRun, extra_assets, godot_unavailable
+
+        self._godot_error = godot_unavailable()
+        if self._godot_error is not None:
+            return
+        try:
+            chosen = {label: a for label, a in self.assets.items() if "Godot 3" in APPLIES[a.fmt.ext]}
+            chosen.update(extra_assets(self.assets, self.asset_dir / "godot-extra"))
+            self._godot = GodotRun.start(self.asset_dir / "godot", chosen)
+        except Exception as err:  # noqa: BLE001 - the Godot cells fail with it, the rest run
+            self._godot_failure = f"{type(err).__name__}: {err}"
 
     def _check(self, client: str) -> tuple[Callable[[Asset], str] | None, str]:
         """The client's check, or None and why it cannot run here."""
@@ -743,6 +757,8 @@ class Matrix:
         return [self.run(label, client) for label, client in cells()]
 
     def close(self) -> None:
+        if self._godot_thread is not None:  # leave no Godot behind
+            self._godot_thread.join()
         for client in (self._three, self._babylon):
             if client is not None:
                 client.close()
