@@ -136,32 +136,13 @@ class GodotRun:
         (project / "fishgen_files.txt").write_text("\n".join(files.values()) + "\n", encoding="utf-8")
         run = cls(project, files, assets)
         env = _env(folder)
-        # Godot 3.2 imports textures and OBJs at the same priority, in no set order, and an OBJ
-        # imported before its pictures has no texture for good. A user imports them again; the
-        # matrix imports the pictures first, then the OBJs.
-        later = sorted(project.rglob("*.obj"))
-        held = folder / "held"
-        for path in later:
-            (held / path.relative_to(project)).parent.mkdir(parents=True, exist_ok=True)
-            path.rename(held / path.relative_to(project))
-        log = ""
-
-        def import_all() -> None:
-            nonlocal log
-            done = subprocess.run([GODOT, "--path", str(project), "--export-pack", "import-only",
+        start = time.perf_counter()
+        imported = subprocess.run([GODOT, "--path", str(project), "--export-pack", "import-only",
                                    str(folder / "import-only.pck")],
                                   capture_output=True, text=True, env=env, timeout=IMPORT_TIMEOUT)
-            log += done.stdout + done.stderr
-            if done.returncode != 0:
-                raise RuntimeError(f"godot3-server --export-pack exited {done.returncode}: "
-                                   f"{(done.stdout + done.stderr).strip()[-500:]}")
-
-        start = time.perf_counter()
-        import_all()
-        if later:
-            for path in later:
-                (held / path.relative_to(project)).rename(path)
-            import_all()
+        log = imported.stdout + imported.stderr
+        if imported.returncode != 0:
+            raise RuntimeError(f"godot3-server --export-pack exited {imported.returncode}: {log.strip()[-500:]}")
         run.import_seconds = time.perf_counter() - start
         start = time.perf_counter()
         inspected = subprocess.run([GODOT, "--path", str(project), "-s", "res://fishgen_inspect.gd"],
