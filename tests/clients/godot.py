@@ -338,7 +338,26 @@ def quantize_positions(src: Path, dst: Path) -> None:
     write_glb(dst, doc, blob)
 
 
+def spoil_weight_key(gltf: Path) -> None:
+    """Change one morph weight key of a .gltf's first clip in its .bin (0.5, or 0.25 if it was 0.5):
+    the counts stay right, so only a comparison of the keys notices."""
+    import numpy as np
+
+    doc = json.loads(gltf.read_text())
+    clip = doc["animations"][0]
+    channel = next(c for c in clip["channels"] if c["target"]["path"] == "weights")
+    acc = doc["accessors"][clip["samplers"][channel["sampler"]]["output"]]
+    view = doc["bufferViews"][acc["bufferView"]]
+    start = view.get("byteOffset", 0) + acc.get("byteOffset", 0) + 4 * 2  # the third value
+    binary = gltf.parent / doc["buffers"][view["buffer"]]["uri"]
+    blob = bytearray(binary.read_bytes())
+    old = float(np.frombuffer(blob, np.float32, 1, start)[0])
+    blob[start:start + 4] = np.float32(0.25 if old == 0.5 else 0.5).tobytes()
+    binary.write_bytes(bytes(blob))
+
+
 SELFTEST_QUANTIZED = "selftest quantized points"
+SELFTEST_KEY = "selftest spoilt weight key"
 TWO_SPECIES = ("two species: bonybream", "two species: centroberyx")
 
 
@@ -346,6 +365,7 @@ def extra_assets(assets: dict[str, Asset], folder: Path) -> dict[str, Asset]:
     """Files only the Godot tests use, imported in the same run as the matrix's:
 
     - the cloud points with quantized positions (the bounds check must catch Godot's misreading);
+    - the fish .gltf with one morph weight key changed (the key check must catch it);
     - two species built into one folder, as a user exports a set (each must keep its own materials).
     """
     import sys
@@ -359,6 +379,12 @@ def extra_assets(assets: dict[str, Asset], folder: Path) -> dict[str, Asset]:
     quantize_positions(points.path, folder / fmt.slug / fmt.filename)
     extra = {fmt.label: Asset(fmt, folder / fmt.slug / fmt.filename, [fmt.filename], points.summary,
                               dict(points.reported), dict(points.expected), None, points.bounds)}
+    fish = assets["fish gltf"]
+    fmt = Format(SELFTEST_KEY, "fish", fish.fmt.filename)
+    shutil.copytree(fish.path.parent, folder / fmt.slug)
+    spoil_weight_key(folder / fmt.slug / fmt.filename)
+    extra[fmt.label] = Asset(fmt, folder / fmt.slug / fmt.filename, list(fish.files), fish.summary,
+                             dict(fish.reported), dict(fish.expected), fish.clip, fish.bounds)
     both = folder / "two-species"
     sources = [FISH_SOURCE, PARAMS / "centroberyx.txt"]
     result = subprocess.run([sys.executable, "-m", "fishgen", "build", *map(str, sources), "-o", str(both),

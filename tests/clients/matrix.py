@@ -371,16 +371,14 @@ def check_pygltflib(asset: Asset) -> str:
     return ""
 
 
-def _check_clip(asset: Asset, clips: list[tuple[str, int]], tracks: int | None = None) -> None:
-    """The asset's clip is there with all its tracks: one per glTF channel unless ``tracks`` says
-    how many this client makes of them."""
+def _check_clip(asset: Asset, clips: list[tuple[str, int]]) -> None:
+    """The asset's clip is there with a track for each of its glTF channels."""
     if asset.clip is None:
         return
     name, channels = asset.clip
-    want = channels if tracks is None else tracks
     found = [n for clip, n in clips if clip == name]
     expect(bool(found), f"no clip named {name} (found {[c for c, _ in clips]})")
-    expect(found[0] == want, f"{name} has {found[0]} tracks, expected {want}")
+    expect(found[0] == channels, f"{name} has {found[0]} tracks, expected {channels}")
 
 
 def check_plyfile(asset: Asset) -> str:
@@ -540,7 +538,7 @@ class LocalBrowser:
 
 
 class HarnessPage(LocalBrowser):
-    """A harness page (under tests/clients, served at /harness/) in its own Chromium, with every
+    """A harness page (under tests/clients, served at /harness/) in the shared Chromium, with every
     console error, page error and request recorded, and nothing fetched from outside 127.0.0.1."""
 
     def __init__(self, mounts: dict[str, Path], page: str):

@@ -118,21 +118,11 @@ def test_babylon_fails_a_gltf_whose_texture_is_missing(matrix, babylon):
 
 def test_babylon_fails_a_clip_with_a_wrong_key(matrix, babylon):
     """Counts are not enough: one morph weight key changed in the .bin fails the cell."""
-    import json
-
-    import numpy as np
+    from tests.clients.godot import spoil_weight_key
 
     asset = _broken_copy(matrix, "fish gltf", "babylon gltf bad key")
-    doc = json.loads(asset.path.read_text())
-    channel = next(c for c in doc["animations"][0]["channels"] if c["target"]["path"] == "weights")
-    acc = doc["accessors"][doc["animations"][0]["samplers"][channel["sampler"]]["output"]]
-    view = doc["bufferViews"][acc["bufferView"]]
-    start = view.get("byteOffset", 0) + acc.get("byteOffset", 0) + 4 * 2  # the third key value
-    blob = bytearray((asset.path.parent / "fish.bin").read_bytes())
-    blob[start:start + 4] = np.float32(0.5).tobytes() if np.frombuffer(blob, np.float32, 1, start)[0] != 0.5 \
-        else np.float32(0.25).tobytes()
-    (asset.path.parent / "fish.bin").write_bytes(bytes(blob))
-    with pytest.raises(AssertionError, match="weight"):
+    spoil_weight_key(asset.path)
+    with pytest.raises(AssertionError, match="key weight off by"):
         babylon.check(asset)
 
 
@@ -161,6 +151,14 @@ def test_godot_fails_positions_it_reads_as_raw_integers(matrix, godot, gltf_vali
     babylon = matrix.babylon()
     if babylon is not None:
         babylon.check(asset)
+
+
+def test_godot_fails_a_clip_with_a_wrong_key(godot):
+    """Counts are not enough: one morph weight key changed in the .bin fails the cell."""
+    from tests.clients.godot import SELFTEST_KEY
+
+    with pytest.raises(AssertionError, match="key weight off by"):
+        godot.check(godot.assets[SELFTEST_KEY])
 
 
 def test_godot_counts_every_blend_shape_track(matrix, godot):
