@@ -96,8 +96,10 @@ def judge(asset: Asset, r: dict) -> str:
     expect_counts(counts, asset.expected)
     if "quads" in asset.expected:
         expect(counts["triangles"] == 2 * asset.expected["quads"], "quads != particles")
-    if points:
-        notes.append("drops radius/density" + ("/_CUBE" if asset.fmt.ext != "ply" else ""))
+    if points and asset.fmt.ext == "ply":
+        notes.append("a point cloud (splat loader): drops radius/density")
+    elif points:
+        notes.append("drops _RADIUS/_DENSITY/_CUBE")
 
     expected = asset.bounds
     assert expected is not None
