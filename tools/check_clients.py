@@ -1,9 +1,12 @@
 #!/usr/bin/env python
 """Load every fishgen output format in the clients people use and print a ✓/✗ table.
 
-    python tools/check_clients.py                 # three.js (headless Chromium), trimesh, pygltflib, plyfile, numpy
+    python tools/check_clients.py                 # three.js and Babylon.js (headless Chromium), Godot 3
+                                                  # (godot3-server), trimesh, pygltflib, plyfile, numpy
     python tools/check_clients.py --blender       # Blender's importers, through the `bpy` module
-    python tools/check_clients.py --out DIR       # keep the generated assets in DIR
+    python tools/check_clients.py --out DIR       # keep the generated assets (and Godot's project) in DIR
+    python tools/check_clients.py --look DIR      # also save what Babylon.js (and Godot 3, if `godot3`
+                                                  # and `xvfb-run` are installed) draw, from three sides
 
 The matrix is the one the test-suite runs (tests/clients/); see docs/clients.md.
 --blender needs a Python with `bpy` (PyPI's wheel is Python 3.11 only and large,
@@ -29,10 +32,22 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from tests.clients.matrix import FORMATS, Asset, Cell, CellFailure, Matrix, expect, table, write_report  # noqa: E402
+from tests.clients.matrix import (  # noqa: E402
+    CLIENTS,
+    FORMATS,
+    THREE_DIR,
+    Asset,
+    Cell,
+    CellFailure,
+    Matrix,
+    expect,
+    table,
+    write_report,
+)
 
 BLENDER_SCRIPT = ROOT / "tests" / "clients" / "blender_import.py"
 BLENDER_FORMATS = ("glb", "gltf", "obj", "ply")
+BLENDER_KINDS = ("fish", "cloud")   # the school row is not judged in Blender yet
 # what Blender cannot do, as (substring of the failure, short reason)
 BLENDER_KNOWN = {"fish ply": ("no material", "ply_import ignores `comment TextureFile`: no material or image")}
 
@@ -95,7 +110,7 @@ def _judge_blender(asset: Asset, r: dict) -> str:
 
 
 def run_blender(assets: dict[str, Asset], bpy_python: str) -> tuple[dict, str]:
-    chosen = [a for a in assets.values() if a.fmt.ext in BLENDER_FORMATS]
+    chosen = [a for a in assets.values() if a.fmt.ext in BLENDER_FORMATS and a.fmt.kind in BLENDER_KINDS]
     proc = subprocess.run([bpy_python, str(BLENDER_SCRIPT), *map(str, (a.path for a in chosen))],
                           capture_output=True, text=True, timeout=600)
     reports = [json.loads(line) for line in proc.stdout.splitlines() if line.startswith("{")]
@@ -119,6 +134,41 @@ def run_blender(assets: dict[str, Asset], bpy_python: str) -> tuple[dict, str]:
     return results, version
 
 
+def versions(matrix: Matrix) -> str:
+    """The versions of the clients that ran, for the table's heading."""
+    out = []
+    three = json.loads((THREE_DIR / "package.json").read_text())["version"] if THREE_DIR.is_dir() else None
+    if three and matrix._three is not None:
+        out.append(f"three.js {three}")
+    if matrix._babylon is not None:
+        out.append(f"Babylon.js {matrix._babylon.version}")
+    if matrix._godot is not None:
+        out.append(f"Godot {matrix._godot.version}")
+    return ", ".join(out)
+
+
+def look(matrix: Matrix, folder: Path) -> None:
+    """PNGs of every asset Babylon.js and Godot 3 load, from three sides, into ``folder``."""
+    import math
+
+    from tests.clients.godot import render
+
+    folder.mkdir(parents=True, exist_ok=True)
+    views = {"side": (0.0, math.pi / 2), "front": (math.pi / 2, math.pi / 2), "above": (0.0, 0.35)}
+    babylon = matrix.babylon()
+    if babylon is not None:
+        for asset in matrix.assets.values():
+            if asset.fmt.ext in ("glb", "gltf", "obj", "ply") and "error" not in babylon.inspect(asset):
+                for side, (alpha, beta) in views.items():
+                    babylon.screenshot(folder / f"babylon-{asset.fmt.slug}-{side}.png", alpha, beta)
+    godot = matrix.godot()
+    if godot is not None:
+        why = render(godot, folder)
+        if why:
+            print(f"Godot pictures skipped: {why}", file=sys.stderr)
+    print(f"pictures in {folder}")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--blender", action="store_true", help="import each format with Blender's bpy module instead")
@@ -129,12 +179,15 @@ def main(argv: list[str] | None = None) -> int:
                     help="where to write the markdown table (default: out/client-matrix.md; "
                          "out/client-matrix-blender.md with --blender)")
     ap.add_argument("--json", action="store_true", help="also print every cell's details as JSON")
+    ap.add_argument("--look", type=Path, metavar="DIR",
+                    help="save PNGs of each asset as Babylon.js (and Godot 3, with `godot3` and `xvfb-run`) "
+                         "draws it, from the side, the front and above")
     args = ap.parse_args(argv)
 
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="fishgen-clients-") as tmp:
         folder = args.out or Path(tmp)
-        matrix = Matrix(folder)
+        matrix = Matrix(folder, godot_now=not args.blender)
         try:
             if args.blender:
                 bpy_python = _bpy_python(args.bpy_python)
@@ -147,7 +200,9 @@ def main(argv: list[str] | None = None) -> int:
                 title = f"Blender {version} (bpy)"
             else:
                 matrix.run_all()
-                results, clients, title = matrix.results, ("three.js", "trimesh", "pygltflib", "plyfile", "numpy"), ""
+                results, clients, title = matrix.results, CLIENTS, versions(matrix)
+                if args.look:
+                    look(matrix, args.look)
         finally:
             matrix.close()
     seconds = time.perf_counter() - start

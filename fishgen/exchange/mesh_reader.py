@@ -14,8 +14,8 @@ Every fault is one ``FishgenError`` reading ``expected ..., found ...``.
 from __future__ import annotations
 
 import io
-import math
 import logging
+import math
 import re
 import warnings
 from pathlib import Path
@@ -23,14 +23,14 @@ from pathlib import Path
 import numpy as np
 from trimesh.resolvers import Resolver
 
-logging.getLogger("trimesh").addHandler(logging.NullHandler())  # its log is not the user's
-logging.getLogger("trimesh").propagate = False
-
 from fishgen.errors import FishgenError, describe, expected
 from fishgen.exchange.guards import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_picture, one_line, size_text
 from fishgen.exchange.sidefiles import side_file
 from fishgen.numeric import srgb_to_linear
 from fishgen.scene.model import Image, Material, Mesh, Node, Primitive, Scene
+
+logging.getLogger("trimesh").addHandler(logging.NullHandler())  # its log is not the user's stderr
+logging.getLogger("trimesh").propagate = False
 
 MAX_TEXT_BYTES = 256 * 2**20
 """Largest OBJ or ASCII PLY file (trimesh's text parse takes a few times the file in memory)."""
@@ -241,7 +241,8 @@ def _named_texture(path: Path, name: str, line: int) -> None:
     asset's folder only, and it must be there (trimesh's loader would log a traceback and go on)."""
     target = side_file(path, name)
     if not target.is_file():
-        raise FishgenError(f"expected the texture {name!r} the PLY names, in its folder, found none", path, line)
+        raise FishgenError(f"expected the texture {name!r} the PLY names, in its folder, found none", path,
+                           line)
 
 
 def _check_ply_header(path: Path) -> None:

@@ -5,7 +5,9 @@ report (tools/check_clients.py). Assets are made by the real `fishgen` command
 line, one folder each, and each cell checks: it loads, nothing failed (console
 errors, failed or 4xx/5xx requests), every texture the file names arrives, the
 counts match the summary line fishgen printed, and the `swim` clip is there
-where the format and the client hold animation.
+where the format and the client hold animation. The Godot 3 and Babylon.js
+cells also compare bounds with fishgen's (tests/clients/bounds.py): a client can
+read the right number of wrong values.
 
 A few cells fail because of what a client cannot do; those are listed in
 KNOWN_LIMITS with the reason, reported as "✗ known: …" and xfail (strict) in
@@ -27,6 +29,14 @@ from dataclasses import dataclass, field
 from functools import partial
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from tests.clients.bounds import Bounds, merged, scene_bounds
+
+if TYPE_CHECKING:
+    from fishgen.scene.model import Scene
+    from tests.clients.babylon import BabylonClient
+    from tests.clients.godot import GodotRun
 
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
@@ -34,13 +44,15 @@ PARAMS = ROOT / "params"
 FISH_SOURCE = PARAMS / "bonybream.txt"
 CLOUD_SOURCE = PARAMS / "clouds" / "table_4_4.awn"
 SWIM_TRACKS = 13  # 4 fin swings (pectoral, pelvic) + the body wave's weights on the body and 8 fins
+SCHOOL_FISH, SCHOOL_FRAMES = 10, 30
+SCHOOL_TRACKS = 2 + SWIM_TRACKS  # each fish: its path (translation, rotation) and its own swim
 CLOUD_COLUMNS = ("x", "y", "z", "radius", "density", "red", "green", "blue")
 
 
 @dataclass(frozen=True)
 class Format:
     label: str          # row of the table
-    kind: str           # "fish" or "cloud"
+    kind: str           # "fish", "school" or "cloud"
     filename: str
     flags: tuple[str, ...] = ()
 
@@ -58,18 +70,19 @@ FORMATS = (
     Format("fish gltf", "fish", "fish.gltf"),
     Format("fish obj", "fish", "fish.obj"),
     Format("fish ply", "fish", "fish.ply"),
+    Format("school glb", "school", "school.glb", ("--count", str(SCHOOL_FISH), "--frames", str(SCHOOL_FRAMES))),
     Format("cloud ply", "cloud", "cloud.ply"),
     Format("cloud glb points", "cloud", "points.glb"),
     Format("cloud glb billboards", "cloud", "billboards.glb", ("--billboards",)),
     Format("cloud csv", "cloud", "cloud.csv"),
     Format("cloud npy", "cloud", "cloud.npy"),
 )
-CLIENTS = ("three.js", "trimesh", "pygltflib", "plyfile", "numpy")
-APPLIES = {
-    "glb": ("three.js", "trimesh", "pygltflib"),
-    "gltf": ("three.js", "trimesh", "pygltflib"),
-    "obj": ("three.js", "trimesh"),
-    "ply": ("three.js", "trimesh", "plyfile"),
+CLIENTS = ("three.js", "Babylon.js", "Godot 3", "trimesh", "pygltflib", "plyfile", "numpy")
+APPLIES = {  # Godot 3 has no PLY importer; Babylon.js reads PLY through its splat loader
+    "glb": ("three.js", "Babylon.js", "Godot 3", "trimesh", "pygltflib"),
+    "gltf": ("three.js", "Babylon.js", "Godot 3", "trimesh", "pygltflib"),
+    "obj": ("three.js", "Babylon.js", "Godot 3", "trimesh"),
+    "ply": ("three.js", "Babylon.js", "trimesh", "plyfile"),
     "csv": ("numpy",),
     "npy": ("numpy",),
 }
@@ -77,12 +90,24 @@ APPLIES = {
 # (format label, client) -> (substring of the failure it must show, short reason for the table)
 KNOWN_LIMITS: dict[tuple[str, str], tuple[str, str]] = {
     ("fish ply", "three.js"): ("never requested", "PLYLoader ignores `comment TextureFile`: no texture"),
+    ("fish ply", "Babylon.js"): ("material has no texture",
+                                 "the splat loader's PLY mesh ignores `comment TextureFile` and s/t: no texture"),
+    ("fish obj", "Godot 3"): ("map_d", "the OBJ importer ignores `map_d`: fins opaque and one-sided"),
+    ("cloud glb points", "Godot 3"): ("COLOR_0 imported but not shown",
+                                      "COLOR_0 kept but not shown (the importer uses vertex colours only for "
+                                      "materials named `…-vcol`): particles white"),
+    ("cloud glb billboards", "Godot 3"): ("COLOR_0 imported but not shown, KHR_materials_unlit ignored",
+                                          "COLOR_0 not shown, KHR_materials_unlit ignored: particles white and lit"),
     ("fish obj", "trimesh"): ("map_d", "trimesh ignores map_d (fins keep the skin png's alpha)"),
 }
 
 
+# The order cells run in: Godot's last, since its import runs in the background meanwhile.
+RUN_ORDER = ("three.js", "Babylon.js", "trimesh", "pygltflib", "plyfile", "numpy", "Godot 3")
+
+
 def cells() -> list[tuple[str, str]]:
-    return [(f.label, c) for f in FORMATS for c in CLIENTS if c in APPLIES[f.ext]]
+    return [(f.label, c) for c in RUN_ORDER for f in FORMATS if c in APPLIES[f.ext]]
 
 
 # --------------------------------------------------------------------------- assets
@@ -95,6 +120,8 @@ class Asset:
     summary: str                # the one line fishgen printed
     reported: dict[str, int]    # counts from that line
     expected: dict[str, int]    # vertices / triangles / particles a loader must find
+    clip: tuple[str, int] | None = None     # the clip's name and glTF channels, where the format holds it
+    bounds: Bounds | None = None            # fishgen's bounds (tests/clients/bounds.py)
 
     @property
     def label(self) -> str:
@@ -106,17 +133,22 @@ class Asset:
 
 
 def _summary_counts(line: str) -> dict[str, int]:
-    return {k: int(m[1]) for k in ("triangles", "particles") if (m := re.search(rf"(\d+) {k}\b", line))}
+    found = {k: int(m[1]) for k in ("triangles", "particles", "frames") if (m := re.search(rf"(\d+) {k}\b", line))}
+    if m := re.search(r": (\d+) \w+;", line):  # a school: "school.glb: 10 bonybream; 30 frames (1.0 s), ..."
+        found["fish"] = int(m[1])
+    return found
 
 
-def _scene_counts(kind: str) -> dict[str, dict[str, int]]:
-    """Counts of the scene fishgen builds in-process (the summary line has no vertex count)."""
+def _scenes() -> dict[str, Scene]:
+    """The scenes fishgen builds in-process for the fish and cloud rows, as the CLI builds them
+    (the summary line has no vertex count, and the bounds come from these)."""
     import fishgen
     from fishgen.clouds import fill_cloud, load_cubes
+    from fishgen.clouds.scene import cloud_scene
 
-    if kind == "fish":
-        return {"fish": fishgen.build_fish(fishgen.load_species(FISH_SOURCE)).counts()}
-    return {"points": {"particles": len(fill_cloud(load_cubes(CLOUD_SOURCE), seed=0))}}
+    cloud = fill_cloud(load_cubes(CLOUD_SOURCE), seed=0)
+    return {"fish": fishgen.build_fish(fishgen.load_species(FISH_SOURCE)),
+            "points": cloud_scene(cloud), "billboards": cloud_scene(cloud, billboards=True)}
 
 
 def make_assets(folder: Path) -> dict[str, Asset]:
@@ -129,35 +161,59 @@ def make_assets(folder: Path) -> dict[str, Asset]:
             shutil.rmtree(out_dir)
         out_dir.mkdir()
         out = out_dir / fmt.filename
-        command = "build" if fmt.kind == "fish" else "clouds"
-        source = FISH_SOURCE if fmt.kind == "fish" else CLOUD_SOURCE
+        command = {"fish": "build", "school": "school", "cloud": "clouds"}[fmt.kind]
+        source = CLOUD_SOURCE if fmt.kind == "cloud" else FISH_SOURCE
         result = subprocess.run([sys.executable, "-m", "fishgen", command, str(source), "-o", str(out), *fmt.flags],
                                 cwd=ROOT, capture_output=True, text=True)
         if result.returncode != 0:
             raise RuntimeError(f"fishgen {command} -o {fmt.filename} failed: {result.stderr.strip()}")
         lines = result.stdout.strip().splitlines()
-        if len(lines) != 1:
+        # one summary line; a school's is followed by its table of measures
+        if len(lines) != 1 and fmt.kind != "school":
             raise RuntimeError(f"fishgen printed {len(lines)} lines, expected one summary line: {result.stdout!r}")
         files = [fmt.filename] + sorted(p.name for p in out_dir.iterdir() if p.name != fmt.filename)
         return Asset(fmt, out, files, lines[0], _summary_counts(lines[0]), {})
 
     with ThreadPoolExecutor(4) as pool:
-        assets = {a.label: a for a in pool.map(build, FORMATS)}
-    fish = _scene_counts("fish")["fish"]
-    points = _scene_counts("cloud")["points"]
+        jobs = [pool.submit(build, fmt) for fmt in FORMATS]
+        scenes = _scenes()
+        assets = {a.label: a for a in (job.result() for job in jobs)}
+    fish = scenes["fish"].counts()
+    points = scenes["points"].counts()
     for a in assets.values():
         if a.fmt.kind == "fish":
             if a.reported.get("triangles") != fish["triangles"]:
                 raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, the scene has {fish['triangles']} triangles")
             a.expected = {"vertices": fish["vertices"], "triangles": a.reported["triangles"], "particles": 0}
+            a.bounds = scene_bounds(scenes["fish"])
+            if a.fmt.ext == "ply":  # one mesh of every part
+                a.bounds = merged(a.bounds, "fish")
+            if a.fmt.ext in ("glb", "gltf"):
+                a.clip = ("swim", SWIM_TRACKS)
+        elif a.fmt.kind == "school":
+            n = a.reported.get("fish")
+            if n != SCHOOL_FISH or a.reported.get("frames") != SCHOOL_FRAMES:
+                raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, asked for {SCHOOL_FISH} fish "
+                                   f"and {SCHOOL_FRAMES} frames")
+            a.expected = {"vertices": n * fish["vertices"], "triangles": n * fish["triangles"], "particles": 0,
+                          "fish": n}
+            a.clip = ("school", n * SCHOOL_TRACKS)
+            from fishgen.exchange.gltf_reader import read_gltf
+
+            a.bounds = scene_bounds(read_gltf(a.path))
         else:
             n = a.reported["particles"]
             if n != points["particles"]:
                 raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, fill_cloud made {points['particles']}")
-            if "--billboards" in a.fmt.flags:  # one quad (4 vertices, 2 triangles) per particle
-                a.expected = {"vertices": 4 * n, "triangles": 2 * n, "particles": 0, "quads": n}
+            if "--billboards" in a.fmt.flags:  # QUADS crossed quads (4 vertices, 2 triangles each) a particle
+                from fishgen.clouds.scene import QUADS
+
+                a.expected = {"vertices": 4 * QUADS * n, "triangles": 2 * QUADS * n, "particles": 0,
+                              "quads": QUADS * n}
+                a.bounds = scene_bounds(scenes["billboards"])
             else:
                 a.expected = {"vertices": 0, "triangles": 0, "particles": n}
+                a.bounds = scene_bounds(scenes["points"])
     return assets
 
 
@@ -229,7 +285,7 @@ def check_trimesh(asset: Asset) -> str:
     if merged:
         notes.append(f"default load merges {merged} duplicate vertex{'es' if merged > 1 else ''}")
 
-    if asset.fmt.kind == "fish" or "--billboards" in asset.fmt.flags:
+    if asset.fmt.kind in ("fish", "school") or "--billboards" in asset.fmt.flags:
         for g in meshes:
             mat = getattr(g.visual, "material", None)
             expect(mat is not None, f"{g.metadata.get('name', 'mesh')}: no material")
@@ -254,7 +310,7 @@ def check_trimesh(asset: Asset) -> str:
                 attrs |= set(getattr(g, "vertex_attributes", {}) or {})
             if not attrs & {"_RADIUS", "_radius"}:
                 notes.append("drops _RADIUS/_DENSITY/_CUBE")
-    if asset.fmt.ext in ("glb", "gltf") and asset.fmt.kind == "fish":
+    if asset.clip:
         notes.append("no animation support")
     _ = np
     return "; ".join(notes)
@@ -312,16 +368,20 @@ def check_pygltflib(asset: Asset) -> str:
     for buf in g.buffers:
         if buf.uri and not buf.uri.startswith("data:"):
             expect((asset.path.parent / buf.uri).is_file(), f"buffer {buf.uri} missing")
-    if asset.fmt.kind == "fish":
+    if asset.fmt.kind in ("fish", "school"):
         expect(bool(g.images), "no images")
-        _check_clip([(a.name, len(a.channels)) for a in g.animations or []])
+        _check_clip(asset, [(a.name, len(a.channels)) for a in g.animations or []])
     return ""
 
 
-def _check_clip(clips: list[tuple[str, int]]) -> None:
-    swim = [n for name, n in clips if name == "swim"]
-    expect(bool(swim), f"no clip named swim (found {[c for c, _ in clips]})")
-    expect(swim[0] == SWIM_TRACKS, f"swim has {swim[0]} tracks, expected {SWIM_TRACKS}")
+def _check_clip(asset: Asset, clips: list[tuple[str, int]]) -> None:
+    """The asset's clip is there with a track for each of its glTF channels."""
+    if asset.clip is None:
+        return
+    name, channels = asset.clip
+    found = [n for clip, n in clips if clip == name]
+    expect(bool(found), f"no clip named {name} (found {[c for c, _ in clips]})")
+    expect(found[0] == channels, f"{name} has {found[0]} tracks, expected {channels}")
 
 
 def check_plyfile(asset: Asset) -> str:
@@ -417,13 +477,44 @@ class _Handler(SimpleHTTPRequestHandler):
         pass
 
 
+class _Chromium:
+    """One playwright and one headless Chromium per process, shared by every LocalBrowser open at
+    once (playwright's sync API allows one instance per thread); closed with the last of them."""
+
+    users = 0
+    playwright: Any = None
+    browser: Any = None
+
+    @classmethod
+    def acquire(cls):
+        if cls.users == 0:
+            from playwright.sync_api import sync_playwright
+
+            cls.playwright = sync_playwright().start()
+            try:
+                cls.browser = cls.playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+            except Exception:
+                cls.playwright.stop()
+                raise
+        cls.users += 1
+        return cls.browser
+
+    @classmethod
+    def release(cls) -> None:
+        cls.users -= 1
+        if cls.users == 0:
+            try:
+                cls.browser.close()
+            finally:
+                cls.playwright.stop()
+                cls.browser = cls.playwright = None
+
+
 class LocalBrowser:
     """A local HTTP server for ``mounts`` (URL prefix -> folder) on loopback, and one headless
-    Chromium page; ``close()`` stops both."""
+    Chromium page of its own (in the process's shared Chromium); ``close()`` stops both."""
 
     def __init__(self, mounts: dict[str, Path]):
-        from playwright.sync_api import sync_playwright
-
         handler = type("Handler", (_Handler,), {"mounts": {k: v.resolve() for k, v in mounts.items()},
                                                 "log": []})
         handler.extensions_map = {**SimpleHTTPRequestHandler.extensions_map, ".js": "text/javascript"}
@@ -431,24 +522,30 @@ class LocalBrowser:
         self.server = ThreadingHTTPServer(("127.0.0.1", 0), handler)
         self.base = f"http://127.0.0.1:{self.server.server_address[1]}"
         threading.Thread(target=self.server.serve_forever, daemon=True).start()
-        self._pw = sync_playwright().start()
-        self.browser = self._pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        self.page = self.browser.new_page()
+        try:
+            self.browser = _Chromium.acquire()
+        except Exception:
+            self.server.shutdown()
+            self.server.server_close()
+            raise
+        self.context = self.browser.new_context()
+        self.page = self.context.new_page()
 
     def close(self) -> None:
         try:
-            self.browser.close()
-            self._pw.stop()
+            self.context.close()
+            _Chromium.release()
         finally:
             self.server.shutdown()
             self.server.server_close()
 
 
-class ThreeClient(LocalBrowser):
-    """One local HTTP server, one Chromium, one harness page for all the three.js cells."""
+class HarnessPage(LocalBrowser):
+    """A harness page (under tests/clients, served at /harness/) in the shared Chromium, with every
+    console error, page error and request recorded, and nothing fetched from outside 127.0.0.1."""
 
-    def __init__(self, asset_dir: Path):
-        super().__init__({"/three/": THREE_DIR, "/harness/": HERE, "/assets/": asset_dir})
+    def __init__(self, mounts: dict[str, Path], page: str):
+        super().__init__({**mounts, "/harness/": HERE})
         self.console: list[str] = []
         self.requests: list[tuple[str, int | str]] = []
         self.outside: list[str] = []
@@ -457,8 +554,8 @@ class ThreeClient(LocalBrowser):
         self.page.on("response", lambda r: self.requests.append((r.url, r.status)))
         self.page.on("requestfailed", lambda r: self.requests.append((r.url, f"failed {r.failure}")))
         self.page.route("**/*", self._route)
-        self.page.goto(f"{self.base}/harness/harness.html")
-        self.page.wait_for_function("window.harnessReady === true", timeout=30_000)
+        self.page.goto(f"{self.base}/harness/{page}")
+        self.page.wait_for_function("window.harnessReady === true", timeout=60_000)
         problems = self._problems()
         if problems:
             raise RuntimeError(f"the harness page did not load cleanly: {problems}")
@@ -481,10 +578,25 @@ class ThreeClient(LocalBrowser):
         out += [f"outside request {u}" for u in self.outside]
         return out
 
-    def check(self, asset: Asset) -> str:
+    def _clear(self) -> None:
         self.console.clear()
         self.requests.clear()
         self.outside.clear()
+
+    def _never_fetched(self, asset: Asset) -> list[str]:
+        """Files fishgen wrote for ``asset`` that the page never fetched (with a 200)."""
+        fetched = {u.rsplit("/", 1)[1] for u, s in self.requests if s == 200}
+        return [f for f in asset.files if f not in fetched]
+
+
+class ThreeClient(HarnessPage):
+    """One local HTTP server, one Chromium, one harness page for all the three.js cells."""
+
+    def __init__(self, asset_dir: Path):
+        super().__init__({"/three/": THREE_DIR, "/assets/": asset_dir}, "harness.html")
+
+    def check(self, asset: Asset) -> str:
+        self._clear()
         loader = {"glb": "gltf", "gltf": "gltf", "obj": "obj", "ply": "ply"}[asset.fmt.ext]
         url = f"{self.base}/assets/{asset.fmt.slug}/{asset.fmt.filename}"
         options = {}
@@ -524,8 +636,7 @@ class ThreeClient(LocalBrowser):
         if "--billboards" in asset.fmt.flags:
             expect(counts["triangles"] / 2 == asset.expected["quads"], "quads != particles")
         # every file fishgen wrote is fetched, once or more, and every texture arrives
-        fetched = {u.rsplit("/", 1)[1] for u, s in self.requests if s == 200}
-        never = [f for f in asset.files if f not in fetched]
+        never = self._never_fetched(asset)
         expect(not never, f"{', '.join(never)} never requested")
         for o in meshes:
             for m in o["materials"]:
@@ -537,13 +648,18 @@ class ThreeClient(LocalBrowser):
             fins = [m for o in meshes for m in o["materials"] if m["name"] == "fins"]
             expect(bool(fins) and all(m["alphaMap"] and m["alphaMap"]["arrived"] for m in fins),
                    "fins material has no alphaMap")
-        if asset.fmt.kind == "fish" and asset.fmt.ext in ("glb", "gltf"):
+        if asset.clip:
             clips = r["clips"]
-            _check_clip([(c["name"], len(c["tracks"])) for c in clips])
+            _check_clip(asset, [(c["name"], len(c["tracks"])) for c in clips])
             unbound = [t["name"] for c in clips for t in c["tracks"] if not t["bound"]]
             expect(not unbound, f"tracks target no node: {unbound}")
             fins = [m for o in meshes for m in o["materials"] if m["name"] == "fins"]
             expect(all(m["alphaTest"] == 0.5 and m["side"] == 2 for m in fins), "fins lost MASK/double-sided")
+        if asset.fmt.kind == "cloud" and asset.fmt.ext == "glb":  # COLOR_0 shown; billboards unlit
+            materials = [m for o in objects for m in o["materials"]]
+            expect(all(m["vertexColors"] for m in materials), "particle colours (COLOR_0) not used")
+            if "--billboards" in asset.fmt.flags:
+                expect(all(m["type"] == "MeshBasicMaterial" for m in materials), "KHR_materials_unlit ignored")
         if points:
             want = {"color", "_radius", "_density", "_cube"} if asset.fmt.ext == "glb" else {"color", "radius", "density"}
             have = set().union(*(o["attributes"] for o in points))
@@ -556,12 +672,21 @@ class ThreeClient(LocalBrowser):
 # --------------------------------------------------------------------------- running
 
 class Matrix:
-    def __init__(self, asset_dir: Path):
+    def __init__(self, asset_dir: Path, godot_now: bool = True):
         self.asset_dir = asset_dir
         self.assets = make_assets(asset_dir)
         self.results: dict[tuple[str, str], Cell] = {}
         self._three: ThreeClient | None = None
         self._three_error: str | None = None
+        self._babylon: BabylonClient | None = None
+        self._babylon_error: str | None = None
+        self._godot: GodotRun | None = None
+        self._godot_error: str | None = None        # not installed: the cells are skipped
+        self._godot_failure: str | None = None      # the import or the inspection failed: the cells fail
+        self._godot_thread: threading.Thread | None = None
+        if godot_now:  # Godot imports in its own process while the other clients run
+            self._godot_thread = threading.Thread(target=self._start_godot, daemon=True)
+            self._godot_thread.start()
 
     def three(self) -> ThreeClient | None:
         if self._three is None and self._three_error is None:
@@ -570,18 +695,59 @@ class Matrix:
                 self._three = ThreeClient(self.asset_dir)
         return self._three
 
+    def babylon(self) -> BabylonClient | None:
+        if self._babylon is None and self._babylon_error is None:
+            from tests.clients.babylon import BabylonClient, babylon_unavailable
+
+            self._babylon_error = babylon_unavailable()
+            if self._babylon_error is None:
+                self._babylon = BabylonClient(self.asset_dir)
+        return self._babylon
+
+    def godot(self) -> GodotRun | None:
+        """Every file Godot reads, and the extra files of the Godot tests, imported in one run."""
+        if self._godot_thread is not None:
+            self._godot_thread.join()
+        elif self._godot is None and self._godot_error is None and self._godot_failure is None:
+            self._start_godot()
+        return self._godot
+
+    def _start_godot(self) -> None:
+        from tests.clients.godot import GodotRun, extra_assets, godot_unavailable
+
+        self._godot_error = godot_unavailable()
+        if self._godot_error is not None:
+            return
+        try:
+            chosen = {label: a for label, a in self.assets.items() if "Godot 3" in APPLIES[a.fmt.ext]}
+            chosen.update(extra_assets(self.assets, self.asset_dir / "godot-extra"))
+            self._godot = GodotRun.start(self.asset_dir / "godot", chosen)
+        except Exception as err:  # noqa: BLE001 - the Godot cells fail with it, the rest run
+            self._godot_failure = f"{type(err).__name__}: {err}"
+
+    def _check(self, client: str) -> tuple[Callable[[Asset], str] | None, str]:
+        """The client's check, or None and why it cannot run here."""
+        if client == "three.js":
+            three = self.three()
+            return (three.check if three else None), self._three_error or ""
+        if client == "Babylon.js":
+            babylon = self.babylon()
+            return (babylon.check if babylon else None), self._babylon_error or ""
+        if client == "Godot 3":
+            godot = self.godot()
+            if self._godot_failure is not None:
+                return partial(_raise, RuntimeError(self._godot_failure)), ""
+            return (godot.check if godot else None), self._godot_error or ""
+        return PY_CHECKS[client], ""
+
     def run(self, label: str, client: str) -> Cell:
         if (label, client) in self.results:
             return self.results[(label, client)]
         asset = self.assets[label]
         start = time.perf_counter()
-        if client == "three.js":
-            three = self.three()
-            check = three.check if three is not None else None
-        else:
-            check = PY_CHECKS[client]
+        check, why = self._check(client)
         if check is None:
-            cell = Cell(label, client, "skip", self._three_error or "unavailable")
+            cell = Cell(label, client, "skip", why or "unavailable")
         else:
             cell = _judge_known(label, client, partial(check, asset))
         cell.seconds = time.perf_counter() - start
@@ -592,9 +758,16 @@ class Matrix:
         return [self.run(label, client) for label, client in cells()]
 
     def close(self) -> None:
-        if self._three is not None:
-            self._three.close()
-            self._three = None
+        if self._godot_thread is not None:  # leave no Godot behind
+            self._godot_thread.join()
+        for client in (self._three, self._babylon):
+            if client is not None:
+                client.close()
+        self._three = self._babylon = None
+
+
+def _raise(err: Exception, *_) -> str:
+    raise err
 
 
 def _judge_known(label: str, client: str, check: Callable[[], str]) -> Cell:
@@ -603,7 +776,7 @@ def _judge_known(label: str, client: str, check: Callable[[], str]) -> Cell:
         note = check()
     except Exception as e:  # noqa: BLE001 - every failure is a cell's reason
         reason = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-        if not isinstance(e, CellFailure):
+        if not isinstance(e, AssertionError):
             reason = f"{type(e).__name__}: {reason}"
         if known and known[0] in reason:
             return Cell(label, client, "known", known[1], {"error": reason})
