@@ -175,8 +175,9 @@ def _metrics_json(run, per_frame: dict, numbers: dict, warmup: int) -> bytes:
         if isinstance(value, dict):
             return {str(k): plain(v) for k, v in value.items()}
         if isinstance(value, np.ndarray):
-            rounded = np.round(value.astype(float), 6)
-            return np.where(np.isfinite(rounded), rounded, None).tolist()
+            rounded = np.round(value.astype(float), 6).astype(object)
+            rounded[~np.isfinite(value.astype(float))] = None
+            return rounded.tolist()
         if isinstance(value, (np.floating, np.integer, float)):
             number = float(value)
             return number if math.isfinite(number) else None
