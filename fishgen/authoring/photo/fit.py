@@ -2,11 +2,12 @@
 
 Measured first, then refined:
 
-1. **Frame and body.** The silhouette is levelled head-left (:mod:`.frame`). The body is what
-   remains after an opening by a disk of half the body's half-depth (fins are thinner than the
-   body); its half-depth is read at every BodySection and becomes a FishShapeSpline control
-   point there, so the built body's outline (straight between sections) is the measured one.
-   The body's length ends behind the tail base (the deepest neck) by the caudal connection.
+1. **Frame and body.** The silhouette is levelled head-left (:mod:`.frame`). Fins only add to a
+   silhouette and a fishgen body is symmetric about its axis, so the body is no deeper than the
+   nearer outline at each column; a smooth hump (:func:`_hump`) fitted under those depths
+   bridges where fins stand on both sides. Its half-depth at every BodySection becomes a
+   FishShapeSpline control point there, so the built body's outline (straight between sections)
+   is the measured one. The body ends a little behind the tail base (the deepest neck).
 2. **Fins from what is left.** Pixels outside the body are fin. Behind the tail base they are
    the caudal fin: its lobe tips and fork give the top, bottom and middle lines and angles.
    Runs above the back are the dorsal fin (the largest) and the adipose fin (a second one
@@ -26,7 +27,8 @@ stay the base's. Everything here is pure numpy/scipy on masks and plain numbers.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 from scipy import ndimage  # type: ignore[import-untyped]
@@ -39,8 +41,6 @@ from fishgen.species.model import CaudalFin, PelvicFin, Species, VerticalFin
 TAIL_BASE = 0.965
 #: The fish's nose-to-tail-base length in the working frame, in pixels.
 WORK_LENGTH = 360
-#: Disk that opens fins off the body, as a share of the body's largest half-depth.
-OPENING = 0.5
 #: A column stands out as fin when the outline is this far past the body (share of body length).
 FIN_MARGIN = 0.012
 #: Runs of fin smaller than this share of the fish's area are specks.
@@ -71,8 +71,12 @@ class Placement:
 class ShapeFit:
     species: Species
     iou: float                 # side view against the silhouette, in the working frame
-    placement: Placement
+    placement: Placement       # where the species lies on ``work``
     notes: tuple[str, ...]     # what was left out or changed, one line each
+    #: the levelled silhouette the fit was made on (working scale)
+    work: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((1, 1), bool))
+    frame: Any = field(default=None, repr=False)              # the levelled frame (:class:`.frame.Frame`)
+    frame_map: tuple[float, float, float, float] | None = None   # thesis -> frame: x0, y0, x scale, y scale
 
 
 @dataclass(frozen=True)
@@ -94,7 +98,8 @@ def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False) -
     """Fit ``base``'s geometry to the silhouette ``mask`` (any orientation; it is levelled here)."""
     from fishgen.authoring.photo.frame import fish_frame
 
-    work = _working_mask(fish_frame(mask).mask)
+    frame = fish_frame(mask)
+    work, to_frame, offset = _working_mask(frame.mask)
     body = _measure_body(work)
     base = replace(base, texture_points=None, colour_texture=None, mask_texture=None)
     counts = [base.body_sections] if sections_fixed else \
@@ -105,12 +110,82 @@ def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False) -
         first, place = _measured(start, work, body)
         if _holds(first, place, work, body):
             break
-    fit = _fit_at(first, place, work, body)
+    fit = replace(_fit_at(first, place, work, body), work=work, frame=frame)
+    fit = _trimmed(fit)
+    fit = replace(fit, frame_map=_frame_map(fit, to_frame, offset))
     if fit.species.body_sections != base.body_sections:
         fit = replace(fit, notes=fit.notes + (
             f"BodySections {base.body_sections} -> {fit.species.body_sections}: the base's rings "
             "could not hold the photographed body and fins",))
     return fit
+
+
+#: Length fields of each fin record, shortened together when a fin stands past the photo's fish.
+LENGTHS = {"caudal": ("top_line", "bottom_line", "middle_line"), "dorsal": ("start_length", "end_length"),
+           "adipose": ("start_length", "end_length"), "anal": ("start_length", "end_length"),
+           "pelvic": ("start_length", "end_length"), "pectoral": ("start_length",)}
+
+
+def _trimmed(fit: ShapeFit) -> ShapeFit:
+    """Shorten (x0.92 a step, at most 12 steps) any fin that stands past the photographed fish: the
+    overlap may favour a fin tip over the line, but a fin taller than the fish is a broken fish."""
+    from fishgen.authoring.photo.checks import height_problems
+
+    sp = fit.species
+    for _ in range(12):
+        found = height_problems(sp, fit.work, fit.placement)
+        tall = [n for n in FIN_RECORDS if any(f" {n} fin " in p for p in found)]
+        if not tall:
+            break
+        for name in tall:
+            fin = getattr(sp, name)
+            sp = _with(sp, name, replace(fin, **{k: getattr(fin, k) * 0.92 for k in LENGTHS[name]}))
+    if sp is fit.species:
+        return fit
+    return replace(fit, species=sp, iou=_shape_score(fit.work)(draw(sp, fit.placement, fit.work.shape)))
+
+
+def _frame_map(fit: ShapeFit, to_frame: float, offset: np.ndarray) -> tuple[float, float, float, float]:
+    """Where the fitted fish lies on the frame. The overlap compares bounding boxes, so the fit
+    pins proportions, not place and size: the drawing's box is mapped onto the silhouette's (as
+    the overlap maps it), then the working pixels onto the frame's."""
+    drawn = draw(fit.species, fit.placement, fit.work.shape)
+    d_rows, d_cols = np.flatnonzero(drawn.any(axis=1)), np.flatnonzero(drawn.any(axis=0))
+    t_rows, t_cols = np.flatnonzero(fit.work.any(axis=1)), np.flatnonzero(fit.work.any(axis=0))
+    ax = (t_cols[-1] + 1 - t_cols[0]) / (d_cols[-1] + 1 - d_cols[0])
+    ay = (t_rows[-1] + 1 - t_rows[0]) / (d_rows[-1] + 1 - d_rows[0])
+    p = fit.placement
+    x0 = t_cols[0] + (p.x0 - d_cols[0]) * ax
+    y0 = t_rows[0] + (p.y0 - d_rows[0]) * ay
+    return (float(x0 * to_frame + offset[0]), float(y0 * to_frame + offset[1]),
+            float(p.s * ax * to_frame), float(p.s * ay * to_frame))
+
+
+def body_outline(fit: ShapeFit, width: int):
+    """The fitted body as :mod:`.anatomy` describes one (:class:`.anatomy.BodyOutline`) in the
+    frame's pixels, so Fixel's points are measured where the fitted fish lies on the photo."""
+    from fishgen.authoring.photo.anatomy import BodyOutline
+    from fishgen.geometry.body import ring_positions
+    from fishgen.geometry.shapes import profile_for
+
+    sp = fit.species
+    assert fit.frame_map is not None
+    x0, y0, kx, ky = fit.frame_map
+    rings, _ = ring_positions(profile_for(sp.shape_class, sp.shape_params), sp.body_sections,
+                              sp.circle_sections, sp.scale)
+    xs = x0 + rings[:, 0, 0] * kx
+    cols = np.arange(width) + 0.5
+    inside = (cols >= xs[0]) & (cols <= xs[-1])
+    upper = np.where(inside, np.interp(cols, xs, rings[:, :, 1].max(axis=1) * ky), np.nan)
+    lower = np.where(inside, np.interp(cols, xs, -rings[:, :, 1].min(axis=1) * ky), np.nan)
+    none = np.zeros(width, bool)
+    return BodyOutline(float(xs[0]), float(xs[-1]), y0, 0.0, upper, lower, none, none.copy(), ky)
+
+
+def _with(sp: Species, record: str, fin: Any) -> Species:
+    """``sp`` with fin record ``record`` replaced."""
+    changes: dict[str, Any] = {record: fin}
+    return replace(sp, **changes)
 
 
 def _with_sections(base: Species, sections: int) -> Species:
@@ -119,18 +194,21 @@ def _with_sections(base: Species, sections: int) -> Species:
     return with_counts(base, sections, None)
 
 
-def _working_mask(frame_mask: np.ndarray) -> np.ndarray:
+def _working_mask(frame_mask: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
     """The levelled silhouette scaled so the fish is about WORK_LENGTH long, with a margin of half
-    its size all round (a fin grown past the photo's edge must still count against the fit)."""
+    its size all round (a fin grown past the photo's edge must still count against the fit); and
+    (scale, offset) taking working pixels back to the frame's: frame = work * scale + offset."""
     from PIL import Image
 
     ys, xs = np.nonzero(frame_mask)
     crop = frame_mask[ys.min():ys.max() + 1, xs.min():xs.max() + 1]
-    k = WORK_LENGTH / max(crop.shape[1], 1)
-    w, h = max(1, round(crop.shape[1] * k)), max(1, round(crop.shape[0] * k))
+    w, h = max(1, round(WORK_LENGTH)), max(1, round(crop.shape[0] * WORK_LENGTH / max(crop.shape[1], 1)))
     small = np.asarray(Image.fromarray(crop.astype(np.uint8) * 255).resize((w, h), Image.Resampling.BILINEAR))
     pad_y, pad_x = max(h, 40) // 2 + 8, w // 2
-    return np.pad(small >= 128, ((pad_y, pad_y), (pad_x, pad_x)))
+    kx, ky = crop.shape[1] / w, crop.shape[0] / h
+    scale = 0.5 * (kx + ky)
+    offset = np.array([xs.min() - pad_x * kx, ys.min() - pad_y * ky])
+    return np.pad(small >= 128, ((pad_y, pad_y), (pad_x, pad_x))), scale, offset
 
 
 def _measure_body(work: np.ndarray) -> _Body:
@@ -147,7 +225,6 @@ def _measure_body(work: np.ndarray) -> _Body:
     y0 = float(ped[1])
     top, bottom = columns.run_through(work, np.full(work.shape[1], y0))
     length = max(ped[0] - nose[0], 1.0)
-    tol = max(1.0, 0.5 * FIN_MARGIN * length)
     xc = np.arange(work.shape[1]) + 0.5
     inside = (xc >= nose[0]) & (xc <= ped[0]) & ~np.isnan(top)
     cols = np.flatnonzero(inside)
@@ -224,7 +301,8 @@ def _parts(sp: Species) -> tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]]
     xs = rings[:, 0, 0]
     outline = np.concatenate([np.stack([xs, rings[:, :, 1].max(axis=1)], 1),
                               np.stack([xs, rings[:, :, 1].min(axis=1)], 1)[::-1]])
-    fins = [(f.mesh.positions[:, :2], f.mesh.faces) for f in build_fins(replace(sp, texture_points=None), rings)]
+    built = build_fins(replace(sp, texture_points=None), rings)
+    fins = [(f.mesh.positions[:, :2], f.mesh.faces) for f in built]
     return outline, fins
 
 
@@ -341,7 +419,8 @@ def _measured_fins(sp: Species, work: np.ndarray, body: _Body, place: Placement,
 def _body_mask(sp: Species, place: Placement, shape: tuple[int, int]) -> np.ndarray:
     from PIL import Image, ImageDraw
 
-    outline, _ = _parts(replace(sp, caudal=replace(sp.caudal, top_line=0.0, bottom_line=0.0, middle_line=0.0)))
+    no_tail = replace(sp.caudal, top_line=0.0, bottom_line=0.0, middle_line=0.0)
+    outline, _ = _parts(replace(sp, caudal=no_tail))
     img = Image.new("L", (shape[1], shape[0]), 0)
     ImageDraw.Draw(img).polygon([tuple(p) for p in place.to_frame(outline).tolist()], fill=255)
     return np.asarray(img) >= 128
@@ -378,7 +457,8 @@ def _caudal_from(sp: Species, outside: np.ndarray, body: _Body, place: Placement
     def line(v: np.ndarray | None, fallback: float) -> tuple[float, float]:
         if v is None:
             return 0.05, fallback
-        return float(np.hypot(*v) / unit), float(np.clip(np.degrees(np.arctan2(abs(v[1]), max(v[0], 1e-6))), 5, 85))
+        angle = np.degrees(np.arctan2(abs(v[1]), max(v[0], 1e-6)))
+        return float(np.hypot(*v) / unit), float(np.clip(angle, 5, 85))
 
     top_line, top_angle = line(top, c.top_angle)
     bottom_line, bottom_angle = line(bottom, c.bottom_angle)
@@ -395,14 +475,13 @@ def _vertical_from(sp: Species, name: str, run: tuple[int, int] | None, side_mas
     if run is None:
         if fin.present and notes is not None:
             notes.append(f"no {name} fin in the photo: left out")
-        return replace(sp, **{name: replace(fin, start_length=0.0, end_length=0.0)})
+        return _with(sp, name, replace(fin, start_length=0.0, end_length=0.0))
     lo, hi = PLACES[name]
     s0 = int(np.clip(round(_section_of(run[0], sp, place)), max(1, np.ceil(lo * (b - 1))), b - 3))
     s1 = int(np.clip(round(_section_of(run[1], sp, place)), s0 + 1, min(b - 2, np.floor(hi * (b - 1)))))
     s1 = max(s1, s0 + 1)
-    ys, xs = np.nonzero(side_mask[:, run[0]:run[1]])
-    xs = xs + run[0] + 0.5
-    ys = ys + 0.5
+    rows, cols = np.nonzero(side_mask[:, run[0]:run[1]])
+    xs, ys = cols + run[0] + 0.5, rows + 0.5
     far = np.argmax(np.abs(ys - place.y0))
     apex = np.array([xs[far], ys[far]])
     unit = place.s * sp.scale[1]
@@ -414,10 +493,9 @@ def _vertical_from(sp: Species, name: str, run: tuple[int, int] | None, side_mas
     end_col = min(int(run[1]) - 1, side_mask.shape[1] - 1)
     col = np.flatnonzero(side_mask[:, end_col])
     end = float((np.abs(col + 0.5 - place.y0).max() - abs(base_y - place.y0)) / unit) if col.size else 0.02
-    return replace(sp, **{name: replace(fin, start_section=s0, end_section=s1, start_length=max(start, 0.02),
-                                        end_length=float(np.clip(end, 0.0, start)),
-                                        start_angle=side * angle if fin.start_angle >= 0 or side > 0
-                                        else -angle)})
+    return _with(sp, name, replace(fin, start_section=s0, end_section=s1, start_length=max(start, 0.02),
+                                   end_length=float(np.clip(end, 0.0, start)),
+                                   start_angle=angle if side > 0 else -angle))
 
 
 def _surface_row(sp: Species, place: Placement, section: int, side: float) -> float:
@@ -439,9 +517,8 @@ def _pelvic_from(sp: Species, run: tuple[int, int] | None, below: np.ndarray, pl
     s0 = int(np.clip(round(_section_of(run[0], sp, place)), np.ceil(lo * (b - 1)), b - 3))
     rear = _section_of(run[1], sp, place)
     s1 = int(np.clip(round(s0 + 0.4 * (rear - s0)), s0 + 1, s0 + max(1, int(MAX_PELVIC_SPAN * (b - 1)))))
-    ys, xs = np.nonzero(below[:, run[0]:run[1]])
-    xs = xs + run[0] + 0.5
-    ys = ys + 0.5
+    rows, cols = np.nonzero(below[:, run[0]:run[1]])
+    xs, ys = cols + run[0] + 0.5, rows + 0.5
     unit = place.s * sp.scale[1]
     far = np.argmax(ys + 0.3 * xs)
     tip = np.array([xs[far], ys[far]])
@@ -504,7 +581,8 @@ def valid(sp: Species) -> bool:
             continue
         lo, hi = PLACES[name]
         if not (1 <= f.start_section < f.end_section <= b - 2 and lo <= share(f.start_section)
-                and share(f.end_section) <= hi and 0.3 <= f.proportion <= 1 and 10 <= abs(f.start_angle) <= 140
+                and share(f.end_section) <= hi and 0.3 <= f.proportion <= 1
+                and 10 <= abs(f.start_angle) <= 140
                 and f.end_length <= max(f.start_length, 0.05) * 1.5):
             return False
     p = sp.pelvic
@@ -600,7 +678,8 @@ class _Drawer:
 FIN_RECORDS = ("caudal", "dorsal", "adipose", "anal", "pectoral", "pelvic")
 
 
-def _refine(sp: Species, work: np.ndarray, body: _Body, place: Placement) -> tuple[Species, Placement, float, float]:
+def _refine(sp: Species, work: np.ndarray, body: _Body,
+            place: Placement) -> tuple[Species, Placement, float, float]:
     """Pattern search on the side view's overlap with the silhouette: keep a step while it pays,
     else halve it. The body (length, depth, axis) first, then each fin's parameters."""
     depth = 1.0
@@ -610,7 +689,9 @@ def _refine(sp: Species, work: np.ndarray, body: _Body, place: Placement) -> tup
     scale = 1.0
     for _ in range(MAX_SWEEPS):
         improved = False
-        for kind in ("length", "depth", "axis"):
+        # (no overall depth: the overlap is measured between bounding boxes, blind to the aspect,
+        # which the measured body already has right)
+        for kind in ("length", "axis"):
             for step in (-1.0, 1.0):
                 d = step * scale
                 p2, depth2 = place, depth
@@ -640,7 +721,7 @@ def _refine(sp: Species, work: np.ndarray, body: _Body, place: Placement) -> tup
                 new_value = int(value) if kind == "section" else value
                 if kind == "angle" and name == "start_angle" and current < 0:
                     new_value = min(value, -1e-3)
-                trial = replace(sp, **{record: replace(fin, **{name: new_value})})
+                trial = _with(sp, record, replace(fin, **{name: new_value}))
                 if not valid(trial):
                     continue
                 changed = {record: drawer.fin(trial, record)}
@@ -665,7 +746,7 @@ def _drop_hidden(sp: Species, work: np.ndarray, place: Placement, notes: list[st
         fin: VerticalFin = getattr(sp, name)
         if not fin.present:
             continue
-        without = replace(sp, **{name: replace(fin, start_length=0.0, end_length=0.0)})
+        without = _with(sp, name, replace(fin, start_length=0.0, end_length=0.0))
         if np.count_nonzero(whole & ~draw(without, place, work.shape)) < SPECK * np.count_nonzero(work):
             sp = without
             if name != "adipose":

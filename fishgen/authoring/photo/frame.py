@@ -29,6 +29,10 @@ class Frame:
     def to_photo(self, points: np.ndarray) -> np.ndarray:
         return (np.asarray(points, float) - self.shift) @ np.linalg.inv(self.linear).T
 
+    def level(self, mask: np.ndarray) -> np.ndarray:
+        """Another mask of the photo (a true silhouette, say) turned as this frame turns the fish."""
+        return _resample(mask, self.linear)[0]
+
 
 def _rotation(degrees: float) -> np.ndarray:
     a = np.radians(degrees)
