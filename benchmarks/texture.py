@@ -163,8 +163,8 @@ def photographs() -> None:
             print(f"{name:16s} {kind:13s} {iou:6.3f} {body.max():9.4f} {body.mean():9.4f} "
                   f"{worst + ' ' + format(fins[worst], '.4f'):>18s} {how}", flush=True)
             rows.append((name, kind, path, truth, how))
-    print(f"\n--fit-shape on each shipped base; IoU of the rebuilt fish photographed by three.js (and by "
-          f"the command's own render), against the photo's true silhouette")
+    print("\n--fit-shape on each shipped base; IoU of the rebuilt fish photographed by three.js (and by "
+          "the command's own render), against the photo's true silhouette")
     print(f"{'subject':16s} {'photo':13s} {'base':16s} {'IoU 3js':>8s} {'own':>6s} {'kept':>5s} "
           f"{'whole':>6s} {'s':>5s} note")
     worst_iou = 1.0

@@ -21,7 +21,8 @@ def sand(w: int, h: int, seed: int = 0) -> np.ndarray:
     n = _noise(h, w, seed, (32, 8, 1), (0.35, 0.35, 0.3))
     ripple = 0.5 + 0.5 * np.sin(np.arange(h)[:, None] / h * 40 + 6 * _noise(h, w, seed + 1, (64,), (1.0,)))
     t = (0.6 * n + 0.4 * ripple)[:, :, None]
-    return np.clip((1 - t) * np.array([120, 100, 70]) + t * np.array([190, 170, 130]), 0, 255).astype(np.uint8)
+    colour = (1 - t) * np.array([120, 100, 70]) + t * np.array([190, 170, 130])
+    return np.clip(colour, 0, 255).astype(np.uint8)
 
 
 def water(w: int, h: int, seed: int = 0) -> np.ndarray:

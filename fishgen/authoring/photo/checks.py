@@ -28,7 +28,7 @@ ATTACHED = 0.01
 #: A fin may reach past the photo's fish by this share of the body length (drawing tolerance).
 TALLER = 0.03
 #: Times sampled over the swim clip.
-CLIP_SAMPLES = 49
+CLIP_SAMPLES = 33
 #: Body triangles searched per fin vertex (the nearest at rest; the wave moves them together).
 NEAREST = 24
 
@@ -129,9 +129,17 @@ def attachment_problems(species: Species) -> list[str]:
             if gap > worst:
                 worst, where = gap, names[node]
     if worst > ATTACHED * length:
-        return [f"the {where.replace('_', ' ')} comes off the body while swimming "
+        return [f"the {_fin_name(where)} comes off the body while swimming "
                 f"({worst / length:.1%} of the body length; at most {ATTACHED:.0%})"]
     return []
+
+
+def _fin_name(node: str) -> str:
+    """'pelvic_fin_left' -> 'left pelvic fin'."""
+    words = node.split("_")
+    if words[-1] in ("left", "right"):
+        words = [words[-1], *words[:-1]]
+    return " ".join(words)
 
 
 def _distance(points: np.ndarray, triangles: np.ndarray, candidates: np.ndarray) -> np.ndarray:

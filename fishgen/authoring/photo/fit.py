@@ -113,6 +113,14 @@ def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False) -
     fit = replace(_fit_at(first, place, work, body), work=work, frame=frame)
     fit = _trimmed(fit)
     fit = replace(fit, frame_map=_frame_map(fit, to_frame, offset))
+    notes = []
+    for name in ("dorsal", "anal"):
+        if getattr(base, name).present and not getattr(fit.species, name).present:
+            notes.append(f"no {name} fin in the photo: left out")
+    p = fit.species.pelvic
+    if p.start_length == 0 and p.end_length == 0 and (base.pelvic.start_length or base.pelvic.end_length):
+        notes.append("no pelvic fin in the photo: kept at zero size (a species file cannot leave it out)")
+    fit = replace(fit, notes=tuple(notes))
     if fit.species.body_sections != base.body_sections:
         fit = replace(fit, notes=fit.notes + (
             f"BodySections {base.body_sections} -> {fit.species.body_sections}: the base's rings "
@@ -356,15 +364,13 @@ def _measured(base: Species, work: np.ndarray, body: _Body) -> tuple[Species, Pl
     y0 = float(np.nanmedian(body.centre))
     place = Placement(body.nose, y0, length_px / sx)
     sp = _body_species(base, body, place, 1.0)
-    return _measured_fins(sp, work, body, place, None), place
+    return _measured_fins(sp, work, body, place), place
 
 
 def _fit_at(first: Species, place: Placement, work: np.ndarray, body: _Body) -> ShapeFit:
-    notes: list[str] = []
-    sp = _measured_fins(first, work, body, place, notes)   # again, to collect its notes
-    sp, place, _, score = _refine(sp, work, body, place)
-    sp = _drop_hidden(sp, work, place, notes)
-    return ShapeFit(sp, score, place, tuple(notes))
+    sp, place, _, score = _refine(first, work, body, place)
+    sp = _drop_hidden(sp, work, place)
+    return ShapeFit(sp, score, place, ())
 
 
 def _section_of(x_px: float, sp: Species, place: Placement) -> float:
@@ -377,8 +383,7 @@ def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(d == 1).tolist(), np.flatnonzero(d == -1).tolist(), strict=True))
 
 
-def _measured_fins(sp: Species, work: np.ndarray, body: _Body, place: Placement,
-                   notes: list[str] | None) -> Species:
+def _measured_fins(sp: Species, work: np.ndarray, body: _Body, place: Placement) -> Species:
     """Every fin's place and size read off the silhouette outside the body."""
     h, w = work.shape
     drawn_body = _body_mask(sp, place, work.shape)
@@ -398,8 +403,8 @@ def _measured_fins(sp: Species, work: np.ndarray, body: _Body, place: Placement,
     runs_up.sort(key=lambda r: -int(up[r[0]:r[1]].sum()))
     dorsal = runs_up[0] if runs_up else None
     adipose = next((r for r in runs_up[1:] if dorsal is not None and r[0] > dorsal[1]), None)
-    sp = _vertical_from(sp, "dorsal", dorsal, above, place, 1.0, notes)
-    sp = _vertical_from(sp, "adipose", adipose, above, place, 1.0, None)
+    sp = _vertical_from(sp, "dorsal", dorsal, above, place, 1.0)
+    sp = _vertical_from(sp, "adipose", adipose, above, place, 1.0)
     runs_down.sort(key=lambda r: r[0])
     def centre(r: tuple[int, int]) -> float:
         return ((r[0] + r[1]) / 2 - place.x0) / length
@@ -411,8 +416,8 @@ def _measured_fins(sp: Species, work: np.ndarray, body: _Body, place: Placement,
     pelvic = max(front, key=size) if front else None
     back = [r for r in runs_down if centre(r) > 0.45 and r is not pelvic]
     anal = max(back, key=size) if back else None
-    sp = _vertical_from(sp, "anal", anal, below, place, -1.0, notes)
-    sp = _pelvic_from(sp, pelvic, below, place, notes)
+    sp = _vertical_from(sp, "anal", anal, below, place, -1.0)
+    sp = _pelvic_from(sp, pelvic, below, place)
     return sp
 
 
@@ -469,12 +474,10 @@ def _caudal_from(sp: Species, outside: np.ndarray, body: _Body, place: Placement
 
 
 def _vertical_from(sp: Species, name: str, run: tuple[int, int] | None, side_mask: np.ndarray,
-                   place: Placement, side: float, notes: list[str] | None) -> Species:
+                   place: Placement, side: float) -> Species:
     fin: VerticalFin = getattr(sp, name)
     b = sp.body_sections
     if run is None:
-        if fin.present and notes is not None:
-            notes.append(f"no {name} fin in the photo: left out")
         return _with(sp, name, replace(fin, start_length=0.0, end_length=0.0))
     lo, hi = PLACES[name]
     s0 = int(np.clip(round(_section_of(run[0], sp, place)), max(1, np.ceil(lo * (b - 1))), b - 3))
@@ -505,13 +508,10 @@ def _surface_row(sp: Species, place: Placement, section: int, side: float) -> fl
     return place.y0 - side * r * sp.scale[1] * _reach(sp.circle_sections) * place.s
 
 
-def _pelvic_from(sp: Species, run: tuple[int, int] | None, below: np.ndarray, place: Placement,
-                 notes: list[str] | None) -> Species:
+def _pelvic_from(sp: Species, run: tuple[int, int] | None, below: np.ndarray, place: Placement) -> Species:
     p: PelvicFin = sp.pelvic
     b = sp.body_sections
     if run is None:
-        if notes is not None:
-            notes.append("no pelvic fin in the photo: kept at zero size (a species file cannot leave it out)")
         return replace(sp, pelvic=replace(p, start_length=0.0, end_length=0.0))
     lo, hi = PLACES["pelvic"]
     s0 = int(np.clip(round(_section_of(run[0], sp, place)), np.ceil(lo * (b - 1)), b - 3))
@@ -739,7 +739,7 @@ def _refine(sp: Species, work: np.ndarray, body: _Body,
     return sp, place, depth, best
 
 
-def _drop_hidden(sp: Species, work: np.ndarray, place: Placement, notes: list[str]) -> Species:
+def _drop_hidden(sp: Species, work: np.ndarray, place: Placement) -> Species:
     """A vertical fin the refinement shrank into the body (it adds under 0.2 % to the fish) goes."""
     whole = draw(sp, place, work.shape)
     for name in ("adipose", "dorsal", "anal"):
@@ -749,8 +749,6 @@ def _drop_hidden(sp: Species, work: np.ndarray, place: Placement, notes: list[st
         without = _with(sp, name, replace(fin, start_length=0.0, end_length=0.0))
         if np.count_nonzero(whole & ~draw(without, place, work.shape)) < SPECK * np.count_nonzero(work):
             sp = without
-            if name != "adipose":
-                notes.append(f"no {name} fin in the photo: left out")
     return sp
 
 

@@ -7,8 +7,8 @@ import re
 import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -178,7 +178,7 @@ def texture_bytes(original: Photo, work: Photo, mask: np.ndarray) -> tuple[bytes
     colour, so blended fin edges and mipmaps show fish, not the photo's backdrop; the mask keeps
     the true outline. ``mask`` is the silhouette measured on ``work``."""
     from PIL import Image, ImageOps
-    from scipy import ndimage  # type: ignore[import-untyped]
+    from scipy import ndimage
 
     colour = Image.fromarray(original.rgb, "RGB")
     longest = max(colour.size)
