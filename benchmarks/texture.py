@@ -2,7 +2,7 @@
 
     python benchmarks/texture.py            # a table: species x photo kind
     python benchmarks/texture.py --fit      # and --fit-shape: each photo on each base species
-    python benchmarks/texture.py --photographs [--subjects a,b] [--kinds k,l]
+    python benchmarks/texture.py --photographs [--subjects a,b] [--kinds k,l] [--fit-kinds k] [--bases a,b]
         # issue 25: fish fishgen does not ship, lit photos on textured backdrops, turned and in
         # perspective; each on its own geometry, then --fit-shape on every shipped base, the
         # rebuilt fish photographed by three.js
@@ -168,7 +168,10 @@ def photographs() -> None:
     print(f"{'subject':16s} {'photo':13s} {'base':16s} {'IoU 3js':>8s} {'own':>6s} {'kept':>5s} "
           f"{'whole':>6s} {'s':>5s} note")
     worst_iou = 1.0
+    fit_kinds = _option("--fit-kinds") or kinds
     for name, kind, path, truth, _ in rows:
+        if kind not in fit_kinds:
+            continue
         for base_name, base in bases.items():
             notes = []
             out = path.with_name(f"fit_{base_name}.txt")
