@@ -131,3 +131,18 @@ def test_plain_texture_advises_fit_shape_below_085(tmp_path, gl_available, photo
     result = make_texture(tmp_path / "p.png", load_species(PARAMS / "threadfingoldie.txt"), tmp_path / "b.txt",
                           on_note=own.append)
     assert result.iou is not None and result.iou >= 0.85 and own == []
+
+
+def test_a_deep_fish_is_not_stood_on_its_head(gl_available):
+    """A deep, angelfish-like body with its fins is taller than long: its principal axis is vertical,
+    yet the photo shows it level, and the frame says so (it turned it 88 degrees before)."""
+    from fishgen.authoring.photo.frame import fish_frame
+    from tests.authoring.photos import render_photo
+    from tests.authoring.subjects import variants
+
+    deep, _ = variants()["deep"]
+    mask = render_photo(deep).rgba[:, :, 3] >= 64
+    ys, xs = np.nonzero(mask)
+    assert np.ptp(ys) > np.ptp(xs) * 0.9
+    frame = fish_frame(mask)
+    assert abs(frame.angle) < 3 and not frame.mirrored
