@@ -146,3 +146,20 @@ def test_a_deep_fish_is_not_stood_on_its_head(gl_available):
     assert np.ptp(ys) > np.ptp(xs) * 0.9
     frame = fish_frame(mask)
     assert abs(frame.angle) < 3 and not frame.mirrored
+
+
+def test_paired_fins_are_kept_on_the_body_while_swimming():
+    """A pectoral fin whose base curves round half the ring lifts off the flank as it swings
+    (tests/authoring/test_checks.py); the fit narrows its base until it stays on, and says so."""
+    from dataclasses import replace
+
+    from fishgen.authoring.photo.checks import attachment_problems
+    from fishgen.authoring.photo.fit import Placement, ShapeFit, _attached
+
+    bream = replace(load_species(PARAMS / "bonybream.txt"), texture_points=None)
+    wide = replace(bream, pectoral=replace(bream.pectoral, triangles=6, movement_angle=45.0, step_size=3.0))
+    assert attachment_problems(wide)
+    fixed, notes = _attached(ShapeFit(wide, 1.0, Placement(0.0, 0.0, 1.0), ()))
+    assert attachment_problems(fixed.species) == []
+    assert fixed.species.pectoral.triangles < 6
+    assert notes and notes[0].startswith("the pectoral fin spans")

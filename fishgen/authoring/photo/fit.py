@@ -112,8 +112,8 @@ def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False) -
             break
     fit = replace(_fit_at(first, place, work, body), work=work, frame=frame)
     fit = _trimmed(fit)
+    fit, notes = _attached(fit)
     fit = replace(fit, frame_map=_frame_map(fit, to_frame, offset))
-    notes = []
     for name in ("dorsal", "anal"):
         if getattr(base, name).present and not getattr(fit.species, name).present:
             notes.append(f"no {name} fin in the photo: left out")
@@ -132,6 +132,44 @@ def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False) -
 LENGTHS = {"caudal": ("top_line", "bottom_line", "middle_line"), "dorsal": ("start_length", "end_length"),
            "adipose": ("start_length", "end_length"), "anal": ("start_length", "end_length"),
            "pelvic": ("start_length", "end_length"), "pectoral": ("start_length",)}
+
+
+def _attached(fit: ShapeFit) -> tuple[ShapeFit, list[str]]:
+    """Keep the paired fins on the body while it swims. Each is hinged on the line from its first
+    to its last base point, so a base curving round a deep body lifts its middle off the flank as
+    it swings: the pectoral fin then spans one CircleSection less, the pelvic fin one BodySection
+    less, and as a last resort the fin swings less (angle and step together: the same cycle)."""
+    from fishgen.authoring.photo.checks import attachment_problems
+
+    sp = fit.species
+    for _ in range(8):
+        problems = attachment_problems(sp)
+        if not problems:
+            break
+        q, p = sp.pectoral, sp.pelvic
+        if "pectoral" in problems[0] and q.triangles > 1:
+            sp = replace(sp, pectoral=replace(q, triangles=q.triangles - 1))
+        elif "pelvic" in problems[0] and p.end_section - p.start_section > 1:
+            sp = replace(sp, pelvic=replace(p, end_section=p.end_section - 1))
+        else:
+            name = "pectoral" if "pectoral" in problems[0] else "pelvic"
+            fin = getattr(sp, name)
+            sp = _with(sp, name, replace(fin, movement_angle=fin.movement_angle * 0.6,
+                                         step_size=fin.step_size * 0.6))
+    if sp is fit.species:
+        return fit, []
+    was, notes = fit.species, []
+    if sp.pectoral.triangles != was.pectoral.triangles:
+        notes.append(f"the pectoral fin spans {sp.pectoral.triangles} CircleSections, not "
+                     f"{was.pectoral.triangles}, to stay on the body while swimming")
+    if sp.pelvic.end_section != was.pelvic.end_section:
+        notes.append(f"the pelvic fin ends on BodySection {sp.pelvic.end_section}, not "
+                     f"{was.pelvic.end_section}, to stay on the body while swimming")
+    for name in ("pectoral", "pelvic"):
+        before, after = getattr(was, name).movement_angle, getattr(sp, name).movement_angle
+        if after != before:
+            notes.append(f"the {name} fin swings {after:.3g} degrees, not {before:.3g}, to stay on the body")
+    return replace(fit, species=sp), notes
 
 
 def _trimmed(fit: ShapeFit) -> ShapeFit:
