@@ -39,6 +39,8 @@ from fishgen.species.model import CaudalFin, PelvicFin, Species, VerticalFin
 
 #: Where the tail base (the deepest neck) falls on a built fish, as a share of its body length.
 TAIL_BASE = 0.965
+#: A tail base found this close to the fish's end (share of its length) is a lobe tip, not a neck.
+TAIL_TIP = 0.05
 #: The fish's nose-to-tail-base length in the working frame, in pixels.
 WORK_LENGTH = 360
 #: A column stands out as fin when the outline is this far past the body (share of body length).
@@ -268,6 +270,11 @@ def _measure_body(work: np.ndarray) -> _Body:
     from fishgen.authoring.photo.anatomy import nose_and_tail_base
 
     nose, ped = nose_and_tail_base(work)
+    cols = np.flatnonzero(work.any(axis=0))
+    if cols[-1] + 1 - ped[0] < TAIL_TIP * (cols[-1] + 1 - cols[0]):
+        # A "neck" at the very end is a caudal lobe's tip beyond the other's (a turned fish in
+        # perspective): the run through the nose's row, which lobes do not widen, finds the real one.
+        nose, ped = nose_and_tail_base(work, np.full(work.shape[1], nose[1]))
     y0 = float(ped[1])
     top, bottom = columns.run_through(work, np.full(work.shape[1], y0))
     length = max(ped[0] - nose[0], 1.0)
