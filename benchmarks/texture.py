@@ -2,6 +2,10 @@
 
     python benchmarks/texture.py            # a table: species x photo kind
     python benchmarks/texture.py --fit      # and --fit-shape: each photo on each base species
+    python benchmarks/texture.py --photographs [--subjects a,b] [--kinds k,l] [--fit-kinds k] [--bases a,b]
+        # issue 25: fish fishgen does not ship, lit photos on textured backdrops, turned and in
+        # perspective; each on its own geometry, then --fit-shape on every shipped base, the
+        # rebuilt fish photographed by three.js
 
 Each photo is an orthographic side render (tests/authoring/photos.py), varied as
 the robustness tests vary it. Columns: the rebuilt fish's silhouette IoU against
@@ -15,6 +19,7 @@ from __future__ import annotations
 import sys
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -85,7 +90,119 @@ def fit_table() -> None:
                   f"{seconds:5.1f}")
 
 
+def _option(name: str) -> list[str] | None:
+    if name in sys.argv:
+        return sys.argv[sys.argv.index(name) + 1].split(",")
+    return None
+
+
+def photographs() -> None:
+    """Issue 25's photos: every subject x photographic kind, on its own geometry (IoU and point
+    errors), then with --fit-shape on each shipped base (IoU by three.js, and whether the fit is
+    whole by fishgen.authoring.photo.checks)."""
+    import numpy as np
+    from PIL import Image
+
+    from fishgen.authoring.photo.checks import fit_problems
+    from fishgen.authoring.photo.run import TextureOptions
+    from fishgen.errors import FishgenError
+    from tests.authoring.subjects import write_subjects
+    from tests.authoring.threejs import LIT_KINDS, ThreePhotographer, lit_photo, unavailable
+
+    if unavailable() is not None:
+        print(f"--photographs needs three.js in Chromium: {unavailable()}")
+        return
+    work = Path(tempfile.mkdtemp(prefix="fishgen-photographs-"))
+    subjects = {n: load_species(ROOT / "params" / f"{n}.txt") for n in SHIPPED}
+    subjects.update(write_subjects(work / "subjects"))
+    wanted = _option("--subjects")
+    kinds = _option("--kinds") or ["three.js", *LIT_KINDS]
+    bases = {n: load_species(ROOT / "params" / f"{n}.txt") for n in (_option("--bases") or SHIPPED)}
+    camera = ThreePhotographer(work / "assets")
+
+    def shoot(sp, kind):
+        if kind == "three.js":
+            p = camera.photo(sp)
+            return p, p.rgba[:, :, 3] >= 64
+        return lit_photo(camera, sp, kind)
+
+    def run(photo_path, base, out, options, notes):
+        """make_texture, and with the true silhouette as --mask when the photo's own fails."""
+        try:
+            return make_texture(photo_path, base, out, options, notes.append), ""
+        except FishgenError as err:
+            mask = photo_path.with_name("mask.png")
+            return make_texture(photo_path, base, out, replace(options, mask=mask), notes.append), \
+                f"needs --mask ({err.message.split(' (')[0]})"
+
+    def three_iou(result, out, truth):
+        rebuilt = load_species(out)
+        shot = camera.photo(replace(rebuilt, name=f"r{time.monotonic_ns()}"))
+        return silhouette_iou(result.frame.level(truth), shot.rgba[:, :, 3] >= 64)
+
+    rows = []
+    print(f"{'subject':16s} {'photo':13s} {'IoU':>6s} {'body max':>9s} {'body mean':>9s} {'worst fin':>18s} "
+          "note")
+    for name, sp in subjects.items():
+        if wanted and name not in wanted:
+            continue
+        for kind in kinds:
+            photo, truth = shoot(sp, kind)
+            folder = work / name / kind
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / "photo.png"
+            photo.save(path)
+            Image.fromarray(truth.astype(np.uint8) * 255).save(folder / "mask.png")
+            notes: list[str] = []
+            result, how = run(path, sp, folder / "own.txt", TextureOptions(), notes)
+            rebuilt = load_species(folder / "own.txt")
+            body, fins = ph.errors(rebuilt, photo)
+            iou = silhouette_iou(result.frame.level(truth), ph.rendered_mask(rebuilt))
+            worst = max(fins, key=lambda n: fins[n])
+            print(f"{name:16s} {kind:13s} {iou:6.3f} {body.max():9.4f} {body.mean():9.4f} "
+                  f"{worst + ' ' + format(fins[worst], '.4f'):>18s} {how}", flush=True)
+            rows.append((name, kind, path, truth, how))
+    print("\n--fit-shape on each shipped base; IoU of the rebuilt fish photographed by three.js (and by "
+          "the command's own render), against the photo's true silhouette")
+    print(f"{'subject':16s} {'photo':13s} {'base':16s} {'IoU 3js':>8s} {'own':>6s} {'kept':>5s} "
+          f"{'whole':>6s} {'s':>5s} note")
+    worst_iou = 1.0
+    fit_kinds = _option("--fit-kinds") or kinds
+    for name, kind, path, truth, _ in rows:
+        if kind not in fit_kinds:
+            continue
+        for base_name, base in bases.items():
+            notes = []
+            out = path.with_name(f"fit_{base_name}.txt")
+            start = time.perf_counter()
+            result, how = run(path, base, out, TextureOptions(fit_shape=True), notes)
+            seconds = time.perf_counter() - start
+            iou = three_iou(result, out, truth)
+            worst_iou = min(worst_iou, iou)
+            problems = result.fit_problems
+            if result.fitted and result.shape_fit is not None:   # re-checked from the file as written
+                fit = result.shape_fit
+                written = load_species(out)
+                problems = fit_problems(written, fit.work, fit.placement)
+            whole = "yes" if not problems else "NO"
+            if iou < 0.85 and not how:   # the escape hatch: is it the photo's silhouette or the fit?
+                hatch, _ = run(path, base, out, replace(TextureOptions(fit_shape=True),
+                                                        mask=path.with_name("mask.png")), [])
+                how = f"with --mask: {three_iou(hatch, out, truth):.3f}"
+            print(f"{name:16s} {kind:13s} {base_name:16s} {iou:8.3f} {result.iou or 0:6.3f} "
+                  f"{'yes' if result.fitted else 'no':>5s} {whole:>6s} {seconds:5.1f} "
+                  f"{how or (problems[0] if problems else '')}", flush=True)
+    print(f"\nlowest IoU by three.js: {worst_iou:.3f} (target 0.85)")
+    camera.close()
+
+
+SHIPPED = ("bonybream", "centroberyx", "pineapplefish", "threadfingoldie")
+
+
 if __name__ == "__main__":
-    main()
-    if "--fit" in sys.argv:
-        fit_table()
+    if "--photographs" in sys.argv:
+        photographs()
+    else:
+        main()
+        if "--fit" in sys.argv:
+            fit_table()

@@ -16,6 +16,9 @@ from fishgen.authoring.photo import columns
 MARGIN = 4
 #: Below this the photo is taken as level: measuring on its own pixels beats resampling them.
 LEVEL_DEGREES = 0.25
+#: A principal axis steeper than this is a deep fish (fins and all, taller than long), not a fish
+#: standing on its head: side photos show fish about level, so it is taken as level.
+STEEPEST_AXIS = 30.0
 
 
 @dataclass(frozen=True)
@@ -28,6 +31,10 @@ class Frame:
 
     def to_photo(self, points: np.ndarray) -> np.ndarray:
         return (np.asarray(points, float) - self.shift) @ np.linalg.inv(self.linear).T
+
+    def level(self, mask: np.ndarray) -> np.ndarray:
+        """Another mask of the photo (a true silhouette, say) turned as this frame turns the fish."""
+        return _resample(mask, self.linear)[0]
 
 
 def _rotation(degrees: float) -> np.ndarray:
@@ -62,6 +69,8 @@ def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
     vx, vy = np.linalg.eigh(cov)[1][:, -1]
     theta = float(np.degrees(np.arctan2(vy, vx)))
     theta = (theta + 90.0) % 180.0 - 90.0
+    if abs(theta) > STEEPEST_AXIS:
+        theta = 0.0
     first, _ = _resample(mask, _rotation(-theta))
     mirrored = columns.tail_side(first) == "left"
     flip = np.diag([-1.0, 1.0]) if mirrored else np.eye(2)

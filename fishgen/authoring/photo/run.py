@@ -8,6 +8,7 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -24,6 +25,8 @@ from fishgen.species.model import PectoralFin, PelvicFin, Species, TexturePoints
 MAX_TEXTURE_SIDE = 4096
 #: Largest side the photo is measured at.
 MEASURE_SIDE = 2048
+#: Below this silhouette IoU the rebuilt fish does not look like the photographed one: say so.
+ADVICE_IOU = 0.85
 
 
 @dataclass(frozen=True)
@@ -46,8 +49,12 @@ class TextureResult:
     mirrored: bool
     source: str
     unseen: list[str] = field(default_factory=list)
-    iou: float | None = None
+    iou: float | None = None    # the rebuilt fish against the photo's (None: no OpenGL to render it)
     level_mask: np.ndarray | None = field(default=None, repr=False)   # the silhouette, head left, level
+    frame: Frame | None = field(default=None, repr=False)   # photo -> level_mask
+    fitted: bool = False        # --fit-shape's geometry was kept
+    fit_problems: list[str] = field(default_factory=list)   # why a fit was refused
+    shape_fit: Any = field(default=None, repr=False)   # the fit tried (:class:`.fit.ShapeFit`)
 
 
 @dataclass(frozen=True)
@@ -58,6 +65,7 @@ class Measured:
     angle: float
     mirrored: bool
     unseen: tuple[str, ...]
+    frame: Frame | None = None
 
 
 def with_counts(base: Species, sections: int | None, circles: int | None) -> Species:
@@ -99,22 +107,49 @@ class Analysis:
     fins: dict[str, fixel.FinResult]
 
 
-def analyse(mask: np.ndarray, base: Species, spacing: str = "projected", search: float = 1 / 3) -> Analysis:
+def analyse(mask: np.ndarray, base: Species, spacing: str = "projected", search: float = 1 / 3,
+            fit: Any = None) -> Analysis:
+    """``fit``: a :class:`.fit.ShapeFit` of ``base`` to ``mask``; its frame and placement are used
+    rather than measured again, so the points land on the fish where the fit put it."""
     view = side_view(base)
-    ys, xs = np.nonzero(mask)
-    cal = calibrate(view, float(max(np.ptp(xs), np.ptp(ys))))
-    fr = fish_frame(mask, cal.tail_drop)
-    outline = body_outline(fr.mask, view, cal)
+    if fit is not None:
+        from fishgen.authoring.photo.fit import body_outline as fitted_outline
+
+        fr = fit.frame
+        outline = fitted_outline(fit, fr.mask.shape[1])
+    else:
+        ys, xs = np.nonzero(mask)
+        cal = calibrate(view, float(max(np.ptp(xs), np.ptp(ys))))
+        fr = fish_frame(mask, cal.tail_drop)
+        outline = body_outline(fr.mask, view, cal)
     body = fixel.body_points(outline, base.body_sections, base.circle_sections, spacing)
     region = body_region(outline, fr.mask.shape)
     fins = {name: fixel.fin_points(name, xy, view.fin_faces[name], outline, view, fr.mask, region, search)
             for name, xy in view.fins.items()}
+    if fit is not None:
+        fins = {name: replace(res, points=_on_fish(res.points, fr.mask)) for name, res in fins.items()}
     return Analysis(view, fr, outline, body, fins)
 
 
-def measure(photo: Photo, base: Species, mask: np.ndarray, spacing: str = "projected") -> Measured:
-    """Fixel's points for ``base``'s geometry, measured on ``photo``."""
-    a = analyse(mask, base, spacing)
+def _on_fish(points: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """Fin points that fall off the photographed fish moved onto its nearest pixel. A fitted fin
+    follows the silhouette only as closely as its straight edges can; a tip a few pixels off would
+    take backdrop, and the fin mask would cut it away."""
+    from scipy import ndimage  # type: ignore[import-untyped]
+
+    h, w = mask.shape
+    _, (iy, ix) = ndimage.distance_transform_edt(~mask, return_indices=True)
+    c = np.clip(np.floor(points).astype(int), 0, [w - 1, h - 1])
+    off = ~mask[c[:, 1], c[:, 0]]
+    out = points.copy()
+    out[off] = np.stack([ix[c[off, 1], c[off, 0]], iy[c[off, 1], c[off, 0]]], 1) + 0.5
+    return out
+
+
+def measure(photo: Photo, base: Species, mask: np.ndarray, spacing: str = "projected",
+            fit: Any = None) -> Measured:
+    """Fixel's points for ``base``'s geometry, measured on ``photo`` (where ``fit`` put it)."""
+    a = analyse(mask, base, spacing, fit=fit)
     size = np.array(photo.size, float)
 
     def uv(frame_pts: np.ndarray) -> tuple[tuple[float, float], ...]:
@@ -129,7 +164,7 @@ def measure(photo: Photo, base: Species, mask: np.ndarray, spacing: str = "proje
         else:  # an absent fin still has its points in the file
             parts[name] = uv(np.tile(a.body[0, 0], (count, 1)))
     unseen = tuple(name for name, res in a.fins.items() if not res.seen)
-    return Measured(TexturePoints(**parts), a.frame.mask, a.frame.angle, a.frame.mirrored, unseen)
+    return Measured(TexturePoints(**parts), a.frame.mask, a.frame.angle, a.frame.mirrored, unseen, a.frame)
 
 
 def species_name(out: Path) -> str:
@@ -143,7 +178,7 @@ def texture_bytes(original: Photo, work: Photo, mask: np.ndarray) -> tuple[bytes
     colour, so blended fin edges and mipmaps show fish, not the photo's backdrop; the mask keeps
     the true outline. ``mask`` is the silhouette measured on ``work``."""
     from PIL import Image, ImageOps
-    from scipy import ndimage  # type: ignore[import-untyped]
+    from scipy import ndimage
 
     colour = Image.fromarray(original.rgb, "RGB")
     longest = max(colour.size)
@@ -188,34 +223,56 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
     textures = texture_bytes(original, photo, sil.mask)
     chosen = _candidate(photo, sil.mask, base, out, options, imported, textures)
     shown: tuple[np.ndarray, float] | None = None   # the chosen fish rendered, and its IoU
+    fitted, problems, fit = False, [], None
     if options.fit_shape:
-        from fishgen.authoring.photo.fit import fit_shape
+        from fishgen.authoring.photo.checks import fit_problems
+        from fishgen.authoring.photo.fit import fit_species
 
-        fitted = _candidate(photo, sil.mask, fit_shape(base, sil.mask), out, options, imported, textures)
-        # Keep the fit only if the rebuilt fish matches the photo better than the base's geometry.
-        shown, tried = (_rendered(photo, c, out) for c in (chosen, fitted))
-        iou_base, iou_fit = shown[1], tried[1]
-        if iou_fit >= iou_base:
-            note(f"fitted shape: silhouette IoU {iou_base:.3f} with the base's geometry -> {iou_fit:.3f}")
-            chosen, shown = fitted, tried
+        fit = fit_species(base, sil.mask, sections_fixed=options.body_sections is not None)
+        problems = fit_problems(fit.species, fit.work, fit.placement)
+        if problems:
+            # A broken fish is never written: the base's geometry stays, and the command says why.
+            note(f"fitted shape not kept: {problems[0]}")
         else:
-            note(f"fitted shape not kept: silhouette IoU {iou_fit:.3f}, the base's geometry gives "
-                 f"{iou_base:.3f}")
+            candidate = _candidate(photo, sil.mask, fit.species, out, options, imported, textures, fit)
+            # Keep the fit only if the rebuilt fish matches the photo better than the base's geometry.
+            shown, tried = (_rendered(photo, c, out) for c in (chosen, candidate))
+            iou_base, iou_fit = shown[1], tried[1]
+            if iou_fit >= iou_base:
+                note(f"fitted shape: silhouette IoU {iou_base:.3f} with the base's geometry -> {iou_fit:.3f}")
+                for line in fit.notes:
+                    note(f"note: {line}")
+                chosen, shown, fitted = candidate, tried, True
+            else:
+                note(f"fitted shape not kept: silhouette IoU {iou_fit:.3f}, the base's geometry gives "
+                     f"{iou_base:.3f}")
     for name in chosen.unseen:
         note(f"note: no {name} fin found in the photo; its texture is body skin near its attachment")
+    if shown is None:
+        try:
+            shown = _rendered(photo, chosen, out)
+        except FishgenError:   # no OpenGL here: nothing to measure the rebuilt fish with
+            shown = None
+    if shown is not None and shown[1] < ADVICE_IOU:
+        if options.fit_shape:
+            note(f"silhouette IoU {shown[1]:.3f}: the rebuilt fish is still unlike the photo's; if the "
+                 "silhouette is wrong (a busy background), give --mask")
+        else:
+            note(f"silhouette IoU {shown[1]:.3f}: the base's geometry does not match the photographed "
+                 "fish; try --fit-shape")
     files = dict(chosen.files)
     if options.fxl_out is not None:
         tp = chosen.species.texture_points
         assert tp is not None
         files[Path(options.fxl_out)] = fxl.format_fxl(tp, chosen.species.circle_sections).encode()
-    iou = None
     if options.compare is not None:
         if shown is None:
             shown = _rendered(photo, chosen, out)
-        files[Path(options.compare)], iou = _compare_png(photo, *shown)
+        files[Path(options.compare)], _ = _compare_png(photo, *shown)
     write_files(files)
     return TextureResult(chosen.species, list(files), chosen.measured.angle, chosen.measured.mirrored,
-                         sil.source, list(chosen.unseen), iou, chosen.measured.frame_mask)
+                         sil.source, list(chosen.unseen), None if shown is None else shown[1],
+                         chosen.measured.frame_mask, chosen.measured.frame, fitted, problems, fit)
 
 
 @dataclass(frozen=True)
@@ -230,12 +287,13 @@ class _Candidate:
 
 
 def _candidate(photo: Photo, mask: np.ndarray, base: Species, out: Path, options: TextureOptions,
-               imported: dict[str, list[tuple[float, float]]], textures: tuple[bytes, bytes]) -> _Candidate:
+               imported: dict[str, list[tuple[float, float]]], textures: tuple[bytes, bytes],
+               fit: Any = None) -> _Candidate:
     """The species file (and its texture files) ``base``'s geometry gives with this photo."""
     from fishgen.species.parser import parse_species
     from fishgen.species.writer import format_species
 
-    measured = measure(photo, base, mask, options.spacing)
+    measured = measure(photo, base, mask, options.spacing, fit)
     pts = measured.points
     for part, values in imported.items():
         want = len(getattr(pts, part))
