@@ -78,8 +78,7 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     if options.species is None:
         raise UsageError("expected -s/--species BASE.txt, the species to start from, found none")
     sides = [options.mask, options.fxl_in]
-    outputs = [output, output.with_suffix(".png"), output.with_name(f"{output.stem}_mask.png"),
-               options.compare, options.fxl_out]
+    outputs = [output, options.compare, options.fxl_out]  # the texture and mask beside it: atomic.protecting
     check_targets(outputs, [photo, options.species, *(p for p in sides if p is not None)])
     species = load_species(options.species)
     settings = TextureOptions(mask=options.mask, fit_shape=options.fit_shape,
