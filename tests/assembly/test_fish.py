@@ -28,8 +28,10 @@ def swim_channels(scene):
     return {scene.nodes[c.node].name: c for c in scene.clip("swim").channels if c.path == "rotation"}
 
 
-def material(scene, name):
-    return next(m for m in scene.materials if m.name == name)
+def material(scene, part):
+    """The body's or the fins' material: named after the species, so two species in one folder
+    (or one school) keep their own in an engine's import."""
+    return next(m for m in scene.materials if m.name == f"{scene.name}_{part}")
 
 
 def images(scene):

@@ -128,7 +128,7 @@ def judge(asset: Asset, r: dict) -> str:
         if "--billboards" in asset.fmt.flags:
             expect(mat["unlit"], f"{m['name']}: KHR_materials_unlit ignored (particles lit)")
     if asset.fmt.kind in ("fish", "school") and asset.fmt.ext != "ply":
-        fins = [m["material"] for m in meshes if m["material"] and m["material"]["name"] == "fins"]
+        fins = [m["material"] for m in meshes if m["material"] and m["material"]["name"].endswith("_fins")]
         expect(bool(fins), "no fins material")
         if asset.fmt.ext == "obj":
             expect(all(f["opacity"] and f["opacity"]["ready"] for f in fins), "fins: map_d mask not loaded")

@@ -231,7 +231,7 @@ def judge(asset: Asset, r: dict) -> str:
             if "--billboards" in asset.fmt.flags and not mat["unshaded"]:
                 shown.append("KHR_materials_unlit ignored")
             expect(not shown, f"{mesh['name']}: {', '.join(shown)}")
-    fins = [s["material"] for _, s in surfaces if s["material"] and s["material"]["name"] == "fins"]
+    fins = [s["material"] for _, s in surfaces if s["material"] and s["material"]["name"].endswith("_fins")]
     if asset.fmt.kind in ("fish", "school"):
         expect(bool(fins), "no fins material")
         if asset.fmt.ext == "obj":  # the mask png is named by map_d
@@ -387,7 +387,7 @@ def extra_assets(assets: dict[str, Asset], folder: Path) -> dict[str, Asset]:
                              dict(fish.reported), dict(fish.expected), fish.clip, fish.bounds)
     both = folder / "two-species"
     sources = [FISH_SOURCE, PARAMS / "centroberyx.txt"]
-    result = subprocess.run([sys.executable, "-m", "fishgen", "build", *map(str, sources), "-o", str(both),
+    result = subprocess.run([sys.executable, "-m", "fishgen", "build", *map(str, sources), "-o", f"{both}/",
                              "--format", "glb"], cwd=ROOT, capture_output=True, text=True)
     if result.returncode != 0:
         raise RuntimeError(f"fishgen build of two species failed: {result.stderr.strip()}")

@@ -645,7 +645,7 @@ class ThreeClient(HarnessPage):
                     if m[key] is not None:
                         expect(m[key]["arrived"], f"{o['name']}: {key} did not arrive")
         if asset.fmt.ext == "obj":
-            fins = [m for o in meshes for m in o["materials"] if m["name"] == "fins"]
+            fins = [m for o in meshes for m in o["materials"] if m["name"].endswith("_fins")]
             expect(bool(fins) and all(m["alphaMap"] and m["alphaMap"]["arrived"] for m in fins),
                    "fins material has no alphaMap")
         if asset.clip:
@@ -653,7 +653,7 @@ class ThreeClient(HarnessPage):
             _check_clip(asset, [(c["name"], len(c["tracks"])) for c in clips])
             unbound = [t["name"] for c in clips for t in c["tracks"] if not t["bound"]]
             expect(not unbound, f"tracks target no node: {unbound}")
-            fins = [m for o in meshes for m in o["materials"] if m["name"] == "fins"]
+            fins = [m for o in meshes for m in o["materials"] if m["name"].endswith("_fins")]
             expect(all(m["alphaTest"] == 0.5 and m["side"] == 2 for m in fins), "fins lost MASK/double-sided")
         if asset.fmt.kind == "cloud" and asset.fmt.ext == "glb":  # COLOR_0 shown; billboards unlit
             materials = [m for o in objects for m in o["materials"]]

@@ -172,9 +172,6 @@ def test_godot_counts_every_blend_shape_track(matrix, godot):
     assert all(t["bound"] and t.get("property_exists", True) for t in swim["tracks"])
 
 
-@pytest.mark.xfail(strict=True, reason="fishgen bug, reported: every species' materials are named `body` and "
-                   "`fins`; Godot 3.2 saves imported materials as FOLDER/body.material and reuses the file "
-                   "for the next glb in the folder")
 def test_godot_two_species_in_one_folder_keep_their_own_materials(godot):
     """`fishgen build bonybream.txt centroberyx.txt -o DIR --format glb`, DIR imported into Godot:
     each fish keeps its own skin and fin mode (centroberyx's fins blend, bonybream's are masked)."""
@@ -185,6 +182,6 @@ def test_godot_two_species_in_one_folder_keep_their_own_materials(godot):
         return {s["material"]["name"]: s["material"] for m in result["meshes"] for s in m["surfaces"]}
 
     bream, centro = materials(TWO_SPECIES[0]), materials(TWO_SPECIES[1])
-    assert bream["fins"]["alpha_scissor"] and not bream["fins"]["transparent"]
-    assert centro["fins"]["transparent"] and not centro["fins"]["alpha_scissor"]
-    assert bream["body"]["path"] != centro["body"]["path"]
+    assert bream["bonybream_fins"]["alpha_scissor"] and not bream["bonybream_fins"]["transparent"]
+    assert centro["centroberyx_fins"]["transparent"] and not centro["centroberyx_fins"]["alpha_scissor"]
+    assert bream["bonybream_body"]["path"] != centro["centroberyx_body"]["path"]
