@@ -15,6 +15,7 @@ import logging
 import os
 import stat
 import tempfile
+import time
 from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -100,15 +101,80 @@ def check_target(target: Path) -> None:
                          f"{os.fspath(target)!r}, which is the input {same!r}")
 
 
+STALE_SECONDS = 10.0
+"""A temporary file of fishgen's naming pattern that nobody holds locked and that is this old was
+left by a killed run (SIGKILL runs no cleanup): the next write beside it removes it."""
+_held: dict[str, int] = {}  # temporary file -> the descriptor holding its lock until renamed or discarded
+
+
+def _temporary(path: Path) -> tuple[int, str]:
+    """A new temporary file beside ``path``, locked for as long as this run may rename it; stale
+    ones of the same target are swept first."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    sweep(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    _lock(fd)
+    _held[tmp] = fd
+    return fd, tmp
+
+
+def _lock(fd: int) -> bool:
+    """Take an exclusive lock on an open file, without waiting (False: another process holds it)."""
+    try:
+        import fcntl
+    except ImportError:  # Windows: no advisory locks, and no sweeping either
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        return False
+    return True
+
+
+def sweep(path: Path) -> list[Path]:
+    """Remove ``path``'s stale temporary files: ours by their name (``.NAME.XXXX.tmp``), older than
+    STALE_SECONDS, and not locked, so no running writer holds them. Returns what was removed."""
+    removed: list[Path] = []
+    prefix = f".{path.name}."
+    try:
+        entries = list(os.scandir(path.parent))
+    except OSError:
+        return removed
+    now = time.time()
+    for entry in entries:
+        if not (entry.name.startswith(prefix) and entry.name.endswith(".tmp")) or entry.path in _held:
+            continue
+        try:
+            if not entry.is_file(follow_symlinks=False) or now - entry.stat().st_mtime < STALE_SECONDS:
+                continue
+            fd = os.open(entry.path, os.O_RDONLY | os.O_NONBLOCK)
+        except OSError:
+            continue
+        try:
+            if _lock(fd):
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+        except OSError:
+            pass
+        finally:
+            os.close(fd)
+    return removed
+
+
+def _release(tmp: str) -> None:
+    fd = _held.pop(tmp, None)
+    if fd is not None:
+        os.close(fd)
+
+
 def _stage(path: Path, data: bytes) -> str:
     check_target(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        fd, tmp = _temporary(path)
     except OSError as err:
         raise _fail(path, err) from None
     try:
-        with os.fdopen(fd, "wb") as handle:
+        with os.fdopen(os.dup(fd), "wb") as handle:  # the lock stays with fd until the rename
             handle.write(data)
             handle.flush()
             os.fsync(handle.fileno())
@@ -126,6 +192,7 @@ def _discard(tmp: str) -> None:
         os.unlink(tmp)
     except FileNotFoundError:
         pass
+    _release(tmp)
 
 
 def write_files(files: Mapping[_PathT, bytes]) -> None:
@@ -159,6 +226,7 @@ def _commit(staged: list[tuple[str, Path]]) -> None:
                 os.replace(tmp, target)
             except OSError as err:
                 raise _fail(target, err) from None
+            _release(tmp)
     except BaseException:
         for backup, target in reversed(backups):
             if backup is not None:
@@ -196,10 +264,8 @@ class atomic_open:
         check_target(self.path)
         self._tmp = None
         try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            fd, self._tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp",
-                                             dir=self.path.parent)
-            self._handle = os.fdopen(fd, "wb")
+            fd, self._tmp = _temporary(self.path)
+            self._handle = os.fdopen(os.dup(fd), "wb")  # the lock stays with fd until the rename
         except BaseException as err:  # also SIGTERM or Ctrl-C before the `with` body: no temp file left
             if self._tmp is not None:
                 _discard(self._tmp)
@@ -220,6 +286,7 @@ class atomic_open:
                 os.chmod(self._tmp, 0o644)
                 if _staging.get() is None:
                     os.replace(self._tmp, self.path)
+                    _release(self._tmp)
                     _log.info("wrote %s", self.path)
                 else:
                     _land([(self._tmp, self.path)])

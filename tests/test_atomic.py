@@ -74,3 +74,40 @@ def test_streaming_writer_interrupted_while_opening_leaves_no_temp_file(tmp_path
         with atomic_open(tmp_path / "fish.glb"):
             pass
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_killed_writers_temporary_file_is_swept_by_the_next_write(tmp_path):
+    """Issue 26, fault 15: SIGKILL left full-size `.NAME.XXXX.tmp` files that no run removed. A
+    temporary file nobody holds locked and older than a few seconds is a dead run's."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import fishgen.atomic as atomic
+
+    target = tmp_path / "big.bin"
+    code = ("import sys, time; from fishgen.atomic import atomic_open\n"
+            f"with atomic_open({str(target)!r}) as f:\n"
+            "    f.write(b'x' * 1000); f.flush(); print('writing', flush=True); time.sleep(60)\n")
+    writer = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    assert writer.stdout.readline() == "writing\n"
+    (temp,) = tmp_path.glob(".big.bin.*.tmp")
+    old = time.time() - 2 * atomic.STALE_SECONDS
+    os.utime(temp, (old, old))
+    assert atomic.sweep(target) == [] and temp.exists()       # held by a live writer: kept
+    writer.send_signal(signal.SIGKILL)
+    writer.wait()
+    assert temp.exists()                                       # SIGKILL: nothing cleaned up
+    atomic.write_bytes(tmp_path / "big.bin", b"new")           # the next write of that target
+    assert not temp.exists() and target.read_bytes() == b"new"
+
+
+def test_a_fresh_temporary_file_is_never_swept(tmp_path):
+    """One that may be a writer's between creating and locking it: younger than STALE_SECONDS."""
+    import fishgen.atomic as atomic
+
+    fresh = tmp_path / ".a.txt.abcd.tmp"
+    fresh.write_bytes(b"x")
+    assert atomic.sweep(tmp_path / "a.txt") == [] and fresh.exists()
