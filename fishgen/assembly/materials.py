@@ -73,7 +73,8 @@ def make_materials(species: Species, mode: str, texture: int | None) -> tuple[Ma
     body = Material(f"{species.name}_body", (1.0, 1.0, 1.0, 1.0) if textured else colour, tex)
     fin_rgb = (1.0, 1.0, 1.0) if textured else species.colour
     if mode == "blend":
-        fins = Material(f"{species.name}_fins", (*fin_rgb, fin_alpha(species.transparency)), tex, "BLEND", None, True)
+        fins = Material(f"{species.name}_fins", (*fin_rgb, fin_alpha(species.transparency)), tex, "BLEND",
+                        None, True)
     elif mode == "mask" and textured:
         fins = Material(f"{species.name}_fins", (*fin_rgb, 1.0), tex, "MASK", MASK_CUTOFF, True)
     else:

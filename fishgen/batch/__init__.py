@@ -19,7 +19,7 @@ from pathlib import Path
 
 from fishgen.batch.manifest import Job, Manifest
 from fishgen.batch.record import Hashes, Record, relative
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, SystemFailure
 
 LOCK_NAME = ".fishgen-batch.lock"
 STATUSES = ("built", "skipped", "failed", "not run")
@@ -81,6 +81,7 @@ def run_batch(manifest: Manifest, *, workers: int = 1, force: bool = False, fail
                          result.notes))
             return fail_fast and result.status == "failed"
 
+        unsaved: FishgenError | None = None
         try:
             run_jobs([job for job, _ in todo], done, workers=workers, scheduler=scheduler,
                      fail_fast=fail_fast)
@@ -88,8 +89,24 @@ def run_batch(manifest: Manifest, *, workers: int = 1, force: bool = False, fail
             # once, durably, however the run ended; an unreadable record is replaced once this run
             # has something to put in its place (it started empty)
             if todo and (record.jobs or not record.damaged):
-                record.save()
-    return [outcomes.get(job.name) or Outcome(job, "not run", reasons.get(job.name)) for job in manifest.jobs]
+                try:
+                    record.save()
+                except FishgenError as err:  # a full disk: the outputs are whole, their record is not
+                    unsaved = err
+    result = [outcomes.get(job.name) or Outcome(job, "not run",
+                                                reasons.get(job.name)) for job in manifest.jobs]
+    if unsaved is not None:
+        raise RecordNotSaved(unsaved.message, unsaved.file, result)
+    return result
+
+
+class RecordNotSaved(SystemFailure):
+    """The batch ran but its record could not be written (status 1): ``outcomes`` say what ran; the
+    next run finds the outputs whole and rebuilds what the record does not vouch for."""
+
+    def __init__(self, message: str, file: str | None, outcomes: list[Outcome]):
+        super().__init__(message, file)
+        self.outcomes = outcomes
 
 
 @contextmanager

@@ -174,7 +174,10 @@ class Record:
         inputs make it run again."""
         self.jobs[name] = entry
         if time.monotonic() - self._saved >= SAVE_INTERVAL:
-            self.save(durable=False)
+            try:
+                self.save(durable=False)
+            except OSError:  # a full disk: the final, durable save says so, with the path
+                pass
 
     def save(self, durable: bool = True) -> None:
         """Replace the record file atomically. ``durable=False`` skips the fsync: the rename alone

@@ -72,7 +72,7 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
     inputs = tuple(Path(p) for p in inputs)
     import time
 
-    from fishgen.batch import run_batch
+    from fishgen.batch import RecordNotSaved, run_batch
     from fishgen.batch.manifest import load_manifest, scan_folder
     from fishgen.commands.paths import needs
     from fishgen.errors import JobsFailed, UsageError
@@ -98,8 +98,12 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
         def finished(outcome) -> None:
             _tell(outcome, events, bar[0] if bar else None)
 
-        outcomes = run_batch(manifest, workers=workers, force=options.force, fail_fast=options.fail_fast,
-                             scheduler=options.scheduler, started=started, finished=finished)
+        unsaved: FishgenError | None = None
+        try:
+            outcomes = run_batch(manifest, workers=workers, force=options.force, fail_fast=options.fail_fast,
+                                 scheduler=options.scheduler, started=started, finished=finished)
+        except RecordNotSaved as err:  # the summary still says what ran, then why the record did not
+            outcomes, unsaved = err.outcomes, err
     seconds = time.perf_counter() - start
     written = []
     if options.report is not None:
@@ -114,11 +118,15 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
             + (f", {counts['not run']} not run" if counts["not run"] else "")
             + f" in {seconds:.2f} s ({where})")
     errors = tuple(_job_error(o) for o in outcomes if o.status == "failed")
-    verdict = None
+    verdict: FishgenError | None = None
     if errors:
         verdict = JobsFailed(f"{len(errors)} of {len(outcomes)} jobs failed (each said why above)",
                              any(e.status == 2 for e in errors))
     written += [manifest.out / p for o in outcomes if o.status == "built" for p in o.outputs]
+    if unsaved is not None:
+        verdict = verdict or unsaved
+        if verdict is not unsaved and events.failed is not None:
+            events.failed(unsaved)
     return Made(tuple(written), (manifest.file,) if manifest.file else (), (line,),
                 BatchFacts(tuple(outcomes), seconds, workers), errors, verdict)
 

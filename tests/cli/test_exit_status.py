@@ -137,3 +137,16 @@ def test_bad_input_exits_2_in_one_line_and_writes_nothing(tmp_path, name):
     error = one_error(result)
     assert result.returncode == 2 and error["exit"] == 2 and error["kind"] in ("input", "usage"), result.stderr
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.*"))
+
+
+def test_a_batch_whose_record_cannot_be_saved_still_says_what_it_built_and_exits_1(small_disk):
+    """Issue 26, fault 10: a full disk lost the batch's summary line and exited 2."""
+    full, _ = small_disk
+    manifest = full.parent / "m.toml"
+    manifest.write_text(f'out = "{full}"\n[[clouds]]\ninput = "{CUBES}"\noutput = "c.ply"\n')
+    # fill the disk but for the one small output: the record is what no longer fits
+    (full / "filler").write_bytes(b"x" * (48 * 1024))
+    result = run(["batch", str(manifest), "-j", "1"])
+    lines = result.stdout.strip().splitlines()
+    assert result.returncode == 1 and lines and lines[-1].startswith(f"{full}: 1 jobs, 1 built"), result
+    assert "Traceback" not in result.stderr and ".fishgen-batch.json" in result.stderr
