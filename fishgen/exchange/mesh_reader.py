@@ -173,24 +173,28 @@ def _check_obj_vertices(text: str, path: Path) -> None:
 
 
 def _mtl_libraries(obj: Path, text: str) -> list[Path]:
-    """The MTL files an OBJ's ``mtllib`` statements name (several may share one statement)."""
+    """The MTL files an OBJ's ``mtllib`` statements name (several may share one statement). Each
+    must be there: a file an asset names and cannot find is incomplete input, for `preview` and
+    `view` alike, as a glTF's missing buffer or image is."""
     out = []
-    for lib in re.findall(r"^[ \t]*mtllib[ \t]+(.+?)[ \t]*\r?$", text, re.M):
+    for match in re.finditer(r"^[ \t]*mtllib[ \t]+(.+?)[ \t]*\r?$", text, re.M):
+        lib = match[1]
         whole = side_file(obj, lib)
         names = [lib] if whole.is_file() else lib.split()
         for name in names:
             mtl = side_file(obj, name)
-            if mtl.is_file():
-                out.append(mtl)
+            if not mtl.is_file():
+                raise FishgenError(f"expected the material library {name!r} the OBJ names, in its folder, "
+                                   "found none", obj, text.count("\n", 0, match.start()) + 1)
+            out.append(mtl)
     return out
 
 
 def _mtl_alpha(obj: Path, text: str) -> dict[str, tuple[str, float]]:
     """material name -> (alpha mode, opacity) from the OBJ's MTL libraries.
 
-    Every MTL and texture reference is checked to stay in the OBJ's folder, and
-    their sizes against the caps; a missing MTL only loses its materials, as in
-    an engine.
+    Every MTL and texture reference is checked to stay in the OBJ's folder, to be there, and
+    their sizes against the caps.
     """
     out: dict[str, tuple[str, float]] = {}
     for mtl in _mtl_libraries(obj, text):
@@ -204,10 +208,12 @@ def _mtl_alpha(obj: Path, text: str) -> dict[str, tuple[str, float]]:
             if key in _MAP_KEYS and len(words) > 1:
                 # options such as "-imfchan m" come before the file name
                 image = side_file(obj, words[-1])
-                if image.is_file():
-                    _stat(image, MAX_SIDE_BYTES, "a texture file", obj)
-                    if key == "map_kd":  # the one texture decoded: refuse a huge or damaged one now
-                        _check_texture(image, mtl, number)
+                if not image.is_file():
+                    raise FishgenError(f"expected the texture {words[-1]!r} the MTL names, in the OBJ's "
+                                       "folder, found none", mtl, number)
+                _stat(image, MAX_SIDE_BYTES, "a texture file", obj)
+                if key == "map_kd":  # the one texture decoded: refuse a huge or damaged one now
+                    _check_texture(image, mtl, number)
             if key == "newmtl":
                 name = " ".join(words[1:])
                 out[name] = ("OPAQUE", 1.0)

@@ -177,3 +177,18 @@ def test_cli_prints_one_line(tmp_path, case):
     result = run_cli("preview", path, "-o", tmp_path / "x.png", "--size", "64x48")
     assert result.returncode == 2 and result.stderr.startswith(start), result.stderr
     assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("missing", ["f.mtl", "f_skin.png"])
+def test_a_side_file_an_obj_names_must_be_there_for_preview_and_view_alike(tmp_path, missing):
+    """Issue 26: preview rendered an OBJ whose .mtl was missing (exit 0) and view refused it (exit 2).
+    One rule for both: what the asset names must be there."""
+    from tests.conftest import PARAMS, run_cli
+
+    assert run_cli("build", PARAMS / "bonybream.txt", "-o", tmp_path / "f.obj").returncode == 0
+    (tmp_path / missing).unlink()
+    for command in (["preview", tmp_path / "f.obj", "-o", tmp_path / "p.png"],
+                    ["view", tmp_path / "f.obj", "--no-serve", "-o", tmp_path / "p.html"]):
+        result = run_cli(*command)
+        assert result.returncode == 2 and f"{missing!r}" in result.stderr and "found none" in result.stderr
+        assert result.stderr.count("\n") == 1
