@@ -120,6 +120,19 @@ def _number(where: _Where, value: Any, key: str, low: float, high: float, table:
     return value
 
 
+def _inside(where: _Where, scene: Path, name: str, key: str, table: str, nth: int = 0) -> Path:
+    """A file a scene file names: in the scene file's folder (or below), never elsewhere (an absolute
+    path, ``..``, a link out), as an asset's textures are: a scene file someone sent you reads only
+    what came with it."""
+    from fishgen.exchange.sidefiles import side_file
+
+    try:
+        return side_file(scene, name)
+    except FishgenError as err:
+        raise FishgenError(err.message.replace("the asset's folder", "the scene file's folder"), where.file,
+                           where.line(key, table, nth)) from None
+
+
 def _declared(where: _Where, spec: Option, value: Any, key: str, table: str | None = None,
               nth: int = 0) -> Any:
     """A key that is also an option, checked by the option's own declaration."""
@@ -147,7 +160,7 @@ def _path(where: _Where, data: Any, table: str, folder: Path) -> tuple[TargetPat
     if not isinstance(kind, str):
         raise where.fail(f"path as one of {', '.join(PATHS)} or a CSV file", kind, "path", table)
     if kind not in PATHS:
-        csv = folder / kind
+        csv = _inside(where, folder / "scene", kind, "path", table)
         path = replace(path, kind="points", points=_csv_points(where, csv, table))
     else:
         path = replace(path, kind=kind)  # type: ignore[arg-type]
@@ -244,7 +257,7 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
                              "species", k)
         count = _declared(where, COUNT, entry.get("count", COUNT.default), "count", "species", k)
         speed = _declared(where, SPEED, entry.get("speed", SPEED.default), "speed", "species", k)
-        species.append(SpeciesEntry(path.parent / name, count, speed))
+        species.append(SpeciesEntry(_inside(where, path, name, "file", "species", k), count, speed))
     scene = replace(scene, species=tuple(species))
     if "target" in data:
         target, csv = _path(where, data["target"], "target", path.parent)

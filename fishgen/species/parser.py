@@ -284,6 +284,15 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
         raise FishgenError("expected a VRFish species file, found "
                            + ("an empty file" if not text.strip() else "only comments"), file, 1)
 
+    first = reader.peek()
+    header_like = (len(line.tokens) == 7 and all(_is_number(t) for t in line.tokens[1:])
+                   for line in reader.lines[reader.pos:reader.pos + 50])
+    if first is not None and sum(_is_number(t) for t in first.tokens[1:7]) < 4 and not any(header_like):
+        # No species header anywhere near the top: not a species file at all (a scene file may name
+        # any file, /etc/passwd say), so say so without echoing a line of it.
+        numbers = sum(_is_number(t) for t in first.tokens)
+        raise reader.error(first, f"the header record `{' '.join(HEADER)}` of a VRFish species file",
+                           f"a first record that is not one ({numbers} numbers where 6 stand)")
     line = reader.record(f"the header record `{' '.join(HEADER)}`", 7)
     f = _Fields(reader, line, HEADER)
     name = line.tokens[0]

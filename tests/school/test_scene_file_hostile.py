@@ -25,3 +25,31 @@ def test_the_csv_a_scene_reads_is_among_what_it_read(tmp_path):
     scene = tmp_path / "s.toml"
     scene.write_text('model = "pso"\n[[species]]\nfile = "a.txt"\n[predator]\npath = "p.csv"\n')
     assert load_scene_file(scene).read == (tmp_path / "p.csv",)
+
+
+@pytest.mark.parametrize("name", ["/etc/passwd", "../elsewhere/a.txt", "link.txt"])
+def test_a_scene_file_reads_only_files_in_its_own_folder(tmp_path, name):
+    """Issue 26: a scene file named species anywhere, and the error echoed the first line of
+    whatever it named (/etc/passwd)."""
+    import os
+
+    (tmp_path / "outside").mkdir()
+    (tmp_path / "outside" / "secret.txt").write_text("hunter2:x:0:0:hunter2:/home:/bin/bash\n")
+    folder = tmp_path / "scene"
+    folder.mkdir()
+    os.symlink(tmp_path / "outside" / "secret.txt", folder / "link.txt")
+    scene = folder / "s.toml"
+    scene.write_text(f'frames = 10\n[[species]]\ncount = 3\nfile = "{name}"\n')
+    with pytest.raises(FishgenError) as caught:
+        load_scene_file(scene)
+    assert caught.value.file == str(scene) and caught.value.line == 4
+    assert "inside the scene file's folder" in caught.value.message and "hunter2" not in str(caught.value)
+
+
+def test_a_file_that_is_not_a_species_file_is_not_echoed(tmp_path):
+    from fishgen.species.parser import load_species
+
+    (tmp_path / "secret.txt").write_text("hunter2:x:0:0:hunter2:/home:/bin/bash\ndaemon:x:1:1\n")
+    with pytest.raises(FishgenError) as caught:
+        load_species(tmp_path / "secret.txt")
+    assert "hunter2" not in str(caught.value) and "not one" in str(caught.value)
