@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from fishgen.authoring.photo.fxl import format_fxl, parse_fxl
+from fishgen.authoring.photo.fxl import format_fxl, parse_fxl, read_fxl
 from fishgen.errors import FishgenError
 from fishgen.species.parser import load_species
 from tests.conftest import PARAMS
@@ -68,3 +68,28 @@ def test_faults_name_their_line(text, line, words):
     with pytest.raises(FishgenError) as err:
         parse_fxl(text, "p.FXL")
     assert err.value.line == line and words in err.value.message
+
+
+@pytest.mark.parametrize("text,line,message", [
+    ("//body\n4\n1 1 0.1 0.1\n1 0 0.2 0.2\n0 1 0.3 0.3\n0 0 0.4 0.4\n", 3, "section and circle 0 0, found 1 1"),
+    ("//body\n2\n0.1 0.1 0.2 0.2\n0.3 0.3 0.4 0.4\n", 3, "whole numbers first, found '0.1'"),
+    ("//body\n4\n0 0 0.1 0.1\n0 1 0.2 0.2\n0 3 0.3 0.3\n1 0 0.4 0.4\n", 5, "found 0 3"),
+    ("//body\n3\n0 0 0.1 0.1\n0 1 0.2 0.2\n1 0 0.3 0.3\n", 5, "expected 2 points on the last body section"),
+    ("//dorsal\n" + "9" * 400 + "\n", 2, "expected a point count of at most 100,000"),
+])
+def test_body_lines_are_read_in_their_numbered_order_and_counts_are_bounded(text, line, message):
+    """Issue 26, faults 14 and 7: the indices were ignored (a reversed file put the tail's point at
+    the nose), and a count of 400 digits overflowed."""
+    with pytest.raises(FishgenError) as caught:
+        parse_fxl(text, "x.FXL")
+    assert caught.value.line == line and message in caught.value.message
+
+
+def test_a_fifo_given_as_fxl_in_is_refused_at_once(tmp_path):
+    """Issue 26, fault 8: `--fxl-in` given a FIFO blocked forever."""
+    import os
+
+    fifo = tmp_path / "points.FXL"
+    os.mkfifo(fifo)
+    with pytest.raises(FishgenError, match="regular .FXL file"):
+        read_fxl(fifo)

@@ -53,8 +53,10 @@ def parse_fxl(text: str, file: str | os.PathLike = "<fxl>") -> dict[str, list[Ve
         if not tokens:
             raise FishgenError(f"expected a point count after //{current}, found nothing", file, header_line)
         count_text, count_line = tokens[0]
-        if not re.fullmatch(r"\d+(\.0*)?", count_text) or int(float(count_text)) > 100_000:
-            raise FishgenError(f"expected a point count, found {count_text!r}", file, count_line)
+        # at most six digits before converting: a count of 400 digits overflowed float()
+        if not re.fullmatch(r"\d{1,6}(\.0*)?", count_text) or int(float(count_text)) > 100_000:
+            raise FishgenError(f"expected a point count of at most 100,000, found {count_text[:40]!r}", file,
+                               count_line)
         count = int(float(count_text))
         width = 4 if current == "body" else 2
         values = tokens[1:]
@@ -62,8 +64,11 @@ def parse_fxl(text: str, file: str | os.PathLike = "<fxl>") -> dict[str, list[Ve
             raise FishgenError(f"expected {count} points of {width} numbers for //{current}, found "
                                f"{len(values)} numbers", file, values[-1][1] if values else count_line)
         pts = []
+        order = _BodyOrder(file) if current == "body" else None
         for k in range(count):
             chunk = values[k * width:(k + 1) * width]
+            if order is not None:
+                order.next(chunk[0], chunk[1])
             try:
                 u, v = float(chunk[-2][0]), float(chunk[-1][0])
             except ValueError:
@@ -73,6 +78,8 @@ def parse_fxl(text: str, file: str | os.PathLike = "<fxl>") -> dict[str, list[Ve
                 raise FishgenError(f"expected texture coordinates from 0 to 1, found {u:g} {v:g}", file,
                                    chunk[-1][1])
             pts.append((u, v))
+        if order is not None:
+            order.finish(values[-1][1] if values else count_line)
         parts[current] = pts
 
     for number, line in enumerate(text.splitlines(), start=1):
@@ -100,10 +107,60 @@ def parse_fxl(text: str, file: str | os.PathLike = "<fxl>") -> dict[str, list[Ve
     return parts
 
 
+class _BodyOrder:
+    """Body lines are ``section circle u v``, section by section, circle by circle: each line's
+    numbers must be the next ones, so a reversed or shuffled file is refused, not read silently."""
+
+    def __init__(self, file: str):
+        self.file = file
+        self.expected: tuple[int, int] | None = (0, 0)
+        self.last: tuple[int, int] | None = None
+        self.circles: int | None = None
+
+    def next(self, section: tuple[str, int], circle: tuple[str, int]) -> None:
+        found = []
+        for text, line in (section, circle):
+            if not re.fullmatch(r"\d{1,6}", text):
+                raise FishgenError(f"expected a body line `section circle u v` with whole numbers first, "
+                                   f"found {text[:40]!r}", self.file, line)
+            found.append(int(text))
+        s, c = found
+        if self.last is None:
+            allowed = {(0, 0)}
+        else:
+            ls, lc = self.last
+            allowed = set()
+            if self.circles is None or lc + 1 < self.circles:
+                allowed.add((ls, lc + 1))
+            if self.circles is None or lc + 1 == self.circles:
+                allowed.add((ls + 1, 0))
+        if (s, c) not in allowed:
+            want = " or ".join(f"{a} {b}" for a, b in sorted(allowed))
+            raise FishgenError(f"expected the next body point, section and circle {want}, found {s} {c}",
+                               self.file, circle[1])
+        if self.last is not None and s == self.last[0] + 1 and self.circles is None:
+            self.circles = self.last[1] + 1
+        self.last = (s, c)
+
+    def finish(self, line: int) -> None:
+        if self.last is not None and self.circles is not None and self.last[1] + 1 != self.circles:
+            raise FishgenError(f"expected {self.circles} points on the last body section, found "
+                               f"{self.last[1] + 1}", self.file, line)
+
+
 def read_fxl(path: str | os.PathLike) -> dict[str, list[Vec2]]:
+    import stat
+
     try:
-        with open(path, "rb") as handle:
-            data = handle.read(MAX_FXL_BYTES + 1)
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a FIFO must not block the open
+        try:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                raise FishgenError("expected a regular .FXL file, found a device, pipe or other special file",
+                                   path)
+            with os.fdopen(os.dup(fd), "rb") as handle:
+                data = handle.read(MAX_FXL_BYTES + 1)
+        finally:
+            os.close(fd)
     except OSError as err:
         raise FishgenError(f"expected a readable .FXL file, found {err.strerror or err}", path) from None
     if len(data) > MAX_FXL_BYTES:
