@@ -163,3 +163,32 @@ def test_paired_fins_are_kept_on_the_body_while_swimming():
     assert attachment_problems(fixed.species) == []
     assert fixed.species.pectoral.triangles < 6
     assert notes and notes[0].startswith("the pectoral fin spans")
+
+
+def test_a_fish_standing_on_end_is_refused_in_one_line(tmp_path):
+    """Issue 26: a photo turned 91 degrees was accepted as "turned +91", where about 10 is promised;
+    a deep fish (taller than long, fins and all) is still taken as level."""
+    from PIL import Image
+
+    from tests.conftest import PARAMS, run_cli
+
+    photo = tmp_path / "standing.png"
+    Image.open(PARAMS / "photos" / "bonybream-side.png").rotate(91, expand=True, fillcolor=(125, 156, 180)).save(photo)
+    result = run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "new.txt")
+    assert result.returncode == 2 and result.stderr.startswith(f"{photo}: expected a side view of a fish within 30")
+    assert not (tmp_path / "new.txt").exists()
+
+
+def test_a_photo_too_long_for_its_height_is_refused_before_measuring(tmp_path):
+    """Issue 26, fault 5: an 8000 x 64 photo measured 16 pixels tall and ended in a NaN traceback."""
+    from PIL import Image, ImageDraw
+
+    from tests.conftest import PARAMS, run_cli
+
+    photo = tmp_path / "thin.png"
+    image = Image.new("RGBA", (8000, 64), (0, 0, 0, 0))
+    ImageDraw.Draw(image).ellipse((100, 10, 7900, 54), fill=(200, 150, 50, 255))
+    image.save(photo)
+    result = run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "t.txt", "--body-sections", "7")
+    assert result.returncode == 2 and "at most 32 times as long as it is tall" in result.stderr
+    assert "Traceback" not in result.stderr

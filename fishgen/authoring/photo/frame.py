@@ -12,6 +12,7 @@ import numpy as np
 from scipy import ndimage  # type: ignore[import-untyped]
 
 from fishgen.authoring.photo import columns
+from fishgen.errors import FishgenError
 
 MARGIN = 4
 #: Below this the photo is taken as level: measuring on its own pixels beats resampling them.
@@ -19,6 +20,10 @@ LEVEL_DEGREES = 0.25
 #: A principal axis steeper than this is a deep fish (fins and all, taller than long), not a fish
 #: standing on its head: side photos show fish about level, so it is taken as level.
 STEEPEST_AXIS = 30.0
+#: ...unless its tail is up or down: a peduncle (a narrow neck before the tail fin) along the
+#: vertical this many times deeper than any along the horizontal says the fish stands on end. Such a
+#: photo is refused: fish within STEEPEST_AXIS degrees of level are supported.
+STANDING_NECK = 1.5
 
 
 @dataclass(frozen=True)
@@ -70,6 +75,10 @@ def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
     theta = float(np.degrees(np.arctan2(vy, vx)))
     theta = (theta + 90.0) % 180.0 - 90.0
     if abs(theta) > STEEPEST_AXIS:
+        if _neck(mask.T) > STANDING_NECK * _neck(mask):
+            raise FishgenError(f"expected a side view of a fish within {STEEPEST_AXIS:.0f} degrees of "
+                               f"level, found one standing on end (its long axis {abs(theta):.0f} degrees "
+                               "from level); turn the photo first")
         theta = 0.0
     first, _ = _resample(mask, _rotation(-theta))
     mirrored = columns.tail_side(first) == "left"
@@ -85,3 +94,14 @@ def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
     linear = flip @ _rotation(-phi)
     out, shift = _resample(mask, linear)
     return Frame(linear, shift, out, phi, mirrored)
+
+
+def _neck(mask: np.ndarray) -> float:
+    """The deepest neck near either end of the silhouette, column by column (a tail's peduncle)."""
+    _, _, has = columns.extent(mask)
+    cols = np.flatnonzero(has)
+    top, bottom, _ = columns.extent(mask[:, cols[0]:cols[-1] + 1])
+    thick = bottom - top
+    reach = max(2, int(0.45 * thick.size))
+    return float(max(columns.neck_depth(thick)[-reach:].max(),
+                     columns.neck_depth(thick[::-1])[-reach:].max()))

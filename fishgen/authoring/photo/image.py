@@ -15,6 +15,12 @@ from fishgen.errors import FishgenError
 MAX_PHOTO_PIXELS = 64_000_000
 #: Smallest side accepted: below this a fish has too few pixels to measure.
 MIN_PHOTO_SIDE = 64
+MEASURE_SIDE = 2048
+"""Photos are measured on a copy at most this many pixels a side (a 0.05 % step is finer than any
+tolerance, and a 64-megapixel photo would otherwise need gigabytes)."""
+MAX_ASPECT = MEASURE_SIDE // MIN_PHOTO_SIDE
+"""Longest side over the shortest: beyond it the measuring copy is under MIN_PHOTO_SIDE across (an
+8000 x 64 photo measured 16 pixels tall, and its analysis ran out of fish rows: NaN)."""
 
 
 @dataclass(frozen=True)
@@ -64,6 +70,9 @@ def load_photo(path: str | os.PathLike) -> Photo:
                 if min(w, h) < MIN_PHOTO_SIDE:
                     raise FishgenError(f"expected a photo at least {MIN_PHOTO_SIDE} pixels a side, "
                                        f"found {w} x {h}", path)
+                if max(w, h) > MAX_ASPECT * min(w, h):
+                    raise FishgenError(f"expected a photo at most {MAX_ASPECT} times as long as it is tall "
+                                       f"(it is measured {MEASURE_SIDE} pixels long), found {w} x {h}", path)
                 img = ImageOps.exif_transpose(img)  # phones store portrait shots sideways
                 has_alpha = img.mode in ("RGBA", "LA", "PA") or "transparency" in img.info
                 rgba = np.asarray(img.convert("RGBA"))

@@ -15,16 +15,14 @@ import numpy as np
 from fishgen.authoring.photo import points as fixel
 from fishgen.authoring.photo.anatomy import BodyOutline, body_outline, body_region, calibrate
 from fishgen.authoring.photo.frame import Frame, fish_frame
-from fishgen.authoring.photo.image import Photo, load_photo, working_copy
+from fishgen.authoring.photo.image import MEASURE_SIDE, Photo, load_photo, working_copy
 from fishgen.authoring.photo.sideview import SideView, side_view
 from fishgen.authoring.photo.silhouette import silhouette
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, UsageError
 from fishgen.species.model import PectoralFin, PelvicFin, Species, TexturePoints, VerticalFin
 
 #: Largest texture written; a bigger photo is scaled down (texture points are fractions, unchanged).
 MAX_TEXTURE_SIDE = 4096
-#: Largest side the photo is measured at.
-MEASURE_SIDE = 2048
 #: Below this silhouette IoU the rebuilt fish does not look like the photographed one: say so.
 ADVICE_IOU = 0.85
 
@@ -204,14 +202,24 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
                  options: TextureOptions = TextureOptions(),
                  on_note: Callable[[str], None] | None = None) -> TextureResult:
     """Measure ``photo_path``, write the new species file beside its texture and mask, atomically."""
+    try:
+        return _make_texture(photo_path, base, out, options, on_note)
+    except FishgenError as err:
+        if err.file is None and not isinstance(err, UsageError):  # about what the photo shows: say which
+            raise FishgenError(err.message, photo_path) from None
+        raise
+
+
+def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.PathLike,
+                  options: TextureOptions, on_note: Callable[[str], None] | None) -> TextureResult:
     from fishgen.atomic import write_files
     from fishgen.authoring.photo import fxl
 
     out = Path(out)
     if out.suffix.lower() != ".txt":
-        raise FishgenError(f"expected -o to name a species file (.txt), found {out.name!r}")
+        raise UsageError(f"expected -o to name a species file (.txt), found {out.name!r}")
     if options.spacing not in fixel.SPACINGS:
-        raise FishgenError(f"expected --spacing {'|'.join(fixel.SPACINGS)}, found {options.spacing!r}")
+        raise UsageError(f"expected --spacing {'|'.join(fixel.SPACINGS)}, found {options.spacing!r}")
     note = on_note or (lambda _text: None)
     original = load_photo(photo_path)
     # Measured on at most MEASURE_SIDE pixels a side: a 0.05 % step is finer than any tolerance,
