@@ -12,9 +12,9 @@ from tests.conftest import ROOT
 def test_one_plain_line_per_job_and_a_summary_when_not_on_a_terminal(shipped):
     run = batch(shipped / "params" / "assets.toml", "-j", "2")
     lines = run.stdout.splitlines()
-    assert run.returncode == 0 and len(lines) == 9 and run.stderr == ""
-    assert all(line.startswith("built    ") and line.endswith(" s)") for line in lines[:8])
-    assert lines[8].endswith("8 jobs, 8 built, 0 skipped, 0 failed in " + lines[8].split(" in ")[1])
+    assert run.returncode == 0 and len(lines) == 10 and run.stderr == ""
+    assert all(line.startswith("built    ") and line.endswith(" s)") for line in lines[:9])
+    assert lines[9].endswith("9 jobs, 9 built, 0 skipped, 0 failed in " + lines[9].split(" in ")[1])
 
 
 def test_quiet_prints_nothing_and_verbose_says_why_each_job_ran(shipped):
@@ -36,7 +36,7 @@ def test_the_report_has_each_jobs_inputs_options_output_hashes_time_status_and_e
     run = batch(manifest, "-j", "2", "--report", shipped / "report.json")
     assert run.returncode == 2
     report = json.loads((shipped / "report.json").read_text())
-    assert report["counts"] == {"built": 8, "skipped": 0, "failed": 1, "not run": 0}
+    assert report["counts"] == {"built": 9, "skipped": 0, "failed": 1, "not run": 0}
     jobs = {job["name"]: job for job in report["jobs"]}
     out = shipped / "out" / "assets"
     fish = jobs["fish/bonybream.glb"]
@@ -53,7 +53,7 @@ def test_the_report_has_each_jobs_inputs_options_output_hashes_time_status_and_e
     assert bad["error"] == {"message": bad["error"]["message"], "file": str(shipped / "params" / "bad.txt"),
                             "line": 2, "kind": "input"}
     batch(manifest, "--report", shipped / "report.json")
-    assert json.loads((shipped / "report.json").read_text())["counts"]["skipped"] == 8
+    assert json.loads((shipped / "report.json").read_text())["counts"]["skipped"] == 9
 
 
 def test_json_errors_one_object_per_failed_job_and_one_for_the_batch(shipped):
@@ -78,7 +78,8 @@ def test_a_folder_builds_every_species_and_cube_file_with_default_options(shippe
     assert run.returncode == 0, run.stderr
     names = set(statuses(run.stdout))
     assert names == {"bonybream.glb", "centroberyx.glb", "pineapplefish.glb", "threadfingoldie.glb",
-                     "clouds/table_4_2.glb", "clouds/table_4_3.glb", "clouds/table_4_4.glb"}
+                     "clouds/table_4_2.glb", "clouds/table_4_3.glb", "clouds/table_4_4.glb",
+                     "clouds/sky.glb"}
     gltf_validator(*(shipped / "all" / name for name in sorted(names)))
     no_out = batch(shipped / "params")
     assert no_out.returncode == 2 and "expected --out FOLDER" in no_out.stderr

@@ -18,11 +18,11 @@ def write(tmp_path, text: str):
 def test_the_example_manifest_builds_every_shipped_species_a_school_and_the_three_clouds():
     manifest = load_manifest(PARAMS / "assets.toml")
     kinds = [job.kind for job in manifest.jobs]
-    assert kinds.count("school") == 1 and kinds.count("clouds") == 3
+    assert kinds.count("school") == 1 and kinds.count("clouds") == 4  # the report's three, and a texture sky
     built = {job.inputs[0].name for job in manifest.jobs if job.kind == "build"}
     assert built == {p.name for p in PARAMS.glob("*.txt")}
     assert {job.inputs[0].name for job in manifest.jobs if job.kind == "clouds"} == {
-        p.name for p in (PARAMS / "clouds").glob("*.awn")}
+        p.name for p in (PARAMS / "clouds").glob("*.aw[na]")}
     assert manifest.out == (PARAMS.parent / "out" / "assets").resolve()
 
 
@@ -95,7 +95,7 @@ def test_a_folder_scan_makes_one_default_job_per_species_and_cube_file(tmp_path)
     manifest = scan_folder(PARAMS, tmp_path / "out")
     names = sorted(job.name for job in manifest.jobs)
     assert names == sorted([f"{p.stem}.glb" for p in PARAMS.glob("*.txt")]
-                           + [f"clouds/{p.stem}.glb" for p in (PARAMS / "clouds").glob("*.awn")])
+                           + [f"clouds/{p.stem}.glb" for p in (PARAMS / "clouds").glob("*.aw[na]")])
     (tmp_path / "empty").mkdir()
     with pytest.raises(FishgenError, match="expected species files"):
         scan_folder(tmp_path / "empty", tmp_path / "o2")

@@ -11,7 +11,7 @@ from tests.batch.conftest import batch, hashes, record, statuses
 from tests.conftest import ROOT
 
 FISH = {"fish/bonybream.glb", "fish/centroberyx.glb", "fish/pineapplefish.glb", "fish/threadfingoldie.glb"}
-CLOUDS = {"clouds/table_4_2.glb", "clouds/table_4_3.glb", "clouds/table_4_4.glb"}
+CLOUDS = {"clouds/table_4_2.glb", "clouds/table_4_3.glb", "clouds/table_4_4.glb", "clouds/sky.glb"}
 ALL = FISH | CLOUDS | {"schools/reef.glb"}
 
 

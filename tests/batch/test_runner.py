@@ -28,7 +28,7 @@ def test_the_example_gives_identical_bytes_with_one_or_two_processes(shipped):
     one, two = shipped / "j1", shipped / "j2"
     assert batch(manifest, "--out", one, "-j", "1").returncode == 0
     assert batch(manifest, "--out", two, "-j", "2").returncode == 0
-    assert hashes(one) == hashes(two) and len(hashes(one)) == 8
+    assert hashes(one) == hashes(two) and len(hashes(one)) == 9
 
 
 def bad_and_good(shipped, fail_fast: bool = False):
@@ -293,4 +293,4 @@ def test_a_dask_cluster_builds_the_same_bytes_as_the_local_pool(shipped):
     assert hashes(shipped / "dask") == hashes(shipped / "local")
     assert set(statuses(again.stdout).values()) == {"skipped"}
     report = json.loads((shipped / "dask.json").read_text())
-    assert report["scheduler"] == cluster.scheduler_address and report["counts"]["built"] == 8
+    assert report["scheduler"] == cluster.scheduler_address and report["counts"]["built"] == 9

@@ -18,7 +18,7 @@ from fishgen.authoring.photo.frame import Frame, fish_frame
 from fishgen.authoring.photo.image import MEASURE_SIDE, Photo, load_photo, working_copy
 from fishgen.authoring.photo.sideview import SideView, side_view
 from fishgen.authoring.photo.silhouette import silhouette
-from fishgen.errors import FishgenError, UsageError
+from fishgen.errors import FishgenError, UsageError, cannot
 from fishgen.species.model import PectoralFin, PelvicFin, Species, TexturePoints, VerticalFin
 
 #: Largest texture written; a bigger photo is scaled down (texture points are fractions, unchanged).
@@ -329,7 +329,10 @@ def _rendered(photo: Photo, candidate: _Candidate, out: Path) -> tuple[np.ndarra
 
     with tempfile.TemporaryDirectory(prefix="fishgen-texture-") as tmp:
         for path, data in candidate.files.items():
-            (Path(tmp) / path.name).write_bytes(data)
+            try:
+                (Path(tmp) / path.name).write_bytes(data)
+            except OSError as err:  # a full scratch disk: say which output it was for, and where
+                raise cannot(f"check {path} in the scratch folder", tmp, err) from None
         rebuilt = load_species(Path(tmp) / out.name)
         w, h = photo.size
         k = min(1.0, 1024 / max(w, h))
