@@ -1,0 +1,135 @@
+"""Who each fish perceives: its k nearest school-mates (same species), its few nearest fish of any
+species (keep-away, contact and separation), and its nearest fish of another species, from
+scipy's k-d tree.
+
+The lists are rebuilt every frame below NEIGHBOUR_REFRESH_FISH fish, else at most
+NEIGHBOUR_REFRESH_SECONDS of simulated time apart (the k nearest change slowly), while every
+distance is measured from the current positions each frame. Every list is logged (NeighbourLog),
+so the measures reuse them instead of searching again.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree  # type: ignore[import-untyped]
+
+from fishgen.school.model import NeighbourLog
+from fishgen.school.state import SchoolState, norm
+
+HARD_SEPARATION = 0.6      # mean body lengths: centres never closer (metrics flag < 0.5)
+CONTACT_DISTANCE = 0.8     # mean body lengths: bodies push apart inside this, whatever the brain
+NEAR = 4                   # fish of any species each fish keeps clear of
+NEIGHBOUR_REFRESH_FISH = 300
+NEIGHBOUR_REFRESH_SECONDS = 0.5
+PARALLEL_QUERY_FISH = 5000
+LOGGED = 8                 # school-mates per fish kept in the log (the measures' links)
+
+
+class Neighbours:
+    """The current lists as (k, N) arrays, and per step the offsets to the nearest fish."""
+
+    def __init__(self, state: SchoolState, k: int, log: NeighbourLog | None = None) -> None:
+        n = state.n
+        self.state = state
+        self.log = log
+        self.k = max(1, min(int(k), n - 1)) if n > 1 else 0
+        self.refresh_every = 1
+        if n >= NEIGHBOUR_REFRESH_FISH:
+            self.refresh_every = max(1, int(NEIGHBOUR_REFRESH_SECONDS * state.config.fps))
+        # Threads pay off only for big trees: below that the locks cost more than the queries.
+        self.workers = -1 if n >= PARALLEL_QUERY_FISH else 1
+        self.version = 0           # counts rebuilds: models cache per-list constants by it
+        self.other: np.ndarray | None = None
+        self.near_to: np.ndarray | None = None
+        self.near_dist: np.ndarray | None = None
+
+    def due(self, frame: int) -> bool:
+        return frame % self.refresh_every == 0
+
+    def refresh(self, frame: int) -> None:
+        """Rebuild the lists from the current positions, and the per-pair constants read with them."""
+        state = self.state
+        nb, nb_ok, near, near_ok = self._find()
+        self.nb, self.nb_ok = np.ascontiguousarray(nb.T), np.ascontiguousarray(nb_ok.T)
+        self.near, self.near_ok = np.ascontiguousarray(near.T), np.ascontiguousarray(near_ok.T)
+        length = state.length
+        self.near_need = HARD_SEPARATION * 0.5 * (length + length[self.near])
+        self.inv_near_reach = 1.0 / np.maximum(self.near_need * (CONTACT_DISTANCE / HARD_SEPARATION), 1e-12)
+        # `near` is then the first rows of `nb`, and a model that gathers `nb` has its offsets
+        self.near_is_nb = state.n_groups == 1 and self.k >= self.near.shape[0]
+        self.version += 1
+        if self.log is not None:
+            self.log.starts.append(int(frame))
+            self.log.mates.append(self.nb[:LOGGED].astype(np.int32))
+            self.log.mates_ok.append(self.nb_ok[:LOGGED].copy())
+            self.log.near.append(self.near.astype(np.int32))
+            self.log.near_ok.append(self.near_ok.copy())
+
+    def _find(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(nb, nb_ok, near, near_ok) as (N, k) from k-d trees; sets `other`."""
+        state = self.state
+        n = state.n
+        pos = state.pos.T
+        nb = np.zeros((n, max(self.k, 1)), dtype=np.int64)
+        nb_ok = np.zeros((n, max(self.k, 1)), dtype=bool)
+        self.other = None
+        if n < 2:
+            return nb, nb_ok, np.zeros((n, 1), dtype=np.int64), np.zeros((n, 1), dtype=bool)
+        m = min(NEAR, n - 1)
+        tree = cKDTree(pos)
+        k_all = max(self.k, m) if state.n_groups == 1 else m
+        _, idx = tree.query(pos, k=k_all + 1, workers=self.workers)
+        idx = idx[:, 1:]  # drop self (nearest; coincident fish are separated beforehand)
+        near = idx[:, :m]
+        near_ok = near != np.arange(n)[:, None]
+        if state.n_groups == 1:
+            nb = idx[:, : self.k]
+            return nb, nb != np.arange(n)[:, None], near, near_ok
+        other = np.full(n, -1, dtype=np.int64)
+        other_d = np.full(n, np.inf)
+        for g in range(state.n_groups):
+            members = np.flatnonzero(state.group == g)
+            if members.size == 0:
+                continue
+            t = cKDTree(pos[members])
+            kk = min(self.k + 1, members.size)
+            _, li = t.query(pos[members], k=kk, workers=self.workers)
+            li = li.reshape(members.size, kk)[:, 1:]
+            got = li.shape[1]
+            nb[members, :got] = members[li]
+            nb_ok[members, :got] = members[li] != members[:, None]
+            outsiders = np.flatnonzero(state.group != g)
+            if outsiders.size:
+                dd, oi = t.query(pos[outsiders], k=1, workers=self.workers)
+                better = dd < other_d[outsiders]
+                other[outsiders[better]] = members[oi[better]]
+                other_d[outsiders[better]] = dd[better]
+        self.other = other
+        return nb, nb_ok, near, near_ok
+
+    # ----------------------------------------------------------------- per step
+    def begin_step(self) -> None:
+        self.near_to = self.near_dist = None
+
+    def set_near_offsets(self, near_to: np.ndarray, near_dist: np.ndarray) -> None:
+        """Offsets a model measured anyway (`near` being the first rows of its school-mates)."""
+        self.near_to, self.near_dist = near_to, near_dist
+
+    def near_offsets(self) -> tuple[np.ndarray, np.ndarray]:
+        """From each of the few nearest fish (any species) to me (3, m, N), and how far (m, N), at
+        this step's start; measured once a step, shared by the urges and the separation."""
+        if self.near_to is None or self.near_dist is None:
+            pos = self.state.pos
+            self.near_to = np.take(pos, self.near, axis=1) - pos[:, None, :]
+            self.near_dist = norm(self.near_to)
+        return self.near_to, self.near_dist
+
+    def contact_strength(self) -> np.ndarray:
+        """Per nearest fish: 1 at contact falling to 0 at the contact distance, over the distance."""
+        _, dist = self.near_offsets()
+        reach = np.maximum(1.0 - dist * self.inv_near_reach, 0.0) * self.near_ok
+        return reach / np.maximum(dist, 1e-12)
+
+    def push(self, strength: np.ndarray) -> np.ndarray:
+        """Sum over the nearest fish of strength x offset away from them."""
+        near_to, _ = self.near_offsets()
+        return -np.einsum("kn,ckn->cn", strength, near_to)
