@@ -73,23 +73,31 @@ class CouzinParams:
     animal groups", J. Theor. Biol. 218, 1-11: three zones around each fish, a blind volume behind
     it and a turning-rate limit.
 
-    Distances are in body lengths (the paper's unit is the zone of repulsion's radius, rr = 1), times
-    in seconds; the fish swim at their species' cruising speed (the paper's s = 3 units per second
-    is `speed = 3.0` body lengths per second for a [[species]]). Each step a fish wants to move:
-    away from every school-mate inside the zone of repulsion if there is one (that rule alone);
-    otherwise along its own and its visible school-mates' mean heading in the zone of orientation,
-    towards the visible school-mates in the zone of attraction, or half of each when both zones
-    hold fish. It turns towards that by at most `turning_rate`, after a random turn of `noise`.
+    Distances are in body lengths (the paper's unit is the zone of repulsion's radius, rr = 1),
+    times in seconds. Each step a fish wants to move away from every school-mate inside the zone
+    of repulsion if there is one (that rule alone); otherwise along its own and its visible
+    school-mates' headings in the zone of orientation, towards the visible school-mates in the zone
+    of attraction, or half of each when both zones hold fish. It turns towards that by at most
+    `turning_rate`, after a random turn of `noise`.
+
+    Fish swim at their species' cruising speed. The paper's states depend on its turning radius,
+    s / theta (3 units/s over 40 degrees/s: 4.3 units), so `turning_rate` and `noise` hold at
+    `speed`, the paper's s, and a fish swimming at another speed turns and wanders in proportion:
+    the same paths, run faster or slower. A school bigger than `neighbours` + `sampled` + 1 fish
+    takes each fish's `neighbours` nearest exactly and a fresh random sample of `sampled` others,
+    weighted to stand for all of them (fishgen.school.behaviour.couzin).
     """
 
     repulsion: float = 1.0       # rr: radius of the zone of repulsion, body lengths
-    orientation: float = 1.5     # delta ro: width of the zone of orientation beyond rr, body lengths
+    orientation: float = 1.0     # delta ro: width of the zone of orientation beyond rr, body lengths
     attraction: float = 15.0     # delta ra: width of the zone of attraction beyond rr + delta ro
     blind_angle: float = 90.0    # degrees of the cone straight behind a fish it cannot see into
                                  # (the paper's field of perception alpha = 270 degrees)
-    turning_rate: float = 40.0   # theta: the most a fish turns, degrees per second
+    turning_rate: float = 40.0   # theta: the most a fish turns, degrees per second at `speed`
+    speed: float = 3.0           # s: the paper's speed, body lengths per second (see below)
     noise: float = 0.05          # sigma: s.d. of the random turn, radians per 0.1 s (the paper's tau)
-    neighbours: int = 48         # the most school-mates a fish perceives (nearest first)
+    neighbours: int = 40         # school-mates each fish takes exactly, nearest first
+    sampled: int = 60            # more taken at random each step in a bigger school (see above)
 
     @property
     def reach(self) -> float:
@@ -101,8 +109,8 @@ COUZIN_PRESETS: dict[str, CouzinParams] = {
     # The four collective states of the paper's Figure 2 (delta ra = 15, delta ro swept from 0 to 15
     # starting from a disordered group): swarm for delta ro of 0-0.5, torus 0.5-2.5, dynamic parallel
     # 2.5-6, highly parallel 6.5-15. Each preset sits inside its band; docs/decisions.md, Schools.
-    "swarm": CouzinParams(orientation=0.25),
-    "torus": CouzinParams(orientation=1.5),
+    "swarm": CouzinParams(orientation=0.0),
+    "torus": CouzinParams(orientation=1.0),
     "dynamic parallel": CouzinParams(orientation=4.0),
     "highly parallel": CouzinParams(orientation=12.0),
 }
@@ -111,7 +119,7 @@ COUZIN_PRESETS: dict[str, CouzinParams] = {
 COUZIN_RANGES: dict[str, tuple[float, float]] = {
     "repulsion": (0.1, 20.0), "orientation": (0.0, 100.0), "attraction": (0.0, 100.0),
     "blind_angle": (0.0, 360.0), "turning_rate": (1.0, 3600.0), "noise": (0.0, 3.0),
-    "neighbours": (1, 256),
+    "neighbours": (1, 1000), "sampled": (0, 1000), "speed": (0.05, 20.0),
 }
 """Accepted range of each CouzinParams field (the scene file and the command line check these)."""
 
@@ -122,7 +130,9 @@ COUZIN_HELP: dict[str, str] = {
     "blind_angle": "degrees of the cone behind a fish that it cannot see into",
     "turning_rate": "the most a fish turns, degrees per second",
     "noise": "s.d. of each fish's random turn, radians per 0.1 s",
-    "neighbours": "the most school-mates a fish perceives, nearest first",
+    "neighbours": "school-mates each fish takes exactly, nearest first",
+    "sampled": "more school-mates taken at random each step in a bigger school",
+    "speed": "the speed at which turning_rate and noise hold, body lengths per second",
 }
 
 

@@ -48,42 +48,72 @@ class Neighbours:
     def refresh(self, frame: int) -> None:
         """Rebuild the lists from the current positions, and the per-pair constants read with them."""
         state = self.state
-        nb, nb_ok, near, near_ok = self._find()
+        nb, nb_ok, near, near_ok, logged, logged_ok = self._find()
         self.nb, self.nb_ok = np.ascontiguousarray(nb.T), np.ascontiguousarray(nb_ok.T)
         self.near, self.near_ok = np.ascontiguousarray(near.T), np.ascontiguousarray(near_ok.T)
         length = state.length
         self.near_need = HARD_SEPARATION * 0.5 * (length + length[self.near])
         self.inv_near_reach = 1.0 / np.maximum(self.near_need * (CONTACT_DISTANCE / HARD_SEPARATION), 1e-12)
         # `near` is then the first rows of `nb`, and a model that gathers `nb` has its offsets
-        self.near_is_nb = state.n_groups == 1 and self.k >= self.near.shape[0]
+        self.near_is_nb = state.n_groups == 1 and self.k >= self.near.shape[0] and not self.everyone
         self.version += 1
         if self.log is not None:
             self.log.starts.append(int(frame))
-            self.log.mates.append(self.nb[:LOGGED].astype(np.int32))
-            self.log.mates_ok.append(self.nb_ok[:LOGGED].copy())
+            if logged is None:
+                logged, logged_ok = self.nb[:LOGGED], self.nb_ok[:LOGGED]
+            else:
+                logged, logged_ok = logged.T, logged_ok.T
+            self.log.mates.append(logged.astype(np.int32))
+            self.log.mates_ok.append(np.array(logged_ok))
             self.log.near.append(self.near.astype(np.int32))
             self.log.near_ok.append(self.near_ok.copy())
 
-    def _find(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(nb, nb_ok, near, near_ok) as (N, k) from k-d trees; sets `other`."""
+    @property
+    def everyone(self) -> bool:
+        """Whether `nb` holds every school-mate, in no order: when a model perceives more fish than
+        the log keeps and the largest species has no more, its lists are built once (Couzin's
+        zones over a school of a hundred need no tree)."""
+        if self.k <= LOGGED:
+            return False
+        counts = np.bincount(self.state.group, minlength=self.state.n_groups)
+        return bool(self.k >= counts.max() - 1)
+
+    def _find(self):
+        """(nb, nb_ok, near, near_ok) as (N, k) from k-d trees, and the nearest school-mates to log
+        when `nb` does not start with them (else None, None); sets `other`."""
         state = self.state
         n = state.n
         pos = state.pos.T
         nb = np.zeros((n, max(self.k, 1)), dtype=np.int64)
         nb_ok = np.zeros((n, max(self.k, 1)), dtype=bool)
         self.other = None
+        logged = logged_ok = None
         if n < 2:
-            return nb, nb_ok, np.zeros((n, 1), dtype=np.int64), np.zeros((n, 1), dtype=bool)
+            empty = np.zeros((n, 1), dtype=np.int64)
+            return nb, nb_ok, empty, empty.astype(bool), logged, logged_ok
+        everyone = self.everyone
+        if everyone:
+            nb, nb_ok = self._everyone()
+            logged = np.zeros((n, min(LOGGED, self.k)), dtype=np.int64)
+            logged_ok = np.zeros(logged.shape, dtype=bool)
         m = min(NEAR, n - 1)
         tree = cKDTree(pos)
-        k_all = max(self.k, m) if state.n_groups == 1 else m
+        if everyone:
+            k_all = m if state.n_groups > 1 else max(m, logged.shape[1])  # type: ignore[union-attr]
+        else:
+            k_all = max(self.k, m) if state.n_groups == 1 else m
         _, idx = tree.query(pos, k=k_all + 1, workers=self.workers)
         idx = idx[:, 1:]  # drop self (nearest; coincident fish are separated beforehand)
         near = idx[:, :m]
         near_ok = near != np.arange(n)[:, None]
         if state.n_groups == 1:
+            if everyone:
+                got = min(idx.shape[1], logged.shape[1])  # type: ignore[union-attr]
+                logged[:, :got] = idx[:, :got]  # type: ignore[index]
+                logged_ok[:, :got] = idx[:, :got] != np.arange(n)[:, None]  # type: ignore[index]
+                return nb, nb_ok, near, near_ok, logged, logged_ok
             nb = idx[:, : self.k]
-            return nb, nb != np.arange(n)[:, None], near, near_ok
+            return nb, nb != np.arange(n)[:, None], near, near_ok, logged, logged_ok
         other = np.full(n, -1, dtype=np.int64)
         other_d = np.full(n, np.inf)
         for g in range(state.n_groups):
@@ -91,12 +121,13 @@ class Neighbours:
             if members.size == 0:
                 continue
             t = cKDTree(pos[members])
-            kk = min(self.k + 1, members.size)
+            kk = min((logged.shape[1] if everyone else self.k) + 1, members.size)  # type: ignore[union-attr]
             _, li = t.query(pos[members], k=kk, workers=self.workers)
             li = li.reshape(members.size, kk)[:, 1:]
             got = li.shape[1]
-            nb[members, :got] = members[li]
-            nb_ok[members, :got] = members[li] != members[:, None]
+            into, into_ok = (logged, logged_ok) if everyone else (nb, nb_ok)
+            into[members, :got] = members[li]  # type: ignore[index]
+            into_ok[members, :got] = members[li] != members[:, None]  # type: ignore[index]
             outsiders = np.flatnonzero(state.group != g)
             if outsiders.size:
                 dd, oi = t.query(pos[outsiders], k=1, workers=self.workers)
@@ -104,7 +135,25 @@ class Neighbours:
                 other[outsiders[better]] = members[oi[better]]
                 other_d[outsiders[better]] = dd[better]
         self.other = other
-        return nb, nb_ok, near, near_ok
+        return nb, nb_ok, near, near_ok, logged, logged_ok
+
+    def _everyone(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every school-mate of each fish (N, k), padded with the fish itself (not ok); built once."""
+        if getattr(self, "_all", None) is None:
+            state = self.state
+            n = state.n
+            nb = np.tile(np.arange(n)[:, None], (1, self.k))
+            ok = np.zeros((n, self.k), dtype=bool)
+            for g in range(state.n_groups):
+                members = np.flatnonzero(state.group == g)
+                if members.size < 2:
+                    continue
+                others = np.tile(members, (members.size, 1))[~np.eye(members.size, dtype=bool)]
+                others = others.reshape(members.size, members.size - 1)
+                nb[members, : members.size - 1] = others
+                ok[members, : members.size - 1] = True
+            self._all = (nb, ok)
+        return self._all
 
     # ----------------------------------------------------------------- per step
     def begin_step(self) -> None:
