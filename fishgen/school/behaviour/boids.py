@@ -22,6 +22,7 @@ GAIN_SPEED = 1.0
 GAIN_DIRECTION = 6.0
 GAIN_CONTACT = 10.0
 MIN_SPEED = 0.3            # x cruise
+SCHOOL_HEADING = 0.2       # share of the whole school's mean heading in the alignment target
 MAX_SPEED = 2.0            # x cruise
 
 
@@ -41,6 +42,19 @@ class Boids:
         self.inv_repel = 1.0 / np.maximum(state.repel, 1e-12)
         self.ones = np.ones((1, state.n))
         self._version = -1
+        self.group, self.n_groups = state.group, state.n_groups
+        others = np.bincount(state.group, minlength=state.n_groups)[state.group] - 1
+        self.inv_others = np.where(others > 0, 1.0 / np.maximum(others, 1), 0.0)
+
+    def _school_heading(self, d: np.ndarray) -> np.ndarray:
+        """Each fish's mean heading of the rest of its species (3, N): VRFish's "average direction
+        of the school" (7.2), over every fish of the species but itself."""
+        if self.n_groups == 1:
+            total = d.sum(axis=1, keepdims=True)
+        else:
+            total = np.stack([np.bincount(self.group, d[c], minlength=self.n_groups) for c in range(3)])
+            total = total[:, self.group]
+        return (total - d) * self.inv_others
 
     def want(self, state: SchoolState, nbrs: Neighbours, target: np.ndarray | None) -> Want:
         pos, d, v = state.pos, state.dir, state.vel
@@ -63,8 +77,9 @@ class Boids:
             # cohesion: towards the centre of the perceived school-mates, in body lengths, capped
             coh = (sums[:3] - cnt * pos) * (mean * self.inv_length)
             acc += self.g_center / np.maximum(norm(coh), 1.0) * coh
-            # alignment: towards their mean heading
-            acc += self.g_direction * (sums[3:6] * mean - d * has)
+            # alignment: towards their mean heading, and the whole school's (the thesis' cue)
+            heading = (1.0 - SCHOOL_HEADING) * (sums[3:6] * mean) + SCHOOL_HEADING * self._school_heading(d)
+            acc += self.g_direction * (heading - d * has)
             if nbrs.near_is_nb:
                 m = nbrs.near.shape[0]
                 nbrs.set_near_offsets(off[:, :m], dist[:m])
