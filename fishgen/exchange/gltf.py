@@ -176,7 +176,7 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
         ibm = np.asarray(skin.inverse_bind_matrices, np.float32).transpose(0, 2, 1)  # column-major
         doc["skins"].append(_obj(inverseBindMatrices=buf.accessor(ibm.reshape(-1, 16), mat4=True),
                                  skeleton=skin.skeleton, joints=list(skin.joints), name=skin.name))
-    doc["scenes"].append(_obj(name=scene.name or None, nodes=list(scene.roots)))
+    doc["scenes"].append(_obj(extras=scene.extras or None, name=scene.name or None, nodes=list(scene.roots)))
     doc["scene"] = 0
 
     for clip in scene.clips:

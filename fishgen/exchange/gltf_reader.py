@@ -838,6 +838,9 @@ class _Reader:
         scenes = lists["scenes"]
         scene.roots = (list(scenes[self.doc.get("scene", 0)].get("nodes", [])) if scenes
                        else [i for i in range(len(lists["nodes"])) if i not in self.parent])
+        extras = scenes[self.doc.get("scene", 0)].get("extras") if scenes else None
+        if isinstance(extras, dict):  # kept as read; whoever uses a member checks it
+            scene.extras = extras
         for k, a in enumerate(lists["animations"]):
             channels = []
             for j, ch in enumerate(a.get("channels", [])):

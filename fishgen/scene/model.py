@@ -10,7 +10,7 @@ rotations as (x, y, z, w) quaternions. Nothing here knows a file format.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 if TYPE_CHECKING:  # numpy stays out of `fishgen --help`
     import numpy as np
@@ -162,7 +162,8 @@ class Clip:
 @dataclass
 class Scene:
     """A whole asset. ``roots`` are the top-level nodes; ``info`` carries summary facts
-    (``fin_mode`` of a fish, ``source`` of a reader) that writers may ignore."""
+    (``fin_mode`` of a fish, ``source`` of a reader) that writers may ignore; ``extras`` is
+    data a file keeps (a cloud's sunlight)."""
 
     name: str = ""
     nodes: list[Node] = field(default_factory=list)
@@ -173,6 +174,8 @@ class Scene:
     skins: list[Skin] = field(default_factory=list)
     clips: list[Clip] = field(default_factory=list)
     info: dict[str, str | float | int] = field(default_factory=dict)
+    extras: dict[str, Any] = field(default_factory=dict)
+    """Application data for the file (JSON values): glTF writes it as the scene's ``extras``."""
 
     # -- building ------------------------------------------------------------------
     def add_node(self, node: Node, parent: int | None = None) -> int:
