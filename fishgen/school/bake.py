@@ -27,6 +27,8 @@ from fishgen.school.model import Tracks
 
 STEPS = (2, 3, 4, 6, 8, 12, 16, 24, 30)
 """Key spacings tried, in frames; the longest is a one-second horizon at 30 fps."""
+TINT_STREAM = 0x7157
+"""Mixed into the seed of the generators that tint: the fin and wave phases keep their own."""
 FIN_PHASES = 16
 """Distinct fin phases per species: fish sharing one share its fin keys in the file, and 16 phases
 already keep neighbours from beating in step."""
@@ -94,13 +96,20 @@ def _fin_keys(channel: Channel, phase: float, duration: float) -> tuple[np.ndarr
 
 
 def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, seed: int = 0,
-         body_lengths: np.ndarray | None = None, wave: BodyWave | None = None) -> Scene:
+         body_lengths: np.ndarray | None = None, wave: BodyWave | None = None, tints: int = 1,
+         tint: float = 0.15) -> Scene:
     """One scene of every fish of ``tracks``; ``fish_scenes[g]`` is the built fish of group ``g``.
 
     ``wave``: the body wave the species were built with (default :class:`BodyWave`); it drives
-    the species whose meshes carry the wave targets."""
+    the species whose meshes carry the wave targets. ``tints`` colour variants per species
+    (:class:`fishgen.school.model.Variety`; 1: the species' own colours only, and the file is
+    what it was before variants existed), each channel of a variant's colour 1 - ``tint`` to 1."""
     school = Scene(name="school", info={"kind": "school", "fish": int(len(tracks.group))})
     templates = [merge_species(school, fish) for fish in fish_scenes]
+    variants = _tint_variants(school, templates, tints, tint, seed)
+    # which variant each fish wears: its own generator, so that the phases below stay as they were
+    wears = (np.random.default_rng((seed, TINT_STREAM)).integers(0, tints, len(tracks.group))
+             if tints > 1 else np.zeros(len(tracks.group), np.int64))
     swims = [fish.clip("swim") for fish in fish_scenes]
     times = np.asarray(tracks.times, np.float64)
     duration = float(times[-1]) if len(times) else 0.0
@@ -127,7 +136,7 @@ def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, 
         swim = swims[group]
         phase = int(rng.integers(FIN_PHASES))
         weights = None if phases is None or duration <= 0 else weight_sampler(times, phases[:, i])
-        for template, channel_index, waving in templates[group]:
+        for template, channel_index, waving in variants[group][int(wears[i])]:
             part = school.add_node(replace(template, children=[]), parent=node)
             if waving and weights is not None:
                 channels.append(Channel(part, "weights", weights))
@@ -141,6 +150,43 @@ def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, 
     if duration > 0:
         school.clips.append(Clip("school", channels))
     return school
+
+
+Part = tuple[Node, int | None, bool]
+
+
+def _tint_variants(school: Scene, templates: list[list[Part]], tints: int, tint: float,
+                   seed: int) -> list[list[list[Part]]]:
+    """Per species, per variant, its part templates. Variant 0 is the species as merged; each other
+    adds a copy of every species material with its base colour tinted, and a copy of every mesh
+    whose primitives name those materials: the same vertex, index and morph arrays, which the
+    writer stores once."""
+    out = []
+    rng = np.random.default_rng((seed, TINT_STREAM, 1))
+    for parts in templates:
+        variants = [parts]
+        meshes = sorted({t.mesh for t, _, _ in parts if t.mesh is not None})
+        materials = sorted({p.material for m in meshes for p in school.meshes[m].primitives
+                            if p.material is not None})
+        for v in range(1, max(1, int(tints))):
+            factor = 1.0 - float(tint) * rng.uniform(0.0, 1.0, 3)
+            new_material = {}
+            for m in materials:
+                base = school.materials[m]
+                r, g, b, a = base.base_color
+                colour = (r * float(factor[0]), g * float(factor[1]), b * float(factor[2]), a)
+                new_material[m] = school.add_material(replace(base, name=f"{base.name}_tint{v}",
+                                                              base_color=colour))
+            new_mesh = {}
+            for m in meshes:
+                mesh = school.meshes[m]
+                prims = [replace(p, material=None if p.material is None else new_material[p.material])
+                         for p in mesh.primitives]
+                new_mesh[m] = school.add_mesh(replace(mesh, name=f"{mesh.name}_tint{v}", primitives=prims))
+            variants.append([(replace(t, mesh=None if t.mesh is None else new_mesh[t.mesh]), c, w)
+                             for t, c, w in parts])
+        out.append(variants)
+    return out
 
 
 def _wave_phases(fish_scenes: list[Scene], tracks: Tracks, lengths: np.ndarray,

@@ -150,6 +150,32 @@ def couzin_params(preset: str | None = None, **values: Any) -> CouzinParams:
 
 
 @dataclass(frozen=True)
+class Variety:
+    """VRSchool's per-fish variety (thesis 4.2.6, 7.2): seeded, so the same seed gives the same fish.
+
+    `size` is the s.d. of each fish's size factor (its node's scale; clipped at 3 s.d.), which the
+    simulation also spaces the fish by. `tints` colour variants per species share the species'
+    geometry and texture and differ only in material: variant 0 is the species' own colours, each
+    other multiplies every material's base colour by its own seeded (r, g, b), each channel from
+    1 - `tint` to 1. One variant (the default) writes exactly the file it always did.
+    """
+
+    size: float = 0.05
+    tints: int = 1
+    tint: float = 0.15
+
+
+VARIETY_RANGES: dict[str, tuple[float, float]] = {"size": (0.0, 0.3), "tints": (1, 16), "tint": (0.0, 0.5)}
+"""Accepted range of each Variety field."""
+
+VARIETY_HELP: dict[str, str] = {
+    "size": "s.d. of each fish's size factor (its node's scale), 0 for all alike",
+    "tints": "colour variants per species, sharing its geometry; 1 for the species' own colours only",
+    "tint": "how far a colour variant strays: each channel times 1 - tint to 1",
+}
+
+
+@dataclass(frozen=True)
 class SchoolConfig:
     groups: tuple[Group, ...]
     model: Model = "boids"
