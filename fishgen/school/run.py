@@ -90,15 +90,35 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
     `variety` and `warmup` members when it has them), else CouzinParams(), Variety() and the
     default warm-up. `length`: every species' nose-to-tail length in metres (default: each
     species file's own)."""
-    from fishgen.assembly.fish import build_fish
-    from fishgen.scene.pose import bounds
     from fishgen.school.bake import bake
     from fishgen.school.simulate import simulate
+
+    variety = _given(variety, scene_file, "variety", Variety())
+    warmup = _given(warmup, scene_file, "warmup", None)
+    config, fishes = plan_school(scene_file, fins=fins, swim=swim, textures_dir=textures_dir, couzin=couzin,
+                                 variety=variety, length=length)
+    tracks = simulate(config, progress=progress)
+    groups = config.groups
+    lengths = np.array([groups[g].body_length for g in tracks.group]) * tracks.scale
+    scene = bake(fishes, tracks, tolerance=tolerance, seed=scene_file.seed, body_lengths=lengths,
+                 tints=variety.tints, tint=variety.tint)
+    settle = warmup_frames(config.frames, config.fps, warmup)
+    scene.extras[EXTRAS_KEY] = {"warmup": round(settle / config.fps, 6), "model": config.model,
+                                "fps": config.fps, "frames": config.frames}
+    return SchoolRun(config, tracks, scene, lengths, [g.name for g in groups], settle)
+
+
+def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "body",
+                textures_dir: str | os.PathLike | None = None, couzin: CouzinParams | None = None,
+                variety: Variety | None = None,
+                length: float | None = None) -> tuple[SchoolConfig, list[Scene]]:
+    """What run_school simulates, and each species built once (as `fishgen build` builds it)."""
+    from fishgen.assembly.fish import build_fish
+    from fishgen.scene.pose import bounds
     from fishgen.species.parser import load_species
 
     couzin = _given(couzin, scene_file, "couzin", CouzinParams())
     variety = _given(variety, scene_file, "variety", Variety())
-    warmup = _given(warmup, scene_file, "warmup", None)
     fishes, groups = [], []
     for entry in scene_file.species:
         species = load_species(entry.file, textures_dir)
@@ -113,20 +133,12 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
     if region is None:
         half = DEFAULT_BOUNDS_BODY_LENGTHS * max(g.body_length for g in groups) * max(1.0, count ** (1 / 3))
         region = ((-half, -half / 3, -half), (half, half / 3, half))
-    target = scene_file.target
     config = SchoolConfig(groups=tuple(groups), model=scene_file.model,  # type: ignore[arg-type]
                           frames=scene_file.frames, fps=scene_file.fps, seed=scene_file.seed, bounds=region,
-                          layout=scene_file.layout, target=target,  # type: ignore[arg-type]
+                          layout=scene_file.layout, target=scene_file.target,  # type: ignore[arg-type]
                           pso=scene_file.pso, predator=scene_file.predator, couzin=couzin,
                           size_jitter=variety.size)
-    tracks = simulate(config, progress=progress)
-    lengths = np.array([groups[g].body_length for g in tracks.group]) * tracks.scale
-    scene = bake(fishes, tracks, tolerance=tolerance, seed=scene_file.seed, body_lengths=lengths,
-                 tints=variety.tints, tint=variety.tint)
-    settle = warmup_frames(config.frames, config.fps, warmup)
-    scene.extras[EXTRAS_KEY] = {"warmup": round(settle / config.fps, 6), "model": config.model,
-                                "fps": config.fps, "frames": config.frames}
-    return SchoolRun(config, tracks, scene, lengths, [g.name for g in groups], settle)
+    return config, fishes
 
 
 def school_extras(scene: Scene) -> dict[str, Any] | None:

@@ -4,10 +4,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from fishgen.school.behaviour import BEHAVIOURS, behaviour
 from fishgen.school.metrics import measures, nose_directions, summary
-from fishgen.school.model import Brain, Group, PsoParams, SchoolConfig, TargetPath
+from fishgen.school.model import MODELS, Brain, Group, PsoParams, SchoolConfig, TargetPath
 from fishgen.school.paths import path_positions
 from fishgen.school.simulate import headings_from_velocities, simulate
+from fishgen.school.state import SchoolState
 
 L = 0.2
 
@@ -18,7 +20,7 @@ def _cfg(**kw) -> SchoolConfig:
     return SchoolConfig(**base)
 
 
-@pytest.mark.parametrize("model", ["boids", "pso"])
+@pytest.mark.parametrize("model", MODELS)
 def test_same_seed_same_tracks_other_seed_other_tracks(model):
     a = simulate(_cfg(model=model, seed=3))
     b = simulate(_cfg(model=model, seed=3))
@@ -28,7 +30,7 @@ def test_same_seed_same_tracks_other_seed_other_tracks(model):
     assert not np.allclose(a.positions, c.positions)
 
 
-@pytest.mark.parametrize("model", ["boids", "pso"])
+@pytest.mark.parametrize("model", MODELS)
 @pytest.mark.parametrize("layout", ["sphere", "box", "line"])
 def test_tracks_finite_shaped_and_inside_bounds(model, layout):
     bounds = ((-2.0, -1.0, -2.0), (2.0, 1.0, 2.0))
@@ -147,3 +149,31 @@ def test_headings_agree_with_yaw_then_pitch_angles_at_the_awkward_directions():
     same = np.minimum(np.abs(q - expected).max(axis=1), np.abs(q + expected).max(axis=1))
     assert same.max() < 1e-12
     assert np.allclose(np.linalg.norm(q, axis=1), 1.0)
+
+
+def test_every_model_is_a_module_of_its_own_behind_one_interface():
+    assert tuple(BEHAVIOURS) == MODELS
+    modules = {where.split(":")[0] for where in BEHAVIOURS.values()}
+    assert len(modules) == len(MODELS)
+    for model in MODELS:
+        config = _cfg(model=model, frames=2)
+        state = SchoolState.start(config)
+        chosen = behaviour(config, state)
+        assert type(chosen).__module__ == BEHAVIOURS[model].split(":")[0]
+        assert chosen.neighbours >= 1 and callable(chosen.want)
+    with pytest.raises(ValueError):
+        behaviour(_cfg(model="vicsek"), SchoolState.start(_cfg()))
+
+
+def test_the_simulation_logs_the_lists_it_used():
+    small = simulate(_cfg(frames=30))                       # below 300 fish: rebuilt every frame
+    assert small.neighbours.starts == list(range(30))
+    big = simulate(_cfg(groups=(Group("a", 320, L),), frames=40, bounds=((-4, -1, -4), (4, 1, 4))))
+    assert big.neighbours.starts == [0, 15, 30]            # half a second apart at 30 fps
+    mates = big.neighbours.mates[1]
+    assert mates.shape == (7, 320) and mates.dtype == np.int32 and big.neighbours.mates_ok[1].all()
+    # nearest first, from where the fish were when the list was built (the step to frame 15 starts
+    # from frame 14)
+    pos = big.positions[14]
+    d = np.linalg.norm(pos[mates] - pos[None], axis=2)
+    assert np.all(np.diff(d, axis=0) >= -1e-12)

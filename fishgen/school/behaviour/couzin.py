@@ -14,7 +14,8 @@ A fish sees all round but for a cone of `blind_angle` straight behind it (the pa
 perception alpha = 360 - blind angle); the zone of repulsion is felt all round. The wanted
 heading is turned by a random angle (s.d. `noise` per 0.1 s, the paper's time step tau, scaled by
 sqrt(dt / tau) so that the heading diffuses alike at any frame rate), and the fish turns towards
-it by at most `turning_rate` (the shared turn limit), swimming at its cruising speed. The paper's
+it by at most `turning_rate` (the shared turn limit; faster next to the region's walls, which the
+paper's open water has none of), swimming at its cruising speed. The paper's
 states depend on its turning radius s / theta (4.3 zone widths at s = 3, theta = 40 degrees/s), so
 a fish swimming at another speed turns, and wanders, in proportion: the paper's clock runs at
 cruise / `speed` of ours.
@@ -56,6 +57,7 @@ class Couzin:
         # distance swum hold at any speed
         clock = state.cruise / state.length / p.speed
         self.max_turn = math.radians(p.turning_rate) * clock
+        self.wall_turn = float(config.max_turn)
         self.sigma = p.noise * np.sqrt(state.dt * clock / PAPER_TAU)
         self.noisy = p.noise > 0
         # each fish's species as a run of fish indices (state.group is sorted): where samples come from
@@ -101,7 +103,17 @@ class Couzin:
             wanted = wanted + kick
             wanted /= np.maximum(norm(wanted), 1e-12)
         cruise = state.cruise
-        return Want(wanted * cruise, self.max_turn, cruise, cruise)
+        return Want(wanted * cruise, self._turn_rate(state), cruise, cruise)
+
+    def _turn_rate(self, state: SchoolState) -> np.ndarray:
+        """The paper's turning rate; the paper's fish swim in open water, so inside the margin of
+        the region's walls a fish may turn up to the other models' rate (config.max_turn) as the
+        wall nears, else its turning radius would carry it into the wall."""
+        pos = state.pos
+        below = np.minimum(np.maximum((state.inner_lo - pos) * state.inv_margin, 0.0), 1.0)
+        above = np.minimum(np.maximum((pos - state.inner_hi) * state.inv_margin, 0.0), 1.0)
+        wall = np.maximum(below, above).max(axis=0)
+        return np.maximum(self.max_turn, self.wall_turn * wall)
 
     def _zones(self, pos: np.ndarray, d: np.ndarray, mates: np.ndarray, ok: np.ndarray):
         """Which of `mates` (6, k, N: positions, headings) are in each zone, as 0/1 floats (k, N);
