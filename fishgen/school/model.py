@@ -12,7 +12,8 @@ if TYPE_CHECKING:
 
 Model = Literal["boids", "pso", "couzin"]
 MODELS: tuple[Model, ...] = ("boids", "pso", "couzin")
-Layout = Literal["sphere", "box", "line"]
+Layout = Literal["sphere", "box", "line", "ring"]
+LAYOUTS: tuple[Layout, ...] = ("sphere", "box", "line", "ring")
 PathKind = Literal["circle", "figure8", "spline", "points", "none"]
 
 

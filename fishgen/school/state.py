@@ -25,6 +25,7 @@ WANDER_VERTICAL = 0.3      # wander points are flattened: fish wander mostly hor
 WANDER_POOL = 4096         # random wander points drawn at a time
 LAYOUT_SPACING = 1.5       # body lengths between start positions
 BOUNDS_MARGIN = 3.0        # body lengths inside the walls where they start to steer fish back
+RING_LEAST = 2.0           # x the layout spacing: the least radius of a ring layout
 
 
 @dataclass(eq=False)
@@ -86,6 +87,8 @@ class SchoolState:
         hi = np.asarray(config.bounds[1], dtype=np.float64)[:, None]
         pos = layout(config, group, rng)
         d = random_units(rng, n, vertical=WANDER_VERTICAL)
+        if config.layout == "ring":
+            d = ring_headings(config, group, pos, d)
         wander = Wander.start(rng, d, change_rate)
         fallback = random_units(rng, n, vertical=1.0)
         margin = np.minimum(BOUNDS_MARGIN * length, 0.25 * (hi - lo))   # (3, N)
@@ -171,6 +174,15 @@ def layout(config: SchoolConfig, group: np.ndarray, rng: np.random.Generator) ->
                 sub_lo[0] = lo[0] + g * extent[0] / n_groups + inset[0]
                 sub_hi[0] = lo[0] + (g + 1) * extent[0] / n_groups - inset[0]
             pos[sel] = rng.uniform(sub_lo, sub_hi, (m, 3))
+        elif config.layout == "ring":  # a horizontal ring (torus) of about the layout's density
+            ring = spacing * max(RING_LEAST, float(np.cbrt(9.0 * m / (2.0 * np.pi ** 2))))
+            ring = min(ring, 0.35 * float(min(extent[0], extent[2])), 0.9 * float(room[0]))
+            angle, depth, around = rng.uniform(0.0, 1.0, (3, m))
+            angle, around = 2.0 * np.pi * angle, 2.0 * np.pi * around
+            tube = ring / 3.0 * np.sqrt(depth)
+            radius = ring + tube * np.cos(around)
+            ring_pos = np.stack([radius * np.cos(angle), tube * np.sin(around), radius * np.sin(angle)], 1)
+            pos[sel] = gc + ring_pos
         else:  # line along X (or along Z per species when there are several)
             axis = 0 if n_groups == 1 else 2
             width = min(m * spacing, 0.9 * float(extent[axis]))
@@ -179,6 +191,21 @@ def layout(config: SchoolConfig, group: np.ndarray, rng: np.random.Generator) ->
             p += rng.normal(0.0, 0.05 * spacing, (m, 3))
             pos[sel] = p
     return np.ascontiguousarray(np.clip(pos, lo, hi).T)
+
+
+def ring_headings(config: SchoolConfig, group: np.ndarray, pos: np.ndarray, noise: np.ndarray) -> np.ndarray:
+    """Headings round each species' ring (turning about -Y: clockwise seen from above, as +X turns
+    to +Z), a little off (noise x 0.2)."""
+    d = np.empty_like(pos)
+    for g in range(len(config.groups)):
+        sel = group == g
+        if sel.any():
+            centre = pos[:, sel].mean(axis=1, keepdims=True)
+            out = pos[:, sel] - centre
+            d[:, sel] = np.stack([-out[2], np.zeros_like(out[0]), out[0]])
+    d /= np.maximum(norm(d), 1e-12)
+    d = d + 0.2 * noise
+    return d / np.maximum(norm(d), 1e-12)
 
 
 def norm(v: np.ndarray) -> np.ndarray:

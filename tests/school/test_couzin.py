@@ -138,3 +138,13 @@ def test_rules_blind_angle():
     assert np.allclose(wanted(positions, headings, blind_angle=0.0), [0, 0, -1])
     # beyond the zone of attraction nobody counts
     assert np.allclose(wanted([[0, 0, 0], [0, 0, 20]], headings, blind_angle=0.0), [0, 0, 1])
+
+
+def test_a_torus_keeps_milling_and_a_parallel_group_does_not():
+    """From a ring of fish already milling: the torus rules keep the mill (the paper's collective
+    memory), the highly parallel group's rules straighten it out."""
+    mill = replace(paper_config("torus", frames=300), layout="ring")
+    p, m = order(mill)
+    assert m > 0.8 and p < 0.3
+    p, m = order(replace(mill, couzin=couzin_params("highly parallel")))
+    assert p > 0.9 and m < 0.3

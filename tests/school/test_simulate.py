@@ -31,7 +31,7 @@ def test_same_seed_same_tracks_other_seed_other_tracks(model):
 
 
 @pytest.mark.parametrize("model", MODELS)
-@pytest.mark.parametrize("layout", ["sphere", "box", "line"])
+@pytest.mark.parametrize("layout", ["sphere", "box", "line", "ring"])
 def test_tracks_finite_shaped_and_inside_bounds(model, layout):
     bounds = ((-2.0, -1.0, -2.0), (2.0, 1.0, 2.0))
     cfg = _cfg(model=model, layout=layout, bounds=bounds, frames=150,
@@ -177,3 +177,16 @@ def test_the_simulation_logs_the_lists_it_used():
     pos = big.positions[14]
     d = np.linalg.norm(pos[mates] - pos[None], axis=2)
     assert np.all(np.diff(d, axis=0) >= -1e-12)
+
+
+def test_a_ring_layout_starts_each_species_milling_round_its_own_ring():
+    cfg = _cfg(layout="ring", frames=2, groups=(Group("a", 60, L), Group("b", 40, 0.3)),
+               bounds=((-4, -1, -4), (4, 1, 4)))
+    tr = simulate(cfg)
+    m = measures(tr, [L, 0.3], only=("rotation", "polarization"))
+    assert np.all(m["rotation"][0] > 0.9) and np.all(m["polarization"][0] < 0.3)
+    for g in (0, 1):   # a horizontal ring: flat, and hollow
+        pos = tr.positions[0, tr.group == g]
+        out = pos - pos.mean(axis=0)
+        assert np.ptp(out[:, 1]) < 0.6 * np.ptp(out[:, 0])
+        assert np.linalg.norm(out[:, [0, 2]], axis=1).min() > 0.3 * np.linalg.norm(out[:, [0, 2]], axis=1).max()
