@@ -315,10 +315,11 @@ def _tail(arr: np.ndarray, warmup_frames: int) -> np.ndarray:
 
 
 # (measure, label, unit scale, format, which way is worse); per-species measures get one row each.
-# "worst" of the rotation order parameter is its largest: a mill where none is wanted.
+# The rotation order parameter's worst is its least in a school that mills (mean 0.5 or more: a
+# torus losing its mill) and its most in one that does not (a mill where none is wanted).
 TABLE = (
     ("polarization", "polarization (1 = parallel)", 1.0, "{:.2f}", "min"),
-    ("rotation", "rotation (1 = milling)", 1.0, "{:.2f}", "max"),
+    ("rotation", "rotation (1 = milling)", 1.0, "{:.2f}", "state"),
     ("groups", "separate groups", 1.0, "{:.0f}", "max"),
     ("nearest_neighbour", "nearest neighbour (body lengths)", 1.0, "{:.2f}", "min"),
     ("overlaps", "overlapping pairs", 1.0, "{:.0f}", "max"),
@@ -348,7 +349,8 @@ def summary_table(per_frame: dict[str, np.ndarray], warmup_frames: int,
             if column.size == 0:
                 rows.append((name, "-", "-"))
                 continue
-            worst = column.min() if worse == "min" else column.max()
+            way = ("min" if column.mean() >= 0.5 else "max") if worse == "state" else worse
+            worst = column.min() if way == "min" else column.max()
             rows.append((name, fmt.format(column.mean()), fmt.format(worst)))
     return rows
 
