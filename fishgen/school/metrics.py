@@ -150,8 +150,9 @@ def _neighbour_measures(tracks: Tracks, p: np.ndarray, start: int, group: np.nda
     else:
         which = log.index(np.arange(start, start + measured))
     m = min(MATES, log.mates[0].shape[0])
-    idx_all = np.concatenate([np.stack(log.mates)[:, :m], np.stack(log.near)[:, :NEAR]], axis=1)
-    ok_all = np.concatenate([np.stack(log.mates_ok)[:, :m], np.stack(log.near_ok)[:, :NEAR]], axis=1)
+    listed = np.concatenate([np.stack(log.mates)[:, :m], np.stack(log.near)[:, :NEAR]], axis=1)
+    ok_all = listed >= 0
+    idx_all = np.where(ok_all, listed, 0).astype(np.int64)
     # per list: squared thresholds, never met where the entry is no fish
     pair = 0.5 * (length + length[idx_all])
     link2_all = np.where(ok_all, (LINK * pair) ** 2, -1.0).astype(np.float32)
@@ -261,11 +262,7 @@ def _search(p: np.ndarray, group: np.ndarray, n_groups: int) -> NeighbourLog:
             li = li.reshape(ids.size, kk + 1)[:, 1:]
             mates[ids, :kk] = ids[li]
             ok[ids, :kk] = ids[li] != ids[:, None]
-        log.starts.append(f)
-        log.mates.append(mates.T.astype(np.int32))
-        log.mates_ok.append(ok.T)
-        log.near.append(near.T.astype(np.int32))
-        log.near_ok.append((near != np.arange(n)[:, None]).T)
+        log.append(f, mates.T, ok.T, near.T, (near != np.arange(n)[:, None]).T)
     return log
 
 

@@ -219,16 +219,25 @@ class Tracks:
 class NeighbourLog:
     """The neighbour lists the simulation used, each from its frame until the next one's: the
     measures reuse them instead of searching again. Lists are (k, N): row j holds each fish's j-th
-    nearest, `*_ok` whether that entry is a real fish (a species with fewer fish pads its lists)."""
+    nearest at the list's frame, -1 where there is none (a species with fewer fish); int16 below
+    32,767 fish, so a small school, whose lists are rebuilt every frame, logs 22 bytes a fish-frame."""
 
-    starts: list[int] = field(default_factory=list)          # first frame of each list
-    mates: list[np.ndarray] = field(default_factory=list)    # (k, N) int32 nearest of the same species
-    mates_ok: list[np.ndarray] = field(default_factory=list)  # (k, N) bool
-    near: list[np.ndarray] = field(default_factory=list)     # (m, N) int32 nearest of any species
-    near_ok: list[np.ndarray] = field(default_factory=list)  # (m, N) bool
+    starts: list[int] = field(default_factory=list)        # first frame of each list
+    mates: list[np.ndarray] = field(default_factory=list)  # (k, N) nearest of the same species
+    near: list[np.ndarray] = field(default_factory=list)   # (m, N) nearest of any species
 
     def index(self, frames: np.ndarray) -> np.ndarray:
         """Which list each of ``frames`` used."""
         import numpy as np
 
         return np.searchsorted(np.asarray(self.starts), frames, side="right") - 1
+
+    def append(self, frame: int, mates: np.ndarray, mates_ok: np.ndarray, near: np.ndarray,
+               near_ok: np.ndarray) -> None:
+        """Log lists (k, N) of fish indices, `*_ok` saying which entries are fish."""
+        import numpy as np
+
+        kind = np.int16 if mates.shape[-1] < np.iinfo(np.int16).max else np.int32
+        self.starts.append(int(frame))
+        self.mates.append(np.where(mates_ok, mates, -1).astype(kind))
+        self.near.append(np.where(near_ok, near, -1).astype(kind))

@@ -58,15 +58,11 @@ class Neighbours:
         self.near_is_nb = state.n_groups == 1 and self.k >= self.near.shape[0] and not self.everyone
         self.version += 1
         if self.log is not None:
-            self.log.starts.append(int(frame))
             if logged is None:
                 logged, logged_ok = self.nb[:LOGGED], self.nb_ok[:LOGGED]
             else:
                 logged, logged_ok = logged.T, logged_ok.T
-            self.log.mates.append(logged.astype(np.int32))
-            self.log.mates_ok.append(np.array(logged_ok))
-            self.log.near.append(self.near.astype(np.int32))
-            self.log.near_ok.append(self.near_ok.copy())
+            self.log.append(frame, logged, logged_ok, self.near, self.near_ok)
 
     @property
     def everyone(self) -> bool:
