@@ -105,7 +105,7 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
     settle = warmup_frames(config.frames, config.fps, warmup)
     scene.extras[EXTRAS_KEY] = {"warmup": round(settle / config.fps, 6), "model": config.model,
                                 "fps": config.fps, "frames": config.frames}
-    return SchoolRun(config, tracks, scene, lengths, [g.name for g in groups], settle)
+    return SchoolRun(config, tracks, scene, lengths, [g.name for g in groups], warmup_frames=settle)
 
 
 def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "body",
