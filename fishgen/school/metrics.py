@@ -27,13 +27,16 @@
 
 Neighbours come from the simulation's own lists (`tracks.neighbours`, rebuilt every frame below
 300 fish and at most half a second apart above), with every distance measured at the frame
-itself; tracks made elsewhere get lists from a k-d tree per frame.
+itself; tracks made elsewhere get lists from a k-d tree per frame. The order parameters and the
+heading checks (LOGGED) the simulation takes as it runs (`tracks.order`), where the state is at
+hand; they are computed from the tracks when tracks carry none.
 
 `body_lengths`: a number, or one body length (metres) per group; a fish's length is its group's
 times its `tracks.scale`.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Collection, Sequence
 
 import numpy as np
@@ -45,6 +48,8 @@ LINK = 3.0      # body lengths
 MATES = 8       # same-species neighbours a fish links to (at most)
 NEAR = 4        # neighbours of any species a fish links to
 CHUNK_ELEMENTS = 1 << 19  # frames x fish x neighbours per vectorised pass
+LOGGED = ("polarization", "rotation", "heading_angle", "heading_angle_max", "turn")
+"""Measures the simulation takes as it runs (Tracks.order): cheaper there, where the state is at hand."""
 MEASURES = ("polarization", "rotation", "nearest_neighbour", "overlaps", "groups", "mixed_groups",
             "heading_angle", "heading_angle_max", "turn", "target_distance", "predator_distance")
 
@@ -85,48 +90,94 @@ def measures(tracks: Tracks, body_lengths: float | Sequence[float] | np.ndarray,
         full[start:] = values
         out[name] = full
 
+    logged = tracks.order or {}
+    for name in sorted(want & set(logged)):     # the simulation measured these as it ran
+        column(name, np.asarray(logged[name], np.float64)[start:])
+    want -= set(logged)
     if want & {"polarization", "rotation"}:
         v = np.ascontiguousarray(np.asarray(tracks.velocities, np.float64)[start:].transpose(2, 0, 1))
-        unit = v / np.maximum(_norm(v), 1e-12)
-        member = np.zeros((n, n_groups))
-        member[np.arange(n), group] = 1.0
-        count = member.sum(axis=0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            inv = np.where(count > 0, 1.0 / count, np.nan)
-            if "polarization" in want:
-                column("polarization", _norm(unit @ member) * inv)
-            if "rotation" in want:
-                centre = (p @ member) * inv                        # (3, F', G)
-                r = p - centre[:, :, group]
-                r /= np.maximum(_norm(r), 1e-12)
-                cross = np.stack([r[1] * unit[2] - r[2] * unit[1], r[2] * unit[0] - r[0] * unit[2],
-                                  r[0] * unit[1] - r[1] * unit[0]])
-                column("rotation", _norm(cross @ member) * inv)
+        polar, rotation = order_parameters(p, v / np.maximum(_norm(v), 1e-12), group, n_groups)
+        for name, values in (("polarization", polar), ("rotation", rotation)):
+            if name in want:
+                column(name, values)
     if want & {"nearest_neighbour", "overlaps", "groups", "mixed_groups"}:
         p32 = p.astype(np.float32)  # distances to a micrometre are plenty; half the memory traffic
         for name, values in _neighbour_measures(tracks, p32, start, group, n_groups, length, want).items():
             column(name, values)
     if want & {"heading_angle", "heading_angle_max", "turn"}:
-        q = np.asarray(tracks.headings, np.float64)[max(start - 1, 0):]
-        nose = _nose(np.ascontiguousarray(q.transpose(2, 0, 1)))
-        if want & {"heading_angle", "heading_angle_max"}:
-            v = np.ascontiguousarray(np.asarray(tracks.velocities, np.float64)[start:].transpose(2, 0, 1))
-            ang = _angle(nose[:, 1:] if start else nose, v)
-            if "heading_angle" in want:
-                column("heading_angle", ang.mean(axis=1) if n else np.zeros(frames - start))
-            if "heading_angle_max" in want:
-                column("heading_angle_max", ang.max(axis=1) if n else np.zeros(frames - start))
-        if "turn" in want:
-            turn = np.zeros(frames - start)
-            if n and nose.shape[1] > 1:
-                steps = _angle(nose[:, 1:], nose[:, :-1]).max(axis=1)
-                turn[-steps.shape[0]:] = steps
-            column("turn", turn)
+        q = np.asarray(tracks.headings, np.float64)
+        v = np.asarray(tracks.velocities, np.float64)
+        before = _nose(q[start - 1].T) if start > 0 else None
+        mean, most, turn = heading_checks(q[start:], v[start:], before)
+        for name, values in (("heading_angle", mean), ("heading_angle_max", most), ("turn", turn)):
+            if name in want:
+                column(name, values)
     for name, path in (("target_distance", tracks.target), ("predator_distance", tracks.predator)):
         if name in want and path is not None:
             away = p - np.asarray(path, np.float64)[start:].T[:, :, None]
             column(name, (_norm(away) / length).mean(axis=1))
     return {name: out[name] for name in MEASURES if name in out}
+
+
+def order_parameters(pos: np.ndarray, unit: np.ndarray, group: np.ndarray, n_groups: int,
+                     member: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Polarization and rotation order parameter of each species, from component-major positions
+    and unit headings (3, ..., N): two arrays (..., G), NaN for a species with no fish.
+
+    The simulation calls this every frame, so the sums over the fish are dot products: the
+    rotation's sum of (r_i / |r_i|) x v_i is sum of r_i x (v_i / |r_i|), one pass per component.
+    `member`: membership_matrix(group, n_groups), when the caller keeps one."""
+    if n_groups == 1 and pos.ndim == 2:   # one species, one frame: the simulation's case
+        n = pos.shape[1]
+        if n == 0:
+            return np.full(1, np.nan), np.full(1, np.nan)
+        hx, hy, hz = unit.sum(axis=1).tolist()
+        r = pos - pos.sum(axis=1, keepdims=True) / n
+        # r_a . (v_b / |r|) for every pair of components a, b, in one product; a fish at the
+        # centre has r = 0 and adds nothing, whatever 1 / |r| is there
+        m = (r @ (unit / np.sqrt(np.einsum("ij,ij->j", r, r) + 1e-300)).T).tolist()
+        sx, sy, sz = m[1][2] - m[2][1], m[2][0] - m[0][2], m[0][1] - m[1][0]
+        return (np.array([math.sqrt(hx * hx + hy * hy + hz * hz) / n]),
+                np.array([math.sqrt(sx * sx + sy * sy + sz * sz) / n]))
+    if member is None:
+        member = membership_matrix(group, n_groups)
+    count = member.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        inv = np.where(count > 0, 1.0 / count, np.nan)
+        r = pos - ((pos @ member) * inv)[..., group]
+        w = unit / np.maximum(_norm(r), 1e-12)
+        spin = np.stack([r[1] * w[2] - r[2] * w[1], r[2] * w[0] - r[0] * w[2], r[0] * w[1] - r[1] * w[0]])
+        return _norm(unit @ member) * inv, _norm(spin @ member) * inv
+
+
+def membership_matrix(group: np.ndarray, n_groups: int) -> np.ndarray:
+    """(N, G): 1 where fish n is of species g."""
+    member = np.zeros((group.size, n_groups))
+    member[np.arange(group.size), group] = 1.0
+    return member
+
+
+def heading_checks(q: np.ndarray, v: np.ndarray,
+                   before: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per frame of headings `q` (F, N, 4) and velocities `v` (F, N, 3): the mean and the largest
+    angle between a fish's nose (+Z) and its velocity, and the largest turn of a nose since the
+    frame before (`before`: the noses (3, N) of the frame before the first; 0 without it)."""
+    frames, n = q.shape[:2]
+    mean, most, turn = np.zeros(frames), np.zeros(frames), np.zeros(frames)
+    if n == 0 or frames == 0:
+        return mean, most, turn
+    chunk = max(1, CHUNK_ELEMENTS // (8 * n))   # a few frames at a time: temporaries stay in cache
+    for lo in range(0, frames, chunk):
+        hi = min(lo + chunk, frames)
+        nose = _nose(np.moveaxis(q[lo:hi], -1, 0))
+        ang = _angle(nose, np.moveaxis(v[lo:hi], -1, 0))
+        mean[lo:hi], most[lo:hi] = ang.mean(axis=1), ang.max(axis=1)
+        if before is not None:
+            nose = np.concatenate([before[:, None], nose], axis=1)
+        if nose.shape[1] > 1:
+            turn[hi - (nose.shape[1] - 1):hi] = _angle(nose[:, 1:], nose[:, :-1]).max(axis=1)
+        before = nose[:, -1]
+    return mean, most, turn
 
 
 def _neighbour_measures(tracks: Tracks, p: np.ndarray, start: int, group: np.ndarray, n_groups: int,
@@ -150,7 +201,9 @@ def _neighbour_measures(tracks: Tracks, p: np.ndarray, start: int, group: np.nda
     else:
         which = log.index(np.arange(start, start + measured))
     m = min(MATES, log.mates[0].shape[0])
-    listed = np.concatenate([np.stack(log.mates)[:, :m], np.stack(log.near)[:, :NEAR]], axis=1)
+    listed = np.stack(log.mates)[:, :m]
+    if n_groups > 1 or m < log.near[0].shape[0]:  # else the nearest of any species lead the mates' lists
+        listed = np.concatenate([listed, np.stack(log.near)[:, :NEAR]], axis=1)
     ok_all = listed >= 0
     idx_all = np.where(ok_all, listed, 0).astype(np.int64)
     # per list: squared thresholds, never met where the entry is no fish

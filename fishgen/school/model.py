@@ -213,6 +213,7 @@ class Tracks:
     target: np.ndarray | None = None    # (F, 3) the pso target
     predator: np.ndarray | None = None  # (F, 3)
     neighbours: NeighbourLog | None = None  # the simulation's neighbour lists, for the measures
+    order: dict[str, np.ndarray] | None = None  # measures the simulation took as it ran (metrics.LOGGED)
 
 
 @dataclass

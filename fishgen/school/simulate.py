@@ -18,6 +18,7 @@ from collections.abc import Callable
 import numpy as np
 
 from fishgen.school.behaviour import Behaviour, behaviour
+from fishgen.school.metrics import heading_checks, membership_matrix, nose_directions, order_parameters
 from fishgen.school.model import NeighbourLog, SchoolConfig, Tracks
 from fishgen.school.neighbours import Neighbours
 from fishgen.school.paths import path_positions
@@ -56,6 +57,8 @@ def simulate(config: SchoolConfig, progress: Progress | None = None) -> Tracks:
 
     frames = int(config.frames)
     n = state.n
+    polar, rotation = np.empty((frames, state.n_groups)), np.empty((frames, state.n_groups))
+    member = membership_matrix(state.group, state.n_groups)
     positions = np.empty((frames, n, 3))
     velocities = np.empty((frames, n, 3))
     headings = np.empty((frames, n, 4))
@@ -68,21 +71,29 @@ def simulate(config: SchoolConfig, progress: Progress | None = None) -> Tracks:
                  None if predator is None else predator[f])
         positions[f] = state.pos.T
         velocities[f] = state.vel.T
+        polar[f], rotation[f] = order_parameters(state.pos, state.dir, state.group, state.n_groups, member)
         if progress is not None:
             progress(f + 1)
     # headings for all frames, a few frames at a time: small chunks keep numpy's temporaries in the
     # CPU cache (at 1,000 fish, 64-frame chunks ran 2.5x slower than 4-frame ones). Each chunk's
     # sign follows the previous chunk's last frame (q and -q are one rotation, but a sign flip
     # breaks linear key interpolation).
+    # The heading checks (the measures' heading_angle and turn) are taken on the same chunks.
     chunk = max(1, HEADING_CHUNK_ELEMENTS // max(n, 1))
+    checks = np.empty((3, frames))
+    before = None
     for start in range(0, frames, chunk):
         q = headings_from_velocities(velocities[start:start + chunk])
         if start > 0:
             q *= np.where(np.einsum("nk,nk->n", q[0], headings[start - 1]) < 0, -1.0, 1.0)[:, None]
         headings[start:start + chunk] = q
+        checks[:, start:start + chunk] = heading_checks(q, velocities[start:start + chunk], before)
+        before = nose_directions(q[-1]).T
+    order = {"polarization": polar, "rotation": rotation, "heading_angle": checks[0],
+             "heading_angle_max": checks[1], "turn": checks[2]}
     return Tracks(times=times, positions=positions, velocities=velocities,
                   headings=headings, group=state.group.copy(),
-                  scale=state.scale.copy(), target=target, predator=predator, neighbours=log)
+                  scale=state.scale.copy(), target=target, predator=predator, neighbours=log, order=order)
 
 
 def step(state: SchoolState, nbrs: Neighbours, model: Behaviour, frame: int,

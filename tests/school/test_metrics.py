@@ -169,3 +169,15 @@ def test_groups_are_fish_that_see_each_other_through_their_nearest():
     mixed = measures(_tracks([np.concatenate([a, a + [0.3, 0, 0]])], [vel], group=[0] * 12 + [1] * 12),
                      [1.0, 1.0])
     assert mixed["mixed_groups"][0] == 1
+
+
+def test_the_order_the_simulation_logs_is_what_the_tracks_give():
+    cfg = SchoolConfig(groups=(Group("a", 30, L), Group("b", 20, 0.3)), frames=80, seed=2)
+    tracks = simulate(cfg)
+    assert set(tracks.order) == {"polarization", "rotation", "heading_angle", "heading_angle_max", "turn"}
+    logged, recomputed = measures(tracks, [L, 0.3]), measures(replace(tracks, order=None), [L, 0.3])
+    for name in tracks.order:
+        assert np.allclose(logged[name], recomputed[name], atol=1e-12, equal_nan=True), name
+    for start in (1, 37):
+        later = measures(replace(tracks, order=None), [L, 0.3], start=start, only=("turn", "heading_angle"))
+        assert np.allclose(later["turn"][start:], recomputed["turn"][start:], atol=1e-15)
