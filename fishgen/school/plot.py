@@ -96,6 +96,10 @@ def _panel(ax, times: np.ndarray, series: list[tuple[str, np.ndarray]], names: l
         ax.text(0.99, 0.8, f"{value:.{digits}f} throughout", transform=ax.transAxes, ha="right",
                 va="top", fontsize=8, color="C0")
         return
+    if digits == 0:  # counts: whole-number ticks
+        from matplotlib.ticker import MaxNLocator
+
+        ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     for (key, _), v in zip(series, values, strict=True):  # one colour per species, as in the top view
         dashes = "--" if key.endswith("_max") else "-"
         for g in range(v.shape[1]):
