@@ -1,7 +1,15 @@
 """Speed of `fishgen school`: the simulation beside Mesa's boid flockers, a 10,000-fish run, the bake
 and the whole command, in one run.
 
-    python benchmarks/school.py [--repeat 3] [--quick]
+    python benchmarks/school.py [--repeat 3] [--quick] [--command-repeat 7]
+
+Issue 23: the whole command as a user runs it (a subprocess: start, imports, species, simulation,
+measures, bake, write) at 1,000 fish for 100 and for 600 frames, alternating, beside the
+simulation alone at the same sizes and Mesa's boid flockers at 1,000 agents in the same run. The
+target: the command's marginal cost per fish-frame, (T(600) - T(100)) / (1,000 x 500), is at most
+1/50 of Mesa's cost per agent-step; the same through `fishgen batch` (one [[school]] job, -j 1).
+Each stage's share of the 600-frame command is measured in a child process doing what the
+command does.
 
 Targets (issue 9, section 5): fishgen's boids at least 100x Mesa's fish-steps per second at 1,000
 fish; 10,000 fish x 1,000 frames simulated in under 20 s on a 2-core machine; 1,000 fish x 300
@@ -161,6 +169,136 @@ def command_run(count: int, repeat: int, folder: Path, frames: int | None) -> li
     return runs
 
 
+COMMAND_FISH = 1000
+COMMAND_FRAMES = (100, 600)
+
+
+def command_pair(count: int, frames: tuple[int, int], repeat: int, folder: Path) -> dict[int, list[float]]:
+    """`fishgen school` at both frame counts, alternating (so drift on a shared machine hits both)."""
+    runs: dict[int, list[float]] = {f: [] for f in frames}
+    for _ in range(repeat):
+        for f in frames:
+            runs[f] += command_run(count, 1, folder, f)
+    return runs
+
+
+def batch_pair(count: int, frames: tuple[int, int], repeat: int, folder: Path) -> dict[int, list[float]]:
+    """The same school as a `fishgen batch` job (-j 1: in the command's own process; --force: every
+    run builds it), at both frame counts, alternating."""
+    runs: dict[int, list[float]] = {f: [] for f in frames}
+    for f in frames:
+        (folder / f"school{f}.toml").write_text(
+            f'out = "out{f}"\n\n[[school]]\ninput = "{SPECIES.as_posix()}"\noutput = "school.glb"\n'
+            f"count = {count}\nframes = {f}\nseed = 1\n", encoding="utf-8")
+    for _ in range(repeat):
+        for f in frames:
+            cmd = [sys.executable, "-m", "fishgen", "batch", str(folder / f"school{f}.toml"), "-j", "1",
+                   "--force", "--quiet"]
+            start = time.perf_counter()
+            proc = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=ROOT)
+            runs[f].append(time.perf_counter() - start)
+            if proc.returncode != 0:
+                raise SystemExit(f"failed: {' '.join(cmd)}\n{proc.stderr.decode()}")
+    return runs
+
+
+def simulation_pair(count: int, frames: tuple[int, int], repeat: int) -> dict[int, list[float]]:
+    """The simulation alone, as `fishgen school` sets it up (BonyBream's brain and length), in process."""
+    from fishgen.school.run import plan_school
+    from fishgen.school.scene_file import SceneFile, SpeciesEntry
+    from fishgen.school.simulate import simulate
+
+    runs: dict[int, list[float]] = {f: [] for f in frames}
+    configs = {f: plan_school(SceneFile(species=(SpeciesEntry(SPECIES, count),), frames=f, seed=1),
+                              swim="fins")[0] for f in frames}
+    for _ in range(repeat):
+        for f in frames:
+            start = time.perf_counter()
+            simulate(configs[f])
+            runs[f].append(time.perf_counter() - start)
+    return runs
+
+
+STAGES_CODE = """
+import sys, time, json
+start = time.perf_counter()
+from pathlib import Path
+sys.path[:0] = [{root!r}]
+from fishgen.school.run import plan_school, warmup_frames, EXTRAS_KEY
+from fishgen.school.scene_file import SceneFile, SpeciesEntry
+from fishgen.school.simulate import simulate
+from fishgen.school.bake import bake
+from fishgen.exchange import export
+from fishgen.school.metrics import PRINTED, measures, summary_table, format_table
+import numpy as np
+marks = {{"start and imports": time.perf_counter()}}
+scene = SceneFile(species=(SpeciesEntry(Path({species!r}), {count}),), frames={frames}, seed=1)
+config, fishes = plan_school(scene)
+marks["species built"] = time.perf_counter()
+tracks = simulate(config)
+marks["simulation"] = time.perf_counter()
+warm = warmup_frames(config.frames, config.fps)
+per_frame = measures(tracks, [g.body_length for g in config.groups], start=warm, only=PRINTED)
+table = format_table(summary_table(per_frame, warm, ["bonybream"]), "")
+marks["measures and summary"] = time.perf_counter()
+lengths = np.array([config.groups[g].body_length for g in tracks.group]) * tracks.scale
+school = bake(fishes, tracks, body_lengths=lengths, seed=1)
+marks["bake"] = time.perf_counter()
+export(school, Path({out!r}))
+marks["glb written"] = time.perf_counter()
+print(json.dumps({{"start": start, "marks": marks}}))
+"""
+
+
+def stages(count: int, frames: int, folder: Path) -> list[tuple[str, float]]:
+    """Seconds of each stage of a school's whole run, in a child process doing what the command does
+    (the interpreter's own start-up is not counted: the command's wall time holds it)."""
+    code = STAGES_CODE.format(root=str(ROOT), species=str(SPECIES), count=count, frames=frames,
+                              out=str(folder / "stages.glb"))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, cwd=ROOT)
+    if proc.returncode != 0:
+        raise SystemExit(f"failed: stages\n{proc.stderr.decode()}")
+    import json
+
+    data = json.loads(proc.stdout.decode().splitlines()[-1])
+    last, out = data["start"], []
+    for name, when in data["marks"].items():
+        out.append((name, when - last))
+        last = when
+    return out
+
+
+def big_school_measures(count: int, frames: int) -> str:
+    """Polarization, groups and overlaps of a default BonyBream school of `count` fish after its
+    warm-up, as `fishgen school` would print them (a child process, as big_run)."""
+    code = (f"import sys; sys.path[:0] = [{str(ROOT)!r}]\n"
+            "from pathlib import Path\n"
+            "from fishgen.school.run import plan_school, warmup_frames\n"
+            "from fishgen.school.scene_file import SceneFile, SpeciesEntry\n"
+            "from fishgen.school.simulate import simulate\n"
+            "from fishgen.school.metrics import measures, summary\n"
+            f"scene = SceneFile(species=(SpeciesEntry(Path({str(SPECIES)!r}), {count}),), frames={frames})\n"
+            "config, _ = plan_school(scene, swim='fins')\n"
+            "tracks = simulate(config)\n"
+            "warm = warmup_frames(config.frames, config.fps)\n"
+            "s = summary(measures(tracks, [config.groups[0].body_length], start=warm,\n"
+            "            only=('polarization', 'groups', 'overlaps', 'nearest_neighbour')), warm)\n"
+            "p, least = s['polarization'][0], s['polarization_least'][0]\n"
+            "print(f'polarization mean {p:.2f} least {least:.2f}, groups at most {s[\"groups_peak\"][0]:.0f}, '\n"
+            "      f'overlapping pairs at most {s[\"overlaps_peak\"]:.0f}, '\n"
+            "      f'nearest neighbour {s[\"nearest_neighbour\"]:.2f} body lengths')\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, cwd=ROOT)
+    if proc.returncode != 0:
+        raise SystemExit(f"failed: {count}-fish measures\n{proc.stderr.decode()}")
+    return proc.stdout.decode().strip()
+
+
+def marginal(runs: dict[int, list[float]], count: int) -> float:
+    """Seconds per fish-frame between the two frame counts, by medians."""
+    (f0, r0), (f1, r1) = sorted(runs.items())
+    return (statistics.median(r1) - statistics.median(r0)) / (count * (f1 - f0))
+
+
 def verdict(ok: bool) -> str:
     return "met" if ok else "NOT met"
 
@@ -169,14 +307,19 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--quick", action="store_true", help="smoke run: small sizes, under 20 s")
+    parser.add_argument("--command-repeat", type=int, default=7,
+                        help="runs of each whole command (and batch) per frame count  [default: 7]")
     args = parser.parse_args()
     repeat = max(1, args.repeat)
     if args.quick:
         sizes = ((100, 60, 20), (1000, 30, 3))          # (fish, fishgen frames, Mesa steps)
         big, baked, command, command_frames = (1000, 100), (100, 60), 20, 30
+        whole_fish, whole_frames = 200, (20, 60)
     else:
         sizes = ((100, 300, 100), (1000, 300, 20), (10000, 100, 3))
         big, baked, command, command_frames = (10000, 1000), (1000, 300), 200, None
+        whole_fish, whole_frames = COMMAND_FISH, COMMAND_FRAMES
+    command_repeat = max(1, args.command_repeat if not args.quick else 1)
 
     import numpy
     import scipy
@@ -215,16 +358,26 @@ def main() -> None:
             ratio_at[(count, space)] = rates["boids"] / mrate
             row(name, count, steps, mruns, mrate, f"{rates['boids'] / mrate:,.0f}x")
 
+    mesa_step = None      # Mesa's seconds per agent-step at 1,000 agents in the issue's space
+    if BoidFlockers is not None and not args.quick:
+        mruns = time_mesa(BoidFlockers, 1000, 20, repeat, mesa_width(1000, "issue"))
+        mesa_step = None if mruns is None else statistics.median(mruns) / (1000 * 20)
     sim_s, wall_s, peak = big_run(*big)
+    big_numbers = big_school_measures(big[0], 300 if not args.quick else 60)
     with tempfile.TemporaryDirectory(prefix="fishgen-bench-") as tmp:
         folder = Path(tmp)
         bake_s, glb_s, write_s, size = bake_run(*baked, repeat, folder, swim="fins")
         wave_bake_s, wave_glb_s, wave_write_s, wave_size = bake_run(*baked, repeat, folder, swim="body")
         cmd_runs = command_run(command, repeat, folder, command_frames)
+        whole = command_pair(whole_fish, whole_frames, command_repeat, folder)
+        batched = batch_pair(whole_fish, whole_frames, command_repeat, folder)
+        alone = simulation_pair(whole_fish, whole_frames, command_repeat)
+        shares = stages(whole_fish, whole_frames[1], folder)
 
     print()
     print(f"{big[0]:,} fish x {big[1]:,} frames (boids, child process): simulate {sim_s:.2f} s, "
           f"process {wall_s:.2f} s, peak RSS {peak:,.0f} MiB")
+    print(f"{big[0]:,} BonyBream, default school of 300 frames, after the warm-up: {big_numbers}")
     for label, times, nbytes in (("with fins, rigid bodies", (bake_s, glb_s, write_s), size),
                                  ("with body wave and fins", (wave_bake_s, wave_glb_s, wave_write_s), wave_size)):
         print(f"bake {baked[0]:,} fish x {baked[1]:,} frames {label} (median of {repeat}): "
@@ -233,6 +386,24 @@ def main() -> None:
     frames_note = "" if command_frames is None else f" --frames {command_frames}"
     print(f"fishgen school params/bonybream.txt --count {command}{frames_note}: median "
           f"{statistics.median(cmd_runs):.2f} s, min {min(cmd_runs):.2f} s ({len(cmd_runs)} runs)")
+
+    print()
+    print(f"whole command, {whole_fish:,} BonyBream (medians of {command_repeat} runs, the two sizes "
+          "alternating; marginal cost between them):")
+    print(f"{'':34} " + "  ".join(f"{f:>5} frames" for f in whole_frames)
+          + "   per fish-frame    fish-frames/s")
+    cost = {}
+    for name, runs in (("fishgen school (subprocess)", whole), ("fishgen batch -j 1 (subprocess)", batched),
+                       ("simulation alone (in process)", alone)):
+        cost[name] = marginal(runs, whole_fish)
+        cells = "  ".join(f"{statistics.median(runs[f]):6.2f} s  " for f in whole_frames)
+        print(f"  {name:32} {cells} {cost[name] * 1e6:8.3f} us   {1 / cost[name]:14,.0f}")
+    total = sum(sec for _, sec in shares)
+    print(f"  stages of {whole_fish:,} x {whole_frames[1]} in one child process ({total:.2f} s): "
+          + ", ".join(f"{name} {sec:.2f} s ({sec / total:.0%})" for name, sec in shares))
+    if mesa_step is not None:
+        print(f"  Mesa boid flockers, 1,000 agents, space 100: {mesa_step * 1e6:.1f} us per agent-step "
+              f"({1 / mesa_step:,.0f} agent-steps/s)")
 
     print()
     print("targets (issue 9)" + (" -- --quick sizes, not the targets' sizes" if args.quick else ""))
@@ -254,6 +425,20 @@ def main() -> None:
     print("targets (issue 10)")
     print(f"  bake {baked[0]:,} x {baked[1]:,} with body wave and fins under 1.5 s: {wave_total:.3f} s  "
           f"{verdict(wave_total < 1.5)}; under 15 MB: {wave_size / 1e6:.2f} MB  {verdict(wave_size < 15e6)}")
+    print("targets (issue 23)")
+    if mesa_step is None:
+        print("  whole command >= 50x Mesa per fish-frame: not measured (" +
+              ("--quick)" if args.quick else "mesa not installed or skipped)"))
+    else:
+        for name in ("fishgen school (subprocess)", "fishgen batch -j 1 (subprocess)"):
+            ratio = mesa_step / cost[name]
+            print(f"  {name}: marginal cost per fish-frame {ratio:,.0f}x Mesa's per agent-step "
+                  f"(target 50x)  {verdict(ratio >= 50)}")
+        print(f"  (the simulation alone: {mesa_step / cost['simulation alone (in process)']:,.0f}x)")
+    sim_share = dict(shares).get("simulation", 0.0)
+    measure_share = dict(shares).get("measures and summary", 0.0)
+    print(f"  per-frame measures cost less than the simulation: {measure_share:.2f} s vs {sim_share:.2f} s  "
+          f"{verdict(measure_share < sim_share)}")
 
 
 if __name__ == "__main__":

@@ -67,6 +67,7 @@ class _Buffer:
         self.length = 0
         # Identical arrays are stored once: a school's fish share fin keys and key times.
         self._known: dict[tuple, int] = {}
+        self._objects: dict[tuple, tuple[np.ndarray, int]] = {}
 
     def view(self, payload: bytes | memoryview, target: int | None = None, stride: int | None = None) -> int:
         pad = -self.length % 4
@@ -84,11 +85,17 @@ class _Buffer:
 
     def accessor(self, array: np.ndarray, *, target: int | None = None, bounds: bool = False,
                  normalized: bool = False, mat4: bool = False) -> int:
+        # A big array passed again as the same object (a school's colour variants of one mesh) is
+        # stored once too; the object is kept alive so that its id cannot be reused.
+        same_object = (id(array), target, bounds, normalized, mat4)
+        if same_object in self._objects:
+            return self._objects[same_object][1]
+        given = array
         array = np.ascontiguousarray(array)
         if array.dtype == np.float64:
             array = array.astype(np.float32)
         identity: tuple | None = None
-        if array.nbytes <= SHARED_ARRAY_BYTES:  # big arrays are never repeated; don't copy them to look
+        if array.nbytes <= SHARED_ARRAY_BYTES:  # big arrays are rarely repeated; don't copy them to look
             identity = (array.dtype.str, array.shape, target, bounds, normalized, mat4, array.tobytes())
             if identity in self._known:
                 return self._known[identity]
@@ -113,6 +120,8 @@ class _Buffer:
                                    count=len(array), type=_TYPE[width], max=big, min=small))
         if identity is not None:
             self._known[identity] = len(self.accessors) - 1
+        else:
+            self._objects[same_object] = (given, len(self.accessors) - 1)
         return len(self.accessors) - 1
 
 

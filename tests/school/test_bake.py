@@ -76,3 +76,39 @@ def test_keys_are_thinned_and_fins_beat_out_of_step(fish):
 def test_same_seed_same_bytes(fish):
     one, two = (glb_bytes(bake(fish, circling(), seed=3)) for _ in range(2))
     assert one == two and glb_bytes(bake(fish, circling(), seed=4)) != one
+
+
+def test_colour_variants_share_geometry_and_differ_only_in_material(fish, tmp_path):
+    tracks = circling(count=24)
+    plain, tinted = bake(fish, tracks, seed=3), bake(fish, tracks, seed=3, tints=4, tint=0.3)
+    assert glb_bytes(bake(fish, tracks, seed=3, tints=1)) == glb_bytes(plain)       # off: the same file
+    assert len(tinted.meshes) == 4 * len(plain.meshes) and len(tinted.materials) == 4 * len(plain.materials)
+    base_meshes = len(plain.meshes)
+    for mesh in tinted.meshes[base_meshes:]:           # each variant: a base mesh's very arrays
+        (source,) = [m for m in tinted.meshes[:base_meshes]
+                     if m.primitives[0].attributes["POSITION"] is mesh.primitives[0].attributes["POSITION"]]
+        assert mesh.name.startswith(source.name + "_tint")
+        for prim, original in zip(mesh.primitives, source.primitives, strict=True):
+            assert all(prim.attributes[a] is original.attributes[a] for a in original.attributes)
+            assert prim.indices is original.indices and prim.targets is original.targets
+            material, first = tinted.materials[prim.material], tinted.materials[original.material]
+            assert material.texture == first.texture and material.alpha_mode == first.alpha_mode
+            factor = np.array(material.base_color[:3]) / np.array(first.base_color[:3])
+            assert np.all((factor >= 0.7 - 1e-9) & (factor <= 1.0))
+            assert material.base_color[3] == first.base_color[3]
+    worn = {scene_mesh for r in tinted.roots for c in tinted.nodes[r].children
+            if (scene_mesh := tinted.nodes[c].mesh) is not None}
+    assert len(worn) > 2 * base_meshes                  # the 24 fish wear several variants
+    path = tmp_path / "tinted.glb"
+    path.write_bytes(glb_bytes(tinted))
+    assert_valid_gltf(path)
+    doc = read_gltf(path)
+    # the file stores the geometry once: its accessors are those of the plain file plus none
+    plain_path = tmp_path / "plain.glb"
+    plain_path.write_bytes(glb_bytes(plain))
+    import pygltflib
+    counts = [len(pygltflib.GLTF2().load(str(p)).accessors) for p in (plain_path, path)]
+    assert counts[0] == counts[1] and len(doc.meshes) == 4 * base_meshes
+    # tinting draws from its own generator: every key of the plain file is in the tinted one
+    assert [c.sampler.values.tobytes() for c in plain.clip("school").channels] == \
+           [c.sampler.values.tobytes() for c in tinted.clip("school").channels]

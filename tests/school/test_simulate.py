@@ -4,10 +4,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from fishgen.school.behaviour import BEHAVIOURS, behaviour
 from fishgen.school.metrics import measures, nose_directions, summary
-from fishgen.school.model import Brain, Group, PsoParams, SchoolConfig, TargetPath
+from fishgen.school.model import MODELS, Brain, Group, PsoParams, SchoolConfig, TargetPath
 from fishgen.school.paths import path_positions
 from fishgen.school.simulate import headings_from_velocities, simulate
+from fishgen.school.state import SchoolState
 
 L = 0.2
 
@@ -18,7 +20,7 @@ def _cfg(**kw) -> SchoolConfig:
     return SchoolConfig(**base)
 
 
-@pytest.mark.parametrize("model", ["boids", "pso"])
+@pytest.mark.parametrize("model", MODELS)
 def test_same_seed_same_tracks_other_seed_other_tracks(model):
     a = simulate(_cfg(model=model, seed=3))
     b = simulate(_cfg(model=model, seed=3))
@@ -28,8 +30,8 @@ def test_same_seed_same_tracks_other_seed_other_tracks(model):
     assert not np.allclose(a.positions, c.positions)
 
 
-@pytest.mark.parametrize("model", ["boids", "pso"])
-@pytest.mark.parametrize("layout", ["sphere", "box", "line"])
+@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("layout", ["sphere", "box", "line", "ring"])
 def test_tracks_finite_shaped_and_inside_bounds(model, layout):
     bounds = ((-2.0, -1.0, -2.0), (2.0, 1.0, 2.0))
     cfg = _cfg(model=model, layout=layout, bounds=bounds, frames=150,
@@ -147,3 +149,44 @@ def test_headings_agree_with_yaw_then_pitch_angles_at_the_awkward_directions():
     same = np.minimum(np.abs(q - expected).max(axis=1), np.abs(q + expected).max(axis=1))
     assert same.max() < 1e-12
     assert np.allclose(np.linalg.norm(q, axis=1), 1.0)
+
+
+def test_every_model_is_a_module_of_its_own_behind_one_interface():
+    assert tuple(BEHAVIOURS) == MODELS
+    modules = {where.split(":")[0] for where in BEHAVIOURS.values()}
+    assert len(modules) == len(MODELS)
+    for model in MODELS:
+        config = _cfg(model=model, frames=2)
+        state = SchoolState.start(config)
+        chosen = behaviour(config, state)
+        assert type(chosen).__module__ == BEHAVIOURS[model].split(":")[0]
+        assert chosen.neighbours >= 1 and callable(chosen.want)
+    with pytest.raises(ValueError):
+        behaviour(_cfg(model="vicsek"), SchoolState.start(_cfg()))
+
+
+def test_the_simulation_logs_the_lists_it_used():
+    small = simulate(_cfg(frames=30))                       # below 300 fish: rebuilt every frame
+    assert small.neighbours.starts == list(range(30))
+    big = simulate(_cfg(groups=(Group("a", 320, L),), frames=40, bounds=((-4, -1, -4), (4, 1, 4))))
+    assert big.neighbours.starts == [0, 15, 30]            # half a second apart at 30 fps
+    mates = big.neighbours.mates[1]
+    assert mates.shape == (7, 320) and mates.dtype == np.int16 and (mates >= 0).all()
+    # nearest first, from where the fish were when the list was built (the step to frame 15 starts
+    # from frame 14)
+    pos = big.positions[14]
+    d = np.linalg.norm(pos[mates] - pos[None], axis=2)
+    assert np.all(np.diff(d, axis=0) >= -1e-12)
+
+
+def test_a_ring_layout_starts_each_species_milling_round_its_own_ring():
+    cfg = _cfg(layout="ring", frames=2, groups=(Group("a", 60, L), Group("b", 40, 0.3)),
+               bounds=((-4, -1, -4), (4, 1, 4)))
+    tr = simulate(cfg)
+    m = measures(tr, [L, 0.3], only=("rotation", "polarization"))
+    assert np.all(m["rotation"][0] > 0.9) and np.all(m["polarization"][0] < 0.3)
+    for g in (0, 1):   # a horizontal ring: flat, and hollow
+        pos = tr.positions[0, tr.group == g]
+        out = pos - pos.mean(axis=0)
+        assert np.ptp(out[:, 1]) < 0.6 * np.ptp(out[:, 0])
+        assert np.linalg.norm(out[:, [0, 2]], axis=1).min() > 0.3 * np.linalg.norm(out[:, [0, 2]], axis=1).max()
