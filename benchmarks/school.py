@@ -233,7 +233,7 @@ from fishgen.school.metrics import PRINTED, measures, summary_table, format_tabl
 import numpy as np
 marks = {{"start and imports": time.perf_counter()}}
 scene = SceneFile(species=(SpeciesEntry(Path({species!r}), {count}),), frames={frames}, seed=1)
-config, fishes = plan_school(scene)
+config, fishes, _ = plan_school(scene)
 marks["species built"] = time.perf_counter()
 tracks = simulate(config)
 marks["simulation"] = time.perf_counter()
@@ -278,7 +278,7 @@ def big_school_measures(count: int, frames: int) -> str:
             "from fishgen.school.simulate import simulate\n"
             "from fishgen.school.metrics import measures, summary\n"
             f"scene = SceneFile(species=(SpeciesEntry(Path({str(SPECIES)!r}), {count}),), frames={frames})\n"
-            "config, _ = plan_school(scene, swim='fins')\n"
+            "config, _, _ = plan_school(scene, swim='fins')\n"
             "tracks = simulate(config)\n"
             "warm = warmup_frames(config.frames, config.fps)\n"
             "s = summary(measures(tracks, [config.groups[0].body_length], start=warm,\n"

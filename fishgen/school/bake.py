@@ -128,7 +128,7 @@ def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, 
     the species whose meshes carry the wave targets. ``tints`` colour variants per species
     (:class:`fishgen.school.model.Variety`; 1: the species' own colours only, and the file is
     what it was before variants existed), each channel of a variant's colour 1 - ``tint`` to 1."""
-    school = Scene(name="school", info={"kind": "school", "fish": int(len(tracks.group))})
+    school = Scene(name="school")
     templates = [merge_species(school, fish) for fish in fish_scenes]
     variants = _tint_variants(school, templates, tints, tint, seed)
     # which variant each fish wears: its own generator, so that the phases below stay as they were

@@ -15,7 +15,7 @@ from tests.conftest import PARAMS
 def after_warmup(*entries: tuple[str, int], seed: int = 0) -> dict:
     scene = SceneFile(species=tuple(SpeciesEntry(PARAMS / f"{name}.txt", count) for name, count in entries),
                       seed=seed)
-    config, _ = plan_school(scene, swim="fins")
+    config, _, _ = plan_school(scene, swim="fins")
     tracks = simulate(config)
     warm = warmup_frames(config.frames, config.fps)
     return summary(measures(tracks, [g.body_length for g in config.groups], start=warm), warm)
