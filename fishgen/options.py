@@ -284,7 +284,7 @@ def _toml_kind_ok(spec: Option, value: Any) -> bool:
         return isinstance(value, numbers.Integral)
     if isinstance(t, click.FloatRange) or t is click.FLOAT:
         return isinstance(value, numbers.Real)
-    if isinstance(t, Triple):
+    if isinstance(t, Triple) or getattr(t, "toml_list", False):  # a TOML array where numbers are declared
         return isinstance(value, list)
     return isinstance(value, str)
 

@@ -10,7 +10,21 @@ from typing import Any
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
 from fishgen.exchange.registry import MESHES, NODE_ANIMATION
 from fishgen.options import FILE, FiniteRange, declare, fins_option, option, swim_option, textures_option
-from fishgen.school.scene_file import COUNT, FPS, FRAMES, MODEL, SEED_KEY
+from fishgen.school.scene_file import (
+    BOUNDS,
+    COUNT,
+    FPS,
+    FRAMES,
+    LENGTH,
+    MODEL,
+    PRESET,
+    SEED_KEY,
+    SIZE_VARIETY,
+    SPEED,
+    TINT,
+    TINTS,
+    WARMUP,
+)
 
 SIDE_OUTPUTS = {"tracks": (".csv", ".npz"), "metrics": (".json",), "plot": (".png",)}
 
@@ -26,6 +40,16 @@ class SchoolOptions:
                                shown_default="the scene file's, else 0; in a batch, derived from the "
                                              "output's name")
     model: str | None = declare(MODEL, default=None, shown_default=f"the scene file's, else {MODEL.default}")
+    preset: str | None = declare(PRESET)
+    speed: float | None = declare(SPEED, default=None,
+                                  shown_default=f"the scene file's, else {SPEED.default:g}")
+    length: float | None = declare(LENGTH)
+    bounds: Any = declare(BOUNDS, shown_default=f"the scene file's, else {BOUNDS.shown_default}")
+    warmup: float | None = declare(WARMUP, shown_default=f"the scene file's, else {WARMUP.shown_default}")
+    size_variety: float | None = declare(SIZE_VARIETY, default=None,
+                                         shown_default=f"the scene file's, else {SIZE_VARIETY.default:g}")
+    tints: int | None = declare(TINTS, default=None, shown_default=f"the scene file's, else {TINTS.default}")
+    tint: float | None = declare(TINT, default=None, shown_default=f"the scene file's, else {TINT.default:g}")
     tolerance: float = option(FiniteRange(0, 1),
                               "How far thinned keyframes may stray from the simulated path.",
                               0.002, metavar="METRES")
@@ -107,9 +131,14 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         scene = load_scene_file(scene_files[0])
     else:
         scene = SceneFile(species=tuple(SpeciesEntry(p) for p in inputs))
+    if options.preset is not None and options.model not in (None, "couzin"):
+        raise UsageError(f"expected --preset with the couzin model, found --model {options.model}")
+    variety = {key: value for key, value in (("size", options.size_variety), ("tints", options.tints),
+                                             ("tint", options.tint)) if value is not None}
     scene = with_options(scene, count=options.count, frames=options.frames, fps=options.fps,
-                         seed=options.seed,
-                         model=options.model)
+                         seed=options.seed, model=options.model, speed=options.speed, bounds=options.bounds,
+                         length=options.length, warmup=options.warmup, preset=options.preset,
+                         variety=variety)
     check_size(scene)  # before anything is built
     species_files = [e.file for e in scene.species]
     check_targets([output, *sides.values()], [*inputs, *species_files, *scene.read])
@@ -119,18 +148,17 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     with events.progress("simulating", scene.frames) as bar:
         run = run_school(scene, fins=options.fins, swim=options.swim, tolerance=options.tolerance,
                          textures_dir=options.textures, progress=bar.update)
-    warmup = min(scene.frames // 3, int(3 * scene.fps))
+    warmup = run.warmup_frames
     per_frame: dict = {}
     numbers: dict = {}
     table = ""
-    measured = events.summary or "metrics" in sides or "plot" in sides  # else nobody reads the measures
-    if measured:
-        from fishgen.school.metrics import format_table, measures, summary, summary_table
+    if "metrics" in sides or "plot" in sides:
+        from fishgen.school.metrics import summary
 
-        per_frame = measures(run.tracks, run.group_lengths)
+        per_frame = run.measures(every_frame=True)
         numbers = summary(per_frame, warmup)
-        table = format_table(summary_table(per_frame, warmup, run.species_names),
-                             f"after {warmup / scene.fps:.1f} s warm-up")
+    if events.summary:  # else nobody reads the table: only what it prints is measured
+        table = run.summary(per_frame or None)
     files = _write_all(output, run, sides, per_frame, numbers, warmup)
     size = sum(p.stat().st_size for p in files if p not in sides.values())
     kinds_line = ", ".join(f"{e.count} {Path(e.file).stem}" for e in scene.species)
@@ -139,7 +167,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     facts = SchoolFacts(tuple((Path(e.file).stem, e.count) for e in scene.species), scene.frames, scene.fps,
                         scene.model, size, warmup, table)
     read = tuple(dict.fromkeys([*inputs, *scene.read, *run.read]))
-    return Made(tuple(files), read, (line, table) if measured else (line,), facts)
+    return Made(tuple(files), read, (line, table) if table else (line,), facts)
 
 
 def _write_all(output: Path, run, sides: dict[str, Path], per_frame: dict, numbers: dict,

@@ -15,6 +15,9 @@ MODELS: tuple[Model, ...] = ("boids", "pso", "couzin")
 Layout = Literal["sphere", "box", "line", "ring"]
 LAYOUTS: tuple[Layout, ...] = ("sphere", "box", "line", "ring")
 PathKind = Literal["circle", "figure8", "spline", "points", "none"]
+WARMUP_SECONDS = 3.0
+WARMUP_SHARE = 1 / 3
+"""Without a warm-up given, the school forms in the first third of the run, at most 3 s."""
 
 
 @dataclass(frozen=True)

@@ -10,13 +10,20 @@ from typing import Any
 import numpy as np
 
 from fishgen.scene.model import Scene
-from fishgen.school.model import Brain, CouzinParams, Group, SchoolConfig, Tracks, Variety
+from fishgen.school.model import (
+    WARMUP_SECONDS,
+    WARMUP_SHARE,
+    Brain,
+    CouzinParams,
+    Group,
+    SchoolConfig,
+    Tracks,
+    Variety,
+)
 from fishgen.school.scene_file import SceneFile
 
 DEFAULT_BOUNDS_BODY_LENGTHS = 4.0
 """Without bounds in the scene file, the region is this many body lengths per cube-root of the count."""
-WARMUP_SECONDS = 3.0
-WARMUP_SHARE = 1 / 3
 EXTRAS_KEY = "fishgen_school"
 """The member of a school file's glTF scene extras that records the run: {"warmup": seconds,
 "model": name, "fps": frames per second, "frames": count}."""
@@ -96,6 +103,7 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
 
     variety = _given(variety, scene_file, "variety", Variety())
     warmup = _given(warmup, scene_file, "warmup", None)
+    length = _given(length, scene_file, "length", None)
     config, fishes, read = plan_school(scene_file, fins=fins, swim=swim, textures_dir=textures_dir,
                                        couzin=couzin, variety=variety, length=length)
     tracks = simulate(config, progress=progress)
@@ -120,6 +128,7 @@ def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "
 
     couzin = _given(couzin, scene_file, "couzin", CouzinParams())
     variety = _given(variety, scene_file, "variety", Variety())
+    length = _given(length, scene_file, "length", None)
     fishes, groups = [], []
     read: list[Path] = []
     for entry in scene_file.species:

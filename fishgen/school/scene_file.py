@@ -23,6 +23,18 @@
     [pso]                      # the particle swarm's weights (2017 report, Figure 2.2)
     inertia = 0.7
 
+    [couzin]                   # Couzin et al. (2002): a preset, and any zone overriding it
+    preset = "torus"           # swarm | torus | dynamic parallel | highly parallel
+    orientation = 1.0          # body lengths; also repulsion, attraction, blind_angle, ...
+
+    [variety]                  # VRSchool's per-fish variety
+    size = 0.05                # s.d. of each fish's size factor
+    tints = 3                  # colour variants per species (1: its own colours only)
+    tint = 0.15
+
+    warmup = 3.0               # seconds the school takes to form (the summary skips them)
+    length = 0.3               # every species' nose-to-tail length, metres
+
 Every mistake is one ``FILE:LINE: expected ..., found ...`` line; absurd sizes are refused
 before anything is allocated. The keys that are also `fishgen school` options (frames, fps, seed,
 model, a species' count) are declared once, here, and checked exactly as the options are.
@@ -40,7 +52,20 @@ import click
 
 from fishgen.errors import FishgenError, describe
 from fishgen.options import SEED, FiniteRange, Option, check_value
-from fishgen.school.model import MODELS, PsoParams, TargetPath
+from fishgen.school.model import (
+    COUZIN_PRESETS,
+    COUZIN_RANGES,
+    LAYOUTS,
+    MODELS,
+    VARIETY_HELP,
+    VARIETY_RANGES,
+    WARMUP_SECONDS,
+    CouzinParams,
+    PsoParams,
+    TargetPath,
+    Variety,
+    couzin_params,
+)
 from fishgen.tomlfile import Where as _Where
 from fishgen.tomlfile import loads as _loads
 
@@ -49,7 +74,6 @@ MAX_FRAMES = 100_000
 MAX_FISH_FRAMES = 2 * 10**8
 """Fish x frames: 10,000 fish x 1,000 frames is 10^7 (about 1 GB of tracks at 2 x 10^8)."""
 MAX_SCENE_BYTES = 1 << 20
-LAYOUTS = ("sphere", "box", "line")
 PATHS = ("circle", "figure8", "spline", "none")
 DEFAULT_COUNT = 50
 MAX_COORDINATE = 1e4
@@ -62,9 +86,54 @@ COUNT = Option(click.IntRange(1, MAX_FISH), "Fish per species.", DEFAULT_COUNT)
 FRAMES = Option(click.IntRange(2, MAX_FRAMES), "Frames to simulate and bake.", 300)
 FPS = Option(FiniteRange(1, 1000), "Frames per second.", 30.0)
 SEED_KEY = Option(SEED, "Random seed; the same seed gives byte-identical files.", 0)
-MODEL = Option(click.Choice(MODELS), "boids: VRFish's brain (thesis 7.2); pso: the particle swarm following "
-               "a target (2017 report).", "boids")
+MODEL = Option(click.Choice(MODELS), "boids: VRFish's brain (thesis 7.2), steering also by the school's "
+               "heading; pso: the particle swarm following a target (2017 report); couzin: Couzin et al. "
+               "(2002)'s zones of repulsion, orientation and attraction (see --preset).", "boids")
 SPEED = Option(FiniteRange(0.05, 20), "Cruising speed, body lengths per second.", 1.0)
+
+
+class Box(click.ParamType):
+    """``X0,Y0,Z0,X1,Y1,Z1``: a box's min and max corners in metres, each side 0.1 m or more."""
+
+    name = "X0,Y0,Z0,X1,Y1,Z1"
+    toml_list = True  # a scene file's [[x0, y0, z0], [x1, y1, z1]]
+    what = (f"X0,Y0,Z0,X1,Y1,Z1: six numbers within {MAX_COORDINATE:g} m, whose max corner exceeds the min "
+            "by 0.1 m or more each way")
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, (tuple, list)):  # a scene file's [[x0, y0, z0], [x1, y1, z1]]
+            items = [v for corner in value for v in (corner if isinstance(corner, list) else [corner])]
+        else:
+            items = str(value).replace(" ", "").split(",")
+        try:
+            numbers = [float(v) for v in items if not isinstance(v, bool)]
+        except (TypeError, ValueError):
+            numbers = []
+        if (len(numbers) != 6 or len(items) != 6 or not all(math.isfinite(v) and abs(v) <= MAX_COORDINATE
+                                                            for v in numbers)
+                or not all(numbers[k + 3] - numbers[k] >= 0.1 for k in range(3))):
+            self.fail(f"expected {self.what}, found {value!r}", param, ctx)
+        lo, hi = tuple(numbers[:3]), tuple(numbers[3:])
+        return lo, hi
+
+
+BOUNDS = Option(Box(), "The region the fish keep inside, metres (min and max corners).", None,
+                shown_default="4 body lengths x the cube root of the count each way, a third as tall")
+LENGTH = Option(FiniteRange(0.01, 100), "Every species' nose-to-tail length, metres.", None,
+                shown_default="each species file's own", metavar="METRES")
+WARMUP = Option(FiniteRange(0, 1e4), "Seconds the school takes to form from its start layout; the summary "
+                "skips them, and `fishgen preview` of the file starts after them.", None,
+                shown_default=f"a third of the run, at most {WARMUP_SECONDS:g} s", metavar="SECONDS")
+PRESET = Option(click.Choice(tuple(COUZIN_PRESETS)),
+                "Couzin et al. (2002)'s collective state for the couzin model (sets --model couzin): "
+                + ", ".join(f"{name} (orientation zone {p.orientation:g} body lengths)"
+                            for name, p in COUZIN_PRESETS.items()) + ".", None,
+                shown_default="the scene file's [couzin], else zones of 1, 1 and 15 body lengths (torus)")
+SIZE_VARIETY = Option(FiniteRange(*VARIETY_RANGES["size"]), VARIETY_HELP["size"].capitalize() + ".",
+                      Variety.size)
+TINTS = Option(click.IntRange(*map(int, VARIETY_RANGES["tints"])), VARIETY_HELP["tints"].capitalize() + ".",
+               Variety.tints)
+TINT = Option(FiniteRange(*VARIETY_RANGES["tint"]), VARIETY_HELP["tint"].capitalize() + ".", Variety.tint)
 
 
 @dataclass(frozen=True)
@@ -88,17 +157,32 @@ class SceneFile:
     target: TargetPath = TargetPath()
     predator: TargetPath | None = None
     pso: PsoParams = PsoParams()
+    couzin: CouzinParams | None = None   # None: CouzinParams()
+    variety: Variety | None = None       # None: Variety()
+    warmup: float | None = None          # seconds; None: WARMUP_SHARE of the run, at most WARMUP_SECONDS
+    length: float | None = None          # metres, every species; None: each species file's own
     read: tuple[Path, ...] = ()      # the files it named and were read: path CSVs
 
 
 def with_options(scene: SceneFile, *, count: int | None = None, frames: int | None = None,
-                 fps: float | None = None, seed: int | None = None, model: str | None = None) -> SceneFile:
+                 fps: float | None = None, seed: int | None = None, model: str | None = None,
+                 speed: float | None = None, bounds: Any = None, length: float | None = None,
+                 warmup: float | None = None, preset: str | None = None,
+                 variety: dict[str, Any] | None = None) -> SceneFile:
     """``scene`` with the options given (not None) overriding it, as `fishgen school`'s flags do;
-    ``count`` sets every species' count."""
+    ``count`` and ``speed`` set every species'; ``preset`` a Couzin preset (and the couzin model
+    unless ``model`` says otherwise); ``variety`` the Variety fields given."""
     if count is not None:
         scene = replace(scene, species=tuple(replace(e, count=count) for e in scene.species))
+    if speed is not None:
+        scene = replace(scene, species=tuple(replace(e, speed=speed) for e in scene.species))
+    if preset is not None:
+        scene = replace(scene, couzin=COUZIN_PRESETS[preset], model=model or "couzin")
+    if variety:
+        scene = replace(scene, variety=replace(scene.variety or Variety(), **variety))
     given: dict[str, Any] = {name: value for name, value in
-                             (("frames", frames), ("fps", fps), ("seed", seed), ("model", model))
+                             (("frames", frames), ("fps", fps), ("seed", seed), ("model", model),
+                              ("bounds", bounds), ("length", length), ("warmup", warmup))
                              if value is not None}
     return replace(scene, **given)
 
@@ -209,6 +293,40 @@ def _csv_points(where: _Where, path: Path, table: str) -> tuple[tuple[float, flo
     return tuple((r[0], r[1], r[2], r[3]) for r in rows)
 
 
+def _couzin(where: _Where, table: Any) -> CouzinParams:
+    """[couzin]: ``preset`` (one of COUZIN_PRESETS) and any CouzinParams field overriding it."""
+    if not isinstance(table, dict):
+        raise where.fail("a [couzin] table", table, "couzin")
+    keys = ("preset", *COUZIN_RANGES)
+    values: dict[str, Any] = {}
+    preset = None
+    for key, value in table.items():
+        if key not in keys:
+            raise where.fail(f"one of {', '.join(keys)} in [couzin]", key, key, "couzin")
+        if key == "preset":
+            if value not in COUZIN_PRESETS:
+                raise where.fail(f"preset as one of {', '.join(COUZIN_PRESETS)}", value, key, "couzin")
+            preset = value
+        else:
+            whole = key in ("neighbours", "sampled")
+            number = _number(where, value, key, *COUZIN_RANGES[key], "couzin", whole=whole)
+            values[key] = int(number) if whole else float(number)
+    return couzin_params(preset, **values)
+
+
+def _variety(where: _Where, table: Any) -> Variety:
+    """[variety]: size, tints and tint, each checked as its option is."""
+    if not isinstance(table, dict):
+        raise where.fail("a [variety] table", table, "variety")
+    specs = {"size": SIZE_VARIETY, "tints": TINTS, "tint": TINT}
+    values = {}
+    for key, value in table.items():
+        if key not in specs:
+            raise where.fail(f"one of {', '.join(specs)} in [variety]", key, key, "variety")
+        values[key] = _declared(where, specs[key], value, key, "variety")
+    return replace(Variety(), **values)
+
+
 def load_scene_file(path: str | os.PathLike) -> SceneFile:
     """Read and check a school scene file."""
     path = Path(path)
@@ -223,26 +341,20 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
     text = path.read_bytes().decode("utf-8", errors="replace").removeprefix("\ufeff")
     data = _loads(text, file)
     where = _Where(text, file)
-    known = {"model", "frames", "fps", "seed", "bounds", "layout", "species", "target", "predator", "pso"}
+    known = {"model", "frames", "fps", "seed", "bounds", "layout", "species", "target", "predator", "pso",
+             "couzin", "variety", "warmup", "length"}
     for key in data:
         if key not in known:
             raise where.fail(f"one of {', '.join(sorted(known))}", key, key)
     scene = SceneFile()
-    for key, spec in (("model", MODEL), ("frames", FRAMES), ("fps", FPS), ("seed", SEED_KEY)):
+    for key, spec in (("model", MODEL), ("frames", FRAMES), ("fps", FPS), ("seed", SEED_KEY),
+                      ("warmup", WARMUP), ("length", LENGTH), ("bounds", BOUNDS)):
         if key in data:
             scene = replace(scene, **{key: _declared(where, spec, data[key], key)})
     if "layout" in data:
         if data["layout"] not in LAYOUTS:
             raise where.fail(f"layout as one of {', '.join(LAYOUTS)}", data["layout"], "layout")
         scene = replace(scene, layout=data["layout"])
-    if "bounds" in data:
-        b = data["bounds"]
-        if not (isinstance(b, list) and len(b) == 2):
-            raise where.fail("bounds as [[x0, y0, z0], [x1, y1, z1]]", b, "bounds")
-        lo, hi = _triple(where, b[0], "bounds"), _triple(where, b[1], "bounds")
-        if not all(top - bottom >= 0.1 for bottom, top in zip(lo, hi, strict=True)):
-            raise where.fail("bounds whose max corner exceeds the min by 0.1 m or more", b, "bounds")
-        scene = replace(scene, bounds=(lo, hi))
     entries = data.get("species", [])
     if not isinstance(entries, list) or not entries or not all(isinstance(e, dict) for e in entries):
         raise where.fail("one or more [[species]] tables", "none" if not entries else entries, "species")
@@ -276,6 +388,10 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
                 raise where.fail(f"one of {', '.join(sorted(names))} in [pso]", key, key, "pso")
             values[key] = float(_number(where, value, key, 0, 1e3, "pso"))
         scene = replace(scene, pso=replace(PsoParams(), **values))
+    if "couzin" in data:
+        scene = replace(scene, couzin=_couzin(where, data["couzin"]))
+    if "variety" in data:
+        scene = replace(scene, variety=_variety(where, data["variety"]))
     total = sum(e.count for e in scene.species)
     if total > MAX_FISH or total * scene.frames > MAX_FISH_FRAMES:
         raise where.fail(f"at most {MAX_FISH:,} fish and {MAX_FISH_FRAMES:,} fish x frames",

@@ -85,3 +85,43 @@ def test_metrics_are_strict_json_even_when_a_measure_has_no_value(tmp_path):
 
     doc = json.loads(out.read_text(), parse_constant=refuse)
     assert doc["summary"]["nearest_neighbour"] is None  # no neighbour: no distance, said as null
+
+
+def summary_row(stdout: str, name: str) -> tuple[float, float]:
+    """(mean, worst) of one row of the summary table."""
+    line = next(line for line in stdout.splitlines() if line.startswith(name))
+    mean, worst = line.split()[-2:]
+    return float(mean), float(worst)
+
+
+def test_the_shipped_bait_ball_mills_as_one_torus(tmp_path):
+    out = tmp_path / "ball.glb"
+    result = run_cli("school", PARAMS / "bait-ball.toml", "-o", out, "--frames", "180")
+    assert result.returncode == 0, result.stderr
+    assert "200 bonybream" in result.stdout and "couzin" in result.stdout
+    assert summary_row(result.stdout, "rotation")[0] > 0.8
+    assert summary_row(result.stdout, "polarization")[0] < 0.3
+    assert summary_row(result.stdout, "separate groups")[1] <= 2
+    assert_valid_gltf(out)
+    extras = pygltflib.GLTF2().load(str(out)).scenes[0].extras
+    assert extras["fishgen_school"]["model"] == "couzin" and extras["fishgen_school"]["warmup"] > 0
+
+
+def test_school_options_reach_the_run_as_the_scene_file_keys_do(tmp_path):
+    """--speed, --length, --bounds, --warmup, --preset and the variety options, on the command line."""
+    out = tmp_path / "s.glb"
+    result = run_cli("school", PARAMS / "bonybream.txt", "-o", out, "--count", "12", "--frames", "60",
+                     "--speed", "2", "--length", "0.5", "--bounds", "-3,-1,-3,3,1,3", "--warmup", "1",
+                     "--preset", "highly parallel", "--tints", "3", "--size-variety", "0")
+    assert result.returncode == 0, result.stderr
+    assert "couzin" in result.stdout.splitlines()[0] and "after 1.0 s warm-up" in result.stdout
+    assert_valid_gltf(out)
+    doc = pygltflib.GLTF2().load(str(out))
+    assert doc.scenes[0].extras["fishgen_school"]["warmup"] == 1.0
+    assert len(doc.meshes) == 9 * 3                                      # three tints of every part
+    scales = {tuple(doc.nodes[n].scale or (1, 1, 1)) for n in doc.scenes[0].nodes}
+    assert len(scales) == 1                                              # no size variety
+    refused = run_cli("school", PARAMS / "bonybream.txt", "-o", out, "--model", "pso", "--preset", "torus")
+    assert refused.returncode == 2 and "expected --preset with the couzin model" in refused.stderr
+    bad = run_cli("school", PARAMS / "bonybream.txt", "-o", out, "--bounds", "0,0,0,0,1,1")
+    assert bad.returncode == 2 and "X0,Y0,Z0,X1,Y1,Z1" in bad.stderr

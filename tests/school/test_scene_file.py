@@ -1,10 +1,13 @@
 """School scene files: every mistake is one FILE:LINE line; absurd sizes refused before allocating."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from fishgen.errors import FishgenError
-from fishgen.school.scene_file import load_scene_file
+from fishgen.school.model import COUZIN_PRESETS, Variety, couzin_params
+from fishgen.school.scene_file import SceneFile, SpeciesEntry, load_scene_file, with_options
 from tests.conftest import PARAMS
 
 
@@ -22,7 +25,7 @@ def test_the_shipped_reef_has_two_species_and_a_predator():
     ('[[species]]\nfile = "a.txt"\n[[species]]\nfile = "b.txt"\ncount = -1\n', 5, "count as a whole number"),
     ('[[species]]\nfile = "a.txt"\nspeed = nan\n', 3, "speed as a number from 0.05 to 20"),
     ('bounds = [[0, 0, 0], [0, 1, 1]]\n[[species]]\nfile = "a.txt"\n', 1, "max corner exceeds the min"),
-    ('fish = 3\n', 1, "one of bounds, fps, frames"),
+    ('fish = 3\n', 1, "one of bounds, couzin, fps, frames"),
     ('[[species]]\nfile = "a.txt"\n[target]\npath = "zigzag.csv"\n', 4, "an existing CSV file"),
     ('[[species]]\nfile = "a.txt"\n[pso]\ninertia = "high"\n', 4, "inertia as a number"),
     ('[[species]\nfile = "a.txt"\n', 1, "expected TOML"),
@@ -53,3 +56,33 @@ def test_a_csv_target_path(tmp_path):
     (tmp_path / "path.csv").write_text("0,0,0,0\n0,1,0,0\n")
     with pytest.raises(FishgenError, match=r"path.csv:2: expected increasing times"):
         load_scene_file(path)
+
+
+def test_couzin_variety_warmup_and_length_keys_are_read_and_checked(tmp_path):
+    (tmp_path / "a.txt").write_text("")
+    scene = tmp_path / "ball.toml"
+    scene.write_text('model = "couzin"\nwarmup = 2.5\nlength = 0.3\nbounds = [[-5, -2, -5], [5, 2, 5]]\n'
+                     '[[species]]\nfile = "a.txt"\n[couzin]\npreset = "torus"\nrepulsion = 0.75\n'
+                     'neighbours = 30\n[variety]\ntints = 3\nsize = 0\n')
+    loaded = load_scene_file(scene)
+    assert loaded.couzin == couzin_params("torus", repulsion=0.75, neighbours=30)
+    assert loaded.variety == Variety(size=0.0, tints=3)
+    assert (loaded.warmup, loaded.length) == (2.5, 0.3)
+    assert loaded.bounds == ((-5.0, -2.0, -5.0), (5.0, 2.0, 5.0))
+    for bad, expected in (('[couzin]\npreset = "mill"', "preset as one of swarm, torus"),
+                          ("[couzin]\nneighbours = 2.5", "neighbours as a whole number"),
+                          ("[variety]\ntints = 99", "tints as"),
+                          ("[variety]\nhue = 1", r"one of size, tints, tint in \[variety\]")):
+        scene.write_text(f'[[species]]\nfile = "a.txt"\n{bad}\n')
+        with pytest.raises(FishgenError, match=expected) as err:
+            load_scene_file(scene)
+        assert err.value.line == 4
+
+
+def test_options_override_the_scene_file_as_the_command_line_does():
+    scene = SceneFile(species=(SpeciesEntry(Path("a.txt")), SpeciesEntry(Path("b.txt"))))
+    changed = with_options(scene, speed=2.0, preset="swarm", variety={"tints": 4})
+    assert [e.speed for e in changed.species] == [2.0, 2.0]
+    assert changed.model == "couzin" and changed.couzin == COUZIN_PRESETS["swarm"]
+    assert changed.variety == Variety(tints=4)
+    assert with_options(scene, preset="torus", model="couzin").model == "couzin"
