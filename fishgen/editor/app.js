@@ -34,6 +34,7 @@ const state = window.fishgenEditor = {
 	previewBillboards: () => view.billboardMeshes(),
 	handlePoint: ( axis, along = 0.45 ) => handlePoint( axis, along ),
 	cubePoint: ( index ) => cubePoint( index ),
+	cubeColor: ( index ) => cubes.children[ index ] ? '#' + cubes.children[ index ].material.color.getHexString() : null,
 	select: ( index ) => select( index ),
 };
 
@@ -266,8 +267,9 @@ transform.addEventListener( 'objectChange', () => {
 	const step = snapping();
 	const round = ( v ) => step ? Math.round( v / step ) * step : Math.round( v * HANDLE_DIGITS ) / HANDLE_DIGITS;
 	const sized = ( v ) => Math.max( Math.abs( round( v ) ), step || MIN_SIZE );
-	c.centre = mesh.position.toArray().map( round );
-	c.size = mesh.scale.toArray().map( sized );
+	// only what the handle moved is rounded (or snapped): the other values stay exactly as they were
+	c.centre = mesh.position.toArray().map( ( v, k ) => v === c.centre[ k ] ? v : round( v ) );
+	c.size = mesh.scale.toArray().map( ( v, k ) => v === c.size[ k ] ? v : sized( v ) );
 	mesh.position.set( ...c.centre );
 	mesh.scale.set( ...c.size );
 	version ++;
@@ -675,9 +677,14 @@ function showFile() {
 }
 
 function showLists() {
-	$( 'file-list' ).replaceChildren( ...files.map( ( f ) => new Option( f ) ) );
+	$( 'file-list' ).replaceChildren( new Option( `${ files.length } cube file${ files.length === 1 ? '' : 's' }`, '' ),
+		...files.map( ( f ) => new Option( f, f ) ) );
 	showTextures();
 }
+
+$( 'file-list' ).addEventListener( 'change', () => {
+	if ( $( 'file-list' ).value ) $( 'file-name' ).value = $( 'file-list' ).value;
+} );
 
 // Everything that follows a change of the document.
 function changed() {
