@@ -36,6 +36,7 @@ const state = window.fishgenEditor = {
 	cubePoint: ( index ) => cubePoint( index ),
 	cubeColor: ( index ) => cubes.children[ index ] ? '#' + cubes.children[ index ].material.color.getHexString() : null,
 	select: ( index ) => select( index ),
+	drawMs: () => drawMs(),
 };
 
 const json = () => JSON.stringify( { mode: doc.mode, cubes: doc.cubes } );
@@ -97,6 +98,9 @@ scene.background = new THREE.Color( 0x7ea3c9 );
 const camera = new THREE.PerspectiveCamera( 40, 1, 0.05, 5000 );
 const orbit = new OrbitControls( camera, canvas );
 const grid = new THREE.GridHelper( 40, 40, 0x2c3e50, 0x56708c );
+// drawn first and writing no depth: the cloud covers the grid where it is, never cut by its plane
+Object.assign( grid.material, { transparent: true, opacity: 0.6, depthWrite: false } );
+grid.renderOrder = - 1;
 scene.add( grid );
 scene.add( new THREE.AxesHelper( 6 ) );
 const sunArrow = new THREE.ArrowHelper( new THREE.Vector3( 0, 1, 0 ), new THREE.Vector3(), 4, 0xffd54f, 0.8, 0.4 );
@@ -109,7 +113,7 @@ const QUAD = new THREE.PlaneGeometry( 1, 1 );
 const materials = {
 	cube: new THREE.MeshBasicMaterial( { color: 0xe8eef5, transparent: true, opacity: 0.28, depthWrite: false } ),
 	chosen: new THREE.MeshBasicMaterial( { color: 0xe53935, transparent: true, opacity: 0.5, depthWrite: false } ),
-	edge: new THREE.LineBasicMaterial( { color: 0xf4f7fb } ),
+	edge: new THREE.LineBasicMaterial( { color: 0xf4f7fb, transparent: true, opacity: 0.4, depthWrite: false } ),
 	chosenEdge: new THREE.LineBasicMaterial( { color: 0xff1744 } ),
 };
 const cubes = new THREE.Group();
@@ -181,7 +185,7 @@ function bounds() {
 
 function resetView() {
 	const sphere = bounds().getBoundingSphere( new THREE.Sphere() );
-	const radius = Math.max( sphere.radius, 3 ) * 0.85 + 1;   // the particles reach a little past the cubes
+	const radius = Math.max( sphere.radius, 3 ) * 0.75 + 1;   // the particles reach a little past the cubes
 	home = { target: sphere.center.clone(), distance: radius / Math.sin( THREE.MathUtils.degToRad( camera.fov / 2 ) ) };
 	orbit.target.copy( home.target );
 	camera.position.copy( home.target ).addScaledVector( VIEW_DIRECTION, home.distance );
@@ -252,6 +256,14 @@ function tick( now ) {
 		}
 	}
 	requestAnimationFrame( tick );
+}
+
+// One frame drawn and read back, timed: what the renderer (a GPU, or SwiftShader) takes for the scene.
+function drawMs() {
+	const start = performance.now(), gl = renderer.getContext();
+	renderer.render( scene, camera );
+	gl.readPixels( 0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array( 4 ) );
+	return Math.round( performance.now() - start );
 }
 
 orbit.addEventListener( 'change', () => { sortNeeded = true; showZoom(); redraw(); } );
@@ -611,10 +623,13 @@ function seed() {
 	return Number.isInteger( s ) && s >= 0 ? s : settings.seed;
 }
 
+// Preview (Generate Billboards) shows the cloud with the cubes as their bounding boxes, as the
+// manual's Billboards mode does; the cubes can still be clicked, and Cubes shows them again.
 function preview() {
 	previewOn = true;
 	const id = doc.mode === 'texture' ? 'show-billboards' : 'show-particles';
 	if ( ! $( id ).checked ) { $( id ).checked = true; $( id ).dispatchEvent( new Event( 'change' ) ); }
+	if ( $( 'show-cubes' ).checked ) { $( 'show-cubes' ).checked = false; $( 'show-cubes' ).dispatchEvent( new Event( 'change' ) ); }
 	requestFill();
 }
 

@@ -115,8 +115,8 @@ def cube_text(cubes: Sequence[EditCube], mode: str, name: str = "<cubes>") -> st
     noun = "billboard count" if mode == TEXTURE else "particle count"
     for k, cube in enumerate(cubes):  # the total is theirs: a bad one would be blamed on line 1
         if not (isinstance(cube.particles, int) or float(cube.particles).is_integer()) or cube.particles < 0:
-            raise expected(f"a whole number of 0 or more for the {noun}", describe(number_text(cube.particles)),
-                           name, k + 3)
+            raise expected(f"a whole number of 0 or more for the {noun}",
+                           describe(number_text(cube.particles)), name, k + 3)
     lines = [number_text(sum(c.particles for c in cubes)), str(len(cubes))]
     for k, cube in enumerate(cubes):
         fields = [number_text(cube.particles), *map(number_text, cube.size), *map(number_text, cube.centre),

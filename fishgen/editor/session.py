@@ -174,7 +174,7 @@ class Session:
         return {"files": self.workspace.cube_files(), "textures": self.workspace.texture_names(path)}
 
     def _settings(self) -> dict[str, Any]:
-        return {"folder": str(self.workspace.folder), "seed": self.seed,
+        return {"folder": _shown(self.workspace.folder), "seed": self.seed,
                 "light": self.lighting.extras(), "sun": list(self.lighting.sun),
                 "limits": {"particles": PREVIEW_PARTICLES, "billboards": PREVIEW_BILLBOARDS}}
 
@@ -208,6 +208,12 @@ def scaled(cube_file, most: int):
     counts = [max(1, int(c.particles * ratio)) if c.particles else 0 for c in cube_file.cubes]
     return replace(cube_file, cubes=tuple(replace(c, particles=n) for c, n in zip(cube_file.cubes, counts,
                                                                                   strict=True)))
+
+
+def _shown(folder: Path) -> str:
+    """A folder as the page names it: relative to where fishgen runs when inside it."""
+    here = Path.cwd().resolve()
+    return (folder.relative_to(here).as_posix() or ".") if folder.is_relative_to(here) else str(folder)
 
 
 def _member(body: Any, key: str) -> Any:

@@ -12,8 +12,8 @@ from contextlib import contextmanager
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium", shutil.which("chromium"))
-                 if p and Path(p).is_file()), None)
+CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium",
+                             shutil.which("chromium")) if p and Path(p).is_file()), None)
 # The machine has no network and no GPU: no background services, WebGL on SwiftShader.
 ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync",

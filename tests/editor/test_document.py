@@ -7,15 +7,22 @@ import math
 import pytest
 
 from fishgen.clouds.parser import load_cubes
-from fishgen.editor.document import (EditCube, cube_text, cubes_from_json, document_json, number_text,
-                                     read_back)
+from fishgen.editor.document import (
+    EditCube,
+    cube_text,
+    cubes_from_json,
+    document_json,
+    number_text,
+    read_back,
+)
 from fishgen.errors import FishgenError
 from tests.clouds.cloud_tables import TABLES
 
 
 def _as_page_sends(cubes) -> list[dict]:
     """Cubes as the page holds them, through JSON as the browser sends them."""
-    return json.loads(json.dumps([EditCube(c.particles, c.size, c.centre, c.max_radius).json() for c in cubes]))
+    page = [EditCube(c.particles, c.size, c.centre, c.max_radius).json() for c in cubes]
+    return json.loads(json.dumps(page))
 
 
 @pytest.mark.parametrize("table", sorted(TABLES))
@@ -50,18 +57,20 @@ def test_a_texture_cloud_line_ends_with_its_texture():
                                             ("a,b.png", "'a,b.png'"), ("x.png\n1", "'x.png\\n1'")])
 def test_a_texture_cloud_needs_a_texture_a_cube_line_can_hold(texture, found):
     with pytest.raises(FishgenError) as err:
-        cube_text([EditCube(1, (1, 1, 1), (0, 0, 0), 1, "a.png"), EditCube(1, (1, 1, 1), (0, 0, 0), 1, texture)],
-                  "texture", "sky.awa")
+        cube_text([EditCube(1, (1, 1, 1), (0, 0, 0), 1, "a.png"),
+                   EditCube(1, (1, 1, 1), (0, 0, 0), 1, texture)], "texture", "sky.awa")
     assert str(err.value).startswith("sky.awa:4: expected a texture") and str(err.value).endswith(found)
+
+
+WHOLE = "x.awn:3: expected a whole number of 0 or more for the particle count"
 
 
 @pytest.mark.parametrize("cube, message", [
     (EditCube(1, (1, 1, 1), (0, 0, 0), 0), "x.awn:3: expected a maximum radius greater than 0, found '0'"),
     (EditCube(1, (1, -2, 1), (0, 0, 0), 1), "x.awn:3: expected a y size greater than 0, found '-2'"),
-    (EditCube(2.5, (1, 1, 1), (0, 0, 0), 1), "x.awn:3: expected a whole number of 0 or more for the particle count, "
-                                             "found '2.5'"),
-    (EditCube(-1, (1, 1, 1), (0, 0, 0), 1), "x.awn:3: expected a whole number of 0 or more for the particle count"),
-    (EditCube(1, (1, 1, 1), (math.nan, 0, 0), 1), "x.awn:3: expected a finite number for the centre x, found 'nan'"),
+    (EditCube(2.5, (1, 1, 1), (0, 0, 0), 1), WHOLE + ", found '2.5'"),
+    (EditCube(-1, (1, 1, 1), (0, 0, 0), 1), WHOLE + ", found '-1'"),
+    (EditCube(1, (1, 1, 1), (math.nan, 0, 0), 1), "x.awn:3: expected a finite number for the centre x"),
     (EditCube(1, (1e39, 1, 1), (0, 0, 0), 1), "x.awn:3: expected a x size within float32 range"),
     (EditCube(0, (1, 1, 1), (0, 0, 0), 1), "x.awn:3: expected at least 1 particle in the cubes, found 0"),
 ])
@@ -76,17 +85,19 @@ def test_an_empty_workspace_is_not_a_file():
         read_back(cube_text([], "particles", "x.awn"), "particles", "x.awn", [])
 
 
+def _cube(**change) -> list[dict]:
+    return [{"particles": 1, "size": [1, 1, 1], "centre": [0, 0, 0], "radius": 1, **change}]
+
+
 @pytest.mark.parametrize("value, message", [
     ({"particles": 1}, "expected the cubes as a list, found a dict of 1"),
     ([{"particles": 1, "size": [1, 1, 1], "centre": [0, 0, 0]}], "expected cube 1 as {particles, size"),
-    ([{"particles": 1, "size": [1, 1, 1], "centre": [0, 0, 0], "radius": 1, "colour": 1}], "expected cube 1 as"),
-    ([{"particles": "1\n2", "size": [1, 1, 1], "centre": [0, 0, 0], "radius": 1}],
-     "expected cube 1's count as a number, found the text"),
-    ([{"particles": True, "size": [1, 1, 1], "centre": [0, 0, 0], "radius": 1}], "expected cube 1's count as a number"),
-    ([{"particles": 1, "size": [1, 1], "centre": [0, 0, 0], "radius": 1}], "expected cube 1's size as three numbers"),
-    ([{"particles": 1, "size": [1, 1, 1], "centre": [0, 0, "0, 5"], "radius": 1}], "expected cube 1's centre as a number"),
-    ([{"particles": 1, "size": [1, 1, 1], "centre": [0, 0, 0], "radius": 1, "texture": 5}],
-     "expected cube 1's texture as a name or null"),
+    (_cube(colour=1), "expected cube 1 as"),
+    (_cube(particles="1\n2"), "expected cube 1's count as a number, found the text"),
+    (_cube(particles=True), "expected cube 1's count as a number"),
+    (_cube(size=[1, 1]), "expected cube 1's size as three numbers"),
+    (_cube(centre=[0, 0, "0, 5"]), "expected cube 1's centre as a number"),
+    (_cube(texture=5), "expected cube 1's texture as a name or null"),
 ])
 def test_the_page_json_must_have_the_cubes_shape(value, message):
     """Nothing but numbers reaches the file's number fields: no text that could add fields or lines."""
@@ -108,12 +119,13 @@ def test_a_texture_cloud_opens_with_its_texture_names(tmp_path):
     folder.mkdir()
     (folder / "own.png").write_bytes(_png())
     (folder / "sky.awa").write_text("3\n3\n1, 1, 1, 1, 0, 0, 0, 1, clouds/a.png\n"
-                                    "1, 1, 1, 1, 2, 0, 0, 1, ./clouds/b.png\n1, 1, 1, 1, 4, 0, 0, 1, own.png\n")
+                                    "1, 1, 1, 1, 2, 0, 0, 1, ./clouds/b.png\n"
+                                    "1, 1, 1, 1, 4, 0, 0, 1, own.png\n")
     from fishgen.clouds.parser import texture_roots
 
     doc = document_json(load_cubes(folder / "sky.awa"), texture_roots(folder / "sky.awa"))
-    assert doc["mode"] == "texture" and [c["texture"] for c in doc["cubes"]] == ["clouds/a.png", "clouds/b.png",
-                                                                                 "own.png"]
+    assert doc["mode"] == "texture"
+    assert [c["texture"] for c in doc["cubes"]] == ["clouds/a.png", "clouds/b.png", "own.png"]
 
 
 def _png() -> bytes:

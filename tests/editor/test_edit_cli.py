@@ -59,8 +59,8 @@ def test_it_prints_the_pages_address_first_and_serves_it_until_ctrl_c(tmp_path, 
 
 
 @pytest.mark.parametrize("content, message", [
-    ("200\n1\n200, 7.3, 1.0\n", ":3: expected 8 fields (particles, x y z size, centre x y z, maximum radius), "
-                                 "found 3 fields"),
+    ("200\n1\n200, 7.3, 1.0\n",
+     ":3: expected 8 fields (particles, x y z size, centre x y z, maximum radius), found 3 fields"),
     ("", ":1: expected the total particle count on line 1, found an empty file"),
 ])
 def test_a_file_that_does_not_parse_is_refused_in_one_line_before_serving(tmp_path, content, message):

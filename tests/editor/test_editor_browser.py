@@ -38,7 +38,8 @@ def open_editor(browser):
         page.close()
         # a refusal the page shows (422: bad input, in one line) is logged by Chromium, and is no error
         assert [e for e in page.errors if "status of 422" not in e] == [], page.errors
-        assert all(u.startswith(page.url.split("?")[0]) or u.startswith(("blob:", "data:")) for u in page.requests)
+        here = page.url.split("?")[0]
+        assert all(u.startswith((here, "blob:", "data:")) for u in page.requests)  # nothing from elsewhere
 
 
 def _values(path: Path) -> list[tuple]:
@@ -122,8 +123,8 @@ def test_texture_mode_with_two_textures(skies, open_editor):
     ed = open_editor(skies / "mysky.awa")
     assert ed.state("mode") == "texture" and ed.state("cubes.length") == 0
     assert ed.page.get_by_role("radio", name="Texture").is_checked()
-    assert ed.page.get_by_role("combobox", name="Texture", exact=True).locator("option").all_inner_texts() == \
-        ["clouds/billow.png", "clouds/cumulus.png", "clouds/wisp.png"]
+    choices = ed.page.get_by_role("combobox", name="Texture", exact=True).locator("option").all_inner_texts()
+    assert choices == ["clouds/billow.png", "clouds/cumulus.png", "clouds/wisp.png"]
 
     ed.page.get_by_role("combobox", name="Texture", exact=True).select_option("clouds/billow.png")
     ed.button("Add Cube").click()
@@ -192,7 +193,8 @@ def test_the_particles_the_page_shows_are_what_fishgen_clouds_writes(skies, open
     (prim,) = read_gltf(out).meshes[0].primitives
     a = prim.attributes
     assert shown["count"] == 554
-    np.testing.assert_array_equal(np.array(shown["position"]).reshape(-1, 3), a["POSITION"].astype(np.float64))
+    np.testing.assert_array_equal(np.array(shown["position"]).reshape(-1, 3),
+                                  a["POSITION"].astype(np.float64))
     np.testing.assert_array_equal(np.array(shown["light"]), a["_LIGHT"].astype(np.float64))
     np.testing.assert_array_equal(np.array(shown["radius"]), a["_RADIUS"].astype(np.float64))
     # COLOR_0 is 16-bit normalized: the page reads u / 65535, fishgen's reader decodes it to float32
@@ -250,7 +252,8 @@ def test_open_switches_file_and_system_and_unsaved_changes_ask_first(skies, open
     ed.page.get_by_label("In the folder", exact=True).select_option("two.awa")  # the folder's cube files
     assert ed.field("File name").input_value() == "two.awa"
     ed.button("Open").click()  # dismissed: the edit stays
-    assert asked == ["confirm"] and ed.state("name") == "table_4_3.awn" and ed.state("cubes[0].centre[2]") == 1
+    assert asked == ["confirm"] and ed.state("name") == "table_4_3.awn"
+    assert ed.state("cubes[0].centre[2]") == 1
     ed.button("Open").click()
     ed.page.wait_for_function("fishgenEditor.name === 'two.awa'")
     assert ed.state("mode") == "texture" and ed.page.get_by_role("radio", name="Texture").is_checked()
@@ -268,10 +271,11 @@ def test_every_control_has_its_accessible_name(skies, open_editor):
     role = ed.page.get_by_role
     shared = {"button": ["Add Cube", "Delete", "Delete All", "Open", "Save", "Reset View", "Undo", "Redo",
                          "Duplicate"],
-              "spinbutton": ["Radius", "Length", "Width", "Height", "Centre X", "Centre Y", "Centre Z", "Scale All",
-                             "Zoom", "Grid step"],
+              "spinbutton": ["Radius", "Length", "Width", "Height", "Centre X", "Centre Y", "Centre Z",
+                             "Scale All", "Zoom", "Grid step"],
               "textbox": ["File name"], "radio": ["Particle System", "Texture"],
-              "checkbox": ["Cubes", "Bounding Box", "Snap to grid"], "slider": ["Sun azimuth", "Sun elevation"]}
+              "checkbox": ["Cubes", "Bounding Box", "Snap to grid"],
+              "slider": ["Sun azimuth", "Sun elevation"]}
     per_mode = {"Particle System": {"button": ["Preview"], "spinbutton": ["Particles", "Seed"]},
                 "Texture": {"button": ["Generate Billboards", "Set Texture", "Set To All"],
                             "spinbutton": ["Billboards per Box"], "combobox": ["Texture"],
@@ -303,10 +307,12 @@ def test_a_texture_cloud_from_the_shipped_params_shows_its_textures(tmp_path, op
     """params/clouds/sky.awa reads its textures from the project's textures/ folder."""
     folder = tmp_path / "params" / "clouds"
     folder.mkdir(parents=True)
-    shutil.copy(Path(__file__).resolve().parents[2] / "params" / "clouds" / "sky.awa", folder)
-    shutil.copytree(Path(__file__).resolve().parents[2] / "textures" / "clouds", tmp_path / "textures" / "clouds")
+    root = Path(__file__).resolve().parents[2]
+    shutil.copy(root / "params" / "clouds" / "sky.awa", folder)
+    shutil.copytree(root / "textures" / "clouds", tmp_path / "textures" / "clouds")
     ed = open_editor(folder / "sky.awa")
     ed.button("Generate Billboards").click()
     ed.settle()
-    assert sorted(m["texture"] for m in ed.state("previewBillboards()")) == ["billow.png", "cumulus.png", "wisp.png"]
+    shown = sorted(m["texture"] for m in ed.state("previewBillboards()"))
+    assert shown == ["billow.png", "cumulus.png", "wisp.png"]
     assert ed.page.locator("#thumbnail").evaluate("img => img.complete && img.naturalWidth") == 128
