@@ -112,7 +112,10 @@ def main() -> int:
     parser.add_argument("--viewport", default="1280x800")
     parser.add_argument("--json", type=Path, help="also write the figures here")
     args = parser.parse_args()
+    from tests.editor import browser as harness
     from tests.editor.browser import chromium
+
+    harness.TIMEOUT_MS = 600_000  # a software-rendered frame of a big cloud takes long
 
     viewport = tuple(int(v) for v in args.viewport.split("x"))
     print(f"fishgen edit: edit -> preview refreshed, on {os.cpu_count()} cores, "
