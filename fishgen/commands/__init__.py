@@ -30,6 +30,7 @@ MODULES = {
     "batch": "fishgen.commands.batch",
     "build": "fishgen.commands.build",
     "clouds": "fishgen.commands.clouds",
+    "edit": "fishgen.commands.edit",
     "preview": "fishgen.commands.preview",
     "school": "fishgen.commands.school",
     "species": "fishgen.commands.species",

@@ -1,0 +1,237 @@
+// The editor's preview: a filled, lit cloud as `fishgen clouds` writes it (a GLB from the server's
+// /api/fill), drawn as fishgen's viewer draws it. The first pass of Harris's method (the sunlight
+// reaching each particle, `_LIGHT`) is baked by the server; the shaders here do the second pass:
+// the light scattered towards the eye by the phase function, over the sky's ambient light.
+// (The same shaders as fishgen/viewer/app.js; kept here because that module is a page of its own.)
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+
+const SECOND_PASS = /* glsl */`
+	uniform vec3 cloudSun, sunColor, skyColor;
+	uniform float albedo, g;
+	float phase( float c ) {
+		float g2 = g * g;
+		return 1.5 * ( 1.0 - g2 ) / ( 2.0 + g2 ) * ( 1.0 + c * c ) / pow( 1.0 + g2 - 2.0 * g * c, 1.5 );
+	}
+	vec3 scattered( float light, vec3 world ) {
+		float c = dot( cloudSun, normalize( world - cameraPosition ) );   // 1: looking towards the sun
+		return albedo * ( skyColor + sunColor * light * phase( c ) );
+	}`;
+
+export const cloudUniforms = {
+	cloudSun: { value: new THREE.Vector3( 0, 1, 0 ) }, sunColor: { value: new THREE.Vector3( 1, 1, 1 ) },
+	skyColor: { value: new THREE.Vector3() }, albedo: { value: 1 }, g: { value: 0 },
+};
+
+function setLight( extras ) {
+	const l = extras && extras.fishgen_light;
+	if ( ! l ) return;
+	cloudUniforms.cloudSun.value.set( ...l.sun ).normalize();
+	cloudUniforms.sunColor.value.set( ...l.sun_color );
+	cloudUniforms.skyColor.value.set( ...l.sky_color );
+	cloudUniforms.albedo.value = l.albedo;
+	cloudUniforms.g.value = l.anisotropy;
+}
+
+// Particles: each a soft disc of its world radius with the billboard sprite's Gaussian profile.
+const particleMaterial = new THREE.ShaderMaterial( {
+	uniforms: { viewportHeight: { value: 1 }, ...cloudUniforms },
+	transparent: true, depthWrite: false,
+	vertexShader: /* glsl */`
+		attribute float _radius;
+		attribute float _density;
+		attribute float _light;
+		uniform float viewportHeight;
+		varying vec3 vColor;
+		varying float vAlpha;
+		${ SECOND_PASS }
+		void main() {
+			vec4 world = modelMatrix * vec4( position, 1.0 );
+			vec4 mv = viewMatrix * world;
+			gl_Position = projectionMatrix * mv;
+			gl_PointSize = 2.0 * _radius * projectionMatrix[ 1 ][ 1 ] * 0.5 * viewportHeight / max( - mv.z, 1e-4 );
+			vColor = scattered( _light, world.xyz );
+			vAlpha = 0.7 * clamp( _density, 0.0, 1.0 );
+		}`,
+	fragmentShader: /* glsl */`
+		varying vec3 vColor;
+		varying float vAlpha;
+		void main() {
+			vec2 p = gl_PointCoord * 2.0 - 1.0;
+			float r2 = dot( p, p );
+			if ( r2 > 1.0 ) discard;
+			float a = vAlpha * max( ( exp( - r2 / 0.32 ) - 0.04394 ) / 0.95606, 0.0 );
+			gl_FragColor = vec4( vColor, a );
+			#include <colorspace_fragment>
+		}`,
+} );
+
+const WHITE = new THREE.DataTexture( new Uint8Array( [ 255, 255, 255, 255 ] ), 1, 1 );
+WHITE.needsUpdate = true;
+
+// A texture cloud's billboards, three crossed quads each as fishgen writes them: the texture's colour
+// and alpha (or, with Show Texture off, a plain quad) times the vertex alpha, lit by the second pass.
+function billboardMaterial( source, textured ) {
+	const material = new THREE.ShaderMaterial( {
+		uniforms: { map: { value: textured && source.map || WHITE }, plain: { value: textured ? 0 : 1 }, ...cloudUniforms },
+		vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide,
+		vertexShader: /* glsl */`
+			attribute float _light;
+			varying vec2 vUv;
+			varying vec4 vColor;
+			${ SECOND_PASS }
+			void main() {
+				vec4 world = modelMatrix * vec4( position, 1.0 );
+				gl_Position = projectionMatrix * viewMatrix * world;
+				vUv = uv;
+				vColor = vec4( scattered( _light, world.xyz ), color.a );
+			}`,
+		fragmentShader: /* glsl */`
+			uniform sampler2D map;
+			uniform float plain;
+			varying vec2 vUv;
+			varying vec4 vColor;
+			void main() {
+				vec4 t = texture2D( map, vUv );
+				float a = plain > 0.5 ? 0.6 : vColor.a * t.a;
+				gl_FragColor = vec4( vColor.rgb * t.rgb, a );
+				#include <colorspace_fragment>
+			}`,
+	} );
+	material.userData.source = source;
+	return material;
+}
+
+// Transparent things are drawn farthest first: each primitive's centroid, sorted along the view.
+class Sorted {
+
+	constructor( object, size ) {
+		const g = object.geometry, pos = g.getAttribute( 'position' );
+		const index = g.index ? g.index.array.slice() : Uint32Array.from( { length: pos.count }, ( _, i ) => i );
+		const n = index.length / size, centroids = new Float32Array( n * 3 );
+		for ( let k = 0; k < n; k ++ ) for ( let j = 0; j < size; j ++ ) {
+			const v = index[ k * size + j ];
+			centroids[ 3 * k ] += pos.getX( v ) / size;
+			centroids[ 3 * k + 1 ] += pos.getY( v ) / size;
+			centroids[ 3 * k + 2 ] += pos.getZ( v ) / size;
+		}
+		if ( ! g.index ) g.setIndex( new THREE.BufferAttribute( index.slice(), 1 ) );
+		Object.assign( this, { object, centroids, index, size, keys: new Float32Array( n ), order: new Uint32Array( n ) } );
+	}
+
+	sort( dir ) {
+		const e = this.object.matrixWorld.elements, c = this.centroids, n = this.keys.length;
+		for ( let k = 0; k < n; k ++ ) {
+			const x = c[ 3 * k ], y = c[ 3 * k + 1 ], z = c[ 3 * k + 2 ];
+			const wx = e[ 0 ] * x + e[ 4 ] * y + e[ 8 ] * z + e[ 12 ], wy = e[ 1 ] * x + e[ 5 ] * y + e[ 9 ] * z + e[ 13 ];
+			const wz = e[ 2 ] * x + e[ 6 ] * y + e[ 10 ] * z + e[ 14 ];
+			this.keys[ k ] = - ( wx * dir.x + wy * dir.y + wz * dir.z );   // farther: smaller key
+			this.order[ k ] = k;
+		}
+		const keys = this.keys;
+		this.order.sort( ( a, b ) => keys[ a ] - keys[ b ] );
+		const out = this.object.geometry.index.array, size = this.size;
+		for ( let k = 0; k < n; k ++ ) for ( let j = 0; j < size; j ++ ) out[ k * size + j ] = this.index[ this.order[ k ] * size + j ];
+		this.object.geometry.index.needsUpdate = true;
+	}
+
+}
+
+const TEXTURE_MATERIAL = 'cloud texture ';
+
+export class CloudView {
+
+	constructor( scene ) {
+		this.group = new THREE.Group();
+		this.group.name = 'preview';
+		scene.add( this.group );
+		this.sorted = [];
+		this.points = null;
+		this.billboards = [];
+		this.textured = true;
+		this.loader = new GLTFLoader();
+	}
+
+	setViewport( height ) {
+		particleMaterial.uniforms.viewportHeight.value = height;
+	}
+
+	// Show the GLB `glb` (an ArrayBuffer) in place of the last one.
+	async show( glb ) {
+		const gltf = await this.loader.parseAsync( glb, '' );
+		this.clear();
+		setLight( gltf.scene.userData );
+		gltf.scene.updateMatrixWorld( true );
+		gltf.scene.traverse( ( o ) => {
+			if ( o.isPoints ) {
+				o.material = particleMaterial;
+				o.frustumCulled = false;
+				this.points = o;
+				this.sorted.push( new Sorted( o, 1 ) );
+			} else if ( o.isMesh ) {
+				o.material = billboardMaterial( o.material, this.textured );
+				o.frustumCulled = false;
+				this.billboards.push( o );
+				this.sorted.push( new Sorted( o, 3 ) );
+			}
+		} );
+		this.group.add( gltf.scene );
+	}
+
+	setTextured( on ) {
+		this.textured = on;
+		for ( const mesh of this.billboards ) {
+			const old = mesh.material;
+			mesh.material = billboardMaterial( old.userData.source, on );
+			old.dispose();
+		}
+	}
+
+	sort( camera ) {
+		const dir = camera.getWorldDirection( new THREE.Vector3() );
+		for ( const s of this.sorted ) s.sort( dir );
+	}
+
+	clear() {
+		for ( const child of [ ...this.group.children ] ) {
+			child.traverse( ( o ) => {
+				if ( o.geometry ) o.geometry.dispose();
+				if ( o.material && o.material !== particleMaterial ) {
+					const source = o.material.userData && o.material.userData.source;
+					if ( source && source.map ) source.map.dispose();
+					o.material.dispose();
+				}
+			} );
+			this.group.remove( child );
+		}
+		this.sorted = [];
+		this.points = null;
+		this.billboards = [];
+	}
+
+	// What is shown, for people and tests: positions, linear colours and light of the particles
+	// (as the file holds them), or the billboards' meshes by texture.
+	particles() {
+		if ( ! this.points ) return null;
+		const g = this.points.geometry, n = g.getAttribute( 'position' ).count;
+		const read = ( name, size ) => {
+			const a = g.getAttribute( name );
+			if ( ! a ) return null;
+			const out = new Array( n * size );
+			for ( let i = 0; i < n; i ++ ) for ( let j = 0; j < size; j ++ ) out[ i * size + j ] = a.getComponent( i, j );
+			return out;
+		};
+		return { count: n, position: read( 'position', 3 ), color: read( 'color', 3 ), light: read( '_light', 1 ),
+			radius: read( '_radius', 1 ), density: read( '_density', 1 ) };
+	}
+
+	billboardMeshes() {
+		return this.billboards.map( ( m ) => {
+			const source = m.material.userData.source;
+			const name = source && source.name && source.name.startsWith( TEXTURE_MATERIAL ) ? source.name.slice( TEXTURE_MATERIAL.length ) : null;
+			return { texture: name, vertices: m.geometry.getAttribute( 'position' ).count, billboards: m.geometry.getAttribute( 'position' ).count / 12,
+				textured: m.material.uniforms.plain.value === 0 };
+		} );
+	}
+
+}

@@ -1,0 +1,102 @@
+"""The real `fishgen edit` page in headless Chromium (the system's, driven by Playwright), for the
+tests, the README's screenshot and the benchmark."""
+from __future__ import annotations
+
+import os
+import queue
+import shutil
+import subprocess
+import sys
+import threading
+from contextlib import contextmanager
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium",
+                             shutil.which("chromium")) if p and Path(p).is_file()), None)
+# The machine has no network and no GPU: no background services, WebGL on SwiftShader.
+ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+        "--disable-background-networking", "--disable-component-update", "--disable-sync",
+        "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+TIMEOUT_MS = 60_000
+
+
+def unavailable() -> str | None:
+    """Why the page cannot be driven here, or None."""
+    if CHROMIUM is None:
+        return "chromium is not installed (Debian: apt-get install chromium)"
+    try:
+        import playwright  # noqa: F401
+    except ImportError:
+        return "playwright is not installed (the test extra)"
+    return None
+
+
+@contextmanager
+def chromium():
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        try:
+            yield browser
+        finally:
+            browser.close()
+
+
+class EditorPage:
+    """`fishgen edit FILE --no-open --port 0 ARGS...` and its page, loaded and ready."""
+
+    def __init__(self, browser, file: Path, *args: str, viewport=(1280, 800)):
+        self.file = Path(file)
+        self.proc = subprocess.Popen([sys.executable, "-u", "-m", "fishgen", "edit", str(file), "--no-open",
+                                      "--port", "0", *args], cwd=ROOT, stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, text=True)
+        lines: queue.Queue = queue.Queue()
+        threading.Thread(target=lambda: [lines.put(line) for line in self.proc.stdout], daemon=True).start()
+        try:
+            self.url = lines.get(timeout=60).strip()
+        except queue.Empty:
+            self.proc.kill()
+            raise RuntimeError(f"fishgen edit printed no address: {self.proc.stderr.read()}") from None
+        self.errors: list[str] = []
+        self.dialogs: list[str] = []
+        self.page = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
+        self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
+        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
+        self.requests: list[str] = []
+        self.page.on("request", lambda r: self.requests.append(r.url))
+        self.page.goto(self.url)
+        self.page.wait_for_function("window.fishgenEditor && (fishgenEditor.ready || fishgenEditor.error)",
+                                    timeout=TIMEOUT_MS)
+        if self.state("error"):
+            raise RuntimeError(f"the editor did not start: {self.state('error')}")
+
+    def state(self, expression: str):
+        """``fishgenEditor.<expression>`` evaluated in the page."""
+        return self.page.evaluate(f"fishgenEditor.{expression}")
+
+    def settle(self) -> None:
+        """Wait until every fill asked for is shown, and a frame after it."""
+        self.page.wait_for_function("fishgenEditor.fill.shown === fishgenEditor.fill.sent && "
+                                    "!fishgenEditor.fill.busy", timeout=TIMEOUT_MS)
+        frames = self.state("frames")
+        self.page.evaluate("() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
+        self.page.wait_for_function(f"fishgenEditor.frames >= {frames}", timeout=TIMEOUT_MS)
+
+    def field(self, label: str):
+        return self.page.get_by_label(label, exact=True)
+
+    def button(self, name: str):
+        return self.page.get_by_role("button", name=name, exact=True)
+
+    def close(self) -> None:
+        try:
+            self.page.close()
+        finally:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
