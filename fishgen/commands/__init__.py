@@ -32,6 +32,7 @@ MODULES = {
     "clouds": "fishgen.commands.clouds",
     "preview": "fishgen.commands.preview",
     "school": "fishgen.commands.school",
+    "sky": "fishgen.commands.sky",
     "species": "fishgen.commands.species",
     "texture": "fishgen.commands.texture",
     "view": "fishgen.commands.view",
