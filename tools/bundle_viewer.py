@@ -35,6 +35,7 @@ NODE_MODULES = ROOT / "node_modules"
 #: page -> (its entry module, the folder its bundle is committed in, the bundle's file name)
 PAGES = {
     "viewer": ("fishgen/viewer/app.js", ROOT / "fishgen" / "viewer" / "static", "viewer.min.js"),
+    "fly": ("fishgen/fly/app.js", ROOT / "fishgen" / "fly" / "static", "fly.min.js"),
 }
 STATIC = PAGES["viewer"][1]
 LICENSE = "THREE-LICENSE"

@@ -30,6 +30,7 @@ MODULES = {
     "batch": "fishgen.commands.batch",
     "build": "fishgen.commands.build",
     "clouds": "fishgen.commands.clouds",
+    "fly": "fishgen.commands.fly",
     "preview": "fishgen.commands.preview",
     "school": "fishgen.commands.school",
     "sky": "fishgen.commands.sky",

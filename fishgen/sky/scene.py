@@ -46,10 +46,11 @@ def bounds(cloud: Cloud) -> tuple[list[float], list[float], list[float]]:
     return [float(v) for v in lo], [float(v) for v in hi], [*(float(v) for v in middle), reach]
 
 
-def sky_scene(plan: SkyPlan, clouds: Sequence[SkyCloud], sources: Sequence[str], *, billboards: bool = False,
-              lod: bool = True) -> tuple[Scene, list[dict[str, Any]]]:
+def sky_scene(plan: SkyPlan | None, clouds: Sequence[SkyCloud], sources: Sequence[str], *,
+              billboards: bool = False, lod: bool = True) -> tuple[Scene, list[dict[str, Any]]]:
     """The scene, and per cloud what it holds (name, source, particles at each level).
 
+    ``plan``: the sky's, recorded in the scene's extras (None: clouds placed otherwise, no record).
     ``billboards``: particle clouds as crossed-quad billboards (a texture cloud always is).
     ``lod``: lower levels for clouds of at least LOD_MIN_PARTICLES.
     """
@@ -82,6 +83,8 @@ def sky_scene(plan: SkyPlan, clouds: Sequence[SkyCloud], sources: Sequence[str],
             scene.nodes[lod0].extras[COVERAGE_KEY] = [LOD_COVERAGE, 0.0]
             fact["lod1"] = len(low)
         facts.append(fact)
+    if plan is None:
+        return scene, facts
     scene.extras[SKY_KEY] = {"mode": plan.mode.name, "seed": plan.seed, "area": list(plan.area),
                              "altitude": list(plan.altitude), "clouds": len(clouds),
                              "particles": sum(len(c.cloud) for c in clouds),
