@@ -20,8 +20,8 @@ WEBGL = ("swiftshader", "llvmpipe")   # fishgen.fly.headless.WEBGL, without impo
 
 @dataclass(frozen=True)
 class FlyOptions:
-    mode: str | None = option(click.Choice(tuple(MODES)), "Fly a sky of this mode (Pakawan's cloud_mode 1, 2, "
-                              "3): with no INPUT, of the shipped clouds; with cube files, of them.", None,
+    mode: str | None = option(click.Choice(tuple(MODES)), "Fly a sky of this mode (Pakawan's cloud_mode 1, "
+                              "2, 3): with no INPUT, of the shipped clouds; with cube files, of them.", None,
                               shown_default="none: fly INPUT as it is")
     size: tuple[int, int] = option(Size(16, 8192), "Window size in pixels (Pakawan's width and height).",
                                    (800, 600), shown_default="800x600")
@@ -36,15 +36,16 @@ class FlyOptions:
                             "pip install 'fishgen[fly]' and a Chromium.", False, flag=True)
     warmup: float = option(FiniteRange(0, 600), "Seconds flown before frames are counted (shaders compiled, "
                            "first sorts).", 2.0, metavar="SECONDS")
-    cloud_resolution: float = option(FiniteRange(0.1, 1), "Draw the clouds into a buffer of this share of the "
-                                     "window's width and height, laid over the view (off-screen particles: "
-                                     "a quarter of the pixels at 0.5); 1 draws them on the window.", 0.5,
+    cloud_resolution: float = option(FiniteRange(0.1, 1), "Draw the clouds into a buffer of this share of "
+                                     "the window's width and height, laid over the view (off-screen "
+                                     "particles: a quarter of the pixels at 0.5); 1 draws them on the "
+                                     "window.", 0.5,
                                      metavar="SHARE")
     webgl: str = option(click.Choice(WEBGL), "--headless: software WebGL, Chromium's SwiftShader or Mesa's "
                         "llvmpipe (through ANGLE).", "swiftshader")
     seed: int = seed_option("It picks a --mode sky's clouds and the headless flight path.")
-    port: int = option(click.IntRange(0, 65535), "Port on 127.0.0.1 to serve the page from; 0 picks a free one.",
-                       0, manifest=False)
+    port: int = option(click.IntRange(0, 65535), "Port on 127.0.0.1 to serve the page from; 0 picks a free "
+                       "one.", 0, manifest=False)
     max_particles: int = option(click.IntRange(min=1), "Refuse scenes with more particles than this, before "
                                 "allocating anything.", DEFAULT_MAX_PARTICLES)
     textures: Path | None = textures_option("a .awa file's folder, then the textures/ folder beside it (or "
@@ -95,7 +96,9 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
     if options.report is not None:
         suffix_of(options.report, SUFFIXES, "a report")
         check_targets([options.report], inputs)
-    timeout = options.timeout if options.timeout is not None else HEADLESS_TIMEOUT if options.headless else None
+    timeout = options.timeout
+    if timeout is None and options.headless:
+        timeout = HEADLESS_TIMEOUT
     if options.report is not None and timeout is None:
         raise UsageError("expected --timeout with --report (the report is written when the time is up), "
                          "found none")
@@ -112,8 +115,8 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
     title = ", ".join(a.name for a in assets)
     run = {"inputs": [str(p) for p in inputs], "mode": options.mode, "timeout": timeout}
     config = FlyConfig(size=options.size, timeout=timeout, warmup=options.warmup,
-                       path="fly" if options.headless else None, seed=options.seed, report=timeout is not None,
-                       cloud_scale=options.cloud_resolution)
+                       path="fly" if options.headless else None, seed=options.seed,
+                       report=timeout is not None, cloud_scale=options.cloud_resolution)
     if options.headless:
         from fishgen.fly.headless import run_headless
 
@@ -122,7 +125,7 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
         assert session.report is not None
         report = full_report(session.report, {**run, **browser})
         written = (write_report(report, options.report),) if options.report is not None else ()
-        return Made(written, read, tuple(summary(report)), facts=report)
+        return Made(written, tuple(read), tuple(summary(report)), facts=report)
 
     holder: dict[str, FlySession] = {}
 
@@ -142,7 +145,7 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
     holder["session"] = session
     lines = (session.url(), f"flying {title}: W/S/A/D move, arrows look and turn, 1/2/3 speed, drag to look"
              + (f"; stops after {timeout:g} s" if timeout else "; Ctrl-C to stop"))
-    return Made((), read, lines, server=session.server)
+    return Made((), tuple(read), lines, server=session.server)
 
 
 def _session(assets, config, port: int, title: str, on_report=None):

@@ -62,7 +62,8 @@ def prepare_assets(inputs: Sequence[str | os.PathLike], *, mode: str | None = No
         raise UsageError(f"expected cube files (or none) with --mode, found {assets[0]}: a glTF asset is "
                          "flown as it is")
     if mode is None and not paths:
-        raise UsageError("expected INPUT... (cube files, .awa, .glb) or --mode thin|medium|thick, found neither")
+        raise UsageError("expected INPUT... (cube files, .awa, .glb) or --mode thin|medium|thick, found "
+                         "neither")
     out: list[Asset] = []
     read: list[Path] = []
     if mode is not None:

@@ -71,7 +71,8 @@ def check_headless() -> str | None:
 
 
 def run_headless(session: FlySession, *, webgl: str = "swiftshader", chromium: str | None = None,
-                 extra_args: tuple[str, ...] = (), screenshot: str | os.PathLike | None = None) -> dict[str, Any]:
+                 extra_args: tuple[str, ...] = (),
+                 screenshot: str | os.PathLike | None = None) -> dict[str, Any]:
     """Serve the session, fly its page in headless Chromium until it reports, and return the run's
     facts (the page's report is ``session.report``): the browser's version and its flags.
     ``screenshot``: a PNG of the page as it was when the time was up (the last frame)."""

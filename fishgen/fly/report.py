@@ -22,6 +22,8 @@ from fishgen.errors import FishgenError
 SUFFIXES = (".json", ".csv")
 MAX_SECONDS = 86_400
 MAX_TEXT = 300
+SCENE = ("particles", "billboards", "distant_particles", "distant_billboards", "clouds", "meshes")
+DRAWN = ("particles", "billboards", "clouds")
 CSV_COLUMNS = ("second", "frames", "fps", "particles_drawn", "billboards_drawn", "width", "height",
                "particles_in_scene", "billboards_in_scene", "fps_median", "renderer", "fishgen")
 
@@ -35,7 +37,8 @@ def _number(value: Any, what: str, low: float = 0.0, high: float = 1e12) -> floa
 
 def _text(value: Any, what: str) -> str:
     if not isinstance(value, str) or len(value) > MAX_TEXT:
-        raise FishgenError(f"expected {what} as text of at most {MAX_TEXT} characters, found {str(value)[:40]!r}")
+        raise FishgenError(f"expected {what} as text of at most {MAX_TEXT} characters, found "
+                           f"{str(value)[:40]!r}")
     return value
 
 
@@ -47,13 +50,12 @@ def _members(value: Any, what: str, names: tuple[str, ...]) -> dict[str, Any]:
 
 def check_report(page: Any) -> dict[str, Any]:
     """The page's report, checked and in fishgen's order; a malformed one is a FishgenError."""
-    r = _members(page, "a report", ("window", "seconds", "warmup", "frames", "fps", "scene", "drawn", "renderer",
-                                    "path", "seed", "sorts", "per_second"))
+    r = _members(page, "a report", ("window", "seconds", "warmup", "frames", "fps", "scene", "drawn",
+                                    "renderer", "path", "seed", "sorts", "per_second"))
     window = _members(r["window"], "window", ("width", "height"))
     fps = _members(r["fps"], "fps", ("median", "p5", "min", "max"))
-    scene = _members(r["scene"], "scene", ("particles", "billboards", "distant_particles", "distant_billboards",
-                                           "clouds", "meshes"))
-    drawn = _members(r["drawn"], "drawn", ("particles", "billboards", "clouds"))
+    scene = _members(r["scene"], "scene", SCENE)
+    drawn = _members(r["drawn"], "drawn", DRAWN)
     rows = r["per_second"]
     if not isinstance(rows, list) or len(rows) > MAX_SECONDS + 1:
         raise FishgenError(f"expected per_second as a list of at most {MAX_SECONDS + 1} rows, found "
@@ -73,9 +75,8 @@ def check_report(page: Any) -> dict[str, Any]:
         "warmup": round(_number(r["warmup"], "warmup", 0, MAX_SECONDS), 3),
         "frames": int(_number(r["frames"], "frames", 0, 1e9)),
         "fps": {k: round(_number(fps[k], f"fps {k}", 0, 1e9), 3) for k in ("median", "p5", "min", "max")},
-        "scene": {k: int(_number(scene[k], f"scene {k}")) for k in scene if k in
-                  ("particles", "billboards", "distant_particles", "distant_billboards", "clouds", "meshes")},
-        "drawn": {k: round(_number(drawn[k], f"drawn {k}"), 1) for k in ("particles", "billboards", "clouds")},
+        "scene": {k: int(_number(scene[k], f"scene {k}")) for k in SCENE},
+        "drawn": {k: round(_number(drawn[k], f"drawn {k}"), 1) for k in DRAWN},
         "renderer": _text(r["renderer"], "renderer"),
         "path": _text(r["path"], "path"),
         "seed": int(_number(r["seed"], "seed", 0, 2**63)),
@@ -123,7 +124,9 @@ def summary(report: dict[str, Any]) -> list[str]:
     """The report in a few lines, for the terminal."""
     fps, w = report["fps"], report["window"]
     scene, drawn = report["scene"], report["drawn"]
-    things = f"{scene['particles']:,} particles" + (f", {scene['billboards']:,} billboards" if scene["billboards"] else "")
+    things = f"{scene['particles']:,} particles"
+    if scene["billboards"]:
+        things += f", {scene['billboards']:,} billboards"
     return [f"flew {report['seconds']:.1f} s at {w['width']}x{w['height']}: {report['frames']:,} frames, "
             f"{fps['median']:.1f} FPS median (5th percentile {fps['p5']:.1f}, min {fps['min']:.1f}, "
             f"max {fps['max']:.1f})",

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from fishgen.fly.assets import Asset
-from fishgen.web.server import LocalServer, Request, Response
+from fishgen.web.server import LocalServer, Request, Response, Route
 
 HERE = Path(__file__).resolve().parent
 BUNDLE = HERE / "static" / "fly.min.js"
@@ -47,9 +47,10 @@ class FlyConfig:
         from fishgen import __version__
 
         return {"assets": [{"name": a.name, "url": f"asset/{k}"} for k, a in enumerate(assets)],
-                "size": list(self.size) if self.size else None, "timeout": self.timeout, "warmup": self.warmup,
-                "path": self.path, "seed": self.seed % 2**32, "report": self.report, "baseline": self.baseline,
-                "background": self.background, "cloudScale": self.cloud_scale, "version": __version__}
+                "size": list(self.size) if self.size else None, "timeout": self.timeout,
+                "warmup": self.warmup, "path": self.path, "seed": self.seed % 2**32, "report": self.report,
+                "baseline": self.baseline, "background": self.background, "cloudScale": self.cloud_scale,
+                "version": __version__}
 
 
 def page_html(assets: Sequence[Asset], config: FlyConfig, title: str) -> str:
@@ -81,7 +82,7 @@ class FlySession:
         self.received = threading.Event()
         self._check = check_report
         self._on_report = on_report
-        routes = {("GET", "/"): self._page, ("POST", "/report"): self._receive}
+        routes: dict[tuple[str, str], Route] = {("GET", "/"): self._page, ("POST", "/report"): self._receive}
         for k in range(len(self.assets)):
             routes[("GET", f"/asset/{k}")] = self._asset(k)
         self.server = LocalServer(routes, port, max_body=MAX_REPORT_BYTES)
