@@ -384,6 +384,33 @@ function update() {
 	}
 }
 
+// For tests and people: each cloud as drawn now (its level, whether it is in view), and whether
+// its particles are in back-to-front order along the view direction of its last sort, how far the
+// view has turned (degrees) and moved (share of its distance) since.
+state.inspect = () => units.map( ( u ) => {
+	const l = u.levels[ u.level ], s = l.sorters[ 0 ];
+	const out = { visible: u.visible, level: u.level, levels: u.levels.length, particles: l.particles,
+		billboards: l.billboards, distance: u.distance, radius: u.world.radius };
+	if ( ! s || s.from.x === Infinity ) return { ...out, sorted: false };
+	_inv.copy( s.object.matrixWorld ).invert();
+	_local.copy( s.dir ).transformDirection( _inv );
+	const order = s.object.geometry.index.array, c = s.centroids, pos = s.object.geometry.getAttribute( 'position' );
+	let worst = 0, previous = Infinity, lo = Infinity, hi = - Infinity;
+	const particleOf = new Map();
+	if ( s.size > 1 ) for ( let j = 0; j < s.n; j ++ ) particleOf.set( s.index[ j * s.size ], j );
+	for ( let k = 0; k < s.n; k ++ ) {
+		const v = order[ k * s.size ];
+		let d = 0;
+		if ( s.size === 1 ) d = pos.getX( v ) * _local.x + pos.getY( v ) * _local.y + pos.getZ( v ) * _local.z;
+		else { const j = particleOf.get( v ); d = c[ 3 * j ] * _local.x + c[ 3 * j + 1 ] * _local.y + c[ 3 * j + 2 ] * _local.z; }
+		worst = Math.max( worst, d - previous ); previous = d; lo = Math.min( lo, d ); hi = Math.max( hi, d );
+	}
+	camera.getWorldDirection( _dir );
+	return { ...out, sorted: true, disorder: hi > lo ? worst / ( hi - lo ) : 0,
+		turn: THREE.MathUtils.radToDeg( Math.acos( Math.min( 1, _dir.dot( s.dir ) ) ) ),
+		moved: s.from.distanceTo( camera.position ) / Math.max( u.distance, 1e-6 ) };
+} );
+
 // -- moving: Pakawan's keys, the mouse, or a seeded path ----------------------------------------
 const keys = new Set();
 const SPEEDS = [ 0.01, 0.04, 0.12 ];   // share of the scene's size flown per second, keys 1/2/3
@@ -487,12 +514,15 @@ function frame() {
 	if ( path || orbit ) follow( ( now - started ) / 1000 ); else steer( dt );
 	for ( const mixer of mixers ) mixer.update( dt );
 	update();
+	const updated = performance.now();
 	draw();
+	const submitted = performance.now();
 	gl.readPixels( 0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel );   // wait for the frame to be drawn
 	const end = performance.now();
 	if ( measuring === null && ( end - started ) / 1000 >= config.warmup ) measuring = end;
 	else if ( measuring !== null && last !== null ) {
-		frames.push( [ end - measuring, end - last, drawn.particles, drawn.billboards, drawn.clouds ] );
+		frames.push( [ end - measuring, end - last, drawn.particles, drawn.billboards, drawn.clouds,
+			updated - now, submitted - updated, end - submitted ] );
 		state.frames = frames.length;
 	}
 	last = end;
@@ -547,6 +577,10 @@ function finish( end ) {
 		scene: { particles: counts.particles, billboards: counts.billboards, distant_particles: counts.distantParticles,
 			distant_billboards: counts.distantBillboards, clouds: counts.clouds, meshes: counts.meshes },
 		drawn: { particles: mean( 2 ), billboards: mean( 3 ), clouds: mean( 4 ) },
+		// where a frame's time goes, medians in ms: culling, levels and sorting (JS); handing the draws
+		// to WebGL; waiting for the drawing (the pixel read back)
+		split: { update: median( frames.map( ( f ) => f[ 5 ] ) ), submit: median( frames.map( ( f ) => f[ 6 ] ) ),
+			wait: median( frames.map( ( f ) => f[ 7 ] ) ) },
 		renderer: rendererName(), path: config.path || 'keys', seed: config.seed, sorts: state.sorts,
 		per_second: seconds.map( ( fs, s ) => ( { second: s, frames: fs.length,
 			fps: fs.length ? 1000 / median( fs.map( ( f ) => f[ 1 ] ) ) : 0,

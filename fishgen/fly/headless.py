@@ -87,6 +87,7 @@ def run_headless(session: FlySession, *, webgl: str = "swiftshader", chromium: s
     args = [*COMMON, *WEBGL[webgl], *extra_args]
     chromium = chromium or find_chromium()         # None: Playwright's own browser
     width, height = config.size or (800, 600)
+    load_before = _load()
     session.serve_in_background()
     base = f"http://127.0.0.1:{session.server.port}/"
     errors: list[str] = []
@@ -120,4 +121,14 @@ def run_headless(session: FlySession, *, webgl: str = "swiftshader", chromium: s
                 browser.close()
     finally:
         session.close()
-    return {"headless": True, "browser": f"Chromium {version}", "webgl": webgl, "flags": args}
+    return {"headless": True, "browser": f"Chromium {version}", "webgl": webgl, "flags": args,
+            "cpus": os.cpu_count(), "load_average": [load_before, _load()]}
+
+
+def _load() -> float | None:
+    """The system's 1-minute load average (None where there is none): how busy the CPUs that do the
+    software rendering were, which the frame rate depends on."""
+    try:
+        return round(os.getloadavg()[0], 2)
+    except (AttributeError, OSError):
+        return None

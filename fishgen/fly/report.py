@@ -24,6 +24,7 @@ MAX_SECONDS = 86_400
 MAX_TEXT = 300
 SCENE = ("particles", "billboards", "distant_particles", "distant_billboards", "clouds", "meshes")
 DRAWN = ("particles", "billboards", "clouds")
+SPLIT = ("update", "submit", "wait")
 CSV_COLUMNS = ("second", "frames", "fps", "particles_drawn", "billboards_drawn", "width", "height",
                "particles_in_scene", "billboards_in_scene", "fps_median", "renderer", "fishgen")
 
@@ -50,12 +51,13 @@ def _members(value: Any, what: str, names: tuple[str, ...]) -> dict[str, Any]:
 
 def check_report(page: Any) -> dict[str, Any]:
     """The page's report, checked and in fishgen's order; a malformed one is a FishgenError."""
-    r = _members(page, "a report", ("window", "seconds", "warmup", "frames", "fps", "scene", "drawn",
+    r = _members(page, "a report", ("window", "seconds", "warmup", "frames", "fps", "scene", "drawn", "split",
                                     "renderer", "path", "seed", "sorts", "per_second"))
     window = _members(r["window"], "window", ("width", "height"))
     fps = _members(r["fps"], "fps", ("median", "p5", "min", "max"))
     scene = _members(r["scene"], "scene", SCENE)
     drawn = _members(r["drawn"], "drawn", DRAWN)
+    split = _members(r["split"], "split", SPLIT)
     rows = r["per_second"]
     if not isinstance(rows, list) or len(rows) > MAX_SECONDS + 1:
         raise FishgenError(f"expected per_second as a list of at most {MAX_SECONDS + 1} rows, found "
@@ -77,6 +79,7 @@ def check_report(page: Any) -> dict[str, Any]:
         "fps": {k: round(_number(fps[k], f"fps {k}", 0, 1e9), 3) for k in ("median", "p5", "min", "max")},
         "scene": {k: int(_number(scene[k], f"scene {k}")) for k in SCENE},
         "drawn": {k: round(_number(drawn[k], f"drawn {k}"), 1) for k in DRAWN},
+        "split": {k: round(_number(split[k], f"split {k}", 0, 1e9), 3) for k in SPLIT},
         "renderer": _text(r["renderer"], "renderer"),
         "path": _text(r["path"], "path"),
         "seed": int(_number(r["seed"], "seed", 0, 2**63)),

@@ -38,7 +38,7 @@ class Sky:
 
     @property
     def distant_particles(self) -> int:
-        return sum(c["lod1"] for c in self.clouds)
+        return sum(v for c in self.clouds for k, v in c.items() if k.startswith("lod"))
 
 
 def load_models(paths: Sequence[str | os.PathLike] = (), *, max_particles: int = DEFAULT_MAX_PARTICLES,

@@ -48,10 +48,11 @@ ALTITUDE = (40.0, 80.0)
 """Default range of cloud base heights (y)."""
 NOISE = 0.5
 """Default noise amount: radii and densities scaled by 1 +- 0.5 x fBm (mostly within +-25 %)."""
-LOD_RATIO = 8.0
-"""A distant cloud's lower level of detail keeps one particle in this many."""
-LOD_MIN_PARTICLES = 256
-"""Clouds with fewer particles get no lower level (it would save nothing worth a switch)."""
-LOD_COVERAGE = 0.2
-"""MSFT_screencoverage: the cloud switches to its lower level when its bounding sphere spans less
-than this share of the view's height (measured: docs/fly.md, "Levels of detail")."""
+LOD_LEVELS = ((8.0, 0.8), (64.0, 0.2))
+"""A cloud's lower levels of detail: (one particle kept in RATIO, shown below COVERAGE), coarser
+down the list. COVERAGE is MSFT_screencoverage's: the share of the view's height the cloud's
+bounding sphere spans. Chosen where the level differs from full detail by no more than two fills
+of the same cloud differ from each other (measured: docs/fly.md, "Levels of detail")."""
+LOD_MIN_PARTICLES = 32
+"""A level is made only if it keeps at least this many particles (a cloud of 256 has a level 1;
+of 2,048, a level 2)."""

@@ -3,15 +3,16 @@
 Each cloud is a root node ``cloud_007`` carrying the cloud's place and turn (translation, rotation
 about +Y) and, in its extras, its bounds in its own frame (``fishgen_cloud``: the box and the
 bounding sphere of its particles, radii included), so an engine culls it as one object. Its
-particles are the child node ``cloud_007_LOD0``. A cloud of at least ``LOD_MIN_PARTICLES`` also has
-a lower level, ``cloud_007_LOD1`` (``coarsen``: one particle in ``LOD_RATIO``, larger), tied to
-LOD0 by the ``MSFT_lod`` node extension, with the switch in ``extras.MSFT_screencoverage``:
+particles are the child node ``cloud_007_LOD0``. It also has lower levels, ``cloud_007_LOD1`` and
+``_LOD2`` (``coarsen``: one particle in 8, in 64, larger; each only if it keeps at least
+``LOD_MIN_PARTICLES``), tied to LOD0 by the ``MSFT_lod`` node extension, with the switches in
+``extras.MSFT_screencoverage`` (``LOD_LEVELS``):
 
-* a client that knows ``MSFT_lod`` (Babylon.js, UnityGLTF: a ``LODGroup``) shows LOD1 when the
-  cloud spans less than ``LOD_COVERAGE`` of the view's height, and nothing below 0;
-* a client that does not (three.js's stock loader, Blender) shows LOD0 only: the LOD1 node is
-  in no scene's node tree, so it is never drawn twice;
-* the names follow Unity's ``_LOD0``/``_LOD1`` convention, for pipelines that key on names.
+* a client that knows ``MSFT_lod`` (Babylon.js, UnityGLTF: a ``LODGroup``) shows level k when the
+  cloud spans less than its coverage of the view's height, and nothing below 0;
+* a client that does not (three.js's stock loader, Blender) shows LOD0 only: the lower levels'
+  nodes are in no scene's node tree, so nothing is drawn twice;
+* the names follow Unity's ``_LOD0``/``_LOD1``/``_LOD2`` convention, for pipelines that key on names.
 
 The scene's extras hold the lighting (``fishgen_light``, as `fishgen clouds` writes it) and the
 sky's plan (``fishgen_sky``).
@@ -27,7 +28,7 @@ from fishgen.clouds.lighting import EXTRAS_KEY
 from fishgen.clouds.model import Cloud
 from fishgen.scene.model import Mesh, Node, Scene
 from fishgen.sky.compose import SkyCloud, SkyPlan
-from fishgen.sky.modes import LOD_COVERAGE, LOD_MIN_PARTICLES, LOD_RATIO
+from fishgen.sky.modes import LOD_LEVELS, LOD_MIN_PARTICLES
 
 LOD_EXTENSION = "MSFT_lod"
 COVERAGE_KEY = "MSFT_screencoverage"
@@ -67,26 +68,33 @@ def sky_scene(plan: SkyPlan | None, clouds: Sequence[SkyCloud], sources: Sequenc
         quads = billboards or bool(cloud.textures)
         lo, hi, sphere = bounds(cloud)
         fact: dict[str, Any] = {"name": p.name, "source": sources[p.source], "particles": len(cloud),
-                                "lod1": 0, "billboards": quads}
+                                **{f"lod{k}": 0 for k in range(1, len(LOD_LEVELS) + 1)}, "billboards": quads}
         place = {"source": sources[p.source], "particles": len(cloud), "scale": list(p.scale),
                  "bounds": {"min": lo, "max": hi}, "sphere": sphere}
         root = scene.add_node(Node(name=p.name, translation=p.position, rotation=p.rotation,
                                    extras={CLOUD_KEY: place}))
         detail = scene.add_mesh(Mesh(f"{p.name}_LOD0", cloud_primitives(cloud, scene, billboards=quads)))
         lod0 = scene.add_node(Node(name=f"{p.name}_LOD0", mesh=detail), parent=root)
-        if lod and len(cloud) >= LOD_MIN_PARTICLES:
-            low = coarsen(cloud, LOD_RATIO)
-            mesh = scene.add_mesh(Mesh(f"{p.name}_LOD1", cloud_primitives(low, scene, billboards=quads)))
-            # in no node tree: only MSFT_lod reaches it (UnityGLTF parents it under the LOD group)
-            scene.nodes.append(Node(name=f"{p.name}_LOD1", mesh=mesh))
-            scene.nodes[lod0].extensions[LOD_EXTENSION] = {"ids": [len(scene.nodes) - 1]}
-            scene.nodes[lod0].extras[COVERAGE_KEY] = [LOD_COVERAGE, 0.0]
-            fact["lod1"] = len(low)
+        if lod:
+            ids, coverage = [], []
+            for k, (ratio, cover) in enumerate(LOD_LEVELS, start=1):
+                if len(cloud) / ratio < LOD_MIN_PARTICLES:
+                    break
+                low = coarsen(cloud, ratio)
+                mesh = scene.add_mesh(Mesh(f"{p.name}_LOD{k}", cloud_primitives(low, scene, billboards=quads)))
+                # in no node tree: only MSFT_lod reaches it (UnityGLTF parents it under the LOD group)
+                scene.nodes.append(Node(name=f"{p.name}_LOD{k}", mesh=mesh))
+                ids.append(len(scene.nodes) - 1)
+                coverage.append(cover)
+                fact[f"lod{k}"] = len(low)
+            if ids:
+                scene.nodes[lod0].extensions[LOD_EXTENSION] = {"ids": ids}
+                scene.nodes[lod0].extras[COVERAGE_KEY] = [*coverage, 0.0]
         facts.append(fact)
     if plan is None:
         return scene, facts
     scene.extras[SKY_KEY] = {"mode": plan.mode.name, "seed": plan.seed, "area": list(plan.area),
                              "altitude": list(plan.altitude), "clouds": len(clouds),
                              "particles": sum(len(c.cloud) for c in clouds),
-                             "lod": {"ratio": LOD_RATIO, "coverage": LOD_COVERAGE} if lod else None}
+                             "lod": [{"ratio": r, "coverage": c} for r, c in LOD_LEVELS] if lod else None}
     return scene, facts
