@@ -128,7 +128,8 @@ def plot(rows: list[dict], path: Path) -> None:
     styles = {"plain": ("tab:gray", "--"), "lit": ("tab:blue", "-"), "lit 0.5": ("tab:green", "-")}
     for ax, size in zip(axes[0], sizes, strict=True):
         for way, (colour, line) in styles.items():
-            pts = sorted((r["particles"], r["fps"]["median"]) for r in rows if r["size"] == size and r["way"] == way)
+            pts = sorted((r["particles"], r["fps"]["median"]) for r in rows
+                         if r["size"] == size and r["way"] == way)
             if pts:
                 ax.plot(*zip(*pts, strict=True), line, marker="o", color=colour, label=f"fishgen fly: {way}")
         if size == "800x600":
@@ -160,7 +161,8 @@ def sky(seconds: float, webgl: str, repeats: int) -> None:
     for k in range(repeats):
         r = measure(assets[0], (800, 600), seconds, webgl, path="fly", seed=k)
         print(f"thick sky, path seed {k}: {r['fps']['median']:.1f} FPS median (p5 {r['fps']['p5']:.1f}), "
-              f"{r['frames']} frames, {r['drawn']['particles']:,.0f} of {r['scene']['particles']:,} particles "
+              f"{r['frames']} frames, {r['drawn']['particles']:,.0f} of {r['scene']['particles']:,} "
+              f"particles "
               f"drawn in {r['drawn']['clouds']:.1f} of {r['scene']['clouds']} clouds; split {r['split']}; "
               f"load {r['load_average']}", flush=True)
 
@@ -169,7 +171,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="500 and 5,000 particles at 800x600 only")
     parser.add_argument("--sky", action="store_true", help="only the thick sky target")
-    parser.add_argument("--seconds", type=float, default=5.0, help="seconds measured per cell (after 2 s warm-up)")
+    parser.add_argument("--seconds", type=float, default=5.0,
+                        help="seconds measured per cell (after 2 s warm-up)")
     parser.add_argument("--webgl", choices=("swiftshader", "llvmpipe"), default="swiftshader")
     parser.add_argument("--repeats", type=int, default=3, help="thick sky runs (path seeds 0..)")
     parser.add_argument("--json", type=Path, default=ROOT / "out" / "fly-chapter5.json")
