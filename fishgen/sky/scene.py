@@ -81,7 +81,8 @@ def sky_scene(plan: SkyPlan | None, clouds: Sequence[SkyCloud], sources: Sequenc
                 if len(cloud) / ratio < LOD_MIN_PARTICLES:
                     break
                 low = coarsen(cloud, ratio)
-                mesh = scene.add_mesh(Mesh(f"{p.name}_LOD{k}", cloud_primitives(low, scene, billboards=quads)))
+                prims = cloud_primitives(low, scene, billboards=quads)
+                mesh = scene.add_mesh(Mesh(f"{p.name}_LOD{k}", prims))
                 # in no node tree: only MSFT_lod reaches it (UnityGLTF parents it under the LOD group)
                 scene.nodes.append(Node(name=f"{p.name}_LOD{k}", mesh=mesh))
                 ids.append(len(scene.nodes) - 1)
