@@ -3,6 +3,8 @@
     python benchmarks/fly.py                 # the whole table (about 15 minutes) and the plot
     python benchmarks/fly.py --quick         # 500 and 5,000 particles at 800x600 only
     python benchmarks/fly.py --sky           # the thick sky target only: fishgen fly --mode thick
+    python benchmarks/fly.py --write         # fishgen sky --mode thick: whole command and its steps
+    python benchmarks/fly.py --screenshot docs/images/sky-thick.png   # the README's picture
 
 The report (section 5.3, Figures 5.4-5.11) rendered clouds of 500 to 50,000 particles "distributed
 randomly in the cloud bounding volume" at 800x600, 1024x768 and 1152x864 on five PCs of 2004
@@ -167,10 +169,72 @@ def sky(seconds: float, webgl: str, repeats: int) -> None:
               f"load {r['load_average']}", flush=True)
 
 
+def write(repeats: int) -> None:
+    """`fishgen sky --mode thick` as a user runs it (its own process, median of ``repeats``), with
+    either shadow map, interleaved; then its steps in one process, to say where the time goes."""
+    import subprocess
+    import tempfile
+
+    from fishgen.exchange import export
+    from fishgen.sky.build import load_models
+    from fishgen.sky.compose import fill_sky, plan_sky
+    from fishgen.sky.modes import ALTITUDE, AREA, MODES
+    from fishgen.sky.scene import sky_scene
+
+    times: dict[str, list[float]] = {"cloud": [], "sky": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "sky.glb"
+        for _ in range(repeats):
+            for shadow in times:
+                started = time.perf_counter()
+                subprocess.run([sys.executable, "-m", "fishgen", "sky", "--mode", "thick", "--shadow-map", shadow,
+                                "-o", str(out)], check=True, cwd=ROOT, capture_output=True)
+                times[shadow].append(time.perf_counter() - started)
+        size = out.stat().st_size
+        for shadow, values in times.items():
+            print(f"fishgen sky --mode thick --shadow-map {shadow}: {statistics.median(values):.2f} s median of "
+                  f"{repeats} ({', '.join(f'{v:.2f}' for v in values)}), {size / 1e6:.1f} MB", flush=True)
+        steps: dict[str, float] = {}
+        started = time.perf_counter()
+        models, files = load_models()
+        plan = plan_sky(MODES["thick"], models, seed=0, area=AREA, altitude=ALTITUDE)
+        clouds = fill_sky(plan, models, noise=0.0)
+        steps["fill"] = time.perf_counter() - started
+        started = time.perf_counter()
+        clouds = fill_sky(plan, models, noise=0.5)
+        steps["fill + noise"] = time.perf_counter() - started
+        for shadow in ("cloud", "sky"):
+            started = time.perf_counter()
+            lit = light_sky(clouds, method=shadow)
+            steps[f"light ({shadow} maps)"] = time.perf_counter() - started
+        started = time.perf_counter()
+        scene, _ = sky_scene(plan, lit, [f.name for f in files])
+        steps["levels of detail + scene"] = time.perf_counter() - started
+        started = time.perf_counter()
+        export(scene, out)
+        steps["write"] = time.perf_counter() - started
+    for step, seconds in steps.items():
+        print(f"  {step:>26}: {seconds:.2f} s")
+    print(f"load average {os.getloadavg()}")
+
+
+def screenshot(path: Path, webgl: str, seconds: float) -> None:
+    """The README's picture: a thick sky flown headless along its seeded path, its last frame."""
+    from fishgen.fly.assets import prepare_assets
+
+    assets, _ = prepare_assets([], mode="thick")
+    config = FlyConfig(size=(1024, 576), timeout=seconds, warmup=1.0, path="fly", report=True, seed=1)
+    session = FlySession(assets, config, title="thick sky")
+    run_headless(session, webgl=webgl, screenshot=path)
+    print(f"wrote {path}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="500 and 5,000 particles at 800x600 only")
     parser.add_argument("--sky", action="store_true", help="only the thick sky target")
+    parser.add_argument("--write", action="store_true", help="only fishgen sky --mode thick's write time")
+    parser.add_argument("--screenshot", type=Path, help="only a picture of a thick sky, flown headless")
     parser.add_argument("--seconds", type=float, default=5.0,
                         help="seconds measured per cell (after 2 s warm-up)")
     parser.add_argument("--webgl", choices=("swiftshader", "llvmpipe"), default="swiftshader")
@@ -181,6 +245,12 @@ def main() -> None:
     print(f"{os.cpu_count()} cores, load average {os.getloadavg()}")
     if args.sky:
         sky(max(args.seconds, 10.0), args.webgl, args.repeats)
+        return
+    if args.write:
+        write(args.repeats)
+        return
+    if args.screenshot:
+        screenshot(args.screenshot, args.webgl, args.seconds)
         return
     counts, sizes = ((500, 5_000), SIZES[:1]) if args.quick else (COUNTS, SIZES)
     args.json.parent.mkdir(parents=True, exist_ok=True)

@@ -12,7 +12,7 @@ Each occupied cell becomes one particle, and what it keeps is what a distant vie
 * its density keeps the optical mass, ``D R^2 = sum(d r^2)``, clipped to 1 (a cell of opaque
   particles that overlap stays opaque, and loses the mass hidden behind the front ones);
 * its light is the weighted mean of the merged particles' light, its colour what that light gives;
-* its cube is the heaviest merged particle's; a texture cloud's particles merge only with particles
+* its cube is its cell's first particle's; a texture cloud's particles merge only with particles
   of the same texture.
 
 Pure numpy over the whole cloud: one ``np.unique`` of the cell keys per searched cell size, then
@@ -41,22 +41,22 @@ def coarsen(cloud: Cloud, ratio: float) -> Cloud:
     target = max(1, int(round(n / ratio)))
     if n == 0 or target >= n:
         return cloud
-    centers = np.asarray(cloud.centers, np.float64)
+    columns = [np.ascontiguousarray(cloud.centers[:, k], np.float64) for k in range(3)]
     group = _texture_group(cloud)
-    lo = centers.min(axis=0)
-    extent = float(np.max(centers.max(axis=0) - lo))
+    lo = np.array([c.min() for c in columns])
+    span = np.array([c.max() for c in columns]) - lo
+    extent = float(span.max())
     if not extent > 0:  # every particle at one point: one particle
-        return _merge(cloud, np.zeros(n, np.intp), 1)
+        return _merge(cloud, columns, np.zeros(n, np.intp), 1, np.zeros(1, np.intp))
     # the occupied cells fall as the cell grows, about as its size to a power between -3 (a solid
     # cloud) and -1 (a sheet): secant steps on log(count) against log(cell), from a solid guess
-    span = centers.max(axis=0) - lo
     cell = float(np.prod(np.maximum(span, extent * 1e-3)) / target) ** (1 / 3)
-    best: tuple[int, np.ndarray, int] | None = None
+    best: tuple[np.ndarray, int, np.ndarray] | None = None
     previous: tuple[float, int] | None = None
     for _ in range(SEARCH_STEPS):
-        inverse, count = _cells(centers, lo, cell, group)
-        if best is None or abs(count - target) < abs(best[2] - target):
-            best = (0, inverse, count)
+        inverse, count, first = _cells(columns, lo, span, cell, group)
+        if best is None or abs(count - target) < abs(best[1] - target):
+            best = (inverse, count, first)
         if abs(count - target) <= TOLERANCE * target:
             break
         slope = -2.5
@@ -66,8 +66,8 @@ def coarsen(cloud: Cloud, ratio: float) -> Cloud:
         previous = (cell, count)
         cell *= (target / count) ** (1 / slope)
     assert best is not None
-    _, inverse, count = best
-    return _merge(cloud, inverse, count)
+    inverse, count, first = best
+    return _merge(cloud, columns, inverse, count, first)
 
 
 def _texture_group(cloud: Cloud) -> np.ndarray | None:
@@ -79,35 +79,36 @@ def _texture_group(cloud: Cloud) -> np.ndarray | None:
     return per_cube[cloud.cube_index]
 
 
-def _cells(centers: np.ndarray, lo: np.ndarray, cell: float,
-           group: np.ndarray | None) -> tuple[np.ndarray, int]:
-    """Each particle's occupied-cell number (0..count-1, in key order) and the count."""
-    ijk = np.floor((centers - lo) / cell).astype(np.int64)
-    span = ijk.max(axis=0) + 1
-    key = (ijk[:, 0] * span[1] + ijk[:, 1]) * span[2] + ijk[:, 2]
+def _cells(columns: list[np.ndarray], lo: np.ndarray, span: np.ndarray, cell: float,
+           group: np.ndarray | None) -> tuple[np.ndarray, int, np.ndarray]:
+    """Each particle's occupied-cell number (0..count-1, in key order), the count, and each cell's
+    first particle."""
+    sides = np.floor(span / cell).astype(np.int64) + 1
+    key = np.zeros(len(columns[0]), np.int64)
+    for k in range(3):     # column by column: an (n, 3) reduction along axis 0 is strided and slow
+        index = ((columns[k] - lo[k]) * (1 / cell)).astype(np.int64)
+        np.minimum(index, sides[k] - 1, out=index)
+        key *= sides[k]
+        key += index
     if group is not None:
         key = key * (int(group.max()) + 1) + group
-    unique, inverse = np.unique(key, return_inverse=True)
-    return inverse.ravel(), len(unique)
+    unique, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+    return inverse.ravel(), len(unique), first
 
 
-def _merge(cloud: Cloud, inverse: np.ndarray, count: int) -> Cloud:
+def _merge(cloud: Cloud, columns: list[np.ndarray], inverse: np.ndarray, count: int,
+           first: np.ndarray) -> Cloud:
     r = cloud.radii.astype(np.float64)
-    d = cloud.density.astype(np.float64)
-    mass = d * r * r
+    mass = cloud.density.astype(np.float64) * r * r
     weight = np.bincount(inverse, mass, minlength=count)
     safe = np.where(weight > 0, weight, 1.0)
-    centers = np.asarray(cloud.centers, np.float64)
-    mean = np.stack([np.bincount(inverse, mass * centers[:, k], minlength=count) for k in range(3)],
-                    axis=1) / safe[:, None]
-    spread = centers - mean[inverse]
-    variance = np.bincount(inverse, mass * (spread * spread).sum(axis=1) / 3, minlength=count) / safe
+    mean = [np.bincount(inverse, mass * c, minlength=count) / safe for c in columns]
+    spread = sum(np.bincount(inverse, mass * c * c, minlength=count) / safe - m * m
+                 for c, m in zip(columns, mean, strict=True))
+    variance = np.maximum(spread, 0) / 3             # per axis
     width2 = np.bincount(inverse, mass * (SIGMA * r) ** 2, minlength=count) / safe
     radius = np.sqrt(width2 + variance) / SIGMA
     density = np.minimum(1.0, weight / np.maximum(radius * radius, np.finfo(np.float64).tiny))
-    # the heaviest particle of each cell names its cube (a stable choice: first of equal masses)
-    order = np.lexsort((-mass, inverse))
-    first = order[np.r_[0, np.flatnonzero(np.diff(inverse[order])) + 1]]
     light = None
     colors = cloud.colors[first]
     if cloud.light is not None and cloud.lighting is not None:
@@ -115,6 +116,6 @@ def _merge(cloud: Cloud, inverse: np.ndarray, count: int) -> Cloud:
 
         light = (np.bincount(inverse, mass * cloud.light, minlength=count) / safe).astype(np.float32)
         colors = lit_colors(light, cloud.lighting)
-    return replace(cloud, centers=mean.astype(np.float32), radii=radius.astype(np.float32),
+    return replace(cloud, centers=np.stack(mean, axis=1).astype(np.float32), radii=radius.astype(np.float32),
                    density=np.maximum(density, np.finfo(np.float32).tiny).astype(np.float32),
                    colors=colors, cube_index=cloud.cube_index[first], light=light)

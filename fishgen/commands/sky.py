@@ -73,9 +73,9 @@ class SkyOptions:
     shadow_map: str = option(click.Choice(("cloud", "sky")), "cloud: each cloud lit on its own shadow map, "
                              "the clouds between it and the sun as occluders (fine, 3-10x slower); sky: one "
                              "map for the whole sky (coarse).", "cloud")
-    lod: bool = option(click.BOOL, "Give each cloud of 256 or more particles a distant level of detail "
-                       "(one particle in 8, larger; MSFT_lod and Unity _LOD0/_LOD1 names).", True, flag=True,
-                       off="--no-lod")
+    lod: bool = option(click.BOOL, "Give each cloud lower levels of detail for distance: one particle in 8 "
+                       "(below 0.8 of the view's height) and in 64 (below 0.2), larger (MSFT_lod; Unity "
+                       "_LOD0/_LOD1/_LOD2 names).", True, flag=True, off="--no-lod")
     billboards: bool = option(click.BOOL, "Particle clouds as crossed-quad billboards instead of points "
                               "(texture clouds always are).", False, flag=True)
     max_particles: int = option(click.IntRange(min=1), "Refuse skies with more particles than this, before "

@@ -47,6 +47,21 @@ def bounds(cloud: Cloud) -> tuple[list[float], list[float], list[float]]:
     return [float(v) for v in lo], [float(v) for v in hi], [*(float(v) for v in middle), reach]
 
 
+def levels(cloud: Cloud) -> list[Cloud]:
+    """The cloud's lower levels of detail (``LOD_LEVELS``), each merged from the one before (fewer
+    particles to sort); a level that would keep fewer than ``LOD_MIN_PARTICLES`` is not made."""
+    from fishgen.clouds.lod import coarsen
+
+    out, low, done = [], cloud, 1.0
+    for ratio, _ in LOD_LEVELS:
+        if len(cloud) / ratio < LOD_MIN_PARTICLES:
+            break
+        low = coarsen(low, ratio / done)
+        done = ratio
+        out.append(low)
+    return out
+
+
 def sky_scene(plan: SkyPlan | None, clouds: Sequence[SkyCloud], sources: Sequence[str], *,
               billboards: bool = False, lod: bool = True) -> tuple[Scene, list[dict[str, Any]]]:
     """The scene, and per cloud what it holds (name, source, particles at each level).
@@ -55,7 +70,6 @@ def sky_scene(plan: SkyPlan | None, clouds: Sequence[SkyCloud], sources: Sequenc
     ``billboards``: particle clouds as crossed-quad billboards (a texture cloud always is).
     ``lod``: lower levels for clouds of at least LOD_MIN_PARTICLES.
     """
-    from fishgen.clouds.lod import coarsen
     from fishgen.clouds.scene import cloud_primitives
 
     scene = Scene(name="sky")
@@ -77,10 +91,7 @@ def sky_scene(plan: SkyPlan | None, clouds: Sequence[SkyCloud], sources: Sequenc
         lod0 = scene.add_node(Node(name=f"{p.name}_LOD0", mesh=detail), parent=root)
         if lod:
             ids, coverage = [], []
-            for k, (ratio, cover) in enumerate(LOD_LEVELS, start=1):
-                if len(cloud) / ratio < LOD_MIN_PARTICLES:
-                    break
-                low = coarsen(cloud, ratio)
+            for k, ((_, cover), low) in enumerate(zip(LOD_LEVELS, levels(cloud)), start=1):
                 prims = cloud_primitives(low, scene, billboards=quads)
                 mesh = scene.add_mesh(Mesh(f"{p.name}_LOD{k}", prims))
                 # in no node tree: only MSFT_lod reaches it (UnityGLTF parents it under the LOD group)

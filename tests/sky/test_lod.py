@@ -16,6 +16,7 @@ from fishgen.sky.build import load_models
 from fishgen.sky.compose import fill_sky, plan_sky
 from fishgen.sky.light import light_sky
 from fishgen.sky.modes import ALTITUDE, AREA, LOD_LEVELS, MODES
+from fishgen.sky.scene import levels
 from tests.conftest import PARAMS
 
 
@@ -25,6 +26,11 @@ def thick_cloud():
     plan = plan_sky(MODES["thick"], models, seed=0, area=AREA, altitude=ALTITUDE)
     one = replace(plan, placements=plan.placements[:1])
     return light_sky(fill_sky(one, models, noise=0.5))[0].cloud, one, models
+
+
+def test_the_levels_keep_one_in_8_and_one_in_64(thick_cloud):
+    cloud = thick_cloud[0]
+    assert [round(len(cloud) / len(low)) for low in levels(cloud)] == [r for r, _ in LOD_LEVELS] == [8, 64]
 
 
 @pytest.mark.parametrize("ratio", [8, 64])
@@ -97,8 +103,8 @@ def _render_difference(thick_cloud, coverage: float) -> dict[str, float]:
     renderer = Renderer(800, 600)
     try:
         shot = {name: renderer.render(cloud_scene(c), camera, None, background)[..., :3].astype(float)
-                for name, c in (("full", cloud), ("other fill", refill), *(
-                    (f"LOD{k}", coarsen(cloud, ratio)) for k, (ratio, _) in enumerate(LOD_LEVELS, 1)))}
+                for name, c in (("full", cloud), ("other fill", refill),
+                                *((f"LOD{k}", low) for k, low in enumerate(levels(cloud), 1)))}
     finally:
         renderer.release()
     inside = np.abs(shot["full"] - np.array(background[:3]) * 255).sum(axis=-1) > 5
