@@ -187,13 +187,13 @@ def write(repeats: int) -> None:
         for _ in range(repeats):
             for shadow in times:
                 started = time.perf_counter()
-                subprocess.run([sys.executable, "-m", "fishgen", "sky", "--mode", "thick", "--shadow-map", shadow,
-                                "-o", str(out)], check=True, cwd=ROOT, capture_output=True)
+                subprocess.run([sys.executable, "-m", "fishgen", "sky", "--mode", "thick", "--shadow-map",
+                                shadow, "-o", str(out)], check=True, cwd=ROOT, capture_output=True)
                 times[shadow].append(time.perf_counter() - started)
         size = out.stat().st_size
         for shadow, values in times.items():
-            print(f"fishgen sky --mode thick --shadow-map {shadow}: {statistics.median(values):.2f} s median of "
-                  f"{repeats} ({', '.join(f'{v:.2f}' for v in values)}), {size / 1e6:.1f} MB", flush=True)
+            print(f"fishgen sky --mode thick --shadow-map {shadow}: {statistics.median(values):.2f} s "
+                  f"median of {repeats} ({', '.join(f'{v:.2f}' for v in values)}), {size / 1e6:.1f} MB", flush=True)
         steps: dict[str, float] = {}
         started = time.perf_counter()
         models, files = load_models()
@@ -222,8 +222,11 @@ def screenshot(path: Path, webgl: str, seconds: float) -> None:
     """The README's picture: a thick sky flown headless along its seeded path, its last frame."""
     from fishgen.fly.assets import prepare_assets
 
-    assets, _ = prepare_assets([], mode="thick")
-    config = FlyConfig(size=(1024, 576), timeout=seconds, warmup=1.0, path="fly", report=True, seed=1)
+    from fishgen.clouds.lighting import Lighting
+
+    # a lower sun behind the camera, so the picture shows sunlit tops and sides
+    assets, _ = prepare_assets([], mode="thick", lighting=Lighting(sun=(0.2, 0.6, 1.0)))
+    config = FlyConfig(size=(1024, 576), timeout=seconds, warmup=1.0, path="still", report=True, seed=1)
     session = FlySession(assets, config, title="thick sky")
     run_headless(session, webgl=webgl, screenshot=path)
     print(f"wrote {path}")

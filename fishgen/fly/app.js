@@ -471,6 +471,13 @@ function plan( box ) {
 		orbit = { centre: sphere.center, distance: sphere.radius / Math.sin( THREE.MathUtils.degToRad( camera.fov / 2 ) ) * 1.1 };
 		return;
 	}
+	if ( config.path === 'still' ) {   // a picture: above the sky's edge, looking down across it
+		camera.position.set( home.x, box.max.y + 0.05 * span.y, home.z + 0.1 * span.z );
+		eye.pitch = - 0.2;
+		camera.rotation.set( eye.pitch, eye.yaw, 0 );
+		orbit = { still: true };
+		return;
+	}
 	if ( config.path !== 'fly' ) return;
 	// a closed loop through seeded waypoints in the middle of the sky, at the clouds' heights
 	const rand = random( config.seed );
@@ -485,6 +492,7 @@ function plan( box ) {
 
 const _at = new THREE.Vector3(), _ahead = new THREE.Vector3();
 function follow( seconds ) {
+	if ( orbit && orbit.still ) return;
 	if ( orbit ) {
 		const a = seconds * Math.PI * 2 / 30;   // once round in 30 s
 		camera.position.set( orbit.centre.x + Math.sin( a ) * orbit.distance, orbit.centre.y + orbit.distance * 0.15, orbit.centre.z + Math.cos( a ) * orbit.distance );

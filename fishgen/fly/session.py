@@ -29,7 +29,8 @@ MAX_REPORT_BYTES = 4 << 20
 class FlyConfig:
     """How the page flies: the window size (None: the browser window's), seconds measured after
     ``warmup`` (None: fly until stopped), a seeded ``path`` ("fly": a loop through the sky; "orbit":
-    round the scene, as chapter 5's test; None: Pakawan's keys and the mouse), ``cloud_scale``: the
+    round the scene, as chapter 5's test; "still": where the keys start; None: Pakawan's keys and the
+    mouse), ``cloud_scale``: the
     clouds are drawn into a buffer of this share of the window's width and height (1: on the window
     itself), and ``baseline``: plain unsorted three.js Points instead (benchmarks/fly.py)."""
 

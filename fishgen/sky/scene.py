@@ -91,7 +91,7 @@ def sky_scene(plan: SkyPlan | None, clouds: Sequence[SkyCloud], sources: Sequenc
         lod0 = scene.add_node(Node(name=f"{p.name}_LOD0", mesh=detail), parent=root)
         if lod:
             ids, coverage = [], []
-            for k, ((_, cover), low) in enumerate(zip(LOD_LEVELS, levels(cloud)), start=1):
+            for k, ((_, cover), low) in enumerate(zip(LOD_LEVELS, levels(cloud), strict=False), start=1):
                 prims = cloud_primitives(low, scene, billboards=quads)
                 mesh = scene.add_mesh(Mesh(f"{p.name}_LOD{k}", prims))
                 # in no node tree: only MSFT_lod reaches it (UnityGLTF parents it under the LOD group)
