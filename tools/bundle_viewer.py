@@ -36,6 +36,7 @@ NODE_MODULES = ROOT / "node_modules"
 PAGES = {
     "viewer": ("fishgen/viewer/app.js", ROOT / "fishgen" / "viewer" / "static", "viewer.min.js"),
     "editor": ("fishgen/editor/app.js", ROOT / "fishgen" / "editor" / "static", "editor.min.js"),
+    "fly": ("fishgen/fly/app.js", ROOT / "fishgen" / "fly" / "static", "fly.min.js"),
 }
 STATIC = PAGES["viewer"][1]
 LICENSE = "THREE-LICENSE"

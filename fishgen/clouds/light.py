@@ -95,17 +95,22 @@ def lit_colors(light: np.ndarray, lighting: Lighting) -> np.ndarray:
 
 
 def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
-                   lighting: Lighting | None = None) -> np.ndarray:
+                   lighting: Lighting | None = None, *, slabs: int | None = None,
+                   grid_cells: int | None = None) -> np.ndarray:
     """The fraction of sunlight (0 to 1) reaching each particle's centre, float32.
 
     ``centers`` (N, 3), ``radii`` (N,) and ``density`` (N,) as in :class:`fishgen.clouds.Cloud`.
+    ``slabs``: go through that many slabs (at most N), whatever the size; by default a cloud of up
+    to SMALL particles goes one particle at a time, a bigger one through FEW_SLABS to SLABS slabs.
+    ``grid_cells``: at most that many cells along a side of the light map (default GRID, FINE_GRID one
+    particle at a time). A sky, far wider than its clouds, needs more (fishgen.sky.light).
     """
     lighting = lighting or Lighting()
     n = len(centers)
     light = np.zeros(n, _F32)
     if n == 0:
         return light
-    small = n <= SMALL
+    small = n <= SMALL and slabs is None
     frame = _frame(np.array(lighting.sun_unit, np.float64))   # rows: sun, across a, across b
     middle = _middle(centers)
     # the depth lives only until it is sorted, the coordinates across the rays only after: a
@@ -114,10 +119,12 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     across = _project(centers, frame[1:], middle, packed=True)      # a + ib, complex64
     lo = np.array([across.real.min(), across.imag.min()], np.float64)
     hi = np.array([across.real.max(), across.imag.max()], np.float64)
-    grid = _Grid(lo, hi, radii, small)
+    grid = _Grid(lo, hi, radii, small, most=grid_cells)
     forward = _F32(lighting.forward_fraction)
-    run = _one_by_one if small else _slabs
-    run(grid, order, across, radii, density, lighting.extinction, forward, light)
+    if small:
+        _one_by_one(grid, order, across, radii, density, lighting.extinction, forward, light)
+    else:
+        _slabs(grid, order, across, radii, density, lighting.extinction, forward, light, slabs)
     np.clip(light, 0, 1, out=light)
     return light
 
@@ -157,7 +164,8 @@ def _one_by_one(grid: _Grid, order, across, radii, density, extinction, forward,
     light[order] = got
 
 
-def _slabs(grid: _Grid, order, across, radii, density, extinction, forward, light) -> None:
+def _slabs(grid: _Grid, order, across, radii, density, extinction, forward, light,
+           count: int | None = None) -> None:
     """A big cloud: SLABS slabs of equal count, each read from and splatted into one light map.
 
     Here a particle passes on the light at each cell as it arrives there (Harris: as it
@@ -169,7 +177,7 @@ def _slabs(grid: _Grid, order, across, radii, density, extinction, forward, ligh
     the light before its slab passed through half the slab's depth at its centre, less its own.
     """
     n = len(order)
-    slabs = min(n, SLABS, max(FEW_SLABS, n // 2048))
+    slabs = min(n, SLABS, max(FEW_SLABS, n // 2048)) if count is None else max(1, min(n, int(count)))
     bounds = [(k * n) // slabs for k in range(slabs + 1)]
 
     packed = across                            # a + ib: one gather a slab instead of two
@@ -354,13 +362,14 @@ def _order(depth: np.ndarray, exact: bool) -> np.ndarray:
 class _Grid:
     """The deep shadow map: ``direct`` and ``scattered`` light on cells across the sun's rays."""
 
-    def __init__(self, lo: np.ndarray, hi: np.ndarray, radii: np.ndarray, small: bool):
+    def __init__(self, lo: np.ndarray, hi: np.ndarray, radii: np.ndarray, small: bool,
+                 most: int | None = None):
         step = max(1, len(radii) // CHUNK)
         typical = float(np.median(radii[::step])) * SIGMA
         sigma_max = float(radii.max()) * SIGMA
         margin = CUT * sigma_max
         extent = float(np.max(hi - lo)) + 2 * margin
-        most = FINE_GRID if small else GRID
+        most = max(16, most) if most is not None else FINE_GRID if small else GRID
         cell = max(extent / (most - 6), typical / CELLS_PER_SIGMA)
         if not (math.isfinite(cell) and cell > 0):
             cell = max(sigma_max, float(np.max(np.abs(hi - lo))), 1.0)

@@ -52,10 +52,15 @@ def cloud_scene(cloud: Cloud, *, billboards: bool = False, name: str = "cloud") 
     scene = Scene(name=name)
     if cloud.lighting is not None:
         scene.extras[EXTRAS_KEY] = cloud.lighting.extras()
-    prims = _billboards(cloud, scene) if billboards else [_points(cloud)]
-    mesh = scene.add_mesh(Mesh(name, prims))
+    mesh = scene.add_mesh(Mesh(name, cloud_primitives(cloud, scene, billboards=billboards)))
     scene.add_node(Node(name=name, mesh=mesh))
     return scene
+
+
+def cloud_primitives(cloud: Cloud, scene: Scene, *, billboards: bool = False) -> list[Primitive]:
+    """The primitives of ``cloud``: one POINTS primitive, or its billboards, whose materials and
+    images are added to ``scene`` (once each: several clouds of one scene share them)."""
+    return _billboards(cloud, scene) if billboards else [_points(cloud)]
 
 
 def _points(cloud: Cloud) -> Primitive:
@@ -97,6 +102,10 @@ def _texture_material(scene: Scene, path: str) -> int:
     from pathlib import Path
 
     name = Path(path).name
+    for k, m in enumerate(scene.materials):  # another cloud of the scene carries it already
+        if m.name == f"cloud texture {name}" and m.texture is not None \
+                and scene.images[m.texture].data == Path(path).read_bytes():
+            return k
     texture = scene.add_image(Image(name, Path(path).read_bytes()))
     return scene.add_material(Material(f"cloud texture {name}", texture=texture, alpha_mode="BLEND",
                                        double_sided=True, unlit=True, roughness=1.0))

@@ -178,7 +178,11 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
                 rotation = [float(v) for v in node.rotation]
             if tuple(node.scale) != (1.0, 1.0, 1.0):
                 scale = [float(v) for v in node.scale]
-        doc["nodes"].append(_obj(mesh=node.mesh, skin=node.skin, rotation=rotation, translation=translation,
+        for name in node.extensions:
+            if name not in doc["extensionsUsed"]:
+                doc["extensionsUsed"].append(name)
+        doc["nodes"].append(_obj(extensions=node.extensions or None, extras=node.extras or None,
+                                 mesh=node.mesh, skin=node.skin, rotation=rotation, translation=translation,
                                  scale=scale, children=list(node.children), matrix=matrix,
                                  name=node.name or None))
     for skin in scene.skins:

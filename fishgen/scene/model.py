@@ -131,6 +131,8 @@ class Node:
     mesh: int | None = None
     skin: int | None = None
     matrix: np.ndarray | None = None    # 4x4 column-vector local matrix; wins over TRS, not animatable
+    extras: dict[str, Any] = field(default_factory=dict)       # application data (a sky cloud's bounds)
+    extensions: dict[str, Any] = field(default_factory=dict)   # glTF node extensions by name (MSFT_lod)
 
 
 @dataclass

@@ -1,0 +1,157 @@
+"""`fishgen sky`: a sky of many lit clouds (Pakawan's thin, medium and thick modes) for engines."""
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import click
+
+from fishgen.clouds.lighting import Lighting
+from fishgen.clouds.model import DEFAULT_MAX_PARTICLES
+from fishgen.commands import QUIET, Command, Events, Made, Output
+from fishgen.options import FILE, FLOAT32_MAX, FiniteRange, group, option, seed_option, textures_option
+from fishgen.sky.modes import ALTITUDE, AREA, MODES, NOISE
+
+
+class Pair(click.ParamType):
+    """``A,B``: two finite numbers within ``low`` .. ``high``; ``ordered``: A <= B; ``positive``: both > 0."""
+
+    def __init__(self, name: str, low: float = -FLOAT32_MAX, high: float = FLOAT32_MAX, *,
+                 ordered: bool = False, positive: bool = False):
+        self.name, self.low, self.high, self.ordered, self.positive = name, low, high, ordered, positive
+        self.what = (f"{name} with two finite numbers from {low:g} to {high:g}"
+                     + (", the first at most the second" if ordered else "")
+                     + (", both above 0" if positive else ""))
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, (tuple, list)):
+            numbers = tuple(value)
+        else:
+            try:
+                numbers = tuple(float(part) for part in str(value).replace(" ", "").split(","))
+            except ValueError:
+                numbers = ()
+        ok = (len(numbers) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                        and math.isfinite(v) and self.low <= v <= self.high for v in numbers))
+        if ok and self.ordered and numbers[0] > numbers[1]:
+            ok = False
+        if ok and self.positive and min(numbers) <= 0:
+            ok = False
+        if not ok:
+            self.fail(f"expected {self.what}, found {value!r}", param, ctx)
+        return tuple(float(v) for v in numbers)
+
+
+def _modes_help() -> str:
+    return "; ".join(f"{m.name}: {m.clouds} clouds, {m.particles:,} particles, "
+                     f"scale {m.scale[0]:g}-{m.scale[1]:g}"
+                     for m in MODES.values())
+
+
+@dataclass(frozen=True)
+class SkyOptions:
+    mode: str = option(click.Choice(tuple(MODES)), f"Pakawan's sky modes ({_modes_help()}).", "medium")
+    area: tuple[float, float] = option(Pair("W,D", 1.0, 1e6, positive=True), "Width (x) and depth (z) of the "
+                                       "sky, centred on the origin, in cube-file units.", AREA,
+                                       metavar="W,D")
+    altitude: tuple[float, float] = option(Pair("LOW,HIGH", -1e6, 1e6, ordered=True), "Range of the "
+                                           "clouds' base heights (y, up).", ALTITUDE, metavar="LOW,HIGH")
+    seed: int = seed_option("It picks every cloud's model, scale, turn, place, fill and noise.")
+    clouds: tuple[Path, ...] = option(FILE, "A cube file (.awn) or texture cloud (.awa) to draw the clouds "
+                                      "from, each varied (scaled, turned, re-filled, noise); give it once "
+                                      "per file.", (), shown_default="the report's two cumulus files "
+                                      "(Tables 4.3, 4.4)", multiple=True, path=True, metavar="CUBES")
+    noise: float = option(FiniteRange(0, 0.9), "Seeded 3D noise on particle sizes and densities: each is "
+                          "scaled by 1 + NOISE x fBm (mostly within +-0.4); 0 turns it off.", NOISE,
+                          metavar="AMOUNT")
+    particles: int | None = option(click.IntRange(1, DEFAULT_MAX_PARTICLES), "Particles in the whole sky, "
+                                   "shared by the clouds by volume.", shown_default="the mode's",
+                                   metavar="N")
+    shadow_map: str = option(click.Choice(("cloud", "sky")), "cloud: each cloud lit on its own shadow map, "
+                             "the clouds between it and the sun as occluders (fine, 3-10x slower); sky: one "
+                             "map for the whole sky (coarse).", "cloud")
+    lod: bool = option(click.BOOL, "Give each cloud lower levels of detail for distance: one particle in 8 "
+                       "(below 0.8 of the view's height) and in 64 (below 0.2), larger (MSFT_lod; Unity "
+                       "_LOD0/_LOD1/_LOD2 names).", True, flag=True, off="--no-lod")
+    billboards: bool = option(click.BOOL, "Particle clouds as crossed-quad billboards instead of points "
+                              "(texture clouds always are).", False, flag=True)
+    max_particles: int = option(click.IntRange(min=1), "Refuse skies with more particles than this, before "
+                                "allocating anything.", DEFAULT_MAX_PARTICLES)
+    textures: Path | None = textures_option("a .awa file's folder, then the textures/ folder beside it (or "
+                                            "beside its parent)")
+    lighting: Lighting = group(Lighting)
+
+
+COMMAND = Command(
+    name="sky",
+    summary="Compose a sky of many lit clouds (thin, medium, thick) for engines.",
+    help="""Compose a sky of many clouds, lit by one sun, as one glTF file.
+
+    Each cloud is a variation of a cloud model (the shipped cumulus files, or
+    --clouds): scaled, turned about the vertical, re-filled with the report's
+    randomized algorithm and roughened by seeded 3D noise, placed in the area
+    and altitude band. The whole sky is lit by one sun (Harris's method, as
+    `fishgen clouds`), clouds shadowing clouds. Each cloud is its own node with
+    its bounds, so engines cull it as one; a distant cloud can switch to its
+    lower level of detail (MSFT_lod; Unity's _LOD0/_LOD1 names).
+
+    \b
+    Examples:
+      fishgen sky --mode thick -o out/sky.glb
+      fishgen sky --mode thin --seed 7 --area 600,600 --altitude 60,90 -o out/thin.glb
+      fishgen sky --clouds params/clouds/table_4_4.awn --clouds params/clouds/sky.awa -o out/mixed.glb
+      fishgen sky --mode medium --sun 1,0.2,0 --noise 0.8 -o out/evening.glb
+    """,
+    options=SkyOptions,
+    run="fishgen.commands.sky:sky",
+    output=Output("Output file: .glb or .gltf (nodes, levels of detail and the lighting need glTF)."),
+)
+
+
+@dataclass(frozen=True)
+class SkyFacts:
+    mode: str
+    clouds: int
+    particles: int
+    distant_particles: int    # in the lower levels of detail, besides `particles`
+    bytes: int
+    seed: int
+
+
+def sky(inputs: Sequence[Path], output: str | os.PathLike, options: SkyOptions = SkyOptions(),
+        events: Events = QUIET) -> Made:
+    """Build the sky and write it atomically; the summary says its clouds, particles and size."""
+    from fishgen.clouds.export import check_output
+    from fishgen.commands.paths import check_inputs, check_targets
+    from fishgen.errors import UsageError
+    from fishgen.exchange import export
+    from fishgen.exchange.registry import FORMATS
+
+    output = Path(output)
+    if output.suffix.lower() not in (".glb", ".gltf"):
+        raise UsageError(f"expected a .glb or .gltf output (a sky's nodes and levels of detail need glTF), "
+                         f"found {output.suffix or 'no extension'!r}")
+    models = tuple(Path(p) for p in options.clouds)
+    check_inputs(models, "sky", [FORMATS["cubes"], FORMATS["texture cubes"]], default=FORMATS["cubes"])
+    check_targets([output], models)
+    total = options.particles if options.particles is not None else MODES[options.mode].particles
+    check_output(output, options.billboards, particles=total)
+    from fishgen.sky.build import build_sky
+
+    built = build_sky(options.mode, seed=options.seed, area=options.area, altitude=options.altitude,
+                      models=models, noise=options.noise, particles=options.particles,
+                      lighting=options.lighting,
+                      shadow_map=options.shadow_map, billboards=options.billboards, lod=options.lod,
+                      textures_dir=options.textures, max_particles=options.max_particles)
+    written = export(built.scene, output)
+    size = sum(p.stat().st_size for p in written)
+    sun = ",".join(f"{v:g}" for v in options.lighting.sun)
+    line = (f"{output}: {built.mode} sky, {len(built.clouds)} clouds, {built.particles:,} particles"
+            + (f" (+{built.distant_particles:,} in distant levels)" if built.distant_particles else "")
+            + f", {size / 1e6:.1f} MB (seed {options.seed}, sun {sun})")
+    facts = SkyFacts(built.mode, len(built.clouds), built.particles, built.distant_particles, size,
+                     options.seed)
+    return Made(tuple(written), (*built.models, *built.textures), (line,), facts)

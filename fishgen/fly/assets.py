@@ -1,0 +1,132 @@
+"""What a fly-through shows, as binary glTF: a sky of a mode, cube files made into clouds, any glb.
+
+* no input and a mode: a sky of that mode (``fishgen sky``'s, with the seed);
+* cube files (.awn, .awa) and a mode: a sky of that mode drawn from them;
+* cube files without a mode: each file one cloud as `fishgen clouds` fills it (input i with seed
+  + i), side by side along +x, lit together, each its own node with its lower level;
+* .glb files as they are (a sky, a fish school, anything: the page flies through it), after
+  fishgen's glTF reader has checked them; .gltf files through that reader into one glb.
+
+Several assets stand side by side along +x in the page.
+"""
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from fishgen.clouds.lighting import Lighting
+from fishgen.clouds.model import DEFAULT_MAX_PARTICLES
+from fishgen.errors import FishgenError, UsageError
+
+MAX_ASSET_BYTES = 1 << 30
+"""Most bytes of glb the page is handed (a browser tab holds about this much; a thick sky is 41 MB)."""
+GAP = 0.25
+"""Cube files stand this share of the wider one apart."""
+
+
+@dataclass(frozen=True)
+class Asset:
+    """One binary glTF the page loads, and where it came from."""
+
+    name: str
+    data: bytes
+    source: str                 # "sky", "cubes" or "glb"
+
+    def __repr__(self) -> str:  # not the bytes
+        return f"Asset({self.name!r}, {len(self.data):,} bytes, {self.source})"
+
+
+CUBES = (".awn", ".awa")
+GLTF = (".glb", ".gltf")
+
+
+def prepare_assets(inputs: Sequence[str | os.PathLike], *, mode: str | None = None, seed: int = 0,
+                   lighting: Lighting | None = None, textures_dir: str | os.PathLike | None = None,
+                   max_particles: int = DEFAULT_MAX_PARTICLES) -> tuple[list[Asset], list[Path]]:
+    """The page's assets for these inputs, and every file read (cube files, their textures, glbs)."""
+    from fishgen.exchange.gltf import glb_bytes
+    from fishgen.sky.build import build_sky
+
+    paths = [Path(p) for p in inputs]
+    for path in paths:
+        if path.suffix.lower() not in CUBES + GLTF:
+            raise FishgenError(f"expected a cube file (.awn, .awa) or a glTF asset (.glb, .gltf), found "
+                               f"{path.suffix or 'no extension'!r}", path)
+        if path.is_dir():
+            raise FishgenError("expected a file, found a directory", path)
+    cubes = [p for p in paths if p.suffix.lower() in CUBES]
+    assets = [p for p in paths if p.suffix.lower() in GLTF]
+    if mode is not None and assets:
+        raise UsageError(f"expected cube files (or none) with --mode, found {assets[0]}: a glTF asset is "
+                         "flown as it is")
+    if mode is None and not paths:
+        raise UsageError("expected INPUT... (cube files, .awa, .glb) or --mode thin|medium|thick, found "
+                         "neither")
+    out: list[Asset] = []
+    read: list[Path] = []
+    if mode is not None:
+        sky = build_sky(mode, seed=seed, models=cubes, lighting=lighting, textures_dir=textures_dir,
+                        max_particles=max_particles)
+        out.append(Asset(f"{mode} sky", glb_bytes(sky.scene), "sky"))
+        read += [*sky.models, *sky.textures]
+    elif cubes:
+        scene, files = cube_files_scene(cubes, seed=seed, lighting=lighting, textures_dir=textures_dir,
+                                        max_particles=max_particles)
+        out.append(Asset(", ".join(p.name for p in cubes), glb_bytes(scene), "cubes"))
+        read += files
+    for path in assets:
+        out.append(Asset(path.name, _glb(path), "glb"))
+        read.append(path)
+    return out, read
+
+
+def _glb(path: Path) -> bytes:
+    """A .glb's bytes as they are, once fishgen's reader has checked them; a .gltf (and its side
+    files, only from its folder) read and written as one glb."""
+    from fishgen.exchange.gltf import glb_bytes
+    from fishgen.exchange.registry import FORMATS
+
+    if not path.is_file():
+        raise FishgenError("expected an existing file, found none", path)
+    size = path.stat().st_size
+    if size > MAX_ASSET_BYTES:
+        raise FishgenError(f"expected at most {MAX_ASSET_BYTES >> 20} MiB of glTF to fly through, found "
+                           f"{size / 2**20:.0f} MiB", path)
+    scene = FORMATS[path.suffix.lower()[1:]].read(path)   # refuses what is not glTF, before the page sees it
+    if path.suffix.lower() == ".glb":
+        return path.read_bytes()
+    return glb_bytes(scene, path)
+
+
+def cube_files_scene(paths: Sequence[Path], *, seed: int = 0, lighting: Lighting | None = None,
+                     textures_dir: str | os.PathLike | None = None,
+                     max_particles: int = DEFAULT_MAX_PARTICLES):
+    """Each cube file one cloud (input i filled with seed + i), side by side along +x, lit together
+    (clouds shadow clouds), each its own node with a lower level: the scene and the files read."""
+    from fishgen.clouds.fill import fill_cloud
+    from fishgen.sky.build import load_models
+    from fishgen.sky.compose import Placement, SkyCloud, model_box
+    from fishgen.sky.light import light_sky
+    from fishgen.sky.scene import sky_scene
+
+    models, files = load_models(paths, max_particles=max_particles, textures_dir=textures_dir)
+    total = sum(m.total for m in models)
+    if total > max_particles:
+        raise FishgenError(f"expected at most {max_particles:,} particles (raise --max-particles), found "
+                           f"{total:,} in {len(models)} files")
+    clouds, edge = [], None
+    for i, (model, path) in enumerate(zip(models, files, strict=True)):
+        if model.total == 0:
+            raise FishgenError("expected a cube file with at least one particle, found none", path)
+        lo, hi = model_box(model)
+        shift = 0.0 if edge is None else edge - float(lo[0]) + GAP * float(hi[0] - lo[0])
+        placement = Placement(name=path.stem, source=i, scale=(1.0, 1.0, 1.0), yaw=0.0,
+                              position=(shift, 0.0, 0.0), particles=model.total, seed=seed + i)
+        clouds.append(SkyCloud(placement, fill_cloud(model, seed=seed + i)))
+        edge = shift + float(hi[0])
+    lit = light_sky(clouds, lighting or Lighting())
+    scene, _ = sky_scene(None, lit, [p.name for p in files])
+    textures = list(dict.fromkeys(Path(c.texture) for m in models for c in m.cubes if c.texture))
+    return scene, [*files, *textures]

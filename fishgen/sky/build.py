@@ -1,0 +1,79 @@
+"""`fishgen sky`'s work as one function: cloud models in, a lit scene of many clouds out."""
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from fishgen.clouds.lighting import Lighting
+from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, CubeFile
+from fishgen.scene.model import Scene
+from fishgen.sky.modes import ALTITUDE, AREA, MODES, NOISE
+
+MODELS = Path(__file__).resolve().parent / "models"
+"""The shipped cloud models: the report's two real editor files (Tables 4.3 and 4.4)."""
+
+
+def shipped_models() -> list[Path]:
+    return sorted(MODELS.glob("*.awn"))
+
+
+@dataclass(frozen=True)
+class Sky:
+    """A composed, lit sky: its scene (write it with :func:`fishgen.exchange.export`) and, per
+    cloud, what it holds."""
+
+    scene: Scene
+    clouds: tuple[dict[str, Any], ...]
+    mode: str
+    seed: int
+    models: tuple[Path, ...]
+    textures: tuple[Path, ...] = ()     # the PNGs texture clouds (.awa) named
+
+    @property
+    def particles(self) -> int:
+        return sum(c["particles"] for c in self.clouds)
+
+    @property
+    def distant_particles(self) -> int:
+        return sum(v for c in self.clouds for k, v in c.items() if k.startswith("lod"))
+
+
+def load_models(paths: Sequence[str | os.PathLike] = (), *, max_particles: int = DEFAULT_MAX_PARTICLES,
+                textures_dir: str | os.PathLike | None = None) -> tuple[list[CubeFile], list[Path]]:
+    """The cube files a sky draws its clouds from: ``paths``, or the shipped models."""
+    from fishgen.clouds.parser import load_cubes
+
+    files = [Path(p) for p in paths] or shipped_models()
+    return [load_cubes(p, max_particles=max_particles, textures_dir=textures_dir) for p in files], files
+
+
+def build_sky(mode: str = "medium", *, seed: int = 0, area: tuple[float, float] = AREA,
+              altitude: tuple[float, float] = ALTITUDE, models: Sequence[str | os.PathLike] = (),
+              noise: float = NOISE, particles: int | None = None, lighting: Lighting | None = None,
+              shadow_map: str = "cloud", billboards: bool = False, lod: bool = True,
+              textures_dir: str | os.PathLike | None = None,
+              max_particles: int = DEFAULT_MAX_PARTICLES) -> Sky:
+    """Compose, fill, light and level a sky of ``mode`` (thin, medium, thick) from ``models`` (cube
+    files, .awn or .awa; default: the shipped ones). Same arguments, same scene, bit for bit."""
+    from fishgen.errors import FishgenError
+    from fishgen.sky.compose import fill_sky, plan_sky
+    from fishgen.sky.light import light_sky
+    from fishgen.sky.scene import sky_scene
+
+    cubes, files = load_models(models, max_particles=max_particles, textures_dir=textures_dir)
+    for cube_file, path in zip(cubes, files, strict=True):
+        if cube_file.total == 0:
+            raise FishgenError("expected a cloud model with at least one particle, found none", path)
+    sky_mode = MODES[mode]
+    total = sky_mode.particles if particles is None else particles
+    if total > max_particles:
+        raise FishgenError(f"expected at most {max_particles:,} particles (raise --max-particles), found "
+                           f"{total:,} for a {mode} sky")
+    plan = plan_sky(sky_mode, cubes, seed=seed, area=area, altitude=altitude, particles=total)
+    clouds = light_sky(fill_sky(plan, cubes, noise=noise), lighting or Lighting(), method=shadow_map)
+    scene, facts = sky_scene(plan, clouds, [p.name for p in files], billboards=billboards, lod=lod)
+    textures = tuple(dict.fromkeys(Path(c.texture) for f in cubes for c in f.cubes if c.texture))
+    return Sky(scene, tuple(facts), mode, seed, tuple(files), textures)

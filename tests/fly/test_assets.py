@@ -1,0 +1,51 @@
+"""What a fly-through shows: a sky of a mode, cube files as clouds, or glTF assets as they are."""
+from __future__ import annotations
+
+import pytest
+
+from fishgen.errors import FishgenError, UsageError
+from fishgen.exchange.gltf_reader import read_gltf
+from fishgen.fly.assets import prepare_assets
+from tests.conftest import PARAMS, ROOT
+
+
+def glb_scene(data: bytes, tmp_path):
+    path = tmp_path / "x.glb"
+    path.write_bytes(data)
+    return read_gltf(path)
+
+
+def test_cube_files_become_one_scene_of_clouds_side_by_side(tmp_path):
+    cubes = [PARAMS / "clouds" / "table_4_3.awn", PARAMS / "clouds" / "table_4_4.awn"]
+    assets, read = prepare_assets(cubes, seed=2)
+    assert len(assets) == 1 and assets[0].source == "cubes" and read == cubes
+    scene = glb_scene(assets[0].data, tmp_path)
+    roots = [scene.nodes[k] for k in scene.roots]
+    assert [n.name for n in roots] == ["table_4_3", "table_4_4"]
+    assert roots[1].translation[0] > roots[0].translation[0]
+    assert scene.counts()["particles"] == 554 + 615
+
+
+def test_a_mode_makes_a_sky_and_glb_files_go_as_they_are(tmp_path):
+    assets, read = prepare_assets([], mode="thin", seed=1)
+    assert assets[0].source == "sky" and assets[0].name == "thin sky"
+    assert glb_scene(assets[0].data, tmp_path).counts()["particles"] == 20_000
+    fish = ROOT / "tests" / "fixtures" / "tiny.glb"
+    assets, read = prepare_assets([fish])
+    assert assets[0].data == fish.read_bytes() and read == [fish]
+
+
+@pytest.mark.parametrize("inputs, mode, error", [
+    ([], None, UsageError), ([ROOT / "tests" / "fixtures" / "tiny.glb"], "thin", UsageError),
+    ([PARAMS / "bonybream.txt"], None, FishgenError),
+])
+def test_what_cannot_be_flown_is_refused_in_one_line(inputs, mode, error):
+    with pytest.raises(error, match="expected"):
+        prepare_assets(inputs, mode=mode)
+
+
+def test_a_damaged_glb_is_refused_before_the_page_sees_it(tmp_path):
+    bad = tmp_path / "bad.glb"
+    bad.write_bytes(b"glTF" + bytes(20))
+    with pytest.raises(FishgenError):
+        prepare_assets([bad])

@@ -1,0 +1,176 @@
+"""`fishgen fly` in a real headless Chromium: reports, Pakawan's keys, culling, levels and sorting."""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import threading
+
+import pytest
+
+from fishgen.commands.fly import FlyOptions, fly
+from fishgen.commands.sky import SkyOptions, sky
+from fishgen.errors import MissingDependency
+from fishgen.fly.assets import prepare_assets
+from fishgen.fly.headless import COMMON, WEBGL
+from fishgen.fly.session import FlyConfig, FlySession
+from tests.conftest import PARAMS
+from tests.fly.conftest import CHROMIUM, needs_chromium
+
+pytestmark = needs_chromium
+
+
+@pytest.fixture(scope="module")
+def thin_sky(tmp_path_factory):
+    path = tmp_path_factory.mktemp("sky") / "thin.glb"
+    made = sky((), path, SkyOptions(mode="thin", seed=2))
+    return path, made.facts
+
+
+def test_a_cube_file_flown_headless_reports_its_particles_and_frames(tmp_path, cli):
+    report = tmp_path / "r.json"
+    run = cli("fly", PARAMS / "clouds" / "table_4_4.awn", "--headless", "--timeout", "3", "--report", report)
+    assert run.returncode == 0, run.stderr
+    r = json.loads(report.read_text())
+    assert r["scene"]["particles"] == 615 and r["scene"]["clouds"] == 1 and r["frames"] > 0
+    assert r["window"] == {"width": 800, "height": 600} and r["seconds"] >= 3
+    assert r["fps"]["min"] <= r["fps"]["p5"] <= r["fps"]["median"] <= r["fps"]["max"]
+    assert r["renderer"] and r["fishgen"] and r["headless"] is True and "--disable-gpu-vsync" in r["flags"]
+    assert "FPS median" in run.stdout and "615 particles" in run.stdout
+
+
+def test_a_sky_flown_headless_reports_its_particles_per_second_in_csv(tmp_path, cli, thin_sky):
+    path, facts = thin_sky
+    report = tmp_path / "r.csv"
+    run = cli("fly", path, "--headless", "--timeout", "3", "--size", "640x480", "--report", report)
+    assert run.returncode == 0, run.stderr
+    rows = list(csv.DictReader(report.open()))
+    assert len(rows) >= 3 and [r["second"] for r in rows[:3]] == ["0", "1", "2"]
+    assert all(r["particles_in_scene"] == str(facts.particles) for r in rows)
+    assert sum(int(r["frames"]) for r in rows) > 0
+    assert rows[0]["width"] == "640" and rows[0]["height"] == "480"
+
+
+def test_a_mode_alone_flies_a_sky_of_that_mode():
+    made = fly((), None, FlyOptions(mode="thin", headless=True, timeout=2, warmup=1))
+    assert made.facts["scene"]["particles"] == 20_000 and made.facts["scene"]["clouds"] == 16
+    assert made.facts["frames"] > 0 and made.facts["mode"] == "thin"
+
+
+@pytest.fixture
+def page(thin_sky):
+    """An interactive page of the thin sky (no path: the keys steer), in headless Chromium."""
+    from playwright.sync_api import sync_playwright
+
+    assets, _ = prepare_assets([thin_sky[0]])
+    session = FlySession(assets, FlyConfig(size=(640, 480), warmup=0.5))
+    session.serve_in_background()
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=CHROMIUM, args=[*COMMON, *WEBGL["swiftshader"]])
+        tab = browser.new_page(viewport={"width": 640, "height": 480})
+        tab.goto(session.url())
+        tab.wait_for_function("window.fishgenFly.loaded && window.fishgenFly.frames > 2", timeout=120_000)
+        yield tab
+        browser.close()
+    session.close()
+
+
+def camera(tab) -> dict:
+    return tab.evaluate("({...window.fishgenFly.camera, speed: window.fishgenFly.speed})")
+
+
+def hold(tab, key: str, seconds: float = 1.5) -> None:
+    frames = tab.evaluate("window.fishgenFly.frames")
+    tab.keyboard.down(key)
+    tab.wait_for_timeout(seconds * 1000)
+    tab.wait_for_function(f"window.fishgenFly.frames > {frames + 2}", timeout=60_000)
+    tab.keyboard.up(key)
+
+
+def test_pakawans_keys_move_and_turn_the_camera(page):
+    start = camera(page)
+    assert start["yaw"] == 0 and start["pitch"] == 0          # looking along -z, into the sky
+    hold(page, "w")
+    ahead = camera(page)
+    dx, dy, dz = (a - b for a, b in zip(ahead["position"], start["position"], strict=True))
+    assert dz < 0 and abs(dx) < 1e-6 * abs(dz) + 1e-9 and abs(dy) < 1e-6 * abs(dz) + 1e-9   # forward
+    hold(page, "s", 0.5)
+    assert camera(page)["position"][2] > ahead["position"][2]                                  # back
+    before = camera(page)
+    hold(page, "d", 0.5)
+    assert camera(page)["position"][0] > before["position"][0]                                 # right
+    hold(page, "ArrowLeft", 0.5)
+    assert camera(page)["yaw"] > 0                                                             # turned left
+    hold(page, "ArrowUp", 0.5)
+    assert camera(page)["pitch"] > 0                                                           # looks up
+    page.keyboard.press("3")
+    assert camera(page)["speed"] == 3
+    page.keyboard.press("1")
+    assert camera(page)["speed"] == 1
+
+
+def test_the_mouse_looks_around(page):
+    before = camera(page)
+    page.mouse.move(320, 240)
+    page.mouse.down()
+    page.mouse.move(220, 240, steps=5)
+    page.mouse.up()
+    page.wait_for_timeout(300)
+    assert camera(page)["yaw"] > before["yaw"]
+
+
+def test_the_overlay_shows_window_size_time_and_fps(page):
+    page.wait_for_timeout(600)
+    text = page.inner_text("#hud")
+    assert text.startswith("640 × 480") and " s " in text and "FPS" in text
+
+
+def test_clouds_out_of_view_are_culled_far_ones_levelled_and_the_rest_sorted_back_to_front(page):
+    units = page.evaluate("window.fishgenFly.inspect()")
+    assert len(units) == 16
+    visible = [u for u in units if u["visible"]]
+    assert 0 < len(visible) < len(units)                     # the clouds behind the camera are culled
+    assert any(u["level"] > 0 for u in visible)              # distant clouds at a lower level
+    tan = math.tan(math.radians(30))
+    for u in visible:
+        cover = u["radius"] / (u["distance"] * tan) if u["distance"] > u["radius"] else 1
+        assert (u["level"] == 0) == (cover >= 0.8 or u["levels"] == 1)
+        assert u["sorted"] and u["disorder"] < 1e-3          # back to front, to a bucket's width
+        assert u["turn"] <= 4.5 and u["moved"] <= 0.06       # re-sorted once the view turned or moved
+    drawn = page.evaluate("window.fishgenFly.drawn")
+    assert drawn["clouds"] == len(visible) and drawn["particles"] == sum(u["particles"] for u in visible)
+
+
+def test_with_a_timeout_the_page_reports_writes_the_file_and_stops_serving(tmp_path, thin_sky):
+    from playwright.sync_api import sync_playwright
+
+    from fishgen.commands import Events
+
+    report = tmp_path / "r.json"
+    notes: list[str] = []
+
+    options = FlyOptions(timeout=1.5, warmup=0.5, report=report)
+    made = fly((thin_sky[0],), None, options, Events(note=notes.append))
+    assert made.lines[0].startswith("http://127.0.0.1:") and made.written == ()
+    served = threading.Thread(target=made.server.serve_forever, daemon=True)
+    served.start()
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=CHROMIUM, args=[*COMMON, *WEBGL["swiftshader"]])
+        tab = browser.new_page()
+        tab.goto(made.lines[0])
+        served.join(timeout=120)
+        browser.close()
+    made.server.server_close()
+    assert not served.is_alive()                             # Pakawan closed its window at the time-out
+    r = json.loads(report.read_text())
+    assert r["headless"] is False and r["frames"] > 0 and any("FPS median" in n for n in notes)
+
+
+def test_headless_without_playwright_says_what_to_install_before_any_work(monkeypatch, tmp_path):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == "playwright" else real(name, *a))
+    with pytest.raises(MissingDependency, match=r"pip install 'fishgen\[fly\]'"):
+        fly((tmp_path / "missing.awn",), None, FlyOptions(headless=True))
