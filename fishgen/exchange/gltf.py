@@ -156,7 +156,8 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
             alphaMode=mat.alpha_mode, alphaCutoff=cutoff, doubleSided=mat.double_sided, name=mat.name))
 
     for mesh in scene.meshes:
-        doc["meshes"].append(_obj(primitives=[_primitive(buf, p) for p in mesh.primitives],
+        names = {"targetNames": list(mesh.target_names)} if mesh.target_names else None  # three.js, Blender
+        doc["meshes"].append(_obj(extras=names, primitives=[_primitive(buf, p) for p in mesh.primitives],
                                   weights=[float(w) for w in mesh.weights], name=mesh.name))
     for node in scene.nodes:
         matrix = rotation = translation = scale = None
@@ -169,14 +170,23 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
                 rotation = [float(v) for v in node.rotation]
             if tuple(node.scale) != (1.0, 1.0, 1.0):
                 scale = [float(v) for v in node.scale]
-        doc["nodes"].append(_obj(mesh=node.mesh, skin=node.skin, rotation=rotation, translation=translation,
-                                 scale=scale, children=list(node.children), matrix=matrix,
-                                 name=node.name or None))
+        lod = extras = None
+        if node.lods:  # levels of detail (MSFT_lod, a Microsoft vendor extension: optional, not required)
+            lod = {"MSFT_lod": {"ids": [int(i) for i in node.lods]}}
+            if "MSFT_lod" not in doc["extensionsUsed"]:
+                doc["extensionsUsed"].append("MSFT_lod")
+            if node.screen_coverage:
+                extras = {"MSFT_screencoverage": [float(c) for c in node.screen_coverage]}
+        doc["nodes"].append(_obj(extensions=lod, extras=extras, mesh=node.mesh, skin=node.skin,
+                                 rotation=rotation, translation=translation, scale=scale,
+                                 children=list(node.children), matrix=matrix, name=node.name or None))
     for skin in scene.skins:
         ibm = np.asarray(skin.inverse_bind_matrices, np.float32).transpose(0, 2, 1)  # column-major
         doc["skins"].append(_obj(inverseBindMatrices=buf.accessor(ibm.reshape(-1, 16), mat4=True),
                                  skeleton=skin.skeleton, joints=list(skin.joints), name=skin.name))
     doc["scenes"].append(_obj(name=scene.name or None, nodes=list(scene.roots)))
+    if scene.hidden_roots:  # not the default scene: clients that know nothing of levels leave it out
+        doc["scenes"].append(_obj(name="levels of detail", nodes=list(scene.hidden_roots)))
     doc["scene"] = 0
 
     for clip in scene.clips:
@@ -188,10 +198,13 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
             smp = ch.sampler
             if id(smp) not in stored:  # a fish's parts share one weights Sampler: look it up once
                 times = buf.accessor(np.asarray(smp.times, np.float32).ravel(), bounds=True)
-                values = np.asarray(smp.values, np.float32)
+                values = np.asarray(smp.values)
+                if values.dtype.kind not in "iu":
+                    values = values.astype(np.float32)
                 if ch.path == "weights":
                     values = values.ravel()  # glTF: SCALAR, (keys x targets) values
-                key = (times, buf.accessor(values), smp.interpolation)
+                # integer rotations and weights are normalized (glTF 2.0 allows them for these outputs)
+                key = (times, buf.accessor(values, normalized=values.dtype.kind in "iu"), smp.interpolation)
                 if key not in known:  # channels with the same keys share one sampler
                     samplers.append({"input": key[0], "interpolation": key[2], "output": key[1]})
                     known[key] = len(samplers) - 1

@@ -109,6 +109,7 @@ class Mesh:
     name: str
     primitives: list[Primitive]
     weights: list[float] = field(default_factory=list)  # default morph weights, one per target
+    target_names: list[str] = field(default_factory=list)  # one per target (glTF extras.targetNames)
 
 
 @dataclass
@@ -131,6 +132,8 @@ class Node:
     mesh: int | None = None
     skin: int | None = None
     matrix: np.ndarray | None = None    # 4x4 column-vector local matrix; wins over TRS, not animatable
+    lods: list[int] = field(default_factory=list)             # MSFT_lod: coarser levels' nodes, finest first
+    screen_coverage: list[float] = field(default_factory=list)  # extras.MSFT_screencoverage, one per level
 
 
 @dataclass
@@ -164,7 +167,9 @@ class Scene:
     """A whole asset. ``roots`` are the top-level nodes. ``source`` is the file a reader read it
     from, and ``note`` what a reader wants the user told (a subsampled cloud); writers ignore both.
     What a builder knows about what it built travels beside the scene, typed
-    (:class:`fishgen.assembly.fish.FishFacts`), never inside it."""
+    (:class:`fishgen.assembly.fish.FishFacts`), never inside it. ``hidden_roots`` are written as a
+    second glTF scene, which clients show only when asked: the coarser levels of detail a node's
+    ``lods`` names (MSFT_lod), kept out of sight of clients that know nothing of levels."""
 
     name: str = ""
     nodes: list[Node] = field(default_factory=list)
@@ -176,6 +181,7 @@ class Scene:
     clips: list[Clip] = field(default_factory=list)
     source: str | None = None
     note: str | None = None
+    hidden_roots: list[int] = field(default_factory=list)  # a second glTF scene's: coarser levels of detail
 
     # -- building ------------------------------------------------------------------
     def add_node(self, node: Node, parent: int | None = None) -> int:

@@ -33,11 +33,20 @@ def slerp(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
     return (np.sin((1 - s) * theta) * a + np.sin(s * theta) * b) / np.sin(theta)
 
 
+def dequantized(values: np.ndarray) -> np.ndarray:
+    """Key values as floats: normalized integers (a compact file's rotations and weights) divided by
+    their type's largest value, as glTF reads them, and never below -1."""
+    raw = np.asarray(values)
+    if raw.dtype.kind in "iu":
+        return np.maximum(raw.astype(np.float64) / np.iinfo(raw.dtype).max, -1.0)
+    return raw.astype(np.float64)
+
+
 def sample(channel: Channel, t: float) -> np.ndarray:
     """The channel's value at time ``t`` seconds."""
     smp = channel.sampler
     times = np.asarray(smp.times, float).ravel()
-    values = np.asarray(smp.values, float)
+    values = dequantized(smp.values)
     cubic = smp.interpolation == "CUBICSPLINE"
     keys = values.reshape(len(times), 3, -1) if cubic else values.reshape(len(times), -1)
 
