@@ -170,9 +170,7 @@ def deformed(scene: Scene, node: int, prim: Primitive, posed: Pose) -> tuple[np.
         skin = scene.skins[skin_index]
         joint_mats = np.stack([posed.world[j] for j in skin.joints]) @ np.asarray(skin.inverse_bind_matrices)
         joints = np.asarray(prim.attributes["JOINTS_0"], np.int64)
-        wts = np.asarray(prim.attributes["WEIGHTS_0"], np.float64)
-        if wts.dtype.kind in "iu":
-            wts = wts / np.iinfo(prim.attributes["WEIGHTS_0"].dtype).max
+        wts = dequantized(prim.attributes["WEIGHTS_0"])  # normalized integers read as glTF reads them
         blend = np.einsum("nk,nkij->nij", wts, joint_mats[joints])  # (n, 4, 4) per vertex
         out = np.einsum("nij,nj->ni", blend[:, :3, :3], pos) + blend[:, :3, 3]
         if nrm is not None:
