@@ -172,7 +172,8 @@ def fishgen_play(scene: Scene, clip: str, times: np.ndarray, probe_points: np.nd
             meshes[f"{name}#{k}"][2].append(nrm)
             everything.append(pos)
         tracks.append(np.concatenate(everything)[nearest])
-    return Played(times, {k: (f, np.array(p), np.array(n)) for k, (f, p, n) in meshes.items()}, np.array(tracks))
+    arrays = {k: (f, np.array(p), np.array(n)) for k, (f, p, n) in meshes.items()}
+    return Played(times, arrays, np.array(tracks))
 
 
 class ThreeEngine:
@@ -189,8 +190,9 @@ class ThreeEngine:
         page.wait_for_function("window.harnessReady === true", timeout=30_000)
 
     def play(self, name: str, clip: str, times: np.ndarray, probe_points: np.ndarray) -> Played:
+        url = f"{self.browser.base}/assets/{name}"
         result = self.browser.page.evaluate("([u, c, t]) => window.poseTracks(u, c, t)",
-                                            [f"{self.browser.base}/assets/{name}", clip, [float(t) for t in times]])
+                                            [url, clip, [float(t) for t in times]])
         if "error" in result:
             raise AssertionError(f"three.js: {result['error']}")
         meshes = {}
@@ -211,6 +213,11 @@ class ThreeEngine:
         return self.play(name, clip, np.array([0.0]), np.zeros((0, 3))).meshes
 
     def frame_rate(self, name: str, frames: int = 30, size: tuple[int, int] = (960, 540)) -> dict:
+        """Milliseconds a frame of the whole file's animation takes to play and draw (a fresh page each
+        time: nothing of one file's run stays for the next)."""
+        page = self.browser.page
+        page.goto(f"{self.browser.base}/harness/harness.html")
+        page.wait_for_function("window.harnessReady === true", timeout=30_000)
         result = self.browser.page.evaluate("([u, f, w, h]) => window.schoolFrameRate(u, f, w, h)",
                                             [f"{self.browser.base}/assets/{name}", frames, *size])
         if "error" in result:
@@ -229,8 +236,8 @@ def blender_play(path: Path, clips: dict[str, np.ndarray], probe_points: np.ndar
         spec = Path(tmp) / "spec.json"
         spec.write_text(json.dumps({"probes": probe_points.tolist(),
                                     "clips": {k: [float(t) for t in v] for k, v in clips.items()}}))
-        run = subprocess.run([BPY, str(HERE / "blender_engine.py"), str(path), str(spec)], capture_output=True,
-                             text=True, timeout=1200)
+        run = subprocess.run([BPY, str(HERE / "blender_engine.py"), str(path), str(spec)],
+                             capture_output=True, text=True, timeout=1200)
     if run.returncode != 0:
         raise RuntimeError(run.stderr[-2000:])
     report = json.loads(next(line for line in run.stdout.splitlines() if line.startswith("{")))
@@ -260,7 +267,8 @@ def silhouette(scene: Scene, size: tuple[int, int] = (1024, 512), t: float | Non
     from PIL import Image, ImageDraw
 
     posed = pose(scene, t, clip)
-    tris = [deformed(scene, n, p, posed)[0][np.asarray(p.indices)] for n, p in scene.drawn() if p.indices is not None]
+    tris = [deformed(scene, n, p, posed)[0][np.asarray(p.indices)]
+            for n, p in scene.drawn() if p.indices is not None]
     tri = np.concatenate(tris)[..., [2, 1]]
     if box is None:
         lo, hi = tri.reshape(-1, 2).min(0), tri.reshape(-1, 2).max(0)
@@ -297,7 +305,8 @@ def fin_gap(scene: Scene, clip: str, times: np.ndarray) -> float:
     rest = pose(scene)
     body = [(n, p) for name, n, p in parts if name == "body"]
     fins = [(n, p) for name, n, p in parts if name != "body"]
-    body_rest = trimesh.Trimesh(deformed(scene, *body[0], rest)[0], np.asarray(body[0][1].indices), process=False)
+    faces = np.asarray(body[0][1].indices)
+    body_rest = trimesh.Trimesh(deformed(scene, *body[0], rest)[0], faces, process=False)
     points = np.concatenate([deformed(scene, n, p, rest)[0] for n, p in scene.drawn()])
     length = float(np.ptp(points[:, 2]))
     touching = []
@@ -307,7 +316,7 @@ def fin_gap(scene: Scene, clip: str, times: np.ndarray) -> float:
     worst = 0.0
     for t in times:
         posed = pose(scene, float(t), clip)
-        surface = trimesh.Trimesh(deformed(scene, *body[0], posed)[0], np.asarray(body[0][1].indices), process=False)
+        surface = trimesh.Trimesh(deformed(scene, *body[0], posed)[0], faces, process=False)
         for (n, p), idx in zip(fins, touching, strict=True):
             if len(idx):
                 _, d, _ = trimesh.proximity.closest_point(surface, deformed(scene, n, p, posed)[0][idx])

@@ -71,7 +71,8 @@ def test_every_clip_is_in_the_file_and_valid(written):
     assert list(animations) == list(CLIPS)
 
 
-@pytest.mark.parametrize("clip,hz,ptp", [("swim", 1.5, 0.2), ("idle", IDLE_WAVE_HZ, 0.2 * IDLE_WAVE_AMPLITUDE),
+@pytest.mark.parametrize("clip,hz,ptp", [("swim", 1.5, 0.2),
+                                         ("idle", IDLE_WAVE_HZ, 0.2 * IDLE_WAVE_AMPLITUDE),
                                          ("sprint", 1.5 * SPRINT_SPEED, 0.2)])
 def test_swimming_clips_beat_at_their_frequency(written, clip, hz, ptp):
     """Tail frequency from the Strouhal number (0.3): 1.5 beats per body length; sprint at 3 body
@@ -124,7 +125,7 @@ def test_looping_clips_close_and_all_clips_drive_the_same_targets_and_fins(writt
         widths = {v.shape[1] for (n, p), (_, v) in channels.items() if p == "weights"}
         assert widths == {len(fish.facts.targets)}
         if clip != "burst":
-            for (_, p), (times, values) in channels.items():
+            for (_, p), (_, values) in channels.items():
                 assert np.allclose(values[0], values[-1], atol=1e-6), (clip, p)
     assert all(d == driven[0] for d in driven)
     names = doc.meshes[0].extras["targetNames"]
@@ -136,7 +137,8 @@ def test_fins_scull_when_idle_and_fold_in_a_sprint(written):
 
     def swing(clip):
         doc, channels = node_channels(path, animations[clip])
-        (_, q), = [v for (n, p), v in channels.items() if doc.nodes[n].name == "pectoral_fin_left" and p == "rotation"]
+        (_, q), = [v for (n, p), v in channels.items()
+                   if doc.nodes[n].name == "pectoral_fin_left" and p == "rotation"]
         return np.degrees(2 * np.arcsin(np.clip(np.linalg.norm(q[:, :3], axis=1), 0, 1)))
 
     assert swing("idle").max() >= max(2 * swing("swim").max(), 10.0) - 1e-3

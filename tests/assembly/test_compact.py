@@ -5,7 +5,12 @@ import numpy as np
 import pygltflib
 import pytest
 
-from fishgen.assembly.compact import compact_clips, quantize_rotations, quantize_weights, rotation_error_degrees
+from fishgen.assembly.compact import (
+    compact_clips,
+    quantize_rotations,
+    quantize_weights,
+    rotation_error_degrees,
+)
 from fishgen.assembly.fish import make_fish
 from fishgen.exchange import export
 from fishgen.exchange.gltf_reader import read_gltf

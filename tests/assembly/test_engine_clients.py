@@ -1,7 +1,8 @@
 """The issue's fish as three.js and Blender play it: the finest level only, each clip as fishgen poses
 it, and bent bodies shaded bent (normals within 5 degrees of the posed surface's own).
 
-    fishgen build params/bonybream.txt --lods 32x24,16x12,8x6 --merge --clips swim,idle,turn_left,turn_right,burst
+    fishgen build params/bonybream.txt --lods 32x24,16x12,8x6 --merge \
+        --clips swim,idle,turn_left,turn_right,burst
 
 three.js runs in the client matrix's headless Chromium; Blender needs a Python with PyPI's `bpy`
 ($FISHGEN_BPY_PYTHON or /tmp/bpyvenv/bin/python). Each is skipped where it is missing.
@@ -106,4 +107,5 @@ def test_blender_shows_the_finest_level_and_plays_one_action_per_clip(fish):
         print(clip, {k: f"{a[k]:.3f}/{b[k]:.3f}" for k in a})
         assert np.abs(ours.probes - theirs).max() < 5e-3 * probes.length, clip
         assert b["tail"] == pytest.approx(a["tail"], rel=0.02)
-        assert b["bend"] == pytest.approx(a["bend"], abs=0.02) and b["bend_min"] == pytest.approx(a["bend_min"], abs=0.02)
+        assert b["bend"] == pytest.approx(a["bend"], abs=0.02)
+        assert b["bend_min"] == pytest.approx(a["bend_min"], abs=0.02)

@@ -65,7 +65,8 @@ def test_one_glb_holds_every_level_and_names_them_for_msft_lod_and_unity(levels)
     ids = finest[0].extensions["MSFT_lod"]["ids"]
     assert [doc.nodes[i].name for i in ids] == ["bonybream_LOD1", "bonybream_LOD2"]
     coverage = finest[0].extras["MSFT_screencoverage"]
-    assert len(coverage) == 3 and coverage == sorted(coverage, reverse=True) and 0 < coverage[-1] < coverage[0] <= 1
+    assert len(coverage) == 3 and coverage == sorted(coverage, reverse=True)
+    assert 0 < coverage[-1] < coverage[0] <= 1
     # the default scene reaches the finest level only; the coarser ones stand in the second scene
     reach, stack = set(), list(doc.scenes[doc.scene].nodes)
     while stack:

@@ -44,14 +44,16 @@ def test_one_mesh_two_primitives_a_joint_per_moving_fin(bony, swim, tmp_path):
     moving = MOVING | ({"caudal_fin"} if swim == "fins" else set())
     assert joints[0] == "bonybream" and set(joints[1:]) == moving
     mesh_node = next(n for n in doc.nodes if n.mesh is not None)
-    assert doc.nodes.index(mesh_node) in doc.scenes[0].nodes and not mesh_node.translation  # a root, as glTF asks
+    assert doc.nodes.index(mesh_node) in doc.scenes[0].nodes      # a root, as glTF asks of skinned meshes
+    assert not mesh_node.translation
     prims = scene.meshes[0].primitives
     body_joints = prims[0].attributes["JOINTS_0"]
     assert not body_joints.any() and (prims[0].attributes["WEIGHTS_0"][:, 0] == 255).all()  # body on the root
     assert set(np.unique(prims[1].attributes["JOINTS_0"][:, 0])) == set(range(len(joints)))
     targets = len(fish.facts.targets)
     assert targets == (7 if swim == "body" else 0) and all(len(p.targets) == targets for p in prims)
-    channels = {a.name: {(doc.nodes[c.target.node].name, c.target.path) for c in a.channels} for a in doc.animations}
+    channels = {a.name: {(doc.nodes[c.target.node].name, c.target.path) for c in a.channels}
+                for a in doc.animations}
     assert len({frozenset(v) for v in channels.values()}) == 1      # every clip drives the same things
 
 

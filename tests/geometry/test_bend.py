@@ -54,7 +54,8 @@ def _targets(positions):
 
 def _client_normals(positions, faces, moves, weights):
     """What a glTF client shades with: normalize(n0 + sum w_i * delta_i)."""
-    n = vertex_normals(positions, faces) + np.einsum("k,knc->nc", weights, normal_deltas(positions, faces, moves))
+    deltas = normal_deltas(positions, faces, moves)
+    n = vertex_normals(positions, faces) + np.einsum("k,knc->nc", weights, deltas)
     return n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
@@ -80,8 +81,9 @@ def test_turning_the_cross_sections_would_not_blend_exactly():
     kappa = np.radians(110.0)
     u = (PIVOT - (nose - positions[:, 2]) / length) * length
     phi = kappa * u / length
-    rigid = np.stack([length / kappa * (1 - np.cos(phi)) + positions[:, 0] * np.cos(phi), positions[:, 1],
-                      positions[:, 2] - u + length / kappa * np.sin(phi) - positions[:, 0] * np.sin(phi)], axis=1)
+    x, y, z = positions.T
+    rigid = np.stack([length / kappa * (1 - np.cos(phi)) + x * np.cos(phi), y,
+                      z - u + length / kappa * np.sin(phi) - x * np.sin(phi)], axis=1)
     moves = (rigid - positions)[None]
     half = positions + 0.5 * moves[0]
     assert _angles(_client_normals(positions, faces, moves, np.array([0.5])),

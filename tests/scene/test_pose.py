@@ -135,8 +135,9 @@ def test_normalized_integer_skin_weights_read_as_fractions():
     ibm = np.stack([np.eye(4), np.eye(4)])
     ibm[1][:3, 3] = [0, 0, -1]
     clip = Clip("bend", [channel(2, "rotation", [0.0, 1.0], np.stack([_qy(0), _qy(90)]))])
-    scene = scene_of(Node("skinned", mesh=0, skin=0), Node("j0", children=[2]), Node("j1", translation=(0.0, 0.0, 1.0)),
-                     roots=(0, 1), meshes=[Mesh("m", [prim])], skins=[Skin("s", [1, 2], ibm)], clips=[clip])
+    scene = scene_of(Node("skinned", mesh=0, skin=0), Node("j0", children=[2]),
+                     Node("j1", translation=(0.0, 0.0, 1.0)), roots=(0, 1), meshes=[Mesh("m", [prim])],
+                     skins=[Skin("s", [1, 2], ibm)], clips=[clip])
     assert np.allclose(deformed(scene, 0, prim, pose(scene))[0], positions)       # not 255 times as far
     bent, _ = deformed(scene, 0, prim, pose(scene, 1.0, "bend"))
     assert np.allclose(bent[0], [1, 0, 1]) and np.allclose(bent[1], [127 / 255, 0, 1 + 128 / 255], atol=1e-6)

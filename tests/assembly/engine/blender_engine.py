@@ -91,7 +91,8 @@ def main(path: Path, spec: dict) -> dict:
     every = np.concatenate(rest)
     probes = np.asarray(spec["probes"], float)
     nearest = [int(np.argmin(np.linalg.norm(every - p, axis=1))) for p in probes]
-    found = float(max(np.linalg.norm(every[n] - p) for n, p in zip(nearest, probes))) if len(probes) else 0.0
+    gaps = [np.linalg.norm(every[n] - p) for n, p in zip(nearest, probes, strict=True)]
+    found = float(max(gaps)) if gaps else 0.0
     clips = {}
     for name, times in spec["clips"].items():
         _use_clip(name)
@@ -110,4 +111,5 @@ def main(path: Path, spec: dict) -> dict:
 
 
 if __name__ == "__main__":
-    print(json.dumps(main(Path(sys.argv[1]).resolve(), json.loads(Path(sys.argv[2]).read_text()))), flush=True)
+    spec = json.loads(Path(sys.argv[2]).read_text())
+    print(json.dumps(main(Path(sys.argv[1]).resolve(), spec)), flush=True)
