@@ -113,6 +113,53 @@ class Colour(click.ParamType):
         return int(r), int(g), int(b), int(a)
 
 
+class Lods(click.ParamType):
+    """``32x24,16x12,8x6``: levels of detail as BodySections x CircleSections, finest first, each
+    level with fewer sections than the one before; at most ``most`` levels, each count 3 to ``high``."""
+
+    name = "BxC,..."
+
+    def __init__(self, most: int = 8, high: int = 1024):
+        self.most, self.high = most, high
+        self.what = (f"levels BODIESxCIRCLES from finest to coarsest (e.g. 32x24,16x12,8x6): at most {most}, "
+                     f"each count 3 to {high}")
+
+    def convert(self, value, param, ctx):
+        import re
+
+        if isinstance(value, tuple):
+            return value
+        parts = [p.strip() for p in str(value).split(",")]
+        levels = []
+        for part in parts:
+            m = re.fullmatch(r"(\d{1,5})\s*[xX×]\s*(\d{1,5})", part)
+            if not m or not all(3 <= int(v) <= self.high for v in m.groups()):
+                self.fail(f"expected {self.what}, found {value!r}", param, ctx)
+            levels.append((int(m[1]), int(m[2])))
+        if not 1 <= len(levels) <= self.most or any(
+                b1 * c1 <= b2 * c2 for (b1, c1), (b2, c2) in zip(levels, levels[1:], strict=False)):
+            self.fail(f"expected {self.what}, found {value!r}", param, ctx)
+        return tuple(levels)
+
+
+class Names(click.ParamType):
+    """``a,b,c``: distinct names, each one of ``choices``, in the order given."""
+
+    name = "NAME,..."
+
+    def __init__(self, choices: tuple[str, ...]):
+        self.choices = choices
+        self.what = f"names from {', '.join(choices)}, separated by commas, each once"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, tuple):
+            return value
+        names = tuple(p.strip() for p in str(value).split(","))
+        if not names or any(n not in self.choices for n in names) or len(set(names)) != len(names):
+            self.fail(f"expected {self.what}, found {value!r}", param, ctx)
+        return names
+
+
 def _finite_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 

@@ -25,7 +25,8 @@ tail within 0.5 % of the wave's amplitude."""
 
 
 def wave_nodes(scene: Scene) -> list[int]:
-    """Nodes whose meshes carry the body-wave targets."""
+    """Nodes whose meshes carry the body-wave targets (and no others: a weights key array of the
+    wave's four drives them)."""
     return [i for i, node in enumerate(scene.nodes) if node.mesh is not None
             and len(scene.meshes[node.mesh].weights) == TARGETS]
 

@@ -8,10 +8,11 @@ from pathlib import Path
 
 import click
 
+from fishgen.assembly.clip_names import CLIP_NAMES, DEFAULT_CLIPS
 from fishgen.assembly.swim_modes import DEFAULT_SPEED
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output, each_input
 from fishgen.exchange.registry import MESHES, extensions, formats
-from fishgen.options import FiniteRange, fins_option, option, swim_option, textures_option
+from fishgen.options import FiniteRange, Lods, Names, fins_option, option, swim_option, textures_option
 
 FISH_FORMATS = formats(writable=True, holding=[MESHES])
 
@@ -32,6 +33,16 @@ class BuildOptions:
                           "second; the tail beats at Strouhal number 0.3, rounded to a whole number of beats "
                           "in the loop.", DEFAULT_SPEED, metavar="BL/S")
     textures: Path | None = textures_option("the species file's folder, then the textures/ folder beside it")
+    lods: tuple[tuple[int, int], ...] | None = option(
+        Lods(), "Levels of detail, BodySections x CircleSections from finest to coarsest: one glTF holds "
+        "them all (MSFT_lod on the finest, screen-coverage switch points; clients without levels of detail "
+        "show the finest).", shown_default="the species file's own level", metavar="BxC,...")
+    merge: bool = option(click.BOOL, "One skinned mesh of two primitives (opaque body, fins): two draw calls "
+                         "a fish instead of one per part; fins swing on joints.", False, flag=True)
+    clips: tuple[str, ...] = option(Names(CLIP_NAMES), "Clips to write, each looping but burst: "
+                                    f"{', '.join(CLIP_NAMES)}.", DEFAULT_CLIPS, metavar="NAME,...")
+    compact: bool = option(click.BOOL, "Rotation keys and morph weights as normalized 16-bit integers "
+                           "(core glTF 2.0), about half their size.", False, flag=True)
 
 
 COMMAND = Command(
@@ -86,7 +97,8 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
             species = load_species(source, options.textures)
             check_targets([target], species.side_files)
             fish = make_fish(species, fins=options.fins, length=options.length, fps=options.fps,
-                             swim=options.swim, speed=options.speed)
+                             swim=options.swim, speed=options.speed, lods=options.lods, merge=options.merge,
+                             clips=options.clips, compact=options.compact)
             files = export(fish.scene, target, require=[MESHES])
             read += [source, *species.side_files]
             written += files
@@ -102,11 +114,18 @@ def summary(fish, target: Path, written: list[Path]) -> str:
     scene, facts = fish.scene, fish.facts
     fmt = by_extension(target)
     dropped = lost(fmt, scene) if fmt is not None else []
-    animated = facts.clip_seconds is not None and "node animation" not in dropped
-    motion = (f"swim loop {facts.clip_seconds:.2f} s" if animated
-              else "rest pose only" if facts.clip_seconds is not None else "no animation")
+    animated = bool(facts.clips) and "node animation" not in dropped
+    motion = (f"swim loop {facts.clip_seconds:.2f} s" if animated and facts.clip_seconds is not None
+              else "rest pose only" if facts.clips else "no animation")
     if animated and facts.tail_beat_hz is not None:
         motion += f", body wave {facts.tail_beat_hz:.2f} Hz"
+    others = [c for c in facts.clips if c.name != "swim"]
+    if animated and others:
+        motion += ", clips " + ", ".join(f"{c.name} {c.seconds:.2f} s" for c in others)
+    if len(facts.levels) > 1 and fmt is not None and fmt.name in ("glb", "gltf"):
+        motion += ", levels " + ", ".join(f"{lv.bodies}x{lv.circles} ({lv.triangles})" for lv in facts.levels)
+    if facts.merged:
+        motion += f", merged ({facts.draw_calls} draw calls)"
     listed = ", ".join(dropped[:-1]) + (" or " if len(dropped) > 1 else "") + dropped[-1] if dropped else ""
     note = f" ({fmt.extensions[0][1:].upper()} holds no {listed})" if dropped and fmt else ""
     return (f"{target}: {scene.name}, {scene.counts()['triangles']} triangles, "

@@ -165,7 +165,8 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
             alphaMode=mat.alpha_mode, alphaCutoff=cutoff, doubleSided=mat.double_sided, name=mat.name))
 
     for mesh in scene.meshes:
-        doc["meshes"].append(_obj(primitives=[_primitive(buf, p) for p in mesh.primitives],
+        names = {"targetNames": list(mesh.target_names)} if mesh.target_names else None  # three.js, Blender
+        doc["meshes"].append(_obj(extras=names, primitives=[_primitive(buf, p) for p in mesh.primitives],
                                   weights=[float(w) for w in mesh.weights], name=mesh.name))
     for node in scene.nodes:
         matrix = rotation = translation = scale = None
@@ -178,10 +179,15 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
                 rotation = [float(v) for v in node.rotation]
             if tuple(node.scale) != (1.0, 1.0, 1.0):
                 scale = [float(v) for v in node.scale]
-        for name in node.extensions:
+        extensions, extras = dict(node.extensions), dict(node.extras)
+        if node.lods:  # levels of detail (MSFT_lod, a Microsoft vendor extension: optional, not required)
+            extensions["MSFT_lod"] = {"ids": [int(i) for i in node.lods]}
+            if node.screen_coverage:
+                extras["MSFT_screencoverage"] = [float(c) for c in node.screen_coverage]
+        for name in extensions:
             if name not in doc["extensionsUsed"]:
                 doc["extensionsUsed"].append(name)
-        doc["nodes"].append(_obj(extensions=node.extensions or None, extras=node.extras or None,
+        doc["nodes"].append(_obj(extensions=extensions or None, extras=extras or None,
                                  mesh=node.mesh, skin=node.skin, rotation=rotation, translation=translation,
                                  scale=scale, children=list(node.children), matrix=matrix,
                                  name=node.name or None))
@@ -190,6 +196,8 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
         doc["skins"].append(_obj(inverseBindMatrices=buf.accessor(ibm.reshape(-1, 16), mat4=True),
                                  skeleton=skin.skeleton, joints=list(skin.joints), name=skin.name))
     doc["scenes"].append(_obj(extras=scene.extras or None, name=scene.name or None, nodes=list(scene.roots)))
+    if scene.hidden_roots:  # not the default scene: clients that know nothing of levels leave it out
+        doc["scenes"].append(_obj(name="levels of detail", nodes=list(scene.hidden_roots)))
     doc["scene"] = 0
 
     for clip in scene.clips:
@@ -201,10 +209,13 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
             smp = ch.sampler
             if id(smp) not in stored:  # a fish's parts share one weights Sampler: look it up once
                 times = buf.accessor(np.asarray(smp.times, np.float32).ravel(), bounds=True)
-                values = np.asarray(smp.values, np.float32)
+                values = np.asarray(smp.values)
+                if values.dtype.kind not in "iu":
+                    values = values.astype(np.float32)
                 if ch.path == "weights":
                     values = values.ravel()  # glTF: SCALAR, (keys x targets) values
-                key = (times, buf.accessor(values), smp.interpolation)
+                # integer rotations and weights are normalized (glTF 2.0 allows them for these outputs)
+                key = (times, buf.accessor(values, normalized=values.dtype.kind in "iu"), smp.interpolation)
                 if key not in known:  # channels with the same keys share one sampler
                     samplers.append({"input": key[0], "interpolation": key[2], "output": key[1]})
                     known[key] = len(samplers) - 1

@@ -28,15 +28,36 @@ def face_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
 
 
-def vertex_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Area-weighted average of adjacent face normals, as the thesis does (Figure 4.4)."""
-    acc = np.zeros_like(positions, dtype=np.float64)
+def area_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Per vertex, the sum of its faces' normals, each as long as twice the face's area."""
+    acc = np.zeros(positions.shape, dtype=np.float64)
     fn = face_normals(positions, faces)
     for corner in range(3):
         np.add.at(acc, faces[:, corner], fn)
+    return acc
+
+
+def vertex_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Area-weighted average of adjacent face normals, as the thesis does (Figure 4.4)."""
+    acc = area_normals(positions, faces)
     length = np.linalg.norm(acc, axis=1, keepdims=True)
     fallback = np.array([0.0, 1.0, 0.0])
     return np.where(length > 1e-300, acc / np.maximum(length, 1e-300), fallback)
+
+
+def normal_deltas(positions: np.ndarray, faces: np.ndarray, displacements: np.ndarray) -> np.ndarray:
+    """NORMAL deltas of morph targets that move ``positions`` by ``displacements`` (t, n, 3).
+
+    A client poses normals as ``normalize(n0 + sum w_i delta_i)`` with ``n0`` the unit rest normal.
+    Each delta is the change of the area-weighted normal sum scaled by the rest sum's length, so
+    wherever that sum is linear in the displacement (every body vertex under fishgen's targets,
+    see :mod:`fishgen.geometry.bend`) any blend of targets is shaded exactly as its own recomputed
+    normals, not only the targets at full weight.
+    """
+    rest = area_normals(positions, faces)
+    length = np.linalg.norm(rest, axis=1, keepdims=True)
+    scale = np.where(length > 1e-300, 1.0 / np.maximum(length, 1e-300), 0.0)
+    return np.stack([(area_normals(positions + d, faces) - rest) * scale for d in displacements])
 
 
 def strip_faces(bottom: np.ndarray, top: np.ndarray) -> np.ndarray:

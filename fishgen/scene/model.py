@@ -109,6 +109,7 @@ class Mesh:
     name: str
     primitives: list[Primitive]
     weights: list[float] = field(default_factory=list)  # default morph weights, one per target
+    target_names: list[str] = field(default_factory=list)  # one per target (glTF extras.targetNames)
 
 
 @dataclass
@@ -133,6 +134,8 @@ class Node:
     matrix: np.ndarray | None = None    # 4x4 column-vector local matrix; wins over TRS, not animatable
     extras: dict[str, Any] = field(default_factory=dict)       # application data (a sky cloud's bounds)
     extensions: dict[str, Any] = field(default_factory=dict)   # glTF node extensions by name (MSFT_lod)
+    lods: list[int] = field(default_factory=list)             # MSFT_lod: coarser levels' nodes, finest first
+    screen_coverage: list[float] = field(default_factory=list)  # extras.MSFT_screencoverage, one per level
 
 
 @dataclass
@@ -168,7 +171,9 @@ class Scene:
     What a builder knows about what it built travels beside the scene, typed
     (:class:`fishgen.assembly.fish.FishFacts`), never inside it. ``extras`` is application data the
     file keeps, as JSON values (a cloud's sunlight, a school's warm-up): glTF writes it as the scene's
-    ``extras``."""
+    ``extras``. ``hidden_roots`` are written as a second glTF scene, which clients show only when
+    asked: the coarser levels of detail a node's ``lods`` names (MSFT_lod), kept out of sight of
+    clients that know nothing of levels."""
 
     name: str = ""
     nodes: list[Node] = field(default_factory=list)
@@ -181,6 +186,7 @@ class Scene:
     source: str | None = None
     note: str | None = None
     extras: dict[str, Any] = field(default_factory=dict)
+    hidden_roots: list[int] = field(default_factory=list)  # a second glTF scene's: coarser levels of detail
 
     # -- building ------------------------------------------------------------------
     def add_node(self, node: Node, parent: int | None = None) -> int:

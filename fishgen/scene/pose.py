@@ -33,11 +33,20 @@ def slerp(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
     return (np.sin((1 - s) * theta) * a + np.sin(s * theta) * b) / np.sin(theta)
 
 
+def dequantized(values: np.ndarray) -> np.ndarray:
+    """Key values as floats: normalized integers (a compact file's rotations and weights) divided by
+    their type's largest value, as glTF reads them, and never below -1."""
+    raw = np.asarray(values)
+    if raw.dtype.kind in "iu":
+        return np.maximum(raw.astype(np.float64) / np.iinfo(raw.dtype).max, -1.0)
+    return raw.astype(np.float64)
+
+
 def sample(channel: Channel, t: float) -> np.ndarray:
     """The channel's value at time ``t`` seconds."""
     smp = channel.sampler
     times = np.asarray(smp.times, float).ravel()
-    values = np.asarray(smp.values, float)
+    values = dequantized(smp.values)
     cubic = smp.interpolation == "CUBICSPLINE"
     keys = values.reshape(len(times), 3, -1) if cubic else values.reshape(len(times), -1)
 
@@ -161,9 +170,7 @@ def deformed(scene: Scene, node: int, prim: Primitive, posed: Pose) -> tuple[np.
         skin = scene.skins[skin_index]
         joint_mats = np.stack([posed.world[j] for j in skin.joints]) @ np.asarray(skin.inverse_bind_matrices)
         joints = np.asarray(prim.attributes["JOINTS_0"], np.int64)
-        wts = np.asarray(prim.attributes["WEIGHTS_0"], np.float64)
-        if wts.dtype.kind in "iu":
-            wts = wts / np.iinfo(prim.attributes["WEIGHTS_0"].dtype).max
+        wts = dequantized(prim.attributes["WEIGHTS_0"])  # normalized integers read as glTF reads them
         blend = np.einsum("nk,nkij->nij", wts, joint_mats[joints])  # (n, 4, 4) per vertex
         out = np.einsum("nij,nj->ni", blend[:, :3, :3], pos) + blend[:, :3, 3]
         if nrm is not None:

@@ -124,3 +124,29 @@ def test_normals_follow_mirrors_and_survive_a_zero_scale():
         scene = scene_of(Node("n", mesh=0, scale=scale), meshes=[Mesh("m", [prim])])
         _, normals = deformed(scene, 0, prim, pose(scene))
         assert np.all(np.isfinite(normals)) and np.allclose(normals, expected), scale
+
+
+def test_normalized_integer_skin_weights_read_as_fractions():
+    """WEIGHTS_0 as normalized unsigned bytes (255 = 1.0), as a merged fish stores them."""
+    positions = np.array([[0, 0, 2], [0, 0, 2]], np.float32)
+    joints = np.array([[1, 0, 0, 0], [0, 1, 0, 0]], np.uint8)
+    weights = np.array([[255, 0, 0, 0], [128, 127, 0, 0]], np.uint8)
+    prim = Primitive({"POSITION": positions, "JOINTS_0": joints, "WEIGHTS_0": weights}, mode="POINTS")
+    ibm = np.stack([np.eye(4), np.eye(4)])
+    ibm[1][:3, 3] = [0, 0, -1]
+    clip = Clip("bend", [channel(2, "rotation", [0.0, 1.0], np.stack([_qy(0), _qy(90)]))])
+    scene = scene_of(Node("skinned", mesh=0, skin=0), Node("j0", children=[2]),
+                     Node("j1", translation=(0.0, 0.0, 1.0)), roots=(0, 1), meshes=[Mesh("m", [prim])],
+                     skins=[Skin("s", [1, 2], ibm)], clips=[clip])
+    assert np.allclose(deformed(scene, 0, prim, pose(scene))[0], positions)       # not 255 times as far
+    bent, _ = deformed(scene, 0, prim, pose(scene, 1.0, "bend"))
+    assert np.allclose(bent[0], [1, 0, 1]) and np.allclose(bent[1], [127 / 255, 0, 1 + 128 / 255], atol=1e-6)
+
+
+def test_normalized_integer_keys_play_as_floats():
+    """A compact file's rotations (signed shorts) and weights (unsigned shorts), divided as glTF says."""
+    q = np.round(np.stack([_qy(0), _qy(90)]) * 32767).astype(np.int16)
+    spin = Channel(0, "rotation", Sampler(np.array([0.0, 1.0]), q))
+    assert np.allclose(sample(spin, 1.0), _qy(90), atol=1e-4)
+    w = Channel(0, "weights", Sampler(np.array([0.0, 1.0]), np.array([[0, 65535], [65535, 0]], np.uint16)))
+    assert np.allclose(sample(w, 0.25), [0.25, 0.75])

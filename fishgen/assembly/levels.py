@@ -1,0 +1,134 @@
+"""Levels of detail: a species at another BodySections x CircleSections, fins and texture included.
+
+The thesis sets a fish's level of detail by its two section counts (4.1) and measures 8x6 against
+32x24 (8.1.1, 8.2.1). A species file describes its fins in its own sections: a vertical fin spans
+BodySections, a pectoral fin starts on a CircleSection and spans a number of them. At another level
+every section number moves to the section nearest the same place along (or around) the body, so
+the fins sit on that level's own rings, and the texture points are resampled on the new grid:
+the body's bilinearly over (section, circle), each fin's along its base and outer edge.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from fishgen.species.model import PectoralFin, PelvicFin, Species, TexturePoints, VerticalFin
+
+Points = tuple[tuple[float, float], ...]
+
+
+def _nearest(value: float) -> int:
+    return math.floor(value + 0.5)  # half up, not Python's half-to-even
+
+
+def at_level(species: Species, bodies: int, circles: int) -> Species:
+    """``species`` built at ``bodies`` x ``circles``: the same fish at another level of detail."""
+    b0, c0 = species.body_sections, species.circle_sections
+    if (bodies, circles) == (b0, c0):
+        return species
+
+    def sec(k: int) -> int:
+        return min(max(_nearest(k * (bodies - 1) / (b0 - 1)), 0), bodies - 1)
+
+    def circ(k: int) -> int:
+        return _nearest(k * circles / c0) % circles
+
+    def vertical(f: VerticalFin) -> VerticalFin:
+        start, end = sec(f.start_section), sec(f.end_section)
+        return replace(f, start_section=start, end_section=max(end, min(start + 1, bodies - 1)))
+
+    p: PelvicFin = species.pelvic
+    ps = sec(p.start_section)
+    pelvic = replace(p, start_circle=circ(p.start_circle), start_section=ps,
+                     end_section=max(sec(p.end_section), min(ps + 1, bodies - 1)))
+    q: PectoralFin = species.pectoral
+    # the same arc of the ring: triangles span CircleSections
+    pectoral = replace(q, start_section=sec(q.start_section), start_circle=circ(q.start_circle),
+                       triangles=min(max(_nearest(q.triangles * circles / c0), 1), max(circles // 2, 1)))
+    out = replace(species, body_sections=bodies, circle_sections=circles, dorsal=vertical(species.dorsal),
+                  adipose=vertical(species.adipose), anal=vertical(species.anal), pelvic=pelvic,
+                  pectoral=pectoral, texture_points=None)
+    tp = species.texture_points
+    if tp is None:
+        return out
+    return replace(out, texture_points=TexturePoints(
+        body=_body_points(tp.body, (b0, c0), (bodies, circles)),
+        caudal=tp.caudal,
+        dorsal=_vertical_points(tp.dorsal, out.dorsal),
+        adipose=_vertical_points(tp.adipose, out.adipose),
+        anal=_vertical_points(tp.anal, out.anal),
+        pectoral=_pectoral_points(tp.pectoral, pectoral.triangles),
+        pelvic=_pelvic_points(tp.pelvic, pelvic.end_section - pelvic.start_section + 1)))
+
+
+def _as_tuple(points: np.ndarray) -> Points:
+    return tuple((float(u), float(v)) for u, v in points)
+
+
+def _body_points(points: Points, old: tuple[int, int], new: tuple[int, int]) -> Points:
+    """The body's (B, C) texture grid resampled at the new rings: linear along the body, periodic
+    around it (circle C - 1 neighbours circle 0)."""
+    b0, c0 = old
+    b, c = new
+    grid = np.asarray(points, np.float64).reshape(b0, c0, 2)
+    f = np.arange(b) * (b0 - 1) / (b - 1)                     # fractional old section of each new ring
+    j = np.minimum(np.floor(f).astype(np.int64), b0 - 2)
+    s = (f - j)[:, None, None]
+    rows = grid[j] * (1 - s) + grid[j + 1] * s                # (b, c0, 2)
+    g = np.arange(c) * c0 / c                                 # fractional old circle of each new point
+    i = np.floor(g).astype(np.int64) % c0
+    t = (g - np.floor(g))[None, :, None]
+    out = rows[:, i] * (1 - t) + rows[:, (i + 1) % c0] * t
+    return _as_tuple(out.reshape(-1, 2))
+
+
+def _resample(row: np.ndarray, count: int) -> np.ndarray:
+    """A row of points resampled to ``count`` points, evenly by index, ends kept."""
+    if len(row) == 1 or count == 1:
+        return np.repeat(row[:1], count, axis=0)
+    old = np.linspace(0.0, 1.0, len(row))
+    new = np.linspace(0.0, 1.0, count)
+    return np.stack([np.interp(new, old, row[:, k]) for k in range(2)], axis=1)
+
+
+def _vertical_points(points: Points, fin: VerticalFin) -> Points:
+    """Fixel order T_0, B_0, B_n, T_n, B_1..B_{n-1}, T_1..T_{n-1}, resampled to ``fin``'s sections."""
+    p = np.asarray(points, np.float64)
+    n = len(p) // 2 - 1
+    if n < 1:
+        base, top = p[1:2], p[0:1]
+    else:
+        base = np.concatenate([p[1:2], p[4:4 + n - 1], p[2:3]])
+        top = np.concatenate([p[0:1], p[4 + n - 1:], p[3:4]])
+    m = fin.end_section - fin.start_section
+    base, top = _resample(base, m + 1), _resample(top, m + 1)
+    if m < 1:
+        return _as_tuple(np.concatenate([top, base]))
+    return _as_tuple(np.concatenate([top[:1], base[:1], base[-1:], top[-1:], base[1:-1], top[1:-1]]))
+
+
+def _pectoral_points(points: Points, triangles: int) -> Points:
+    """Fixel order T_0, B_0, B_n, B_1..B_{n-1}, T_1..T_{n-1} (T_n is B_n), resampled to ``triangles``."""
+    p = np.asarray(points, np.float64)
+    n = (len(p) - 1) // 2
+    base = np.concatenate([p[1:2], p[3:3 + n - 1], p[2:3]])
+    top = np.concatenate([p[0:1], p[3 + n - 1:], p[2:3]])
+    base, top = _resample(base, triangles + 1), _resample(top, triangles + 1)
+    return _as_tuple(np.concatenate([top[:1], base[:1], base[-1:], base[1:-1], top[1:-1]]))
+
+
+def _pelvic_points(points: Points, count: int) -> Points:
+    """Fixel order B_0, B_n, O_0, O_n, B_1..B_{n-1}, O_1..O_{n-1}, resampled to ``count`` sections."""
+    p = np.asarray(points, np.float64)
+    n = len(p) // 2 - 1
+    if n < 1:
+        base, outer = p[0:1], p[1:2]
+    else:
+        base = np.concatenate([p[0:1], p[4:4 + n - 1], p[1:2]])
+        outer = np.concatenate([p[2:3], p[4 + n - 1:], p[3:4]])
+    base, outer = _resample(base, count), _resample(outer, count)
+    if count < 2:
+        return _as_tuple(np.concatenate([base, outer]))
+    return _as_tuple(np.concatenate([base[:1], base[-1:], outer[:1], outer[-1:], base[1:-1], outer[1:-1]]))

@@ -1,0 +1,324 @@
+"""Play a fishgen fish as three.js, Blender and fishgen's own posing do, and measure what each shows.
+
+Each client gives the posed positions of chosen points ("probes", matched by rest position) and,
+where it can, of every vertex with its normal; the measures (tail peak-to-peak and frequency, fin
+swing, bend curvature, normal error) are computed here alike for all. Shared by the engine tests
+(tests/assembly/test_engine_clients.py) and benchmarks/engine.py.
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from fishgen.geometry.mesh import area_normals
+from fishgen.scene.model import Primitive, Scene
+from fishgen.scene.pose import deformed, pose
+
+ROOT = Path(__file__).resolve().parents[2]
+HERE = Path(__file__).resolve().parent / "engine"
+BPY = next((p for p in (os.environ.get("FISHGEN_BPY_PYTHON"), "/tmp/bpyvenv/bin/python")
+            if p and Path(p).is_file()), None)
+
+
+# -- what to look at ------------------------------------------------------------------------------
+
+def _drawn_parts(scene: Scene) -> list[tuple[str, int, Primitive]]:
+    """(part name, node, primitive) of what the default scene draws; a merged fish's primitives are
+    named body and fins."""
+    out = []
+    for node, prim in scene.drawn():
+        name = scene.nodes[node].name
+        if scene.nodes[node].skin is not None:
+            name = "fins" if scene.materials[prim.material].name == "fins" else "body"
+        out.append((name.split("_LOD")[0], node, prim))
+    return out
+
+
+def part_points(scene: Scene, name: str) -> np.ndarray:
+    """Rest world positions of part ``name`` (body, or a fin such as pectoral_fin_left) in either layout."""
+    posed = pose(scene)
+    for part, node, prim in _drawn_parts(scene):
+        points = deformed(scene, node, prim, posed)[0]
+        if part == name:
+            return points
+        if part == "fins" and name != "body":
+            skin = scene.skins[scene.nodes[node].skin]
+            joints = [scene.nodes[j].name.split("_LOD")[0] for j in skin.joints]
+            if name in joints:
+                return points[np.asarray(prim.attributes["JOINTS_0"])[:, 0] == joints.index(name)]
+    raise KeyError(name)
+
+
+@dataclass(frozen=True)
+class Probes:
+    """Rest positions (glTF axes, metres) of the points every client is asked about."""
+
+    tail: np.ndarray            # the tail fin's tip (the rearmost vertex)
+    midline: np.ndarray         # (m, 3) the top vertex of each body ring, nose to tail
+    fin_tip: np.ndarray         # the left pectoral fin's vertex farthest from its hinge
+    fin_base: np.ndarray        # (2, 3) the ends of its base line (its hinge)
+    length: float               # nose to tail tip
+
+    def all(self) -> np.ndarray:
+        return np.vstack([self.tail[None], self.midline, self.fin_tip[None], self.fin_base])
+
+    def split(self, tracks: np.ndarray) -> dict[str, np.ndarray]:
+        """(T, P, 3) tracks of :meth:`all`'s points, by probe."""
+        m = len(self.midline)
+        return {"tail": tracks[:, 0], "midline": tracks[:, 1:1 + m], "fin_tip": tracks[:, 1 + m],
+                "fin_base": tracks[:, 2 + m:4 + m]}
+
+
+def probes(scene: Scene) -> Probes:
+    body = part_points(scene, "body")
+    everything = np.concatenate([deformed(scene, n, p, pose(scene))[0] for _, n, p in _drawn_parts(scene)])
+    tail = everything[np.argmin(everything[:, 2])]
+    length = float(np.ptp(everything[:, 2]))
+    midline = []
+    for z in np.unique(np.round(body[:, 2], 7))[::-1]:        # each ring (and apex), nose first
+        ring = body[np.abs(body[:, 2] - z) < 1e-6]
+        midline.append(ring[np.argmax(ring[:, 1])])
+    fin = part_points(scene, "pectoral_fin_left")
+    # the hinge: the fin's points that lie on the body (its base line), first and last along it
+    d = np.min(np.linalg.norm(fin[:, None] - body[None], axis=2), axis=1)
+    base = fin[d < 1e-6 * length] if np.count_nonzero(d < 1e-6 * length) >= 2 else fin[np.argsort(d)[:2]]
+    ends = base[[np.argmax(base[:, 1]), np.argmin(base[:, 1])]]
+    tip = fin[np.argmax(np.linalg.norm(fin - ends[0], axis=1))]
+    return Probes(tail, np.array(midline), tip, ends, length)
+
+
+# -- measures -------------------------------------------------------------------------------------
+
+def peak_to_peak(track: np.ndarray, length: float) -> float:
+    """Lateral (glTF X) travel of a point, in body lengths."""
+    return float(np.ptp(track[:, 0])) / length
+
+
+def frequency(track: np.ndarray, times: np.ndarray) -> float:
+    """Beats per second of a point's lateral motion (upward crossings of its mean)."""
+    x = track[:, 0] - track[:, 0].mean()
+    ups = np.count_nonzero((x[:-1] < 0) & (x[1:] >= 0))
+    return ups / float(times[-1] - times[0])
+
+
+def bend_curvature(midline: np.ndarray, length: float) -> np.ndarray:
+    """Per time, the midline's mean curvature (radians per body length) between its first and last
+    chords, counted positive when it bends to the fish's left (+X): the turn from the chord of rings
+    1-2 to that of the last two rings, over the path between the chords' middles. All seen from
+    above (the top line also rises and falls)."""
+    m = midline[..., [0, 2]]                               # (T, points, [X, Z])
+    a, b = m[:, 2] - m[:, 1], m[:, -1] - m[:, -2]
+    cross = a[:, 1] * b[:, 0] - a[:, 0] * b[:, 1]
+    angle = np.arctan2(cross, np.sum(a * b, axis=1))
+    chords = np.linalg.norm(np.diff(m[:, 1:], axis=1), axis=2)   # ring 1 onwards
+    path = chords[:, 1:-1].sum(axis=1) + 0.5 * (chords[:, 0] + chords[:, -1])
+    return -angle / (path / length)
+
+
+def fin_swing(tip: np.ndarray, base: np.ndarray) -> np.ndarray:
+    """Per time, the fin's angle about its hinge in degrees, from its rest pose (the first time's hinge
+    frame is rebuilt at each time from the posed hinge, so the body's motion under it does not count)."""
+    axis = base[:, 1] - base[:, 0]
+    axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+    arm = tip - base[:, 0]
+    arm -= np.sum(arm * axis, axis=1, keepdims=True) * axis
+    arm /= np.linalg.norm(arm, axis=1, keepdims=True)
+    ref = arm[0]
+    cross = np.cross(ref, arm)
+    return np.degrees(np.arctan2(np.sum(cross * axis, axis=1), np.sum(arm * ref, axis=1)))
+
+
+def normal_error(positions: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Degrees between each vertex's client normal and the area-weighted normal of its posed triangles."""
+    ref = area_normals(positions, faces)
+    ok = np.linalg.norm(ref, axis=1) > 0
+    ref = ref[ok] / np.linalg.norm(ref[ok], axis=1, keepdims=True)
+    n = normals[ok] / np.linalg.norm(normals[ok], axis=1, keepdims=True)
+    return np.degrees(np.arccos(np.clip(np.sum(ref * n, axis=1), -1.0, 1.0)))
+
+
+# -- clients -------------------------------------------------------------------------------------
+
+@dataclass
+class Played:
+    """One clip as one client played it: per drawn mesh, faces and (T, n, 3) positions and normals,
+    and the probes' (T, P, 3) tracks."""
+
+    times: np.ndarray
+    meshes: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray | None]]
+    probes: np.ndarray
+
+
+def fishgen_play(scene: Scene, clip: str, times: np.ndarray, probe_points: np.ndarray) -> Played:
+    """fishgen's own posing (fishgen.scene.pose), which the preview renders."""
+    drawn = _drawn_parts(scene)
+    rest = np.concatenate([deformed(scene, n, p, pose(scene))[0] for _, n, p in drawn])
+    nearest = [int(np.argmin(np.linalg.norm(rest - p, axis=1))) for p in probe_points]
+    meshes: dict[str, tuple[np.ndarray, list, list]] = {f"{name}#{k}": (np.asarray(p.indices), [], [])
+                                                        for k, (name, _, p) in enumerate(drawn)}
+    tracks = []
+    for t in times:
+        posed = pose(scene, float(t), clip)
+        everything = []
+        for k, (name, node, prim) in enumerate(drawn):
+            pos, nrm = deformed(scene, node, prim, posed)
+            meshes[f"{name}#{k}"][1].append(pos)
+            meshes[f"{name}#{k}"][2].append(nrm)
+            everything.append(pos)
+        tracks.append(np.concatenate(everything)[nearest])
+    arrays = {k: (f, np.array(p), np.array(n)) for k, (f, p, n) in meshes.items()}
+    return Played(times, arrays, np.array(tracks))
+
+
+class ThreeEngine:
+    """three.js r0.187 in headless Chromium (the client matrix's browser), playing files from ``folder``."""
+
+    def __init__(self, folder: Path):
+        from tests.clients.matrix import THREE_DIR, LocalBrowser
+
+        self.browser = LocalBrowser({"/three/": THREE_DIR, "/harness/": HERE, "/assets/": folder})
+        page = self.browser.page
+        self.errors: list[str] = []
+        page.on("pageerror", lambda e: self.errors.append(str(e)))
+        page.goto(f"{self.browser.base}/harness/harness.html")
+        page.wait_for_function("window.harnessReady === true", timeout=30_000)
+
+    def play(self, name: str, clip: str, times: np.ndarray, probe_points: np.ndarray) -> Played:
+        url = f"{self.browser.base}/assets/{name}"
+        result = self.browser.page.evaluate("([u, c, t]) => window.poseTracks(u, c, t)",
+                                            [url, clip, [float(t) for t in times]])
+        if "error" in result:
+            raise AssertionError(f"three.js: {result['error']}")
+        meshes = {}
+        everything, rest = [], []
+        for k, m in enumerate(result["meshes"]):
+            positions = np.array(m["positions"], float).reshape(len(times), -1, 3)
+            normals = np.array(m["normals"], float).reshape(len(times), -1, 3)
+            meshes[f"{m['name']}#{k}"] = (np.array(m["index"]).reshape(-1, 3), positions, normals)
+            everything.append(positions)
+            rest.append(np.array(m["rest"], float).reshape(-1, 3))
+        allp, allr = np.concatenate(everything, axis=1), np.concatenate(rest)
+        nearest = [int(np.argmin(np.linalg.norm(allr - p, axis=1))) for p in probe_points]
+        self.last = result
+        return Played(times, meshes, allp[:, nearest])
+
+    def rest(self, name: str, clip: str) -> np.ndarray:
+        """Every drawn vertex at the clip's start (to match probes against)."""
+        return self.play(name, clip, np.array([0.0]), np.zeros((0, 3))).meshes
+
+    def frame_rate(self, name: str, frames: int = 30, size: tuple[int, int] = (960, 540)) -> dict:
+        """Milliseconds a frame of the whole file's animation takes to play and draw (a fresh page each
+        time: nothing of one file's run stays for the next)."""
+        page = self.browser.page
+        page.goto(f"{self.browser.base}/harness/harness.html")
+        page.wait_for_function("window.harnessReady === true", timeout=30_000)
+        result = self.browser.page.evaluate("([u, f, w, h]) => window.schoolFrameRate(u, f, w, h)",
+                                            [f"{self.browser.base}/assets/{name}", frames, *size])
+        if "error" in result:
+            raise AssertionError(f"three.js: {result['error']}")
+        return result
+
+    def close(self) -> None:
+        self.browser.close()
+
+
+def blender_play(path: Path, clips: dict[str, np.ndarray], probe_points: np.ndarray) -> dict:
+    """Blender's importer and its own evaluated meshes (tests/assembly/engine/blender_engine.py)."""
+    if BPY is None:
+        raise RuntimeError("no Python with bpy ($FISHGEN_BPY_PYTHON)")
+    with tempfile.TemporaryDirectory() as tmp:
+        spec = Path(tmp) / "spec.json"
+        spec.write_text(json.dumps({"probes": probe_points.tolist(),
+                                    "clips": {k: [float(t) for t in v] for k, v in clips.items()}}))
+        run = subprocess.run([BPY, str(HERE / "blender_engine.py"), str(path), str(spec)],
+                             capture_output=True, text=True, timeout=1200)
+    if run.returncode != 0:
+        raise RuntimeError(run.stderr[-2000:])
+    report = json.loads(next(line for line in run.stdout.splitlines() if line.startswith("{")))
+    report["clips"] = {k: np.array(v, float) for k, v in report["clips"].items()}
+    return report
+
+
+# -- levels of detail -----------------------------------------------------------------------------
+
+def level_scene(scene: Scene, level: int) -> Scene:
+    """``scene`` as a client that switched to level ``level`` draws it: the MSFT_lod node's place taken
+    by the level's node (a copy sharing everything else)."""
+    from dataclasses import replace
+
+    if level == 0:
+        return scene
+    finest = next(i for i in scene.reachable() if scene.nodes[i].lods)
+    coarse = scene.nodes[finest].lods[level - 1]
+    roots = [coarse if r == finest else r for r in scene.roots]
+    return replace(scene, roots=roots, hidden_roots=[])
+
+
+def silhouette(scene: Scene, size: tuple[int, int] = (1024, 512), t: float | None = None,
+               clip: str | None = None, box: tuple[float, float, float, float] | None = None) -> np.ndarray:
+    """The side view's silhouette (looking along -X, Z to the right, Y up): every drawn triangle
+    filled, (H, W) bool. ``box``: (z0, z1, y0, y1) of the frame (default: the scene's own, padded)."""
+    from PIL import Image, ImageDraw
+
+    posed = pose(scene, t, clip)
+    tris = [deformed(scene, n, p, posed)[0][np.asarray(p.indices)]
+            for n, p in scene.drawn() if p.indices is not None]
+    tri = np.concatenate(tris)[..., [2, 1]]
+    if box is None:
+        lo, hi = tri.reshape(-1, 2).min(0), tri.reshape(-1, 2).max(0)
+        pad = 0.05 * (hi - lo)
+        box = (lo[0] - pad[0], hi[0] + pad[0], lo[1] - pad[1], hi[1] + pad[1])
+    w, h = size
+    px = (tri[..., 0] - box[0]) / (box[1] - box[0]) * w
+    py = (box[3] - tri[..., 1]) / (box[3] - box[2]) * h
+    img = Image.new("1", size, 0)
+    draw = ImageDraw.Draw(img)
+    for a, b in zip(px, py, strict=True):
+        draw.polygon(list(zip(a.tolist(), b.tolist(), strict=True)), fill=1)
+    return np.asarray(img, bool)
+
+
+def frame_of(scene: Scene, pad: float = 0.05) -> tuple[float, float, float, float]:
+    """(z0, z1, y0, y1) around the scene's drawn triangles at rest, for silhouettes that share a frame."""
+    points = np.concatenate([deformed(scene, n, p, pose(scene))[0] for n, p in scene.drawn()])
+    lo, hi = points[:, [2, 1]].min(0), points[:, [2, 1]].max(0)
+    d = pad * (hi - lo)
+    return (lo[0] - d[0], hi[0] + d[0], lo[1] - d[1], hi[1] + d[1])
+
+
+def iou(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.count_nonzero(a & b) / max(np.count_nonzero(a | b), 1))
+
+
+def fin_gap(scene: Scene, clip: str, times: np.ndarray) -> float:
+    """Largest distance from the posed body surface, over ``times``, of a fin vertex that touches the
+    body at rest, in body lengths (trimesh's closest points)."""
+    import trimesh
+
+    parts = [(name, n, p) for name, n, p in _drawn_parts(scene)]
+    rest = pose(scene)
+    body = [(n, p) for name, n, p in parts if name == "body"]
+    fins = [(n, p) for name, n, p in parts if name != "body"]
+    faces = np.asarray(body[0][1].indices)
+    body_rest = trimesh.Trimesh(deformed(scene, *body[0], rest)[0], faces, process=False)
+    points = np.concatenate([deformed(scene, n, p, rest)[0] for n, p in scene.drawn()])
+    length = float(np.ptp(points[:, 2]))
+    touching = []
+    for n, p in fins:
+        _, d, _ = trimesh.proximity.closest_point(body_rest, deformed(scene, n, p, rest)[0])
+        touching.append(np.flatnonzero(d < 1e-3 * length))
+    worst = 0.0
+    for t in times:
+        posed = pose(scene, float(t), clip)
+        surface = trimesh.Trimesh(deformed(scene, *body[0], posed)[0], faces, process=False)
+        for (n, p), idx in zip(fins, touching, strict=True):
+            if len(idx):
+                _, d, _ = trimesh.proximity.closest_point(surface, deformed(scene, n, p, posed)[0][idx])
+                worst = max(worst, float(d.max()))
+    return worst / length

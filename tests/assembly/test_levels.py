@@ -1,0 +1,115 @@
+"""Levels of detail: each level built from the species file, one glb holding them all (MSFT_lod),
+the coarser levels out of sight of clients that know nothing of levels, and each level measured."""
+from __future__ import annotations
+
+import numpy as np
+import pygltflib
+import pytest
+
+from fishgen.assembly.fish import make_fish
+from fishgen.assembly.levels import at_level
+from fishgen.errors import FishgenError
+from fishgen.exchange import export
+from fishgen.species.parser import load_species
+from tests.assembly.engine_clients import fin_gap, frame_of, iou, level_scene, silhouette
+from tests.conftest import PARAMS, validate_gltf
+
+LODS = ((32, 24), (16, 12), (8, 6))
+CLIPS = ("swim", "idle", "sprint", "turn_left", "turn_right", "burst")
+
+
+@pytest.fixture(scope="module")
+def bony():
+    return load_species(PARAMS / "bonybream.txt")
+
+
+@pytest.fixture(scope="module", params=[False, True], ids=["parts", "merged"])
+def levels(request, bony, tmp_path_factory):
+    fish = make_fish(bony, lods=LODS, merge=request.param, clips=CLIPS)
+    path = tmp_path_factory.mktemp("lods") / "fish.glb"
+    export(fish.scene, path)
+    return fish, path
+
+
+def test_the_files_own_level_is_the_species_itself(bony):
+    assert at_level(bony, 16, 12) is bony
+
+
+def test_texture_points_are_resampled_where_the_grids_meet(bony):
+    """At 31x24 every other ring and circle is one of the file's 16x12: those carry its points as they
+    are; the fins' points keep their ends."""
+    fine = at_level(bony, 31, 24)
+    old = np.asarray(bony.texture_points.body).reshape(16, 12, 2)
+    new = np.asarray(fine.texture_points.body).reshape(31, 24, 2)
+    assert np.allclose(new[::2, ::2], old)
+    assert np.allclose(new[1::2, ::2], (old[:-1] + old[1:]) / 2)
+    for name in ("dorsal", "anal", "pelvic", "pectoral"):
+        fin, points = getattr(fine, name), getattr(fine.texture_points, name)
+        assert len(points) == fin.texture_point_count
+        assert points[0] == getattr(bony.texture_points, name)[0]
+
+
+def test_fins_move_to_the_nearest_section_of_each_level(bony):
+    coarse = at_level(bony, 8, 6)
+    assert (coarse.dorsal.start_section, coarse.dorsal.end_section) == (3, 5)    # 7..10 of 16
+    assert coarse.pectoral.start_circle == 1 and coarse.pectoral.triangles == 2    # 60 degrees down 120
+    assert coarse.texture_points is not None and len(coarse.texture_points.body) == 8 * 6
+
+
+def test_one_glb_holds_every_level_and_names_them_for_msft_lod_and_unity(levels):
+    fish, path = levels
+    doc = pygltflib.GLTF2().load(str(path))
+    assert "MSFT_lod" in doc.extensionsUsed and "MSFT_lod" not in (doc.extensionsRequired or [])
+    finest = [n for n in doc.nodes if "MSFT_lod" in (n.extensions or {})]
+    assert [n.name for n in finest] == ["bonybream_LOD0"]
+    ids = finest[0].extensions["MSFT_lod"]["ids"]
+    assert [doc.nodes[i].name for i in ids] == ["bonybream_LOD1", "bonybream_LOD2"]
+    coverage = finest[0].extras["MSFT_screencoverage"]
+    assert len(coverage) == 3 and coverage == sorted(coverage, reverse=True)
+    assert 0 < coverage[-1] < coverage[0] <= 1
+    # the default scene reaches the finest level only; the coarser ones stand in the second scene
+    reach, stack = set(), list(doc.scenes[doc.scene].nodes)
+    while stack:
+        i = stack.pop()
+        reach.add(i)
+        stack += doc.nodes[i].children or []
+    assert not set(ids) & reach and set(ids) <= set(doc.scenes[1].nodes)
+    triangles = [lv.triangles for lv in fish.facts.levels]
+    assert triangles == sorted(triangles, reverse=True) and len(set(triangles)) == 3
+
+
+def test_the_validator_accepts_msft_lod_with_no_warning(levels):
+    _, path = levels
+    (report,) = validate_gltf(path)
+    assert report["numErrors"] == 0 and report["numWarnings"] == 0
+    assert {m["code"] for m in report["messages"]} <= {"UNSUPPORTED_EXTENSION"}   # an info: MSFT_lod
+
+
+def test_each_coarser_level_keeps_the_side_silhouette(levels):
+    """Side-view silhouette IoU against the finest level: at least 0.9 for LOD1 (the issue's bar)."""
+    fish, _ = levels
+    box = frame_of(fish.scene)
+    finest = silhouette(fish.scene, box=box)
+    scores = [iou(finest, silhouette(level_scene(fish.scene, k), box=box)) for k in (1, 2)]
+    print(f"side silhouette IoU vs LOD0: LOD1 {scores[0]:.3f}, LOD2 {scores[1]:.3f}")
+    assert scores[0] >= 0.9 and scores[1] >= 0.75
+
+
+def test_every_level_keeps_its_fins_on_over_every_clip(levels):
+    fish, _ = levels
+    if fish.facts.merged:          # the layouts pose alike (test_merge.py): measure one
+        pytest.skip("measured on the parts layout")
+    worst = {}
+    for k in range(3):
+        scene = level_scene(fish.scene, k)
+        for clip in CLIPS:
+            duration = scene.clip(clip).duration
+            worst[(k, clip)] = fin_gap(scene, clip, np.linspace(0.0, duration, 9))
+    print({key: f"{v:.2%}" for key, v in worst.items()})
+    assert max(worst.values()) < 0.01
+
+
+@pytest.mark.parametrize("lods", [[(8, 6), (16, 12)], [(16, 12), (16, 12)], [(2, 6)], [(16, 12)] * 9])
+def test_levels_must_go_from_finest_to_coarsest(bony, lods):
+    with pytest.raises(FishgenError, match="--lods"):
+        make_fish(bony, lods=lods)
