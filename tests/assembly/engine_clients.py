@@ -35,7 +35,7 @@ def _drawn_parts(scene: Scene) -> list[tuple[str, int, Primitive]]:
     for node, prim in scene.drawn():
         name = scene.nodes[node].name
         if scene.nodes[node].skin is not None:
-            name = "fins" if scene.materials[prim.material].name == "fins" else "body"
+            name = "fins" if scene.materials[prim.material].name.endswith("fins") else "body"
         out.append((name.split("_LOD")[0], node, prim))
     return out
 
