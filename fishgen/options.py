@@ -374,6 +374,11 @@ def fins_option(shown_default: str) -> Any:
                   "opaque.", shown_default=shown_default)
 
 
+def compact_option() -> Any:
+    return option(click.BOOL, "Rotation keys and morph weights as normalized 16-bit integers "
+                  "(core glTF 2.0), about half their size.", False, flag=True)
+
+
 def swim_option(help_text: str) -> Any:
     from fishgen.assembly.swim_modes import SWIM_MODES
 

@@ -12,7 +12,16 @@ from fishgen.assembly.clip_names import CLIP_NAMES, DEFAULT_CLIPS
 from fishgen.assembly.swim_modes import DEFAULT_SPEED
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output, each_input
 from fishgen.exchange.registry import MESHES, extensions, formats
-from fishgen.options import FiniteRange, Lods, Names, fins_option, option, swim_option, textures_option
+from fishgen.options import (
+    FiniteRange,
+    Lods,
+    Names,
+    compact_option,
+    fins_option,
+    option,
+    swim_option,
+    textures_option,
+)
 
 FISH_FORMATS = formats(writable=True, holding=[MESHES])
 
@@ -41,8 +50,7 @@ class BuildOptions:
                          "a fish instead of one per part; fins swing on joints.", False, flag=True)
     clips: tuple[str, ...] = option(Names(CLIP_NAMES), "Clips to write, each looping but burst: "
                                     f"{', '.join(CLIP_NAMES)}.", DEFAULT_CLIPS, metavar="NAME,...")
-    compact: bool = option(click.BOOL, "Rotation keys and morph weights as normalized 16-bit integers "
-                           "(core glTF 2.0), about half their size.", False, flag=True)
+    compact: bool = compact_option()
 
 
 COMMAND = Command(

@@ -9,7 +9,16 @@ from typing import Any
 
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
 from fishgen.exchange.registry import MESHES, NODE_ANIMATION
-from fishgen.options import FILE, FiniteRange, declare, fins_option, option, swim_option, textures_option
+from fishgen.options import (
+    FILE,
+    FiniteRange,
+    compact_option,
+    declare,
+    fins_option,
+    option,
+    swim_option,
+    textures_option,
+)
 from fishgen.school.scene_file import (
     BOUNDS,
     COUNT,
@@ -65,6 +74,7 @@ class SchoolOptions:
     swim: str = swim_option("body: every fish's body waves, its tail beating faster the faster it swims; "
                             "fins: rigid bodies, only the fins move.")
     textures: Path | None = textures_option("as `fishgen build` resolves them")
+    compact: bool = compact_option()
 
 
 COMMAND = Command(
@@ -148,6 +158,10 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     with events.progress("simulating", scene.frames) as bar:
         run = run_school(scene, fins=options.fins, swim=options.swim, tolerance=options.tolerance,
                          textures_dir=options.textures, progress=bar.update)
+    if options.compact:
+        from fishgen.assembly.compact import compact_clips
+
+        compact_clips(run.scene)
     warmup = run.warmup_frames
     per_frame: dict = {}
     numbers: dict = {}

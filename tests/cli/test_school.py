@@ -125,3 +125,16 @@ def test_school_options_reach_the_run_as_the_scene_file_keys_do(tmp_path):
     assert refused.returncode == 2 and "expected --preset with the couzin model" in refused.stderr
     bad = run_cli("school", PARAMS / "bonybream.txt", "-o", out, "--bounds", "0,0,0,0,1,1")
     assert bad.returncode == 2 and "X0,Y0,Z0,X1,Y1,Z1" in bad.stderr
+
+
+def test_compact_stores_the_school_keys_as_16_bit_integers_and_the_file_shrinks(tmp_path):
+    plain, compact = tmp_path / "plain.glb", tmp_path / "compact.glb"
+    for out, flags in ((plain, ()), (compact, ("--compact",))):
+        result = run_cli("school", PARAMS / "bonybream.txt", "--count", "20", "--frames", "60", "-o", out, *flags)
+        assert result.returncode == 0, result.stderr
+    assert_valid_gltf(compact)
+    doc = pygltflib.GLTF2().load(str(compact))
+    outputs = {doc.accessors[doc.animations[0].samplers[c.sampler].output].componentType
+               for c in doc.animations[0].channels if c.target.path in ("rotation", "weights")}
+    assert outputs <= {pygltflib.SHORT, pygltflib.UNSIGNED_SHORT} and outputs
+    assert compact.stat().st_size < 0.8 * plain.stat().st_size
