@@ -46,6 +46,39 @@ SMALL_SCHOOL = ["school", "params/bonybream.txt", "--count", "10", "--frames", "
 """A small school seen close enough to watch the bodies swim."""
 
 
+CLIPS = ("swim", "idle", "sprint", "turn_left", "turn_right", "burst")
+ENGINE_FISH = ["build", "params/bonybream.txt", "--lods", "32x24,16x12,8x6", "--merge", "--clips", ",".join(CLIPS),
+               "-o", "out/engine-fish.glb"]
+"""The README's engine-ready fish: every clip, three levels, two draw calls."""
+
+
+def clips_gif(out: Path, cell: tuple[int, int] = (240, 180), frames: int = 24) -> None:
+    """Each clip of ENGINE_FISH looped from above, in a labelled 3 x 2 grid (one `fishgen preview` per
+    clip, each clip's own length spread over the same frames)."""
+    import tempfile
+
+    from PIL import Image, ImageDraw, ImageSequence
+
+    loops = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for clip in CLIPS:
+            gif = Path(tmp) / f"{clip}.gif"
+            subprocess.run([sys.executable, "-m", "fishgen", "preview", "out/engine-fish.glb", "-o", str(gif),
+                            "--clip", clip, "--view", "top", "--size", f"{cell[0]}x{cell[1]}",
+                            "--frames", str(frames)], cwd=ROOT, check=True)
+            with Image.open(gif) as im:
+                loops.append([f.convert("RGB") for f in ImageSequence.Iterator(im)])
+    sheet = []
+    for k in range(frames):
+        frame = Image.new("RGB", (cell[0] * 3, cell[1] * 2))
+        for n, (clip, loop) in enumerate(zip(CLIPS, loops, strict=True)):
+            x, y = (n % 3) * cell[0], (n // 3) * cell[1]
+            frame.paste(loop[k % len(loop)], (x, y))
+            ImageDraw.Draw(frame).text((x + 6, y + 4), clip, fill=(20, 30, 40))
+        sheet.append(frame)
+    sheet[0].save(out, save_all=True, append_images=sheet[1:], duration=83, loop=0, optimize=True)
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--list", action="store_true", help="print the renders and exit")
@@ -55,6 +88,9 @@ def main() -> int:
                                   ("school-swim.gif", ["out/school-swim.glb", "--size", "560x380", "--time",
                                                        "2.5", "--duration", "2.5", "--fps", "12"])]
     IMAGES.mkdir(parents=True, exist_ok=True)
+    if not args.list:
+        subprocess.run([sys.executable, "-m", "fishgen", *ENGINE_FISH], cwd=ROOT, check=True)
+        clips_gif(IMAGES / "engine-clips.gif")
     for school in (SCHOOL, SMALL_SCHOOL):
         print(" ".join(["fishgen", *school]))
         if not args.list:
