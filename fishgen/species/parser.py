@@ -201,8 +201,9 @@ URGES = ("random", "center", "keepaway", "repelDistance", "speed", "changeRate",
 def _vertical(reader: _Reader, label: str, bodies: int) -> VerticalFin:
     line = reader.record(f"the {label} record `{' '.join(VERTICAL)}`", 6)
     f = _Fields(reader, line, [f"{label} {n}" for n in VERTICAL])
-    start = f.whole(0, 0, bodies - 1, "a BodySection number")
-    end = f.whole(1, start, bodies - 1, f"a BodySection number (from startBodySection {start})")
+    start = f.whole(0, 0, bodies - 2, "a BodySection number before the last")
+    # a fin needs two base points along the body: one section alone is a line, not a fin
+    end = f.whole(1, start + 1, bodies - 1, f"a BodySection number after startBodySection {start}")
     return VerticalFin(start, end, f.number(2, 0, MAX_FIN_LENGTH), f.number(3, 0, MAX_FIN_LENGTH),
                        f.number(4, -180, 180), f.number(5, 0, 1))
 
@@ -342,8 +343,8 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     line = reader.record(f"the pelvic fin record `{' '.join(PELVIC)}`", 8, key="pelvic")
     f = _Fields(reader, line, [f"pelvic {n}" for n in PELVIC])
     p_circle = f.whole(0, 0, circles - 1, "a CircleSection number")
-    p_start = f.whole(1, 0, bodies - 1, "a BodySection number")
-    p_end = f.whole(2, p_start, bodies - 1, f"a BodySection number (from startBodySection {p_start})")
+    p_start = f.whole(1, 0, bodies - 2, "a BodySection number before the last")
+    p_end = f.whole(2, p_start + 1, bodies - 1, f"a BodySection number after startBodySection {p_start}")
     pelvic = PelvicFin(p_circle, p_start, p_end, f.number(3, 0, MAX_FIN_LENGTH),
                        f.number(4, 0, MAX_FIN_LENGTH), f.number(5, -180, 180),
                        f.number(6, 0, 90), f.number(7, 0))

@@ -172,3 +172,15 @@ def test_the_help_examples_read_as_one_command_each():
     lines = run_cli("texture", "--help").stdout.splitlines()
     example = [line.strip() for line in lines if line.strip().startswith("fishgen texture")]
     assert len(example) == 2 and example[1].endswith("\\")
+
+
+@pytest.mark.parametrize("sections", ["3", "4"])
+def test_the_coarsest_body_sections_still_give_fins_two_sections_each(tmp_path, sections):
+    """--body-sections 3 and 4 were a shape-mismatch traceback: fins mapped onto one section."""
+    out = tmp_path / "coarse.txt"
+    r = run_cli("texture", PARAMS / "photos" / "bonybream-side.png", "-s", PARAMS / "bonybream.txt", "-o", out,
+                "--body-sections", sections)
+    assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
+    built = run_cli("build", out, "-o", tmp_path / "coarse.glb")
+    assert built.returncode == 0, built.stderr
+    assert_valid_gltf(tmp_path / "coarse.glb")

@@ -128,8 +128,19 @@ def test_fin_point_count_must_follow_fin_structure(tmp_path):
 def test_fin_section_outside_the_body(tmp_path):
     err = error_of(tmp_path, replace_record(BONY, "7.0 10.0 0.6 0.05 70.0 0.98",
                                             "7.0 16.0 0.6 0.05 70.0 0.98"))
-    assert ("dorsal fin endBodySection as a BodySection number (from startBodySection 7) in 7..15, "
+    assert ("dorsal fin endBodySection as a BodySection number after startBodySection 7 in 8..15, "
             "found '16.0'" in str(err))
+
+
+@pytest.mark.parametrize("fin,record,one_section", [
+    ("dorsal fin", "7.0 10.0 0.6 0.05 70.0 0.98", "7.0 7.0 0.6 0.05 70.0 0.98"),
+    ("dorsal fin", "7.0 10.0 0.6 0.05 70.0 0.98", "15.0 15.0 0.6 0.05 70.0 0.98"),
+    ("pelvic", "11.0 4.0 7.0 0.1 0.6 90.0 6.0 1.0", "11.0 4.0 4.0 0.1 0.6 90.0 6.0 1.0"),
+])
+def test_a_fin_on_one_body_section_is_refused_at_its_line(tmp_path, fin, record, one_section):
+    """A fin needs two base points along the body: start = end was a shape-mismatch traceback."""
+    err = error_of(tmp_path, replace_record(BONY, record, one_section))
+    assert f"expected {fin} " in str(err) and err.line is not None and "Traceback" not in str(err)
 
 
 def test_pectoral_triangles_may_not_wrap_the_body(tmp_path):

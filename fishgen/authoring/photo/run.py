@@ -79,17 +79,18 @@ def with_counts(base: Species, sections: int | None, circles: int | None) -> Spe
     def circ(k: int) -> int:
         return int(round(k * c / c0)) % c
 
-    def vertical(f: VerticalFin) -> VerticalFin:
-        start, end = sec(f.start_section), sec(f.end_section)
-        return replace(f, start_section=start, end_section=max(end, min(start + 1, b - 1)))
+    def vertical(f: VerticalFin) -> VerticalFin:  # a fin spans at least one section's length
+        start = min(sec(f.start_section), b - 2)
+        return replace(f, start_section=start, end_section=max(sec(f.end_section), start + 1))
 
     p: PelvicFin = base.pelvic
-    ps, pe = sec(p.start_section), sec(p.end_section)
+    ps = min(sec(p.start_section), b - 2)
+    pe = max(sec(p.end_section), ps + 1)
     q: PectoralFin = base.pectoral
     return replace(base, body_sections=b, circle_sections=c, dorsal=vertical(base.dorsal),
                    adipose=vertical(base.adipose), anal=vertical(base.anal),
                    pelvic=replace(p, start_circle=circ(p.start_circle), start_section=ps,
-                                  end_section=max(pe, min(ps + 1, b - 1))),
+                                  end_section=pe),
                    pectoral=replace(q, start_section=sec(q.start_section), start_circle=circ(q.start_circle),
                                     triangles=max(1, min(q.triangles, c // 2))),
                    texture_points=None)
