@@ -178,8 +178,8 @@ def test_the_help_examples_read_as_one_command_each():
 def test_the_coarsest_body_sections_still_give_fins_two_sections_each(tmp_path, sections):
     """--body-sections 3 and 4 were a shape-mismatch traceback: fins mapped onto one section."""
     out = tmp_path / "coarse.txt"
-    r = run_cli("texture", PARAMS / "photos" / "bonybream-side.png", "-s", PARAMS / "bonybream.txt", "-o", out,
-                "--body-sections", sections)
+    r = run_cli("texture", PARAMS / "photos" / "bonybream-side.png", "-s", PARAMS / "bonybream.txt",
+                "-o", out, "--body-sections", sections)
     assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
     built = run_cli("build", out, "-o", tmp_path / "coarse.glb")
     assert built.returncode == 0, built.stderr
