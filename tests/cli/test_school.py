@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 import pygltflib
 
 from tests.conftest import PARAMS, assert_valid_gltf, run_cli
@@ -138,3 +139,31 @@ def test_compact_stores_the_school_keys_as_16_bit_integers_and_the_file_shrinks(
                for c in doc.animations[0].channels if c.target.path in ("rotation", "weights")}
     assert outputs <= {pygltflib.SHORT, pygltflib.UNSIGNED_SHORT} and outputs
     assert compact.stat().st_size < plain.stat().st_size  # small here: the meshes weigh most (-35 % at 1,000 fish)
+
+
+@pytest.mark.parametrize("count,frames", [(100_000, 2), (3_000, 3_000)])
+def test_a_school_too_big_for_the_memory_allowed_is_refused_before_it_starts(tmp_path, count, frames):
+    """Under a 1.5 GiB address-space limit these ended in MemoryError tracebacks (issue 26, fault 1)."""
+    import resource
+    import subprocess
+    import sys
+
+    def cap() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (3 * 2**29, 3 * 2**29))
+
+    run = subprocess.run([sys.executable, "-m", "fishgen", "school", str(PARAMS / "bonybream.txt"), "--count",
+                          str(count), "--frames", str(frames), "-o", str(tmp_path / "big.glb")],
+                         capture_output=True, text=True, preexec_fn=cap, timeout=120)
+    assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr
+    assert "fits in 1.5 GiB (this process's address-space limit)" in run.stderr and "needs about" in run.stderr
+    assert not (tmp_path / "big.glb").exists()
+
+
+def test_the_memory_estimate_is_above_what_a_run_peaks_at():
+    """The estimate errs high: measured peaks (VmPeak, BonyBream with the body wave) stay below it."""
+    from fishgen.school.memory import estimate
+
+    measured = {(1_000, 1_000): 563, (3_000, 300): 589, (10_000, 100): 964, (20_000, 10): 1076,
+                (2_000, 2_000): 1134, (5_000, 300): 910}
+    for (fish, frames), mib in measured.items():
+        assert mib * 2**20 < estimate(fish, frames) < 1.4 * mib * 2**20
