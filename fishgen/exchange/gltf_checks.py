@@ -127,7 +127,8 @@ def _index(d: dict, key: str, where: str, kind: str, count: int, required: bool 
 def _ref(value: Any, where: str, kind: str, count: int) -> int:
     if not _is_int(value) or not 0 <= value < count:
         span = f"from 0 to {count - 1}" if count else f"(the file has no {kind}s)"
-        raise expected(f"a {kind} index {span} at {where}", "none" if value is None else _show(value))
+        article = "an" if kind[0] in "aeiou" else "a"
+        raise expected(f"{article} {kind} index {span} at {where}", "none" if value is None else _show(value))
     return cast(int, value)
 
 
@@ -191,6 +192,10 @@ class _Checker:
         version = asset.get("version")
         if not isinstance(version, str) or version.split(".")[0] != "2":
             raise expected('asset.version "2.0"', "none" if version is None else _show(version))
+        for key in ("extensionsUsed", "extensionsRequired"):  # names, or a list in a set test is a TypeError
+            for k, name in enumerate(_list(doc, key, "document")):
+                if not isinstance(name, str):
+                    raise expected(f"an extension name at {key}[{k}]", _show(name))
         required = _list(doc, "extensionsRequired", "document")
         unknown = [e for e in required if e not in SUPPORTED_EXTENSIONS]
         if unknown:

@@ -35,7 +35,7 @@ from fishgen.errors import FishgenError
 from fishgen.exchange.gltf_checks import check_document
 from fishgen.exchange.gltf_container import read_capped, unpack
 from fishgen.exchange.gltf_scene import build_scene
-from fishgen.exchange.guards import one_line
+from fishgen.exchange.guards import what_was_found
 from fishgen.scene.model import Scene
 
 
@@ -60,5 +60,5 @@ def read_gltf(path: str | Path | None = None, *, data: bytes | None = None,
     except MemoryError:
         raise FishgenError("expected an asset that fits in memory, found it does not", where) from None
     except Exception as err:  # a fault the checks above missed: still one line, never a traceback
-        raise FishgenError(f"expected a well-formed glTF 2.0 asset, found {type(err).__name__}: "
-                           f"{one_line(err)}", where) from None
+        raise FishgenError(f"expected a well-formed glTF 2.0 asset, found {what_was_found(err, 'glTF')}",
+                           where) from None

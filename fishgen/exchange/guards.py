@@ -21,6 +21,19 @@ def one_line(err: BaseException, limit: int = 200) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
+#: A library's own bugs on input it did not expect: their messages name its variables, not the file.
+_INTERNAL = (TypeError, AttributeError, NameError, KeyError, IndexError, AssertionError, RecursionError)
+
+
+def what_was_found(err: BaseException, kind: str, limit: int = 200) -> str:
+    """What a reader's library choked on, said about the file: its message when it speaks of the
+    data (a ValueError's "could not convert string to float: 'x'"), else that the file holds
+    something the {kind} reader cannot parse. Never an exception's class name."""
+    if isinstance(err, _INTERNAL) or not str(err).strip():
+        return f"content the {kind} reader cannot parse"
+    return one_line(err, limit)
+
+
 def size_text(n: int) -> str:
     """A byte count for a message: ``564 bytes``, ``2.0 GiB``."""
     if n < 2**20:
@@ -55,5 +68,4 @@ def check_picture(data: bytes, name: str) -> None:
             with PILImage.open(io.BytesIO(data)) as img:
                 img.verify()
     except Exception as err:
-        raise expected(f"an undamaged image at {name}",
-                       f"{type(err).__name__}: {one_line(err, 80)}") from None
+        raise expected(f"an undamaged image at {name}", what_was_found(err, "image", 80)) from None

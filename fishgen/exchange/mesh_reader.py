@@ -24,7 +24,7 @@ import numpy as np
 from trimesh.resolvers import Resolver
 
 from fishgen.errors import FishgenError, describe, expected
-from fishgen.exchange.guards import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_picture, one_line, size_text
+from fishgen.exchange.guards import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_picture, size_text, what_was_found
 from fishgen.exchange.sidefiles import side_file
 from fishgen.numeric import srgb_to_linear
 from fishgen.scene.model import Image, Material, Mesh, Node, Primitive, Scene
@@ -65,8 +65,8 @@ def read_mesh_file(path: str | Path) -> Scene:
     except MemoryError:
         raise FishgenError(f"expected a {kind} file that fits in memory, found it does not", path) from None
     except Exception as err:  # trimesh and numpy raise anything from KeyError to IndexError
-        raise FishgenError(f"expected a well-formed {kind} file, found {type(err).__name__}: "
-                           f"{one_line(err)}", path) from None
+        raise FishgenError(f"expected a well-formed {kind} file, found {what_was_found(err, kind)}",
+                           path) from None
 
 
 def _stat(path: Path, cap: int, what: str, where: Path) -> int:

@@ -35,7 +35,9 @@ def allowed() -> tuple[int, str] | None:
     except OSError:
         pass
     pages = os.sysconf("SC_AVPHYS_PAGES") if hasattr(os, "sysconf") else -1
-    return (pages * os.sysconf("SC_PAGE_SIZE"), "the memory this machine has available") if pages > 0 else None
+    if pages <= 0:
+        return None
+    return pages * os.sysconf("SC_PAGE_SIZE"), "the memory this machine has available"
 
 
 def size_text(n: int) -> str:

@@ -131,7 +131,8 @@ PRESET = Option(click.Choice(tuple(COUZIN_PRESETS)),
                 shown_default="the scene file's [couzin], else zones of 1, 1 and 15 body lengths (torus)")
 SIZE_VARIETY = Option(FiniteRange(*VARIETY_RANGES["size"]), VARIETY_HELP["size"].capitalize() + ".",
                       Variety.size)
-TINTS = Option(click.IntRange(*map(int, VARIETY_RANGES["tints"])), VARIETY_HELP["tints"].capitalize() + ".",
+TINTS = Option(click.IntRange(int(VARIETY_RANGES["tints"][0]), int(VARIETY_RANGES["tints"][1])),
+               VARIETY_HELP["tints"].capitalize() + ".",
                Variety.tints)
 TINT = Option(FiniteRange(*VARIETY_RANGES["tint"]), VARIETY_HELP["tint"].capitalize() + ".", Variety.tint)
 
@@ -187,7 +188,7 @@ def with_options(scene: SceneFile, *, count: int | None = None, frames: int | No
     return replace(scene, **given)
 
 
-def check_size(scene: SceneFile, file: str | None = None, line: int | None = None) -> None:
+def check_size(scene: SceneFile, file: str | os.PathLike | None = None, line: int | None = None) -> None:
     """Refuse absurd schools before anything is built: MAX_FISH fish, MAX_FISH_FRAMES fish x frames,
     and a run whose estimated peak memory is more than this process may use."""
     from fishgen.school import memory

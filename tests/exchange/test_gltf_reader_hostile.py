@@ -88,6 +88,7 @@ def refused(path: Path, pattern: str) -> str:
     text = str(err.value)
     assert text.startswith(f"{path}: expected "), text
     assert ", found " in text and "\n" not in text, text
+    assert not __import__("re").search(r"found \w+Error\b", text), text  # never an exception's name
     assert __import__("re").search(pattern, text), text
     return text
 
@@ -126,6 +127,11 @@ STRUCTURE = {
     "non-root in scene": (lambda d: _nodes(d, [{"children": [1]}, {"mesh": 0}], [0, 1]),
                           r"only root nodes at scenes\[0\]\.nodes, found node 1"),
     "scene out of range": (_set("scene", 3), r"scene index from 0 to 0"),
+    # was "found TypeError: unhashable type: 'list'" (issue 26): a name, not an exception
+    "extension not a name": (lambda d: d.d.update(extensionsRequired=[["KHR_x"]]),
+                             r"an extension name at extensionsRequired\[0\], found a list"),
+    "used extension not a name": (lambda d: d.d.update(extensionsUsed=[{"a": 1}]),
+                                  r"an extension name at extensionsUsed\[0\], found an object"),
     "mesh out of range": (_set("nodes.0.mesh", 3), r"mesh index from 0 to 0 at nodes\[0\]\.mesh, found 3"),
     "skin out of range": (_set("nodes.0.skin", 0), r"skin index \(the file has no skins\)"),
     "material out of range": (_set("meshes.0.primitives.0.material", 2), r"material index from 0 to 0"),

@@ -192,3 +192,15 @@ def test_a_side_file_an_obj_names_must_be_there_for_preview_and_view_alike(tmp_p
         result = run_cli(*command)
         assert result.returncode == 2 and f"{missing!r}" in result.stderr and "found none" in result.stderr
         assert result.stderr.count("\n") == 1
+
+
+def test_a_library_fault_is_said_about_the_file_not_named_by_its_exception():
+    """A reader library's own bug (TypeError, UnboundLocalError...) says the file holds content the
+    reader cannot parse; a message about the data is kept (issue 26)."""
+    from fishgen.exchange.guards import what_was_found
+
+    assert what_was_found(TypeError("unhashable type: 'list'"), "OBJ") == "content the OBJ reader cannot parse"
+    assert what_was_found(UnboundLocalError("cannot access local variable 'v'"), "PLY") == (
+        "content the PLY reader cannot parse")
+    assert what_was_found(ValueError("could not convert string to float: 'x'"), "OBJ") == (
+        "could not convert string to float: 'x'")
