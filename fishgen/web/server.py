@@ -39,9 +39,14 @@ class Request:
         """The body as JSON; a malformed body is a :class:`Refused` (400), never a traceback."""
         try:
             return json.loads(self.body.decode("utf-8"))
-        except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        except UnicodeDecodeError as err:
             raise Refused(HTTPStatus.BAD_REQUEST,
-                          f"expected a JSON body, found {type(err).__name__}") from None
+                          f"expected a JSON body, found bytes that are not UTF-8 at byte {err.start}") from None
+        except json.JSONDecodeError as err:
+            raise Refused(HTTPStatus.BAD_REQUEST, f"expected a JSON body, found invalid JSON at line "
+                          f"{err.lineno} column {err.colno} ({err.msg})") from None
+        except RecursionError:
+            raise Refused(HTTPStatus.BAD_REQUEST, "expected a JSON body, found JSON nested too deeply") from None
 
 
 @dataclass(frozen=True)

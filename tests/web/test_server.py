@@ -69,7 +69,9 @@ def test_bodies_are_capped_before_they_are_read_and_must_be_json(server):
     status, body = ask(server, "POST", "/echo", b"x" * 1001, token=server.token)
     assert status == 413 and b"at most 1,000 bytes" in body
     status, body = ask(server, "POST", "/echo", b"{not json", token=server.token)
-    assert status == 400 and b"expected a JSON body" in body
+    assert status == 400 and b"expected a JSON body, found invalid JSON at line 1 column 2" in body
+    status, body = ask(server, "POST", "/echo", b'{"a": "\xff"}', token=server.token)
+    assert status == 400 and b"found bytes that are not UTF-8 at byte 7" in body
 
 
 def test_bad_input_from_the_page_is_one_line_with_its_place(server):
