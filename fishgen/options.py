@@ -34,18 +34,23 @@ T = TypeVar("T")
 
 # -- types click checks (and manifests reuse) -------------------------------------------------
 
-class Triple(click.ParamType):
-    """``X,Y,Z``: three finite numbers, by default within float32 range (where particles and nodes
-    live); ``low``/``high`` bound each (a colour's channels), ``nonzero`` refuses 0,0,0 (a direction)."""
+class Numbers(click.ParamType):
+    """``A,B,...``: ``count`` finite numbers, by default within float32 range (where particles and
+    nodes live); ``low``/``high`` bound each, ``ordered`` wants them ascending, ``positive`` all
+    above 0, ``nonzero`` not all 0 (a direction). A TOML array is taken as the numbers."""
 
-    name = "X,Y,Z"
+    toml_list = True
+    _WORDS = {2: "two", 3: "three", 4: "four", 6: "six"}
 
-    def __init__(self, low: float = -FLOAT32_MAX, high: float = FLOAT32_MAX, nonzero: bool = False,
-                 name: str = "X,Y,Z"):
-        self.low, self.high, self.nonzero, self.name = low, high, nonzero, name
+    def __init__(self, count: int, name: str, low: float = -FLOAT32_MAX, high: float = FLOAT32_MAX, *,
+                 ordered: bool = False, positive: bool = False, nonzero: bool = False):
+        self.count, self.name, self.low, self.high = count, name, low, high
+        self.ordered, self.positive, self.nonzero = ordered, positive, nonzero
         float32 = (low, high) == (-FLOAT32_MAX, FLOAT32_MAX)
         within = "within float32 range" if float32 else f"from {low:g} to {high:g}"
-        self.what = f"{name} with three finite numbers {within}" + (", not all 0" if nonzero else "")
+        self.what = (f"{name} with {self._WORDS.get(count, count)} finite numbers {within}"
+                     + (", the first at most the second" if ordered else "")
+                     + (", all above 0" if positive else "") + (", not all 0" if nonzero else ""))
 
     def convert(self, value, param, ctx):
         if isinstance(value, (tuple, list)):
@@ -55,10 +60,22 @@ class Triple(click.ParamType):
                 numbers = tuple(float(part) for part in str(value).replace(" ", "").split(","))
             except ValueError:
                 numbers = ()
-        if (len(numbers) != 3 or not all(_finite_number(v) and self.low <= v <= self.high for v in numbers)
-                or (self.nonzero and not any(numbers))):
+        ok = (len(numbers) == self.count
+              and all(_finite_number(v) and self.low <= v <= self.high for v in numbers)
+              and not (self.ordered and list(numbers) != sorted(numbers))
+              and not (self.positive and min(numbers) <= 0)
+              and not (self.nonzero and not any(numbers)))
+        if not ok:
             self.fail(f"expected {self.what}, found {value!r}", param, ctx)
         return tuple(float(v) for v in numbers)
+
+
+class Triple(Numbers):
+    """``X,Y,Z``: three finite numbers (see :class:`Numbers`)."""
+
+    def __init__(self, low: float = -FLOAT32_MAX, high: float = FLOAT32_MAX, nonzero: bool = False,
+                 name: str = "X,Y,Z"):
+        super().__init__(3, name, low, high, nonzero=nonzero)
 
 
 class FiniteRange(click.FloatRange):
@@ -331,7 +348,7 @@ def _toml_kind_ok(spec: Option, value: Any) -> bool:
         return isinstance(value, numbers.Integral)
     if isinstance(t, click.FloatRange) or t is click.FLOAT:
         return isinstance(value, numbers.Real)
-    if isinstance(t, Triple) or getattr(t, "toml_list", False):  # a TOML array where numbers are declared
+    if getattr(t, "toml_list", False):  # a TOML array where numbers are declared
         return isinstance(value, list)
     return isinstance(value, str)
 

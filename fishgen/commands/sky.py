@@ -1,7 +1,6 @@
 """`fishgen sky`: a sky of many lit clouds (Pakawan's thin, medium and thick modes) for engines."""
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -12,37 +11,8 @@ import click
 from fishgen.clouds.lighting import Lighting
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES
 from fishgen.commands import QUIET, Command, Events, Made, Output
-from fishgen.options import FILE, FLOAT32_MAX, FiniteRange, group, option, seed_option, textures_option
+from fishgen.options import FILE, FiniteRange, Numbers, group, option, seed_option, textures_option
 from fishgen.sky.modes import ALTITUDE, AREA, MODES, NOISE
-
-
-class Pair(click.ParamType):
-    """``A,B``: two finite numbers within ``low`` .. ``high``; ``ordered``: A <= B; ``positive``: both > 0."""
-
-    def __init__(self, name: str, low: float = -FLOAT32_MAX, high: float = FLOAT32_MAX, *,
-                 ordered: bool = False, positive: bool = False):
-        self.name, self.low, self.high, self.ordered, self.positive = name, low, high, ordered, positive
-        self.what = (f"{name} with two finite numbers from {low:g} to {high:g}"
-                     + (", the first at most the second" if ordered else "")
-                     + (", both above 0" if positive else ""))
-
-    def convert(self, value, param, ctx):
-        if isinstance(value, (tuple, list)):
-            numbers = tuple(value)
-        else:
-            try:
-                numbers = tuple(float(part) for part in str(value).replace(" ", "").split(","))
-            except ValueError:
-                numbers = ()
-        ok = (len(numbers) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                                        and math.isfinite(v) and self.low <= v <= self.high for v in numbers))
-        if ok and self.ordered and numbers[0] > numbers[1]:
-            ok = False
-        if ok and self.positive and min(numbers) <= 0:
-            ok = False
-        if not ok:
-            self.fail(f"expected {self.what}, found {value!r}", param, ctx)
-        return tuple(float(v) for v in numbers)
 
 
 def _modes_help() -> str:
@@ -54,10 +24,10 @@ def _modes_help() -> str:
 @dataclass(frozen=True)
 class SkyOptions:
     mode: str = option(click.Choice(tuple(MODES)), f"Pakawan's sky modes ({_modes_help()}).", "medium")
-    area: tuple[float, float] = option(Pair("W,D", 1.0, 1e6, positive=True), "Width (x) and depth (z) of the "
-                                       "sky, centred on the origin, in cube-file units.", AREA,
-                                       metavar="W,D")
-    altitude: tuple[float, float] = option(Pair("LOW,HIGH", -1e6, 1e6, ordered=True), "Range of the "
+    area: tuple[float, float] = option(Numbers(2, "W,D", 1.0, 1e6, positive=True),
+                                       "Width (x) and depth (z) of the sky, centred on the origin, in "
+                                       "cube-file units.", AREA, metavar="W,D")
+    altitude: tuple[float, float] = option(Numbers(2, "LOW,HIGH", -1e6, 1e6, ordered=True), "Range of the "
                                            "clouds' base heights (y, up).", ALTITUDE, metavar="LOW,HIGH")
     seed: int = seed_option("It picks every cloud's model, scale, turn, place, fill and noise.")
     clouds: tuple[Path, ...] = option(FILE, "A cube file (.awn) or texture cloud (.awa) to draw the clouds "

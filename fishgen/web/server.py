@@ -40,13 +40,14 @@ class Request:
         try:
             return json.loads(self.body.decode("utf-8"))
         except UnicodeDecodeError as err:
-            raise Refused(HTTPStatus.BAD_REQUEST,
-                          f"expected a JSON body, found bytes that are not UTF-8 at byte {err.start}") from None
+            raise Refused(HTTPStatus.BAD_REQUEST, "expected a JSON body, found bytes that are not UTF-8 "
+                          f"at byte {err.start}") from None
         except json.JSONDecodeError as err:
             raise Refused(HTTPStatus.BAD_REQUEST, f"expected a JSON body, found invalid JSON at line "
                           f"{err.lineno} column {err.colno} ({err.msg})") from None
         except RecursionError:
-            raise Refused(HTTPStatus.BAD_REQUEST, "expected a JSON body, found JSON nested too deeply") from None
+            raise Refused(HTTPStatus.BAD_REQUEST,
+                          "expected a JSON body, found JSON nested too deeply") from None
 
 
 @dataclass(frozen=True)
