@@ -140,18 +140,18 @@ def total_pixels(options: PreviewOptions, frames: int, inputs: int = 1) -> int:
 
 def subject_points(scene: Scene, times: Sequence[float | None], clip: str | None) -> np.ndarray:
     """Every vertex (and particle extent) the camera must keep in frame, at each of ``times``."""
+    from fishgen.preview.posing import Poser, batches
     from fishgen.preview.render import particles
-    from fishgen.scene.pose import deformed, pose
 
+    poser, shared = Poser(scene, clip), batches(scene)
+    points = [(node, prim) for node, prim in scene.drawn() if prim.mode == "POINTS"]
     out = []
     for t in times:
-        posed = pose(scene, t, clip)
-        for node, prim in scene.drawn():
-            if prim.mode == "POINTS":
-                c, r, _ = particles(scene, node, prim, posed)
-                out += [c - r[:, None], c + r[:, None]]
-            else:
-                out.append(deformed(scene, node, prim, posed)[0])
+        posed = poser(t)
+        for node, prim in points:
+            c, r, _ = particles(scene, node, prim, posed)
+            out += [c - r[:, None], c + r[:, None]]
+        out += [batch.world(scene, posed)[0] for batch in shared]
     return np.concatenate(out) if out else np.zeros((1, 3))
 
 
