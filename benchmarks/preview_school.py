@@ -1,0 +1,85 @@
+"""Speed of `fishgen preview school.glb -o school.gif`: the whole command, as a user runs it.
+
+    python benchmarks/preview_school.py [--repeat 3] [--baseline REV] [--count 200]
+
+Issue 23, section 4: a 200-fish school previewed at the default size (800x600) and frame count
+(48: 4 s at 12 fps) in under 10 s, the whole command (a subprocess: start, imports, reading the
+glb, framing, rendering, GIF encoding, writing). Two schools are timed: params/bait-ball.toml (a
+milling torus) and BonyBream --count N (a polarized school). Prints the median of --repeat runs
+beside the target. With --baseline REV, the same command from that git revision of fishgen (an
+archive of its `fishgen/` folder put first on PYTHONPATH) runs alternately in the same loop, so
+both see the same machine load, and the ratio is printed.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tarfile
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+TARGET = 10.0
+
+
+def _fishgen(*args: object, pythonpath: Path | None = None) -> float:
+    """Seconds the command takes; it must succeed."""
+    env = dict(os.environ)
+    if pythonpath is not None:
+        env["PYTHONPATH"] = os.pathsep.join([str(pythonpath), env.get("PYTHONPATH", "")])
+    start = time.perf_counter()
+    result = subprocess.run([sys.executable, "-m", "fishgen", *map(str, args)], cwd=ROOT, env=env,
+                            capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    if result.returncode:
+        sys.exit(f"fishgen {' '.join(map(str, args))} failed:\n{result.stderr}")
+    return seconds
+
+
+def _checkout(rev: str, into: Path) -> Path:
+    """The `fishgen/` package of ``rev``, unpacked under ``into``."""
+    archive = into / "base.tar"
+    subprocess.run(["git", "archive", "-o", str(archive), rev, "fishgen"], cwd=ROOT, check=True)
+    with tarfile.open(archive) as tar:
+        tar.extractall(into / "base", filter="data")
+    return into / "base"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--repeat", type=int, default=3, help="runs per school (median)")
+    parser.add_argument("--count", type=int, default=200, help="fish in the BonyBream school")
+    parser.add_argument("--baseline", metavar="REV", help="also time this git revision, alternately")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        schools = {"bait ball (params/bait-ball.toml)": folder / "ball.glb",
+                   f"BonyBream --count {args.count}": folder / "bream.glb"}
+        _fishgen("school", "params/bait-ball.toml", "-o", schools["bait ball (params/bait-ball.toml)"],
+                 "--quiet")
+        _fishgen("school", "params/bonybream.txt", "--count", args.count, "-o",
+                 schools[f"BonyBream --count {args.count}"], "--quiet")
+        base = _checkout(args.baseline, folder) if args.baseline else None
+        print(f"fishgen preview SCHOOL.glb -o SCHOOL.gif (800x600, 48 frames), median of {args.repeat}; "
+              f"target under {TARGET:.0f} s")
+        for name, glb in schools.items():
+            now, before = [], []
+            for k in range(args.repeat):
+                now.append(_fishgen("preview", glb, "-o", folder / f"now{k}.gif", "--quiet"))
+                if base is not None:
+                    before.append(_fishgen("preview", glb, "-o", folder / f"base{k}.gif", "--quiet",
+                                           pythonpath=base))
+            median = statistics.median(now)
+            line = f"  {name:<36} {median:6.2f} s  ({'meets' if median < TARGET else 'MISSES'} the target)"
+            if before:
+                old = statistics.median(before)
+                line += f"   {args.baseline}: {old:6.2f} s   {old / median:5.1f}x faster"
+            print(line)
+
+
+if __name__ == "__main__":
+    main()
