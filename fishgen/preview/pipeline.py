@@ -140,10 +140,10 @@ def total_pixels(options: PreviewOptions, frames: int, inputs: int = 1) -> int:
 
 def subject_points(scene: Scene, times: Sequence[float | None], clip: str | None) -> np.ndarray:
     """Every vertex (and particle extent) the camera must keep in frame, at each of ``times``."""
-    from fishgen.preview.posing import Poser, batches
+    from fishgen.preview.posing import batches, poser_for
     from fishgen.preview.render import particles
 
-    poser, shared = Poser(scene, clip), batches(scene)
+    poser, shared = poser_for(scene, clip), batches(scene)
     points = [(node, prim) for node, prim in scene.drawn() if prim.mode == "POINTS"]
     out = []
     for t in times:

@@ -10,6 +10,7 @@ results equal ``pose`` / ``deformed`` to rounding (tests/preview/test_posing.py)
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -86,6 +87,13 @@ class _Group:
         return _normalize_rows(out) if self.path == "rotation" else out
 
 
+@dataclass
+class ArrayPose(Pose):
+    """A ``Pose`` that also keeps its world matrices as one (N, 4, 4) array."""
+
+    array: np.ndarray | None = None
+
+
 class Poser:
     """``pose(scene, t, clip)`` for one scene and clip, compiled once and evaluated per frame."""
 
@@ -140,13 +148,15 @@ class Poser:
                 (order, ch.node, times, keys))
         groups = []
         for (path, interpolation, _), items in buckets.items():
-            most = max(len(it[2]) for it in items)
-            times = np.stack([np.pad(it[2], (0, most - len(it[2])), mode="edge") for it in items])
-            values = np.stack([np.pad(it[3], [(0, most - len(it[3]))] + [(0, 0)] * (it[3].ndim - 1),
-                                      mode="edge") for it in items])
+            counts = np.array([len(it[2]) for it in items])
+            most = int(counts.max())
+            times = np.empty((len(items), most))
+            values = np.empty((len(items), most, *items[0][3].shape[1:]))
+            for row, (_, _, t, keys) in enumerate(items):  # padded with the last key: never chosen
+                times[row, :len(t)], times[row, len(t):] = t, t[-1]
+                values[row, :len(t)], values[row, len(t):] = keys, keys[-1]
             groups.append(_Group(path, interpolation, np.array([it[0] for it in items]),
-                                 np.array([it[1] for it in items]), np.array([len(it[2]) for it in items]),
-                                 times, values))
+                                 np.array([it[1] for it in items]), counts, times, values))
         return groups
 
     def __call__(self, t: float | None) -> Pose:
@@ -157,15 +167,15 @@ class Poser:
         weights = dict(self.rest_weights)
         if t is not None:
             latest: dict[str, list] = {}
+            morphs: list[tuple[int, int, np.ndarray]] = []
             for g in self.groups:
                 values = g.sample(t)
                 if g.path == "weights":
-                    for order, node, v in zip(g.order, g.nodes, values, strict=True):
-                        latest.setdefault("weights", []).append((order, node, v))
+                    morphs += zip(g.order.tolist(), g.nodes.tolist(), values, strict=True)
                 else:
                     latest.setdefault(g.path, []).append((g.order, g.nodes, values))
-            for order, node, v in sorted(latest.get("weights", []), key=lambda item: item[0]):
-                weights[int(node)] = v
+            morphs.sort(key=lambda item: item[0])  # the last channel of a node wins
+            weights.update((node, v) for _, node, v in morphs)
             for path in _PATHS:
                 if path not in latest:
                     continue
@@ -186,7 +196,24 @@ class Poser:
         world = np.empty_like(local)
         for level, idx in enumerate(self.levels):
             world[idx] = local[idx] if level == 0 else world[self.parent[idx]] @ local[idx]
-        return Pose(list(world), weights)
+        return ArrayPose(list(world), weights, world)
+
+
+_POSERS: dict[tuple[int, int], tuple[weakref.ref, Poser]] = {}
+
+
+def poser_for(scene: Scene, clip: str | None) -> Poser:
+    """The scene's ``Poser`` for ``clip``, compiled once while the scene lives (framing and rendering
+    share it)."""
+    active = scene.clip(clip)
+    key = (id(scene), id(active))
+    held = _POSERS.get(key)
+    if held is None or held[0]() is not scene or held[1].active is not active:
+        for k in [k for k, (ref, _) in _POSERS.items() if ref() is None]:
+            del _POSERS[k]
+        held = (weakref.ref(scene), Poser(scene, active))
+        _POSERS[key] = held
+    return held[1]
 
 
 def _quat_matrices(q: np.ndarray) -> np.ndarray:
@@ -221,24 +248,28 @@ class Batch:
         """World positions and unit normals of every instance, stacked: (I * V, 3) each."""
         if self.skinned:
             out = [deformed(scene, int(n), self.prim, posed) for n in self.nodes]
-            nrm = None if out[0][1] is None else np.concatenate([o[1] for o in out])  # type: ignore[misc]
+            normals = [o[1] for o in out]
+            nrm: np.ndarray | None = None if any(n is None for n in normals) \
+                else np.concatenate(normals)  # type: ignore[arg-type]
             return np.concatenate([o[0] for o in out]), nrm
         count = len(self.target_pos)
         w = np.zeros((self.instances, count))
         morphs = np.zeros(self.instances, bool)
-        for row, n in enumerate(self.nodes):
-            weights = posed.weights.get(int(n))
-            if weights is not None and count:
-                m = min(count, len(weights))
-                w[row, :m] = weights[:m]
-                morphs[row] = True
+        if count:
+            for row, n in enumerate(self.nodes.tolist()):
+                weights = posed.weights.get(n)
+                if weights is not None:
+                    m = min(count, len(weights))
+                    w[row, :m] = weights[:m]
+                    morphs[row] = True
         pos = np.broadcast_to(self.base_pos, (self.instances, *self.base_pos.shape))
         nrm = None if self.base_nrm is None else np.broadcast_to(self.base_nrm, pos.shape)
         if count and morphs.any():
             pos = pos + np.einsum("it,tvc->ivc", w, self.target_pos)
             if nrm is not None and self.target_nrm is not None:
                 nrm = nrm + np.einsum("it,tvc->ivc", w, self.target_nrm)
-        mats = np.stack([posed.world[int(n)] for n in self.nodes])
+        array = getattr(posed, "array", None)
+        mats = array[self.nodes] if array is not None else np.stack([posed.world[int(n)] for n in self.nodes])
         out = pos @ mats[:, :3, :3].transpose(0, 2, 1) + mats[:, None, :3, 3]
         if nrm is not None:
             nrm = nrm @ cofactor(mats[:, :3, :3]).transpose(0, 2, 1)

@@ -23,10 +23,9 @@ from fishgen.errors import FishgenError
 from fishgen.geometry.mesh import vertex_normals
 from fishgen.numeric import to_linear_float
 from fishgen.preview.camera import Camera
+from fishgen.preview.posing import Batch, Poser, batches, poser_for
 from fishgen.scene.model import Material, Primitive, Scene
 from fishgen.scene.pose import Pose, deformed
-
-from fishgen.preview.posing import Batch, Poser, batches
 
 SAMPLES = 4
 # World-fixed lights: a sun from above and in front, a weak fill from behind, a
@@ -258,7 +257,7 @@ class Renderer:
             tex = self._texture(scene, material.texture) if material.texture is not None else None
             out.append(_GpuMesh(batch, material, vbo, static, ibo, vao, tex,
                                 np.asarray(prim.positions, float).mean(0), batch.base_nrm is None))
-        self._uploaded[key] = (Poser(scene, clip), out)
+        self._uploaded[key] = (poser_for(scene, clip), out)
         return self._uploaded[key]
 
     @staticmethod
