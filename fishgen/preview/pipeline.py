@@ -182,12 +182,13 @@ def _frame_plan(scene: Scene, options: PreviewOptions, frames: int):
     start = time or 0.0
     if frames == 1:
         return [time], [0.0], 0.0
-    animated = clip is not None and clip.duration > 0
-    duration = options.duration or (min(clip.duration, LOOP_SECONDS) if animated and clip else LOOP_SECONDS)
+    length = clip.duration if clip is not None else 0.0  # a property that reads every channel
+    animated = length > 0
+    duration = options.duration or (min(length, LOOP_SECONDS) if animated else LOOP_SECONDS)
     count = options.frames or max(2, round(duration * options.fps))
     step = duration / count
-    if animated and clip is not None:
-        return [(start + k * step) % clip.duration for k in range(count)], [0.0] * count, step
+    if animated:
+        return [(start + k * step) % length for k in range(count)], [0.0] * count, step
     return [time] * count, [2 * math.pi * k / count for k in range(count)], step
 
 

@@ -92,6 +92,8 @@ class ArrayPose(Pose):
     """A ``Pose`` that also keeps its world matrices as one (N, 4, 4) array."""
 
     array: np.ndarray | None = None
+    weight_rows: np.ndarray | None = None   # (N, most targets) morph weights, zero-padded
+    morphed: np.ndarray | None = None       # (N,) the node has weights
 
 
 class Poser:
@@ -119,6 +121,11 @@ class Poser:
         self.parent = parent
         self.levels = self._levels(parent)
         self.groups = self._compile(self.active, n) if self.active is not None else []
+        self.most_weights = max([len(p.targets) for m in scene.meshes for p in m.primitives], default=0)
+        self.rest_rows, self.rest_morphed = self._rows(self.rest_weights)
+        morph_nodes = np.concatenate([np.zeros(0, int)] + [g.nodes for g in self.groups
+                                                            if g.path == "weights"])
+        self.weights_unique = len(np.unique(morph_nodes)) == len(morph_nodes)
 
     @staticmethod
     def _levels(parent: np.ndarray) -> list[np.ndarray] | None:
@@ -159,23 +166,43 @@ class Poser:
                                  np.array([it[1] for it in items]), counts, times, values))
         return groups
 
+    def _rows(self, weights: dict[int, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """(N, most targets) zero-padded morph weights and (N,) which nodes have any."""
+        rows = np.zeros((len(self.fixed), self.most_weights))
+        morphed = np.zeros(len(self.fixed), bool)
+        if weights:
+            morphed[list(weights)] = True
+            for width in {len(v) for v in weights.values()}:
+                same = [n for n in weights if len(weights[n]) == width]
+                keep = min(width, self.most_weights)
+                rows[same, :keep] = np.stack([weights[n] for n in same])[:, :keep]
+        return rows, morphed
+
     def __call__(self, t: float | None) -> Pose:
         if self.levels is None:
             return pose(self.scene, t, self.active)  # a cycle: let pose raise its error
         trs = {"translation": self.translation.copy(), "rotation": self.rotation.copy(),
                "scale": self.scale.copy()}
         weights = dict(self.rest_weights)
+        rows, morphed = self.rest_rows.copy(), self.rest_morphed.copy()  # the weights as one array
         if t is not None:
             latest: dict[str, list] = {}
             morphs: list[tuple[int, int, np.ndarray]] = []
             for g in self.groups:
                 values = g.sample(t)
-                if g.path == "weights":
-                    morphs += zip(g.order.tolist(), g.nodes.tolist(), values, strict=True)
-                else:
+                if g.path != "weights":
                     latest.setdefault(g.path, []).append((g.order, g.nodes, values))
-            morphs.sort(key=lambda item: item[0])  # the last channel of a node wins
-            weights.update((node, v) for _, node, v in morphs)
+                elif self.weights_unique:  # one channel a node (a school's): no order to keep
+                    weights.update(zip(g.nodes.tolist(), values, strict=True))
+                    keep = min(values.shape[1], rows.shape[1])
+                    rows[g.nodes, :keep], rows[g.nodes, keep:] = values[:, :keep], 0.0
+                    morphed[g.nodes] = True
+                else:
+                    morphs += zip(g.order.tolist(), g.nodes.tolist(), values, strict=True)
+            if morphs:
+                morphs.sort(key=lambda item: item[0])  # the last channel of a node wins
+                weights.update((node, v) for _, node, v in morphs)
+                rows, morphed = self._rows(weights)
             for path in _PATHS:
                 if path not in latest:
                     continue
@@ -196,7 +223,7 @@ class Poser:
         world = np.empty_like(local)
         for level, idx in enumerate(self.levels):
             world[idx] = local[idx] if level == 0 else world[self.parent[idx]] @ local[idx]
-        return ArrayPose(list(world), weights, world)
+        return ArrayPose(list(world), weights, world, rows, morphed)
 
 
 _POSERS: dict[tuple[int, int], tuple[weakref.ref, Poser]] = {}
@@ -255,7 +282,10 @@ class Batch:
         count = len(self.target_pos)
         w = np.zeros((self.instances, count))
         morphs = np.zeros(self.instances, bool)
-        if count:
+        dense = getattr(posed, "weight_rows", None)
+        if count and dense is not None and dense.shape[1] >= count:
+            w, morphs = dense[self.nodes, :count], posed.morphed[self.nodes]  # type: ignore[attr-defined]
+        elif count:
             for row, n in enumerate(self.nodes.tolist()):
                 weights = posed.weights.get(n)
                 if weights is not None:

@@ -214,6 +214,7 @@ class Renderer:
         self.corner_buf = self.ctx.buffer(corners.tobytes())
         self._uploaded: dict[int, tuple[Poser, list[_GpuMesh]]] = {}
         self._textures: dict[tuple[int, int], Any] = {}
+        self._points: dict[int, list[tuple[int, Primitive]]] = {}
 
     # -- uploads -------------------------------------------------------------
     def _texture(self, scene: Scene, index: int) -> Any:
@@ -368,9 +369,10 @@ class Renderer:
         import moderngl
 
         parts = []
-        for node, prim in scene.drawn():
-            if prim.mode != "POINTS" or not prim.vertex_count:
-                continue
+        if id(scene) not in self._points:  # drawn() walks every node: once per scene, not per frame
+            self._points[id(scene)] = [(node, prim) for node, prim in scene.drawn()
+                                       if prim.mode == "POINTS" and prim.vertex_count]
+        for node, prim in self._points[id(scene)]:
             c, r, col = particles(scene, node, prim, posed)
             parts.append((c, r, col, _light(prim)))
         if not parts:
