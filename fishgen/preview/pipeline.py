@@ -151,7 +151,7 @@ def subject_points(scene: Scene, times: Sequence[float | None], clip: str | None
         for node, prim in points:
             c, r, _ = particles(scene, node, prim, posed)
             out += [c - r[:, None], c + r[:, None]]
-        out += [batch.world(scene, posed)[0] for batch in shared]
+        out += [batch.world(scene, posed, normals=False)[0] for batch in shared]
     return np.concatenate(out) if out else np.zeros((1, 3))
 
 
@@ -222,9 +222,10 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
             base = frame(points, options.view, options.width / options.height,
                          azimuths=tuple(sorted(set(azimuths))), ortho=options.ortho)
             images = []
-            for t, az in zip(times, azimuths, strict=True):
-                cam = turned(base, options.view, az) if az else base
-                images.append(Image.fromarray(renderer.render(scene, cam, t, bg, options.clip)))
+            shots = [(turned(base, options.view, az) if az else base, t)
+                     for t, az in zip(times, azimuths, strict=True)]
+            for image in renderer.render_all(scene, shots, bg, options.clip):
+                images.append(Image.fromarray(image))
                 if progress:
                     progress(1)
             out.append(images)

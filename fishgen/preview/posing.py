@@ -271,13 +271,15 @@ class Batch:
     def instances(self) -> int:
         return len(self.nodes)
 
-    def world(self, scene: Scene, posed: Pose) -> tuple[np.ndarray, np.ndarray | None]:
-        """World positions and unit normals of every instance, stacked: (I * V, 3) each."""
+    def world(self, scene: Scene, posed: Pose,
+              normals: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """World positions and unit normals (None without ``normals``) of every instance, stacked:
+        (I * V, 3) each."""
         if self.skinned:
             out = [deformed(scene, int(n), self.prim, posed) for n in self.nodes]
-            normals = [o[1] for o in out]
-            nrm: np.ndarray | None = None if any(n is None for n in normals) \
-                else np.concatenate(normals)  # type: ignore[arg-type]
+            each = [o[1] for o in out]
+            nrm: np.ndarray | None = None if not normals or any(n is None for n in each) \
+                else np.concatenate(each)  # type: ignore[arg-type]
             return np.concatenate([o[0] for o in out]), nrm
         count = len(self.target_pos)
         w = np.zeros((self.instances, count))
@@ -293,7 +295,7 @@ class Batch:
                     w[row, :m] = weights[:m]
                     morphs[row] = True
         pos = np.broadcast_to(self.base_pos, (self.instances, *self.base_pos.shape))
-        nrm = None if self.base_nrm is None else np.broadcast_to(self.base_nrm, pos.shape)
+        nrm = None if self.base_nrm is None or not normals else np.broadcast_to(self.base_nrm, pos.shape)
         if count and morphs.any():
             pos = pos + np.einsum("it,tvc->ivc", w, self.target_pos)
             if nrm is not None and self.target_nrm is not None:

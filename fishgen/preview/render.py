@@ -13,6 +13,7 @@ The framebuffer holds premultiplied alpha, so a transparent background works.
 """
 from __future__ import annotations
 
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -275,11 +276,52 @@ class Renderer:
     def render(self, scene: Scene, camera: Camera, t: float | None,
                background: tuple[float, float, float, float], clip: str | None = None) -> np.ndarray:
         """Draw ``scene`` posed at ``t``; returns (H, W, 4) uint8 RGBA, straight alpha."""
+        self.draw(scene, camera, self.posed(scene, t, clip), background, clip)
+        return self.finish()
+
+    def render_all(self, scene: Scene, shots: Sequence[tuple[Camera, float | None]],
+                   background: tuple[float, float, float, float],
+                   clip: str | None = None) -> Iterator[np.ndarray]:
+        """``render`` of each (camera, time), in order. The next frame is posed on the CPU while
+        Mesa's threads still rasterise this one: a frame is read back only after that."""
+        waiting = False
+        for camera, t in shots:
+            posed = self.posed(scene, t, clip)
+            if waiting:
+                yield self.finish()
+            self.draw(scene, camera, posed, background, clip)
+            self.resolved.use()  # binding another framebuffer hands the frame to Mesa's threads
+            waiting = True
+        if waiting:
+            yield self.finish()
+
+    def posed(self, scene: Scene, t: float | None, clip: str | None = None) -> tuple[Pose, list]:
+        """Every batch of ``scene`` posed at ``t``: the CPU's share of a frame."""
+        poser, meshes = self._upload(scene, clip)
+        posed = poser(t)
+        out = []
+        for m in meshes:  # morph targets, skins and node transforms: posed on the CPU, drawn in world space
+            pos, nrm = m.batch.world(scene, posed)
+            if nrm is None:
+                nrm = vertex_normals(pos, m.batch.indices.reshape(-1, 3))  # type: ignore[union-attr]
+            out.append((pos, np.hstack([pos, nrm]).astype(np.float32)))
+        return posed, out
+
+    def finish(self) -> np.ndarray:
+        """The frame last drawn, resolved and read back: (H, W, 4) uint8 RGBA, straight alpha."""
+        self.ctx.copy_framebuffer(self.resolved, self.msaa)
+        raw = self.resolved.read(components=4, alignment=1)
+        img = np.frombuffer(raw, np.uint8).reshape(self.height, self.width, 4)[::-1]
+        return unpremultiply(img)
+
+    def draw(self, scene: Scene, camera: Camera, frame: tuple[Pose, list],
+             background: tuple[float, float, float, float], clip: str | None = None) -> None:
+        """Issue the GL commands of one frame posed by ``posed``; ``finish`` reads it back."""
         import moderngl
 
         ctx = self.ctx
-        poser, meshes = self._upload(scene, clip)
-        posed = poser(t)
+        _, meshes = self._upload(scene, clip)
+        posed, vertices = frame
         view, proj = camera.view(), camera.projection()
         viewproj = proj @ view
         self.msaa.use()
@@ -300,11 +342,8 @@ class Renderer:
         models: dict[int, np.ndarray] = {}
         posed_positions: dict[int, np.ndarray] = {}
         self._posed = posed_positions
-        for m in meshes:  # morph targets, skins and node transforms: posed on the CPU, drawn in world space
-            pos, nrm = m.batch.world(scene, posed)
-            if nrm is None:
-                nrm = vertex_normals(pos, m.batch.indices.reshape(-1, 3))  # type: ignore[union-attr]
-            m.vbo.write(np.hstack([pos, nrm]).astype(np.float32).tobytes())
+        for m, (pos, data) in zip(meshes, vertices, strict=True):
+            m.vbo.write(data.tobytes())
             posed_positions[id(m)] = pos
             # a BLEND batch holds one node: its depth is that of its rest centroid, placed
             models[id(m)] = posed.matrix(int(m.batch.nodes[0]))
@@ -327,11 +366,6 @@ class Renderer:
             self._draw_mesh(m)
         self._draw_points(scene, posed, view, proj, camera.eye)
         self.msaa.depth_mask = True
-
-        ctx.copy_framebuffer(self.resolved, self.msaa)
-        raw = self.resolved.read(components=4, alignment=1)
-        img = np.frombuffer(raw, np.uint8).reshape(self.height, self.width, 4)[::-1]
-        return unpremultiply(img)
 
     def _sort_triangles(self, m: _GpuMesh, view: np.ndarray) -> None:
         """Rewrite a transparent mesh's index buffer with its triangles farthest first."""
