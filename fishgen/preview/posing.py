@@ -51,6 +51,11 @@ class _Group:
     count: np.ndarray    # (C,) keys
     times: np.ndarray    # (C, K)
     values: np.ndarray   # (C, K, W) or (C, K, 3, W) for CUBICSPLINE
+    shared: np.ndarray | None = None   # (K,) the times, when every channel has these same keys
+
+    def __post_init__(self) -> None:
+        if len(self.times) and (self.count == self.count[0]).all() and (self.times == self.times[0]).all():
+            self.shared = self.times[0]
 
     def sample(self, t: float) -> np.ndarray:
         """(C, W): every channel's value at ``t``, as ``pose.sample`` computes one."""
@@ -62,7 +67,11 @@ class _Group:
             return keys[rows, k, 1] if cubic else keys[rows, k]
 
         last = self.count - 1
-        k = np.clip((self.times <= t).sum(1) - 1, 0, np.maximum(last - 1, 0))
+        if self.shared is not None:  # every channel keyed at the same times (a school's): one search
+            k = np.full(len(rows), min(max(int(np.searchsorted(self.shared, t, side="right")) - 1, 0),
+                                       max(len(self.shared) - 2, 0)))
+        else:
+            k = np.clip((self.times <= t).sum(1) - 1, 0, np.maximum(last - 1, 0))
         k1 = np.minimum(k + 1, last)
         t0, t1 = self.times[rows, k], self.times[rows, k1]
         span = t1 - t0
