@@ -140,18 +140,18 @@ def total_pixels(options: PreviewOptions, frames: int, inputs: int = 1) -> int:
 
 def subject_points(scene: Scene, times: Sequence[float | None], clip: str | None) -> np.ndarray:
     """Every vertex (and particle extent) the camera must keep in frame, at each of ``times``."""
-    from fishgen.preview.posing import batches, poser_for
+    from fishgen.preview.posing import poser_for
     from fishgen.preview.render import particles
 
-    poser, shared = poser_for(scene, clip), batches(scene)
+    poser = poser_for(scene, clip)
     points = [(node, prim) for node, prim in scene.drawn() if prim.mode == "POINTS"]
     out = []
     for t in times:
-        posed = poser(t)
+        posed, worlds = poser.frame(t, keep=True)  # the renderer draws these same vertices
         for node, prim in points:
             c, r, _ = particles(scene, node, prim, posed)
             out += [c - r[:, None], c + r[:, None]]
-        out += [batch.world(scene, posed, normals=False)[0] for batch in shared]
+        out += [pos for pos, _ in worlds]
     return np.concatenate(out) if out else np.zeros((1, 3))
 
 

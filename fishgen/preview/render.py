@@ -24,7 +24,7 @@ from fishgen.errors import FishgenError
 from fishgen.geometry.mesh import vertex_normals
 from fishgen.numeric import to_linear_float
 from fishgen.preview.camera import Camera
-from fishgen.preview.posing import Batch, Poser, batches, poser_for
+from fishgen.preview.posing import Batch, Poser, poser_for
 from fishgen.scene.model import Material, Primitive, Scene
 from fishgen.scene.pose import Pose, deformed
 
@@ -165,6 +165,7 @@ void main() {
 class _GpuMesh:
     """One batch on the GPU: a primitive repeated for each of its nodes, posed on the CPU each frame
     into world space (one buffer upload and one draw call per primitive, not per fish)."""
+    index: int        # of its batch in the scene's Poser.batches
     batch: Batch
     material: Material
     vbo: Any          # moderngl.Buffer: world positions and normals, rewritten each frame
@@ -244,7 +245,8 @@ class Renderer:
         if key in self._uploaded and self._uploaded[key][0].active is scene.clip(clip):
             return self._uploaded[key]
         out: list[_GpuMesh] = []
-        for batch in batches(scene):
+        poser = poser_for(scene, clip)
+        for index, batch in enumerate(poser.batches):
             prim = batch.prim
             if prim.mode != "TRIANGLES" or batch.indices is None:
                 continue
@@ -257,9 +259,9 @@ class Renderer:
                                                          (static, "2f 4f 1f", "in_uv", "in_color",
                                                           "in_light")], ibo)
             tex = self._texture(scene, material.texture) if material.texture is not None else None
-            out.append(_GpuMesh(batch, material, vbo, static, ibo, vao, tex,
+            out.append(_GpuMesh(index, batch, material, vbo, static, ibo, vao, tex,
                                 np.asarray(prim.positions, float).mean(0), batch.base_nrm is None))
-        self._uploaded[key] = (poser_for(scene, clip), out)
+        self._uploaded[key] = (poser, out)
         return self._uploaded[key]
 
     @staticmethod
@@ -298,10 +300,10 @@ class Renderer:
     def posed(self, scene: Scene, t: float | None, clip: str | None = None) -> tuple[Pose, list]:
         """Every batch of ``scene`` posed at ``t``: the CPU's share of a frame."""
         poser, meshes = self._upload(scene, clip)
-        posed = poser(t)
+        posed, worlds = poser.frame(t)
         out = []
         for m in meshes:  # morph targets, skins and node transforms: posed on the CPU, drawn in world space
-            pos, nrm = m.batch.world(scene, posed)
+            pos, nrm = worlds[m.index]
             if nrm is None:
                 nrm = vertex_normals(pos, m.batch.indices.reshape(-1, 3))  # type: ignore[union-attr]
             out.append((pos, np.hstack([pos, nrm]).astype(np.float32)))
