@@ -200,6 +200,7 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
     ``on_planned`` hears how many renders there will be, ``progress`` is called with 1 after each."""
     from PIL import Image
 
+    from fishgen.preview.posing import poser_for
     from fishgen.preview.render import Renderer
 
     for scene in scenes:
@@ -228,6 +229,7 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
                 images.append(Image.fromarray(image))
                 if progress:
                     progress(1)
+            poser_for(scene, options.clip).forget()  # the vertices kept from framing are drawn
             out.append(images)
     finally:
         renderer.release()

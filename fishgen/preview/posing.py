@@ -22,7 +22,8 @@ _PATHS = ("translation", "rotation", "scale")
 Placed = tuple[np.ndarray, "np.ndarray | None"]
 """A batch's world positions and normals (``Batch.world``)."""
 KEEP_BYTES = 256 << 20
-"""Posed vertices a ``Poser`` keeps between framing and rendering: 48 frames of a 200-fish school
+_kept_total = 0
+"""Posed vertices all ``Poser``s keep between framing and rendering: 48 frames of a 200-fish school
 take 105 MB; a larger loop recomputes what does not fit."""
 IDENTITY_QUAT = np.array([0.0, 0.0, 0.0, 1.0])
 
@@ -114,7 +115,7 @@ class Poser:
     """``pose(scene, t, clip)`` for one scene and clip, compiled once and evaluated per frame."""
 
     def __init__(self, scene: Scene, clip: Clip | str | None = None):
-        self.scene = scene
+        self._scene = weakref.ref(scene)  # poser_for keeps a Poser only while its scene lives
         nodes = scene.nodes
         n = len(nodes)
         self.active = scene.clip(clip) if isinstance(clip, str) or clip is None else clip
@@ -144,6 +145,19 @@ class Poser:
         self._kept: dict[float | None, tuple[Pose, list[Placed]]] = {}
         self._kept_bytes = 0
 
+    @property
+    def scene(self) -> Scene:
+        scene = self._scene()
+        if scene is None:
+            raise ReferenceError("the posed scene is gone")
+        return scene
+
+    def forget(self) -> None:
+        """Drop the kept frames (a loop is drawn): their bytes go back to ``KEEP_BYTES``."""
+        global _kept_total
+        _kept_total -= self._kept_bytes
+        self._kept, self._kept_bytes = {}, 0
+
     def frame(self, t: float | None, keep: bool = False) -> tuple[Pose, list[Placed]]:
         """The pose at ``t`` and ``world`` of each of ``batches``. With ``keep`` the result is kept
         (up to ``KEEP_BYTES`` in all) for the next call at ``t``: framing a loop poses every frame,
@@ -153,9 +167,11 @@ class Poser:
         posed = self(t)
         out = [b.world(self.scene, posed) for b in self.batches]
         size = sum(p.nbytes + (0 if n is None else n.nbytes) for p, n in out)
-        if keep and self._kept_bytes + size <= KEEP_BYTES:
+        global _kept_total
+        if keep and _kept_total + size <= KEEP_BYTES:
             self._kept[t] = (posed, out)
             self._kept_bytes += size
+            _kept_total += size
         return posed, out
 
     @staticmethod
@@ -271,7 +287,14 @@ def poser_for(scene: Scene, clip: str | None) -> Poser:
             del _POSERS[k]
         held = (weakref.ref(scene), Poser(scene, active))
         _POSERS[key] = held
+        weakref.finalize(scene, _drop, key, held[1])
     return held[1]
+
+
+def _drop(key: tuple[int, int], poser: Poser) -> None:
+    poser.forget()
+    if key in _POSERS and _POSERS[key][1] is poser:
+        del _POSERS[key]
 
 
 def _quat_matrices(q: np.ndarray) -> np.ndarray:
