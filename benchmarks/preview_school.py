@@ -7,13 +7,12 @@ Issue 23, section 4: a 200-fish school previewed at the default size (800x600) a
 glb, framing, rendering, GIF encoding, writing). Two schools are timed: params/bait-ball.toml (a
 milling torus) and BonyBream --count N (a polarized school). Prints the median of --repeat runs
 beside the target. With --baseline REV, the same command from that git revision of fishgen (an
-archive of its `fishgen/` folder put first on PYTHONPATH) runs alternately in the same loop, so
+archive of its `fishgen/` folder imported in place of this checkout's) runs alternately in the same loop, so
 both see the same machine load, and the ratio is printed.
 """
 from __future__ import annotations
 
 import argparse
-import os
 import statistics
 import subprocess
 import sys
@@ -26,14 +25,24 @@ ROOT = Path(__file__).resolve().parents[1]
 TARGET = 10.0
 
 
+# `python -m fishgen` with fishgen imported from another folder: an editable install's import hook
+# comes before sys.path (PYTHONPATH alone would still run this checkout), so it is removed first.
+_FROM = """import runpy, sys
+base = sys.argv.pop(1)
+sys.meta_path[:] = [f for f in sys.meta_path if not type(f).__module__.startswith("__editable__")]
+sys.path.insert(0, base)
+import fishgen
+assert fishgen.__file__.startswith(base), fishgen.__file__
+runpy.run_module("fishgen", run_name="__main__", alter_sys=True)
+"""
+
+
 def _fishgen(*args: object, pythonpath: Path | None = None) -> float:
-    """Seconds the command takes; it must succeed."""
-    env = dict(os.environ)
-    if pythonpath is not None:
-        env["PYTHONPATH"] = os.pathsep.join([str(pythonpath), env.get("PYTHONPATH", "")])
+    """Seconds the command takes (fishgen imported from ``pythonpath`` if given); it must succeed."""
+    command = [sys.executable, "-m", "fishgen"] if pythonpath is None else \
+        [sys.executable, "-c", _FROM, str(pythonpath)]
     start = time.perf_counter()
-    result = subprocess.run([sys.executable, "-m", "fishgen", *map(str, args)], cwd=ROOT, env=env,
-                            capture_output=True, text=True)
+    result = subprocess.run([*command, *map(str, args)], cwd=ROOT, capture_output=True, text=True)
     seconds = time.perf_counter() - start
     if result.returncode:
         sys.exit(f"fishgen {' '.join(map(str, args))} failed:\n{result.stderr}")
@@ -50,7 +59,8 @@ def _checkout(rev: str, into: Path) -> Path:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeat", type=int, default=3, help="runs per school (median)")
     parser.add_argument("--count", type=int, default=200, help="fish in the BonyBream school")
     parser.add_argument("--baseline", metavar="REV", help="also time this git revision, alternately")
