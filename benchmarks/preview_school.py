@@ -8,11 +8,14 @@ glb, framing, rendering, GIF encoding, writing). Two schools are timed: params/b
 milling torus) and BonyBream --count N (a polarized school). Prints the median of --repeat runs
 beside the target. With --baseline REV, the same command from that git revision of fishgen (an
 archive of its `fishgen/` folder imported in place of this checkout's) runs alternately in the same loop, so
-both see the same machine load, and the ratio is printed.
+both see the same machine load, and the ratio is printed. CPU seconds (user + system of the
+command's process and its Mesa threads) are printed beside: on a machine shared with other work
+they show the cost when wall time only shows the load.
 """
 from __future__ import annotations
 
 import argparse
+import resource
 import statistics
 import subprocess
 import sys
@@ -37,16 +40,19 @@ runpy.run_module("fishgen", run_name="__main__", alter_sys=True)
 """
 
 
-def _fishgen(*args: object, pythonpath: Path | None = None) -> float:
-    """Seconds the command takes (fishgen imported from ``pythonpath`` if given); it must succeed."""
+def _fishgen(*args: object, pythonpath: Path | None = None) -> tuple[float, float]:
+    """Wall and CPU seconds (user + system, all threads) the command takes, with fishgen imported
+    from ``pythonpath`` if given; it must succeed."""
     command = [sys.executable, "-m", "fishgen"] if pythonpath is None else \
         [sys.executable, "-c", _FROM, str(pythonpath)]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     result = subprocess.run([*command, *map(str, args)], cwd=ROOT, capture_output=True, text=True)
     seconds = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if result.returncode:
         sys.exit(f"fishgen {' '.join(map(str, args))} failed:\n{result.stderr}")
-    return seconds
+    return seconds, (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
 
 
 def _checkout(rev: str, into: Path) -> Path:
@@ -86,11 +92,15 @@ def main() -> None:
                 if base is not None and k < args.baseline_repeat:
                     before.append(_fishgen("preview", glb, "-o", folder / f"base{k}.gif", "--quiet",
                                            pythonpath=base))
-            median = statistics.median(now)
-            line = f"  {name:<36} {median:6.2f} s  ({'meets' if median < TARGET else 'MISSES'} the target)"
+            median = statistics.median(w for w, _ in now)
+            cpu = statistics.median(c for _, c in now)
+            line = (f"  {name:<34} {median:6.2f} s (CPU {cpu:5.2f} s)  "
+                    f"{'meets' if median < TARGET else 'MISSES'} the target")
             if before:
-                old = statistics.median(before)
-                line += f"   {args.baseline}: {old:6.2f} s   {old / median:5.1f}x faster"
+                old = statistics.median(w for w, _ in before)
+                old_cpu = statistics.median(c for _, c in before)
+                line += (f"   {args.baseline}: {old:6.2f} s (CPU {old_cpu:5.2f} s)   "
+                         f"{old / median:4.1f}x faster (CPU {old_cpu / cpu:4.1f}x)")
             print(line)
 
 
