@@ -24,8 +24,12 @@ class PreviewCommandOptions:
                                    "16 to 8192 a side. A contact sheet may hold at most 2^28 pixels, all "
                                    "frames "
                                    "and sheets together 2^30.", (800, 600), shown_default="800x600")
-    time: float | None = option(FiniteRange(0, 1e6, max_open=True), "Pose the animation at this time.",
-                                shown_default="rest pose; a loop's start", metavar="SECONDS")
+    time: float | None = option(FiniteRange(0, 1e6, max_open=True),
+                                "Pose the animation at this time, or start a loop there. A school written "
+                                "by `fishgen school` records its warm-up, when its fish still face every "
+                                "way: its preview starts after it.",
+                                shown_default="a school's warm-up, else the rest pose (a loop: 0)",
+                                metavar="SECONDS")
     clip: str | None = option(click.STRING, "Animation clip to pose or loop.",
                               shown_default="the first, `swim` for fishgen fish", metavar="NAME")
     background: tuple[int, int, int, int] = option(
@@ -94,7 +98,7 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
     with ExitStack() as stack:
         bar: list = []
 
-        def start(total: int) -> None:
+        def start(total: int) -> None:  # a bar over the frames of a loop or sheet, not one still
             if total > 1:
                 bar.append(stack.enter_context(events.progress("rendering", total)))
 

@@ -47,7 +47,7 @@ class PreviewOptions:
     view: str = "three-quarter"
     width: int = 800
     height: int = 600
-    time: float | None = None          # seconds into the clip; None is the rest pose
+    time: float | None = None          # seconds into the clip; None: a school's warm-up, else rest pose
     background: tuple[int, int, int, int] = (140, 173, 204, 255)  # sRGB 0-255, a=0 transparent
     frames: int | None = None         # None: duration x fps for a loop, 1 for a still
     fps: float = LOOP_FPS
@@ -140,45 +140,67 @@ def total_pixels(options: PreviewOptions, frames: int, inputs: int = 1) -> int:
 
 def subject_points(scene: Scene, times: Sequence[float | None], clip: str | None) -> np.ndarray:
     """Every vertex (and particle extent) the camera must keep in frame, at each of ``times``."""
+    from fishgen.preview.posing import poser_for
     from fishgen.preview.render import particles
-    from fishgen.scene.pose import deformed, pose
 
+    poser = poser_for(scene, clip)
+    points = [(node, prim) for node, prim in scene.drawn() if prim.mode == "POINTS"]
     out = []
     for t in times:
-        posed = pose(scene, t, clip)
-        for node, prim in scene.drawn():
-            if prim.mode == "POINTS":
-                c, r, _ = particles(scene, node, prim, posed)
-                out += [c - r[:, None], c + r[:, None]]
-            else:
-                out.append(deformed(scene, node, prim, posed)[0])
+        posed, worlds = poser.frame(t, keep=True)  # the renderer draws these same vertices
+        for node, prim in points:
+            c, r, _ = particles(scene, node, prim, posed)
+            out += [c - r[:, None], c + r[:, None]]
+        out += [pos for pos, _ in worlds]
     return np.concatenate(out) if out else np.zeros((1, 3))
+
+
+def start_time(scene: Scene, options: PreviewOptions) -> float | None:
+    """When a still is posed and a loop starts: ``--time``, else the end of a school file's warm-up
+    (its fish start facing every way), else None (a still's rest pose, a loop's 0 s)."""
+    if options.time is not None:
+        return options.time
+    if not scene.extras:
+        return None
+    from fishgen.school.run import school_extras
+
+    record = school_extras(scene)
+    clip = scene.clip(options.clip)
+    if record is None or clip is None:
+        return None
+    return min(float(record["warmup"]), clip.duration)
 
 
 def _frame_plan(scene: Scene, options: PreviewOptions, frames: int):
     """(times, azimuths, seconds per frame) for one scene.
 
     A loop samples ``duration`` seconds of the clip at ``fps`` (or spreads
-    ``--frames`` over it); a static scene turns once in that time.
+    ``--frames`` over it) from ``start_time``; a static scene turns once in that time.
     """
     clip = scene.clip(options.clip)
-    start = options.time or 0.0
+    time = start_time(scene, options)
+    start = time or 0.0
     if frames == 1:
-        return [options.time], [0.0], 0.0
-    animated = clip is not None and clip.duration > 0
-    duration = options.duration or (min(clip.duration, LOOP_SECONDS) if animated and clip else LOOP_SECONDS)
+        return [time], [0.0], 0.0
+    length = clip.duration if clip is not None else 0.0  # a property that reads every channel
+    animated = length > 0
+    duration = options.duration or (min(length, LOOP_SECONDS) if animated else LOOP_SECONDS)
     count = options.frames or max(2, round(duration * options.fps))
     step = duration / count
-    if animated and clip is not None:
-        return [(start + k * step) % clip.duration for k in range(count)], [0.0] * count, step
-    return [options.time] * count, [2 * math.pi * k / count for k in range(count)], step
+    if animated:
+        return [(start + k * step) % length for k in range(count)], [0.0] * count, step
+    return [time] * count, [2 * math.pi * k / count for k in range(count)], step
 
 
 def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
-                  progress: Callable[[int], None] | None = None):
-    """Render each scene's frames; returns (frames[scene][k] as PIL images, seconds per frame)."""
+                  progress: Callable[[int], None] | None = None,
+                  on_planned: Callable[[int], None] | None = None):
+    """Render each scene's frames; returns (frames[scene][k] as PIL images, seconds per frame).
+
+    ``on_planned`` hears how many renders there will be, ``progress`` is called with 1 after each."""
     from PIL import Image
 
+    from fishgen.preview.posing import poser_for
     from fishgen.preview.render import Renderer
 
     for scene in scenes:
@@ -186,24 +208,28 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
             names = ", ".join(a.name for a in scene.clips)
             raise FishgenError(f"expected --clip to name one of {names}, found {options.clip!r}",
                                scene.source or scene.name)
+    plans = [_frame_plan(scene, options, frames) for scene in scenes]
+    if on_planned:
+        on_planned(sum(len(times) for times, _, _ in plans))
     renderer = Renderer(options.width, options.height)
     r, g, b, a = (c / 255.0 for c in options.background)
     bg = (r, g, b, a)
     out, seconds = [], []
     try:
-        for scene in scenes:
-            times, azimuths, step = _frame_plan(scene, options, frames)
+        for scene, (times, azimuths, step) in zip(scenes, plans, strict=True):
             seconds.append(step)
             points = subject_points(scene, sorted(set(times), key=lambda t: -1 if t is None else t),
                                     options.clip)
             base = frame(points, options.view, options.width / options.height,
                          azimuths=tuple(sorted(set(azimuths))), ortho=options.ortho)
             images = []
-            for t, az in zip(times, azimuths, strict=True):
-                cam = turned(base, options.view, az) if az else base
-                images.append(Image.fromarray(renderer.render(scene, cam, t, bg, options.clip)))
+            shots = [(turned(base, options.view, az) if az else base, t)
+                     for t, az in zip(times, azimuths, strict=True)]
+            for image in renderer.render_all(scene, shots, bg, options.clip):
+                images.append(Image.fromarray(image))
                 if progress:
                     progress(1)
+            poser_for(scene, options.clip).forget()  # the vertices kept from framing are drawn
             out.append(images)
     finally:
         renderer.release()
@@ -252,7 +278,10 @@ def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options
             progress: Callable[[int], None] | None = None,
             on_loaded: Callable[[int], None] | None = None,
             on_note: Callable[[str], None] | None = None) -> Path:
-    """Render ``inputs`` to ``out`` (still, contact sheet, or loop); written atomically."""
+    """Render ``inputs`` to ``out`` (still, contact sheet, or loop); written atomically.
+
+    ``on_loaded`` hears the number of renders once the inputs are read and planned; ``progress``
+    is called with 1 after each render (a progress bar's ``update``)."""
     from fishgen.atomic import write_bytes
     from fishgen.preview.inputs import load_input
 
@@ -265,9 +294,7 @@ def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options
     for scene in scenes:  # e.g. a cloud previewed with fewer particles than it holds
         if on_note and scene.note:
             on_note(scene.note)
-    if on_loaded:
-        on_loaded(len(scenes) * frames)
-    per_scene, step = render_frames(scenes, options, frames, progress)
+    per_scene, step = render_frames(scenes, options, frames, progress, on_loaded)
     images = compose(per_scene, [Path(p).name for p in inputs], options)
     write_bytes(out, encode(images, out, step))
     return out

@@ -13,6 +13,7 @@ The framebuffer holds premultiplied alpha, so a transparent background works.
 """
 from __future__ import annotations
 
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -23,8 +24,9 @@ from fishgen.errors import FishgenError
 from fishgen.geometry.mesh import vertex_normals
 from fishgen.numeric import to_linear_float
 from fishgen.preview.camera import Camera
+from fishgen.preview.posing import Batch, Poser, poser_for
 from fishgen.scene.model import Material, Primitive, Scene
-from fishgen.scene.pose import Pose, deformed, pose
+from fishgen.scene.pose import Pose, deformed
 
 SAMPLES = 4
 # World-fixed lights: a sun from above and in front, a weak fill from behind, a
@@ -38,6 +40,8 @@ opacity 0.5 overlap depending on the side it is seen from."""
 POINT_SIZE_FRACTION = 0.004
 """Radius of particles that carry no ``_RADIUS``, as a fraction of the bounding-box diagonal."""
 DEFAULT_MATERIAL = Material("default")
+_IDENTITY4 = np.eye(4, dtype="f4").tobytes()
+_IDENTITY3 = np.eye(3, dtype="f4").tobytes()
 
 _SRGB = """
 vec3 to_srgb(vec3 c) {
@@ -159,15 +163,18 @@ void main() {
 # which only ``Uniform`` has the ``value`` / ``write`` used here.
 @dataclass
 class _GpuMesh:
-    node: int
-    prim: Primitive
+    """One batch on the GPU: a primitive repeated for each of its nodes, posed on the CPU each frame
+    into world space (one buffer upload and one draw call per primitive, not per fish)."""
+    index: int        # of its batch in the scene's Poser.batches
+    batch: Batch
     material: Material
-    vbo: Any          # moderngl.Buffer
+    vbo: Any          # moderngl.Buffer: world positions and normals, rewritten each frame
+    static: Any       # moderngl.Buffer: texture coordinates, colours, baked light
     ibo: Any          # moderngl.Buffer; a BLEND mesh's triangles are rewritten back to front each frame
     vao: Any          # moderngl.VertexArray
     texture: Any      # moderngl.Texture or None
-    centroid: np.ndarray
-    deforms: bool            # skinned or morphed: positions re-posed on the CPU every frame
+    centroid: np.ndarray     # local, of the primitive's rest positions
+    computed_normals: bool   # the file has none: made from the posed triangles each frame
 
 
 class Renderer:
@@ -207,8 +214,9 @@ class Renderer:
         self.point_prog: Any = self.ctx.program(vertex_shader=POINT_VS, fragment_shader=POINT_FS)
         corners = np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32)
         self.corner_buf = self.ctx.buffer(corners.tobytes())
-        self._uploaded: dict[int, list[_GpuMesh]] = {}
+        self._uploaded: dict[int, tuple[Poser, list[_GpuMesh]]] = {}
         self._textures: dict[tuple[int, int], Any] = {}
+        self._points: dict[int, list[tuple[int, Primitive]]] = {}
 
     # -- uploads -------------------------------------------------------------
     def _texture(self, scene: Scene, index: int) -> Any:
@@ -232,56 +240,90 @@ class Renderer:
             self._textures[key] = tex
         return self._textures[key]
 
-    def _upload(self, scene: Scene) -> list[_GpuMesh]:
+    def _upload(self, scene: Scene, clip: str | None) -> tuple[Poser, list[_GpuMesh]]:
         key = id(scene)
-        if key in self._uploaded:
+        if key in self._uploaded and self._uploaded[key][0].active is scene.clip(clip):
             return self._uploaded[key]
         out: list[_GpuMesh] = []
-        for node, prim in scene.drawn():
-            if (prim.mode != "TRIANGLES" or prim.indices is None or not prim.vertex_count
-                    or not len(prim.indices)):
+        poser = poser_for(scene, clip)
+        for index, batch in enumerate(poser.batches):
+            prim = batch.prim
+            if prim.mode != "TRIANGLES" or batch.indices is None:
                 continue
             material = scene.materials[prim.material] if prim.material is not None else DEFAULT_MATERIAL
-            deforms = bool(prim.targets) or (scene.nodes[node].skin is not None
-                                             and "JOINTS_0" in prim.attributes)
-            data = self._vertex_data(prim, *self._local(prim))
-            vbo = self.ctx.buffer(data.tobytes(), dynamic=deforms)
-            ibo = self.ctx.buffer(np.asarray(prim.indices, np.uint32).tobytes(),
+            vbo = self.ctx.buffer(reserve=batch.instances * prim.vertex_count * 24, dynamic=True)
+            static = self.ctx.buffer(np.tile(self._static_data(prim), (batch.instances, 1)).tobytes())
+            ibo = self.ctx.buffer(batch.indices.astype(np.uint32).tobytes(),
                                   dynamic=material.alpha_mode == "BLEND")
-            vao = self.ctx.vertex_array(self.mesh_prog, [(vbo, "3f 3f 2f 4f 1f", "in_pos", "in_normal",
-                                                          "in_uv", "in_color", "in_light")], ibo)
+            vao = self.ctx.vertex_array(self.mesh_prog, [(vbo, "3f 3f", "in_pos", "in_normal"),
+                                                         (static, "2f 4f 1f", "in_uv", "in_color",
+                                                          "in_light")], ibo)
             tex = self._texture(scene, material.texture) if material.texture is not None else None
-            out.append(_GpuMesh(node, prim, material, vbo, ibo, vao, tex,
-                                np.asarray(prim.positions, float).mean(0), deforms))
-        self._uploaded[key] = out
-        return out
+            out.append(_GpuMesh(index, batch, material, vbo, static, ibo, vao, tex,
+                                np.asarray(prim.positions, float).mean(0), batch.base_nrm is None))
+        self._uploaded[key] = (poser, out)
+        return self._uploaded[key]
 
     @staticmethod
-    def _local(prim: Primitive) -> tuple[np.ndarray, np.ndarray]:
-        pos = np.asarray(prim.positions, np.float32)
-        nrm = prim.attributes.get("NORMAL")
-        if nrm is None:
-            nrm = vertex_normals(pos.astype(np.float64), np.asarray(prim.indices, np.int64))
-        return pos, np.asarray(nrm, np.float32)
-
-    @staticmethod
-    def _vertex_data(prim: Primitive, positions: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    def _static_data(prim: Primitive) -> np.ndarray:
         n = prim.vertex_count
         uvs = prim.attributes.get("TEXCOORD_0")
         uvs = np.zeros((n, 2), np.float32) if uvs is None else to_linear_float(uvs)[:, :2] \
             if np.asarray(uvs).dtype.kind in "iu" else np.asarray(uvs, np.float32)
         colors = prim.attributes.get("COLOR_0")
         colors = np.ones((n, 4), np.float32) if colors is None else to_linear_float(colors)
-        return np.hstack([positions, normals, uvs, colors, _light(prim)[:, None]]).astype(np.float32)
+        return np.hstack([uvs, colors, _light(prim)[:, None]]).astype(np.float32)
 
     # -- drawing -------------------------------------------------------------
     def render(self, scene: Scene, camera: Camera, t: float | None,
                background: tuple[float, float, float, float], clip: str | None = None) -> np.ndarray:
         """Draw ``scene`` posed at ``t``; returns (H, W, 4) uint8 RGBA, straight alpha."""
+        self.draw(scene, camera, self.posed(scene, t, clip), background, clip)
+        return self.finish()
+
+    def render_all(self, scene: Scene, shots: Sequence[tuple[Camera, float | None]],
+                   background: tuple[float, float, float, float],
+                   clip: str | None = None) -> Iterator[np.ndarray]:
+        """``render`` of each (camera, time), in order. The next frame is posed on the CPU while
+        Mesa's threads still rasterise this one: a frame is read back only after that."""
+        waiting = False
+        for camera, t in shots:
+            posed = self.posed(scene, t, clip)
+            if waiting:
+                yield self.finish()
+            self.draw(scene, camera, posed, background, clip)
+            self.resolved.use()  # binding another framebuffer hands the frame to Mesa's threads
+            waiting = True
+        if waiting:
+            yield self.finish()
+
+    def posed(self, scene: Scene, t: float | None, clip: str | None = None) -> tuple[Pose, list]:
+        """Every batch of ``scene`` posed at ``t``: the CPU's share of a frame."""
+        poser, meshes = self._upload(scene, clip)
+        posed, worlds = poser.frame(t)
+        out = []
+        for m in meshes:  # morph targets, skins and node transforms: posed on the CPU, drawn in world space
+            pos, nrm = worlds[m.index]
+            if nrm is None:
+                nrm = vertex_normals(pos, m.batch.indices.reshape(-1, 3))  # type: ignore[union-attr]
+            out.append((pos, np.hstack([pos, nrm]).astype(np.float32)))
+        return posed, out
+
+    def finish(self) -> np.ndarray:
+        """The frame last drawn, resolved and read back: (H, W, 4) uint8 RGBA, straight alpha."""
+        self.ctx.copy_framebuffer(self.resolved, self.msaa)
+        raw = self.resolved.read(components=4, alignment=1)
+        img = np.frombuffer(raw, np.uint8).reshape(self.height, self.width, 4)[::-1]
+        return unpremultiply(img)
+
+    def draw(self, scene: Scene, camera: Camera, frame: tuple[Pose, list],
+             background: tuple[float, float, float, float], clip: str | None = None) -> None:
+        """Issue the GL commands of one frame posed by ``posed``; ``finish`` reads it back."""
         import moderngl
 
         ctx = self.ctx
-        posed = pose(scene, t, clip)
+        _, meshes = self._upload(scene, clip)
+        posed, vertices = frame
         view, proj = camera.view(), camera.projection()
         viewproj = proj @ view
         self.msaa.use()
@@ -298,21 +340,15 @@ class Renderer:
         for program in (self.mesh_prog, self.point_prog):
             _set_cloud_light(program, cloud)
 
-        meshes = self._upload(scene)
+        self.msaa.depth_mask = True
         models: dict[int, np.ndarray] = {}
         posed_positions: dict[int, np.ndarray] = {}
         self._posed = posed_positions
-        for m in meshes:
-            if m.deforms:  # morph targets and skins are posed on the CPU, drawn in world space
-                pos, nrm = deformed(scene, m.node, m.prim, posed)
-                if nrm is None:
-                    nrm = vertex_normals(pos, np.asarray(m.prim.indices, np.int64))
-                data = self._vertex_data(m.prim, pos.astype(np.float32), nrm.astype(np.float32))
-                m.vbo.write(data.tobytes())
-                posed_positions[id(m)] = pos
-                models[id(m)] = np.eye(4)
-            else:
-                models[id(m)] = posed.matrix(m.node)
+        for m, (pos, data) in zip(meshes, vertices, strict=True):
+            m.vbo.write(data.tobytes())
+            posed_positions[id(m)] = pos
+            # a BLEND batch holds one node: its depth is that of its rest centroid, placed
+            models[id(m)] = posed.matrix(int(m.batch.nodes[0]))
         opaque = [m for m in meshes if m.material.alpha_mode != "BLEND"]
         blended = [m for m in meshes if m.material.alpha_mode == "BLEND"]
 
@@ -320,44 +356,35 @@ class Renderer:
             c = view @ models[id(m)] @ np.append(m.centroid, 1.0)
             return float(c[2])  # more negative = farther
 
-        self.msaa.depth_mask = True
         for m in opaque:
-            self._draw_mesh(m, models[id(m)])
+            self._draw_mesh(m)
         # Transparent parts are blended over what lies behind them, as three.js blends them (its
         # GLTFLoader turns depth writes off for BLEND materials), and drawn farthest first: whole
         # meshes, and each mesh's triangles (a billboard cloud's quads, a fin's folds).
         self.msaa.depth_mask = self.transparent_depth_writes
         for m in sorted(blended, key=depth):
             if self.sort_triangles:
-                self._sort_triangles(m, view @ models[id(m)])
-            self._draw_mesh(m, models[id(m)])
+                self._sort_triangles(m, view)
+            self._draw_mesh(m)
         self._draw_points(scene, posed, view, proj, camera.eye)
         self.msaa.depth_mask = True
 
-        ctx.copy_framebuffer(self.resolved, self.msaa)
-        raw = self.resolved.read(components=4, alignment=1)
-        img = np.frombuffer(raw, np.uint8).reshape(self.height, self.width, 4)[::-1]
-        return unpremultiply(img)
-
-    def _sort_triangles(self, m: _GpuMesh, modelview: np.ndarray) -> None:
+    def _sort_triangles(self, m: _GpuMesh, view: np.ndarray) -> None:
         """Rewrite a transparent mesh's index buffer with its triangles farthest first."""
-        tris = np.asarray(m.prim.indices, np.int64).reshape(-1, 3)
+        tris = m.batch.indices.reshape(-1, 3)  # type: ignore[union-attr]
         if len(tris) < 2:
             return
-        positions = self._posed.get(id(m), m.prim.positions)
-        centroids = np.asarray(positions, np.float64)[tris].mean(axis=1)
-        depth = centroids @ modelview[2, :3]           # view-space z: more negative = farther
+        centroids = self._posed[id(m)][tris].mean(axis=1)
+        depth = centroids @ view[2, :3]           # view-space z: more negative = farther
         order = np.argsort(depth, kind="stable")
         m.ibo.write(np.ascontiguousarray(tris[order], np.uint32).tobytes())
 
-    def _draw_mesh(self, m: _GpuMesh, model: np.ndarray) -> None:
+    def _draw_mesh(self, m: _GpuMesh) -> None:
         import moderngl
 
         prog, mat = self.mesh_prog, m.material
-        prog["u_model"].write(model.T.astype("f4").tobytes())
-        linear = model[:3, :3]
-        normal = np.linalg.inv(linear).T if abs(np.linalg.det(linear)) > 1e-30 else np.eye(3)
-        prog["u_normal_matrix"].write(normal.T.astype("f4").tobytes())
+        prog["u_model"].write(_IDENTITY4)
+        prog["u_normal_matrix"].write(_IDENTITY3)
         prog["u_base"].value = tuple(mat.base_color)
         prog["u_alpha_mode"].value = {"OPAQUE": 0, "MASK": 1, "BLEND": 2}.get(mat.alpha_mode, 0)
         prog["u_cutoff"].value = 0.5 if mat.alpha_cutoff is None else mat.alpha_cutoff
@@ -378,9 +405,10 @@ class Renderer:
         import moderngl
 
         parts = []
-        for node, prim in scene.drawn():
-            if prim.mode != "POINTS" or not prim.vertex_count:
-                continue
+        if id(scene) not in self._points:  # drawn() walks every node: once per scene, not per frame
+            self._points[id(scene)] = [(node, prim) for node, prim in scene.drawn()
+                                       if prim.mode == "POINTS" and prim.vertex_count]
+        for node, prim in self._points[id(scene)]:
             c, r, col = particles(scene, node, prim, posed)
             parts.append((c, r, col, _light(prim)))
         if not parts:
