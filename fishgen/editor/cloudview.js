@@ -2,36 +2,12 @@
 // /api/fill), drawn as fishgen's viewer draws it. The first pass of Harris's method (the sunlight
 // reaching each particle, `_LIGHT`) is baked by the server; the shaders here do the second pass:
 // the light scattered towards the eye by the phase function, over the sky's ambient light.
-// (The same shaders as fishgen/viewer/app.js; kept here because that module is a page of its own.)
+// (The second pass is fishgen/web/cloudlight.js, as in fishgen view and fly.)
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { SECOND_PASS, cloudUniforms, readCloudLight } from '../web/cloudlight.js';
 
-const SECOND_PASS = /* glsl */`
-	uniform vec3 cloudSun, sunColor, skyColor;
-	uniform float albedo, g;
-	float phase( float c ) {
-		float g2 = g * g;
-		return 1.5 * ( 1.0 - g2 ) / ( 2.0 + g2 ) * ( 1.0 + c * c ) / pow( 1.0 + g2 - 2.0 * g * c, 1.5 );
-	}
-	vec3 scattered( float light, vec3 world ) {
-		float c = dot( cloudSun, normalize( world - cameraPosition ) );   // 1: looking towards the sun
-		return albedo * ( skyColor + sunColor * light * phase( c ) );
-	}`;
-
-export const cloudUniforms = {
-	cloudSun: { value: new THREE.Vector3( 0, 1, 0 ) }, sunColor: { value: new THREE.Vector3( 1, 1, 1 ) },
-	skyColor: { value: new THREE.Vector3() }, albedo: { value: 1 }, g: { value: 0 },
-};
-
-function setLight( extras ) {
-	const l = extras && extras.fishgen_light;
-	if ( ! l ) return;
-	cloudUniforms.cloudSun.value.set( ...l.sun ).normalize();
-	cloudUniforms.sunColor.value.set( ...l.sun_color );
-	cloudUniforms.skyColor.value.set( ...l.sky_color );
-	cloudUniforms.albedo.value = l.albedo;
-	cloudUniforms.g.value = l.anisotropy;
-}
+export { cloudUniforms };
 
 // Particles: each a soft disc of its world radius with the billboard sprite's Gaussian profile.
 const particleMaterial = new THREE.ShaderMaterial( {
@@ -160,7 +136,7 @@ export class CloudView {
 	async show( glb ) {
 		const gltf = await this.loader.parseAsync( glb, '' );
 		this.clear();
-		setLight( gltf.scene.userData );
+		readCloudLight( gltf.scene.userData );
 		gltf.scene.updateMatrixWorld( true );
 		gltf.scene.traverse( ( o ) => {
 			if ( o.isPoints ) {

@@ -4,6 +4,7 @@
 // State for tests and the headless driver: window.fishgenFly = {loaded, error, camera, frames, done, report}.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { SECOND_PASS, cloudUniforms, readCloudLight } from '../web/cloudlight.js';
 
 const config = JSON.parse( document.getElementById( 'fishgen-fly' ).textContent );
 const token = new URLSearchParams( location.search ).get( 'token' ) || '';
@@ -73,43 +74,16 @@ function draw() {
 }
 
 // -- Harris's second pass, from each particle's baked _LIGHT (as fishgen view does) ---------------
-const SECOND_PASS = /* glsl */`
-	uniform bool cloudLit;
-	uniform vec3 cloudSun, sunColor, skyColor;
-	uniform float albedo, g;
-	float phase( float c ) {
-		float g2 = g * g;
-		return 1.5 * ( 1.0 - g2 ) / ( 2.0 + g2 ) * ( 1.0 + c * c ) / pow( 1.0 + g2 - 2.0 * g * c, 1.5 );
-	}
-	vec3 scattered( float light, vec3 world ) {
-		float c = dot( cloudSun, normalize( world - cameraPosition ) );   // 1: looking towards the sun
-		return albedo * ( skyColor + sunColor * light * phase( c ) );
-	}
+const ENCODE_SRGB = /* glsl */`
 	vec3 encodeSRGB( vec3 c ) {   // linear to the window's sRGB, as three's output conversion does it
 		c = clamp( c, 0.0, 1.0 );
 		return mix( pow( c, vec3( 0.41666 ) ) * 1.055 - vec3( 0.055 ), c * 12.92, vec3( lessThanEqual( c, vec3( 0.0031308 ) ) ) );
 	}`;
-const cloudUniforms = {
-	cloudLit: { value: false }, cloudSun: { value: new THREE.Vector3( 0, 1, 0 ) },
-	sunColor: { value: new THREE.Vector3( 1, 1, 1 ) }, skyColor: { value: new THREE.Vector3() },
-	albedo: { value: 1 }, g: { value: 0 },
-};
 
-function readCloudLight( extras ) {
-	const l = extras && extras.fishgen_light;
-	const triple = ( v ) => Array.isArray( v ) && v.length === 3 && v.every( Number.isFinite );
-	if ( ! l || ! triple( l.sun ) || ! triple( l.sun_color ) || ! triple( l.sky_color ) ) return false;
-	if ( ! Number.isFinite( l.albedo ) || ! Number.isFinite( l.anisotropy ) || Math.abs( l.anisotropy ) > 0.9 ) return false;
-	const sun = new THREE.Vector3( ...l.sun );
-	if ( sun.lengthSq() === 0 ) return false;
-	cloudUniforms.cloudLit.value = true;
-	cloudUniforms.cloudSun.value.copy( sun.normalize() );
-	cloudUniforms.sunColor.value.set( ...l.sun_color );
-	cloudUniforms.skyColor.value.set( ...l.sky_color );
-	cloudUniforms.albedo.value = l.albedo;
-	cloudUniforms.g.value = l.anisotropy;
-	sunLight.position.copy( sun );
-	return true;
+function readLight( extras ) {   // the sun lights the page's meshes too
+	const sun = readCloudLight( extras );
+	if ( sun ) sunLight.position.copy( sun );
+	return sun !== null;
 }
 
 // A particle: a soft disc of its world radius with the billboard sprite's Gaussian profile, drawn
@@ -133,6 +107,7 @@ const particleMaterial = new THREE.ShaderMaterial( {
 		varying vec3 vColor;
 		varying float vAlpha;
 		${ SECOND_PASS }
+${ ENCODE_SRGB }
 		void main() {
 			vec4 world = modelMatrix * vec4( position, 1.0 );
 			vec4 mv = viewMatrix * world;
@@ -168,6 +143,7 @@ function billboardMaterial( source ) {
 			varying vec2 vUv;
 			varying vec4 vColor;
 			${ SECOND_PASS }
+${ ENCODE_SRGB }
 			void main() {
 				vec4 world = modelMatrix * vec4( position, 1.0 );
 				gl_Position = projectionMatrix * viewMatrix * world;
@@ -304,7 +280,7 @@ function drawable( object ) {
 }
 
 async function addAsset( gltf, root ) {
-	readCloudLight( gltf.scene.userData );
+	readLight( gltf.scene.userData );
 	const parser = gltf.parser, json = parser.json, byNode = new Map();
 	for ( const [ object, ref ] of parser.associations ) if ( ref && ref.nodes !== undefined && object.isObject3D ) byNode.set( ref.nodes, object );
 	root.updateMatrixWorld( true );

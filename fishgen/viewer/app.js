@@ -6,6 +6,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { PLYLoader } from 'three/addons/loaders/PLYLoader.js';
 import { OBJLoader } from 'three/addons/loaders/OBJLoader.js';
 import { MTLLoader } from 'three/addons/loaders/MTLLoader.js';
+import { SECOND_PASS, cloudUniforms, readCloudLight } from '../web/cloudlight.js';
 
 const state = window.fishgenViewer = {
 	loaded: false, error: null, time: 0, clip: null, clips: [], playing: false,
@@ -53,41 +54,11 @@ const fill = new THREE.DirectionalLight( 0x6b7f95, 0.7 );
 fill.position.set( - 0.6, 0.1, - 0.4 );
 scene.add( fill );
 
-// A fishgen cloud's sunlight (the first pass of Harris's method) is baked into the file: each
-// particle's `_LIGHT` and the scene's extras.fishgen_light. The viewer does the second pass:
-// the light scattered towards the eye by the phase function, over the sky's ambient light.
-const SECOND_PASS = /* glsl */`
-	uniform bool cloudLit;
-	uniform vec3 cloudSun, sunColor, skyColor;
-	uniform float albedo, g;
-	float phase( float c ) {
-		float g2 = g * g;
-		return 1.5 * ( 1.0 - g2 ) / ( 2.0 + g2 ) * ( 1.0 + c * c ) / pow( 1.0 + g2 - 2.0 * g * c, 1.5 );
-	}
-	vec3 scattered( float light, vec3 world ) {
-		float c = dot( cloudSun, normalize( world - cameraPosition ) );   // 1: looking towards the sun
-		return albedo * ( skyColor + sunColor * light * phase( c ) );
-	}`;
-const cloudUniforms = {
-	cloudLit: { value: false }, cloudSun: { value: new THREE.Vector3( 0, 1, 0 ) },
-	sunColor: { value: new THREE.Vector3( 1, 1, 1 ) }, skyColor: { value: new THREE.Vector3() },
-	albedo: { value: 1 }, g: { value: 0 },
-};
-
-function readCloudLight( extras ) {
-	const l = extras && extras.fishgen_light;
-	const triple = ( v ) => Array.isArray( v ) && v.length === 3 && v.every( Number.isFinite );
-	if ( ! l || ! triple( l.sun ) || ! triple( l.sun_color ) || ! triple( l.sky_color ) ) return null;
-	if ( ! Number.isFinite( l.albedo ) || ! Number.isFinite( l.anisotropy ) || Math.abs( l.anisotropy ) > 0.9 ) return null;
-	const sun = new THREE.Vector3( ...l.sun );
-	if ( sun.lengthSq() === 0 ) return null;
-	cloudUniforms.cloudLit.value = true;
-	cloudUniforms.cloudSun.value.copy( sun.normalize() );
-	cloudUniforms.sunColor.value.set( ...l.sun_color );
-	cloudUniforms.skyColor.value.set( ...l.sky_color );
-	cloudUniforms.albedo.value = l.albedo;
-	cloudUniforms.g.value = l.anisotropy;
-	return { sun: sun.toArray() };
+// A fishgen cloud's sunlight is baked into the file; the viewer does Harris's second pass
+// (fishgen/web/cloudlight.js).
+function readLight( extras ) {
+	const sun = readCloudLight( extras );
+	return sun ? { sun: sun.toArray() } : null;
 }
 
 // Particles: each a soft disc of its world radius (`_radius`, fishgen's _RADIUS / PLY radius),
@@ -214,7 +185,7 @@ async function load() {
 	const kind = embedded.kind;
 	if ( kind === 'glb' || kind === 'gltf' ) {
 		const gltf = await new GLTFLoader( manager ).loadAsync( url );
-		state.cloudLight = readCloudLight( gltf.scene.userData );   // GLTFLoader: the scene's extras
+		state.cloudLight = readLight( gltf.scene.userData );   // GLTFLoader: the scene's extras
 		return { root: gltf.scene, clips: gltf.animations };
 	}
 	if ( kind === 'ply' ) {
