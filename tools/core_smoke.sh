@@ -27,4 +27,13 @@ run "$fishgen" view fish.glb --no-serve -o page.html
 run "$fishgen" species --random --seed 1 -o sampled.txt
 run "$fishgen" preview sampled.txt --view side --ortho --background transparent --size 256x128 -o photo.png
 run "$fishgen" texture photo.png -s sampled.txt -o fromphoto.txt --fit-shape --compare compare.png
+run "$fishgen" clouds "$root/params/clouds/sky.awa" -o texture-sky.glb
+run "$fishgen" school "$root/params/bait-ball.toml" --frames 20 -o ball.glb
+run "$fishgen" sky --mode thin --particles 2000 -o sky.glb
+run "$fishgen" build "$root/params/bonybream.txt" --lods 16x12,8x6 --merge --clips swim,burst -o engine.glb
+# the serving commands need a browser or a Ctrl-C; their one-line refusals need neither
+"$fishgen" fly missing.awn >out.txt 2>err.txt && { echo "core install: fly took a missing file" >&2; exit 1; }
+grep -q Traceback err.txt && { echo "core install: fly:" >&2; cat err.txt >&2; exit 1; }
+"$fishgen" fly sky.glb --headless >out.txt 2>err.txt || grep -q "fishgen\[fly\]\|Chromium\|playwright" err.txt || {
+  echo "core install: fly --headless without its extra:" >&2; cat err.txt >&2; exit 1; }
 echo "core install: every command ran without a traceback"
