@@ -43,7 +43,8 @@ def test_the_report_has_each_jobs_inputs_options_output_hashes_time_status_and_e
     assert fish["status"] == "built" and fish["kind"] == "build" and fish["seconds"] > 0
     assert fish["output_sha256"] == hashes(out)["fish/bonybream.glb"]
     assert fish["options"] == {"fins": None, "fps": 30.0, "length": None, "speed": 1.0, "swim": "body",
-                               "textures": None}
+                               "textures": None, "lods": None, "merge": False, "clips": ["swim"],
+                               "compact": False}
     assert set(fish["inputs"]) == {"../../params/bonybream.txt", "../../textures/bonybream.png",
                                    "../../textures/bonybream_mask.png"}
     assert all(len(digest) == 64 for digest in fish["inputs"].values())
