@@ -34,7 +34,9 @@ _PILLOW = ["PIL.Image", "PIL.ImageOps", "PIL.PngImagePlugin", "PIL.JpegImagePlug
 _FISH = ["fishgen.assembly.fish", "fishgen.assembly.materials", "fishgen.species.parser", *_PILLOW]
 PRELOAD = {"build": _FISH,
            "school": [*_FISH, "fishgen.school.run", "fishgen.school.simulate", "fishgen.school.bake",
-                      "fishgen.school.scene_file", "fishgen.exchange.sidefiles"],
+                      "fishgen.school.scene_file", "fishgen.school.memory", "fishgen.school.behaviour.boids",
+                      "fishgen.school.behaviour.pso", "fishgen.school.behaviour.couzin",
+                      "fishgen.exchange.sidefiles"],
            "clouds": ["fishgen.clouds.parser", "fishgen.clouds.fill", "fishgen.clouds.export",
                       "fishgen.clouds.scene", "fishgen.clouds.light", "fishgen.exchange.sidefiles",
                       # np.median reaches for numpy.ma on first use
