@@ -42,7 +42,7 @@ def build_scene(document: Document, label: str, source: str) -> Scene:
     for k, m in enumerate(lists["meshes"]):
         prims = [_primitive(data, p, f"meshes[{k}].primitives[{j}]") for j, p in enumerate(m["primitives"])]
         scene.meshes.append(Mesh(item_name(m, f"mesh{k}"), [p for p in prims if p is not None],
-                                 [float(w) for w in m.get("weights", [])]))
+                                 [float(w) for w in m.get("weights", [])], _target_names(m)))
     scene.images = [Image(item_name(img, f"image{k}"), data.image_bytes(k), _mime(img))
                     for k, img in enumerate(lists["images"])]
     scene.materials = [_material(lists, k) for k in range(len(lists["materials"]))]
@@ -175,3 +175,15 @@ def _clip(data: Decoder, k: int, a: dict) -> Clip:
             values = values.reshape(len(times) * (3 if interp == "CUBICSPLINE" else 1), -1)
         channels.append(Channel(node, path, Sampler(times, values, interp)))
     return Clip(item_name(a, f"clip{k}"), channels)
+
+
+def _target_names(mesh: dict) -> list[str]:
+    """A mesh's ``extras.targetNames`` (three.js and Blender read them), kept only when they are
+    one string per morph target; anything else is application data and ignored."""
+    extras = mesh.get("extras")
+    names = extras.get("targetNames") if isinstance(extras, dict) else None
+    prims = mesh.get("primitives") or [{}]
+    count = len(prims[0].get("targets", []) or [])
+    if isinstance(names, list) and len(names) == count and all(isinstance(n, str) for n in names):
+        return list(names)
+    return []

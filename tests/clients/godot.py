@@ -265,10 +265,8 @@ def _judge_clip(asset: Asset, animations: list[dict], tol: float) -> list[str]:
     keys = [{"node": t["path"], "kind": "trs", "keys": t["keys"]} for t in transform]
     for t in value:
         node, prop = t["path"].split(":", 1)
-        m = re.fullmatch(r"blend_shapes/morph_(\d+)", prop)
-        if m is None:
-            raise CellFailure(f"{t['path']}: not a blend shape track")
-        keys.append({"node": node, "kind": "weight", "target": int(m[1]), "keys": t["keys"]})
+        keys.append({"node": node, "kind": "weight", "target": _target_index(truth, t["path"], node, prop),
+                     "keys": t["keys"]})
     expect_same_keys(key_errors(truth, keys), tol)
     # as the player plays it: Godot's importer resamples node tracks at 15 fps and drops keys
     # its optimizer finds redundant, so between its keys it may differ (a note, with the figure)
@@ -409,3 +407,20 @@ def render(run: GodotRun, folder: Path) -> str | None:
                            "--path", str(run.project), "-s", "res://fishgen_render.gd"],
                           capture_output=True, text=True, env=env, timeout=IMPORT_TIMEOUT)
     return None if done.returncode == 0 else f"godot3 exited {done.returncode}: {done.stderr.strip()[-300:]}"
+
+
+def _target_index(truth: ClipTruth, path: str, node: str, prop: str) -> int:
+    """The morph target a blend-shape track drives: Godot names a blend shape after the mesh's
+    ``extras.targetNames`` when the file has them, else ``morph_N``."""
+    m = re.fullmatch(r"blend_shapes/(.+)", prop)
+    if m is None:
+        raise CellFailure(f"{path}: not a blend shape track")
+    numbered = re.fullmatch(r"morph_(\d+)", m[1])
+    if numbered is not None:
+        return int(numbered[1])
+    index = truth.node(node)
+    mesh = truth.scene.nodes[index].mesh if index is not None else None
+    names = truth.scene.meshes[mesh].target_names if mesh is not None else []
+    if m[1] not in names:
+        raise CellFailure(f"{path}: a blend shape the file's targetNames do not name")
+    return list(names).index(m[1])

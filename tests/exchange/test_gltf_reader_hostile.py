@@ -495,3 +495,20 @@ def test_skinned_mesh_with_a_joint_scaled_to_zero_poses(tmp_path):
     scene = read_gltf(doc.write(tmp_path))
     positions, _ = deformed(scene, 0, scene.meshes[0].primitives[0], pose(scene, 1.0))
     assert np.allclose(positions, 0)
+
+
+def test_morph_target_names_are_read_back_and_odd_ones_ignored(tmp_path):
+    """extras.targetNames (what three.js, Blender and Godot name blend shapes by) survive a round
+    trip; names that are not one string per target are application data, not names."""
+    from fishgen.assembly.fish import build_fish
+    from fishgen.exchange import export
+    from fishgen.species.parser import load_species
+    from tests.conftest import PARAMS
+
+    out = tmp_path / "fish.glb"
+    export(build_fish(load_species(PARAMS / "bonybream.txt")), out)
+    body = next(m for m in read_gltf(out).meshes if m.name == "body")
+    assert body.target_names == ["wave_sin+", "wave_sin-", "wave_cos+", "wave_cos-"]
+    from fishgen.exchange.gltf_scene import _target_names
+    assert _target_names({"extras": {"targetNames": ["a"]}, "primitives": [{"targets": [{}, {}]}]}) == []
+    assert _target_names({"extras": {"targetNames": [1, 2]}, "primitives": [{"targets": [{}, {}]}]}) == []
