@@ -197,6 +197,8 @@ def add_new_inputs(dest: Path) -> None:
         shutil.copy(PARAMS / name, dest / "scene" / name)
     (dest / "scene" / "full.toml").write_text(FULL_SCENE)
     (dest / "scene" / "path.csv").write_text(PATH_CSV)
+    for name in ("bonybream.txt", "threadfingoldie.txt"):   # the species the scene files name
+        shutil.copy(PARAMS / name, dest / "scene" / name)
     shutil.copy(PARAMS / "assets.toml", dest / "manifest" / "assets.toml")
     for p in sorted(PARAMS.glob("*.txt")):
         sp = parse_species(p.read_text(), str(p))
@@ -206,6 +208,7 @@ def add_new_inputs(dest: Path) -> None:
     shutil.copy(PARAMS / "clouds" / "sky.awa", dest / "awa" / "sky.awa")
     for name in ("billow", "cumulus", "wisp"):
         (dest / "awa" / f"{name}.png").write_bytes(png_bytes(8, 8))
+    (dest / "awa" / "small.awn").write_bytes(SMALL_CLOUD)   # the editor's and sky's particle cloud
 
 
 if __name__ == "__main__":

@@ -337,9 +337,11 @@ def photo_bytes(seed_png: bytes, rng: random.Random) -> bytes:
         return mutate.mutate_png(seed_png, rng)
     with Image.open(io.BytesIO(seed_png)) as src:
         im = src.convert("RGBA")
-    w, h = rng.choice([(160, 80), (160, 80), (64, 32), (1, 1), (2, 1), (1, 2), (3, 200), (400, 4), (8000, 64),
-                       (64, 8000) if rng.random() < 0.2 else (64, 64), (17, 9), (33, 33), (120, 119), (5, 3),
-                       (160, 4), (4, 160), (240, 60)])
+    if rng.random() < 0.15:  # below the 64-pixel minimum, or a sliver
+        w, h = rng.choice([(64, 32), (1, 1), (2, 1), (1, 2), (3, 200), (400, 4), (63, 64), (17, 9), (160, 4)])
+    else:
+        w, h = rng.choice([(160, 80), (160, 80), (160, 80), (64, 64), (65, 64), (128, 64), (97, 71), (64, 300),
+                           (300, 64), (2000, 64), (8000, 64), (64, 8000), (120, 119), (240, 60), (320, 160)])
     im = im.resize((w, h), rng.choice([Image.Resampling.NEAREST, Image.Resampling.BILINEAR]))
     edit = rng.random()
     if edit < 0.1:
