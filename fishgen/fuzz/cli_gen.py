@@ -135,10 +135,11 @@ def texture_case(seeds, rng: random.Random) -> tuple[dict[str, bytes | int], lis
     base = rng.choice(seeds.species)
     files: dict[str, bytes | int] = {"photo.png": structured.photo_bytes(photo, rng),
                                      "base.txt": base.encode("utf-8"), **_tiny_textures(base)}
-    argv = ["texture", "photo.png", "-s", "base.txt", "-o", rng.choice(["new.txt"] * 8 + ["new", "sub/new.txt",
-                                                                                           "new.png"])]
+    out = rng.choice(["new.txt"] * 8 + ["new", "sub/new.txt", "new.png"])
+    argv = ["texture", "photo.png", "-s", "base.txt", "-o", out]
     if rng.random() < 0.3:
-        argv += ["--body-sections", _val(rng, INTS + ["3", "4", "5", "7", "256", "257"], ["3", "4", "7", "12"])]
+        argv += ["--body-sections", _val(rng, INTS + ["3", "4", "5", "7", "256", "257"],
+                                         ["3", "4", "7", "12"])]
     if rng.random() < 0.3:
         argv += ["--circle-sections", _val(rng, INTS + ["3", "4", "256", "257"], ["3", "6", "12"])]
     if rng.random() < 0.2:
@@ -147,8 +148,8 @@ def texture_case(seeds, rng: random.Random) -> tuple[dict[str, bytes | int], lis
         argv.append("--fit-shape")
     if rng.random() < 0.15:
         texts = seeds.texts("fxl", ".fxl")
-        files["in.fxl"] = (rng.choice(texts) if rng.random() < 0.4 else structured.fxl_text(texts, rng)).encode(
-            "utf-8", "surrogatepass")
+        fxl = rng.choice(texts) if rng.random() < 0.4 else structured.fxl_text(texts, rng)
+        files["in.fxl"] = fxl.encode("utf-8", "surrogatepass")
         argv += ["--fxl-in", rng.choice(["in.fxl"] * 6 + ["missing.fxl", ".", "photo.png"])]
     if rng.random() < 0.1:
         argv += ["--fxl-out", rng.choice(["out.FXL", "out.fxl", "photo.png", "base.txt", "."])]
@@ -165,21 +166,21 @@ LODS = ["8x6", "8x6,4x4", "16x12,8x6,4x4", "3x3", "2x2", "0x0", "256x256", "257x
         "8x6;4x4", "99999999999999999999x3", ",".join(["8x6"] * 100), "8 x 6", " 8x6", "8x6,4x4,3x3,3x3",
         "64x64,32x32,16x16,8x8,4x4,3x3", "nanx6", "8×6"]
 CLIPS = ["swim", "idle", "sprint", "turn_left,turn_right", "burst", "swim,swim", "", ",", "Swim", "swim,",
-         "fly", "swim,idle,sprint,turn_left,turn_right,burst", "swim ", "\x00", "swim;idle", ",".join(["swim"] * 1000),
-         "idle,burst", "turn_left"]
-PAIRS = ["400,400", "1,1", "0,0", "-1,5", "1e6,1e6", "1e7,1e7", "nan,1", "inf,1", "1,2,3", "1", "", "x,y", "1e309,1",
-         "0.001,0.001", "100,100"]
+         "fly", "swim,idle,sprint,turn_left,turn_right,burst", "swim ", "\x00", "swim;idle",
+         ",".join(["swim"] * 1000), "idle,burst", "turn_left"]
+PAIRS = ["400,400", "1,1", "0,0", "-1,5", "1e6,1e6", "1e7,1e7", "nan,1", "inf,1", "1,2,3", "1", "", "x,y",
+         "1e309,1", "0.001,0.001", "100,100"]
 ALTITUDES = ["40,80", "0,0", "80,40", "-10,10", "1e6,1e7", "nan,1", "1", "", "0,1e308", "5,5"]
-TRIPLES = ["1,0.4,0.2", "0,0,0", "0,1,0", "1e308,1e308,1e308", "nan,0,0", "inf,1,1", "1,2", "1,2,3,4", "", "x,y,z",
-           "-1,-1,-1", "1e-300,0,0"]
+TRIPLES = ["1,0.4,0.2", "0,0,0", "0,1,0", "1e308,1e308,1e308", "nan,0,0", "inf,1,1", "1,2", "1,2,3,4", "",
+           "x,y,z", "-1,-1,-1", "1e-300,0,0"]
 
 
 def _light(rng: random.Random, argv: list[str]) -> None:
     for opt, pool, good in (("--sun", TRIPLES, ["1,0.4,0.2", "0,1,0"]), ("--sun-color", TRIPLES, ["1,1,1"]),
                             ("--sky-color", TRIPLES, ["0.2,0.3,0.4"]),
                             ("--albedo", FLOATS, ["0.9", "0", "1"]), ("--extinction", FLOATS, ["1", "8"]),
-                            ("--solid-angle", FLOATS, ["0.1", "0.5"]), ("--anisotropy", FLOATS + ["0.99", "-0.99"],
-                                                                        ["0.5", "0"])):
+                            ("--solid-angle", FLOATS, ["0.1", "0.5"]),
+                            ("--anisotropy", FLOATS + ["0.99", "-0.99"], ["0.5", "0"])):
         if rng.random() < 0.08:
             argv += [opt, _val(rng, pool, good)]
     if rng.random() < 0.05:
@@ -196,7 +197,8 @@ def options_case(seeds, rng: random.Random) -> tuple[dict[str, bytes | int], lis
         text = rng.choice(seeds.species)
         files["fish.txt"] = text.encode("utf-8")
         files.update(_tiny_textures(text))
-        argv = ["build", "fish.txt", "-o", rng.choice(["out.glb", "out.glb", "out.gltf", "out.obj", "out.ply"])]
+        argv = ["build", "fish.txt", "-o", rng.choice(["out.glb", "out.glb", "out.gltf", "out.obj",
+                                                       "out.ply"])]
         if rng.random() < 0.7:
             argv += ["--lods", rng.choice(LODS)]
         if rng.random() < 0.7:
@@ -259,14 +261,14 @@ def options_case(seeds, rng: random.Random) -> tuple[dict[str, bytes | int], lis
     if rng.random() < 0.4:
         argv += ["--mode", rng.choice(["thin", "medium", "thick", "", "THICK", "1"])]
     if rng.random() < 0.4:
-        argv += ["--size", rng.choice(["800x600", "1x1", "0x0", "16384x16384", "16385x2", "800", "800x", "x600",
-                                       "-800x600", "800x600x1", "1e3x1e3", "800X600", "８00x600", "", " 800x600",
-                                       "99999999999999999999x1", "nanxnan", "800×600"])]
+        argv += ["--size", rng.choice(["800x600", "1x1", "0x0", "16384x16384", "16385x2", "800", "800x",
+                                       "x600", "-800x600", "800x600x1", "1e3x1e3", "800X600", "８00x600", "",
+                                       " 800x600", "99999999999999999999x1", "nanxnan", "800×600"])]
     if rng.random() < 0.4:
         argv += ["--timeout", _val(rng, FLOATS + ["86400", "86400.001"], ["1", "10", "0.5", "86400"])]
     if rng.random() < 0.35:
-        argv += ["--report", rng.choice(["r.json", "r.csv", "r.txt", "r", "small.awn", ".", "sub/r.json", "r.JSON",
-                                         ""])]
+        argv += ["--report", rng.choice(["r.json", "r.csv", "r.txt", "r", "small.awn", ".", "sub/r.json",
+                                         "r.JSON", ""])]
     if rng.random() < 0.2:
         argv.append("--headless")
     if rng.random() < 0.25:

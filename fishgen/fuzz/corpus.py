@@ -139,7 +139,7 @@ def make_corpus(dest: Path = DEFAULT_CORPUS) -> None:
 
 #: A scene file using every key of issue 24's school (couzin, variety, warm-up, length, bounds) and a
 #: target path read from a CSV.
-FULL_SCENE = """# Every scene key: the couzin model's zones, variety, warm-up, length, bounds, a CSV target path.
+FULL_SCENE = """# Every scene key: couzin zones, variety, warm-up, length, bounds, a CSV target path.
 model = "couzin"
 frames = 60
 fps = 30
@@ -202,9 +202,11 @@ def add_new_inputs(dest: Path) -> None:
     shutil.copy(PARAMS / "assets.toml", dest / "manifest" / "assets.toml")
     for p in sorted(PARAMS.glob("*.txt")):
         sp = parse_species(p.read_text(), str(p))
-        (dest / "fxl" / f"{p.stem}.fxl").write_text(format_fxl(sp.texture_points, sp.circle_sections))
+        if sp.texture_points is not None:
+            (dest / "fxl" / f"{p.stem}.fxl").write_text(format_fxl(sp.texture_points, sp.circle_sections))
     with Image.open(PARAMS / "photos" / "bonybream-side.png") as im:
-        im.resize((160, 80), Image.Resampling.LANCZOS).save(dest / "photo" / "bonybream-side.png", optimize=True)
+        small = im.resize((160, 80), Image.Resampling.LANCZOS)
+        small.save(dest / "photo" / "bonybream-side.png", optimize=True)
     shutil.copy(PARAMS / "clouds" / "sky.awa", dest / "awa" / "sky.awa")
     for name in ("billow", "cumulus", "wisp"):
         (dest / "awa" / f"{name}.png").write_bytes(png_bytes(8, 8))

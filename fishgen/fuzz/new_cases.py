@@ -11,6 +11,7 @@
 | editor   | raw HTTP requests to the editor's routes behind a LocalServer, handled in-process |
 | options  | ``fishgen sky/fly/build`` with mutated options (the CLI, in-process; fly never serves) |
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -44,25 +45,41 @@ def make_new_case(seeds: Seeds, target: str, rng: random.Random, index: int, ver
     if target == "manifest":
         manifests = seeds.texts("manifest", ".toml")
         text = manifests[index] if verbatim else structured.manifest_text(manifests, rng)
-        return Case(target, index, files={"assets.toml": text.encode("utf-8", "surrogatepass")}, main="assets.toml")
+        return Case(
+            target, index, files={"assets.toml": text.encode("utf-8", "surrogatepass")}, main="assets.toml"
+        )
     if target == "fxl":
         texts = seeds.texts("fxl", ".fxl")
         return Case(target, index, text=texts[index] if verbatim else structured.fxl_text(texts, rng))
     if target == "photo":
         from fishgen.fuzz.cli_gen import texture_case
+
         files, argv = texture_case(seeds, rng)
         return Case(target, index, files=files, argv=argv)
     if target == "awa":
         data = new["awa"]["sky.awa"]
-        return Case(target, index, files={"sky.awa": data if verbatim else structured.awa_bytes([data], rng)},
-                    main="sky.awa")
+        return Case(
+            target,
+            index,
+            files={"sky.awa": data if verbatim else structured.awa_bytes([data], rng)},
+            main="sky.awa",
+        )
     if target == "editor":
-        files = {"sky.awa": new["awa"]["sky.awa"], "small.awn": new["awa"]["small.awn"],
-                 "bad.awn": b"3\n1\n1, 2, 3\n"}
-        return Case(target, index, files=files, requests=structured.editor_requests(_edit_cubes(seeds), rng),
-                    main=rng.choice(["sky.awa", "small.awn", "new.awn", "new.awa", "bad.awn"]))
+        files = {
+            "sky.awa": new["awa"]["sky.awa"],
+            "small.awn": new["awa"]["small.awn"],
+            "bad.awn": b"3\n1\n1, 2, 3\n",
+        }
+        return Case(
+            target,
+            index,
+            files=files,
+            requests=structured.editor_requests(_edit_cubes(seeds), rng),
+            main=rng.choice(["sky.awa", "small.awn", "new.awn", "new.awa", "bad.awn"]),
+        )
     if target == "options":
         from fishgen.fuzz.cli_gen import options_case
+
         files, argv = options_case(seeds, rng)
         return Case(target, index, files=files, argv=argv)
     raise ValueError(f"unknown target {target!r}")
@@ -81,8 +98,15 @@ def _edit_cubes(seeds: Seeds) -> dict[str, list[dict]]:
                 cells = [c.strip() for c in row.replace(",", " , ").replace(" , ", ",").split(",")]
                 cells = [c for c in ",".join(cells).replace(" ", ",").split(",") if c]
                 values = [float(c) for c in cells[:8]]
-                cubes.append({"particles": int(values[0]), "size": values[1:4], "centre": values[4:7],
-                              "radius": values[7], "texture": cells[8] if len(cells) > 8 else None})
+                cubes.append(
+                    {
+                        "particles": int(values[0]),
+                        "size": values[1:4],
+                        "centre": values[4:7],
+                        "radius": values[7],
+                        "texture": cells[8] if len(cells) > 8 else None,
+                    }
+                )
             _CUBES[mode] = cubes
     return _CUBES
 
@@ -206,27 +230,40 @@ def _run_editor(case: Case, workdir: Path) -> Outcome:
     server = LocalServer(session.routes(), 0, max_body=MAX_REQUEST, token=TOKEN, timeout=0.2)
     try:
         for k, raw in enumerate(case.requests):
-            data = (raw.replace(b"{PORT}", str(server.port).encode()).replace(b"{TOKEN}", TOKEN.encode())
-                    .replace(b"{OUTSIDE}", str(outside).encode()))
+            data = (
+                raw.replace(b"{PORT}", str(server.port).encode())
+                .replace(b"{TOKEN}", TOKEN.encode())
+                .replace(b"{OUTSIDE}", str(outside).encode())
+            )
             answer, err = _exchange(server, _Handler, data)
             if err is not None:
                 where = innermost_fishgen_frame(err.__traceback__)
                 from fishgen.fuzz.cases import classify
+
                 judged = classify(err)
-                key = judged.key if judged.key.startswith(("budget", "RecursionError")) else \
-                    f"editor: {type(err).__name__} escaped the handler at {where}"
+                key = (
+                    judged.key
+                    if judged.key.startswith(("budget", "RecursionError"))
+                    else f"editor: {type(err).__name__} escaped the handler at {where}"
+                )
                 return Outcome("finding", key, f"request {k}: {data[:300]!r}\n{judged.detail or err!r}")
             status = _status(answer)
             if status >= 500 and not _protocol_answer(status, data):
-                return Outcome("finding", f"editor: {status} answer to {_route_of(data)}",
-                               f"request {k}: {data[:300]!r}\n{answer[:500]!r}")
+                return Outcome(
+                    "finding",
+                    f"editor: {status} answer to {_route_of(data)}",
+                    f"request {k}: {data[:300]!r}\n{answer[:500]!r}",
+                )
     finally:
         server.server_close()
     after = _snapshot(workdir, edit)
     changed = sorted(p for p, st in after.items() if before.get(p) != st)
     if changed:
-        return Outcome("finding", "editor: a file written outside the editor's folder",
-                       f"{changed[:5]} after {[r[:200] for r in case.requests]}")
+        return Outcome(
+            "finding",
+            "editor: a file written outside the editor's folder",
+            f"{changed[:5]} after {[r[:200] for r in case.requests]}",
+        )
     return Outcome("ok")
 
 
@@ -234,7 +271,7 @@ def _exchange(server, handler_class, data: bytes) -> tuple[bytes, BaseException 
     client, conn = socket.socketpair()
     received: list[bytes] = []
     slow = data.startswith(SLOW)
-    payload = data[len(SLOW):] if slow else data
+    payload = data[len(SLOW) :] if slow else data
 
     def talk() -> None:
         try:

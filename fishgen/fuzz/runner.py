@@ -37,7 +37,8 @@ TIME_LIMITS = {"species": 2.0, "cubes": 2.0, "gltf": 5.0, "obj": 5.0, "ply": 5.0
 #: Extra seconds the parent waits past a case's limit before killing a worker stuck in C code.
 GRACE = 10.0
 BATCH = {"species": 100, "cubes": 200, "gltf": 20, "obj": 10, "ply": 20, "cli": 2,
-         "scene": 50, "paths": 10, "manifest": 50, "fxl": 200, "photo": 1, "awa": 20, "editor": 5, "options": 2}
+         "scene": 50, "paths": 10, "manifest": 50, "fxl": 200, "photo": 1, "awa": 20, "editor": 5,
+         "options": 2}
 
 
 @dataclass
@@ -78,27 +79,28 @@ class Report:
 def _worker(conn, progress, corpus: str, budget: int, workdir: str, quiet: bool = True) -> None:
     # Import everything a case may need before the memory limit, as a long-lived tool would.
     import fishgen.assembly.fish  # noqa: F401
-    import fishgen.cli.adapter  # noqa: F401
-    import fishgen.clouds.fill  # noqa: F401
-    import fishgen.commands.build  # noqa: F401
-    import fishgen.commands.clouds  # noqa: F401
-    import fishgen.commands.preview  # noqa: F401
-    import fishgen.exchange.gltf_reader  # noqa: F401
-    import fishgen.exchange.mesh_reader  # noqa: F401
-    import fishgen.preview.inputs  # noqa: F401
-    import fishgen.scene.pose  # noqa: F401
-    import fishgen.species.parser  # noqa: F401
+
     # issue 26's targets
     import fishgen.authoring.photo.fxl  # noqa: F401
     import fishgen.authoring.photo.run  # noqa: F401
     import fishgen.batch.manifest  # noqa: F401
+    import fishgen.cli.adapter  # noqa: F401
+    import fishgen.clouds.fill  # noqa: F401
+    import fishgen.commands.build  # noqa: F401
+    import fishgen.commands.clouds  # noqa: F401
     import fishgen.commands.fly  # noqa: F401
+    import fishgen.commands.preview  # noqa: F401
     import fishgen.commands.sky  # noqa: F401
     import fishgen.commands.texture  # noqa: F401
     import fishgen.editor.session  # noqa: F401
+    import fishgen.exchange.gltf_reader  # noqa: F401
+    import fishgen.exchange.mesh_reader  # noqa: F401
     import fishgen.fly.assets  # noqa: F401
     import fishgen.fly.headless  # noqa: F401
+    import fishgen.preview.inputs  # noqa: F401
+    import fishgen.scene.pose  # noqa: F401
     import fishgen.school.scene_file  # noqa: F401
+    import fishgen.species.parser  # noqa: F401
     import fishgen.web.server  # noqa: F401
 
     seeds = load_seeds(Path(corpus))

@@ -7,6 +7,7 @@ inputs are mutated as data (keys deleted, values replaced by edge values of ever
 known optional tables added, unknown keys) and written back with :func:`toml_text`, then
 sometimes damaged as text. Nothing here touches the disk.
 """
+
 from __future__ import annotations
 
 import copy
@@ -14,7 +15,6 @@ import io
 import json
 import math
 import random
-import tomllib
 from typing import Any
 
 from fishgen.fuzz import mutate
@@ -22,13 +22,80 @@ from fishgen.fuzz import mutate
 # -- TOML ------------------------------------------------------------------------------------------
 BIG_INT = int("9" * 400)
 TOML_VALUES: list[Any] = [
-    0, 1, -1, 2, 3, 7, 1000, 100_000, 100_001, 2**31, 2**63 - 1, -(2**63), 10**12,
-    0.0, -0.0, 1e-300, 5e-324, 0.001, 0.05, 0.5, 1.5, 3.0, 20.0, 20.0001, 360.0, 1e4, 1.0001e4, 1e6, 1e300,
-    math.nan, math.inf, -math.inf, True, False, "", "x", "nan", "1", "circle", "figure8", "spline", "none",
-    "sphere", "box", "line", "ring", "boids", "pso", "couzin", "torus", "swarm", "dynamic parallel",
-    "../secret.txt", "/etc/passwd", "missing.txt", "bonybream.txt", "path.csv", "../path.csv", "a" * 300,
-    "\u0000", "é", "\U0001f41f", [], [0], [1, 2, 3], [[0, 0, 0], [1, 1, 1]], [[1, 1, 1], [0, 0, 0]],
-    [[-1e308, 0, 0], [1e308, 1, 1]], [math.nan, 0, 0], ["a", "b"], [1, "a"], {}, {"x": 1}, [{}],
+    0,
+    1,
+    -1,
+    2,
+    3,
+    7,
+    1000,
+    100_000,
+    100_001,
+    2**31,
+    2**63 - 1,
+    -(2**63),
+    10**12,
+    0.0,
+    -0.0,
+    1e-300,
+    5e-324,
+    0.001,
+    0.05,
+    0.5,
+    1.5,
+    3.0,
+    20.0,
+    20.0001,
+    360.0,
+    1e4,
+    1.0001e4,
+    1e6,
+    1e300,
+    math.nan,
+    math.inf,
+    -math.inf,
+    True,
+    False,
+    "",
+    "x",
+    "nan",
+    "1",
+    "circle",
+    "figure8",
+    "spline",
+    "none",
+    "sphere",
+    "box",
+    "line",
+    "ring",
+    "boids",
+    "pso",
+    "couzin",
+    "torus",
+    "swarm",
+    "dynamic parallel",
+    "../secret.txt",
+    "/etc/passwd",
+    "missing.txt",
+    "bonybream.txt",
+    "path.csv",
+    "../path.csv",
+    "a" * 300,
+    "\u0000",
+    "é",
+    "\U0001f41f",
+    [],
+    [0],
+    [1, 2, 3],
+    [[0, 0, 0], [1, 1, 1]],
+    [[1, 1, 1], [0, 0, 0]],
+    [[-1e308, 0, 0], [1e308, 1, 1]],
+    [math.nan, 0, 0],
+    ["a", "b"],
+    [1, "a"],
+    {},
+    {"x": 1},
+    [{}],
 ]
 #: A TOML integer of thousands of digits (int-string limit), written as a raw token.
 HUGE_INT_TOKENS = ["9" * 5000, "-" + "9" * 4301, "1" + "0" * 4300, "0x" + "f" * 1200]
@@ -147,7 +214,9 @@ def mutate_doc(doc: dict[str, Any], rng: random.Random, additions: list[tuple[li
 
 def toml_mutant(seed_text: str, rng: random.Random, additions: list[tuple[list[str], Any]]) -> str:
     """A mutant of a valid TOML seed: as data (most), then sometimes damaged as text."""
-    doc = tomllib.loads(seed_text)
+    from fishgen.tomlfile import loads
+
+    doc = loads(seed_text, "<seed>")
     if rng.random() < 0.85:
         mutate_doc(doc, rng, additions)
     text = toml_text(doc)
@@ -171,25 +240,70 @@ def _zones() -> list[tuple[list[str], Any]]:
 
 
 SCENE_ADDITIONS: list[tuple[list[str], Any]] = [
-    (["warmup"], 0.0), (["warmup"], 3.0), (["warmup"], 1e4), (["warmup"], 10000.5), (["warmup"], -1.0),
-    (["length"], 0.3), (["length"], 0.01), (["length"], 100.0), (["length"], 1e-3), (["length"], 1e9),
-    (["bounds"], [[-3.0, -1.0, -3.0], [3.0, 1.0, 3.0]]), (["bounds"], [[-1e4, -1e4, -1e4], [1e4, 1e4, 1e4]]),
-    (["bounds"], [[0, 0, 0], [0, 0, 0]]), (["bounds"], [[1, 1, 1], [-1, -1, -1]]), (["bounds"], [1, 2, 3, 4, 5, 6]),
-    (["bounds"], [[-1e5, 0, 0], [1, 1, 1]]), (["bounds"], [[0, 0], [1, 1]]),
-    (["model"], "couzin"), (["model"], "pso"), (["model"], "boids"), (["layout"], "ring"),
-    (["frames"], 2), (["frames"], 100_000), (["frames"], 1), (["fps"], 1), (["fps"], 1000), (["fps"], 0.5),
-    (["seed"], 0), (["seed"], 2**63 - 1), (["seed"], 2**63), (["seed"], -1),
-    (["target", "path"], "path.csv"), (["target", "path"], "circle"), (["target", "path"], "spline"),
-    (["target", "path"], "../path.csv"), (["target", "path"], "missing.csv"), (["target", "path"], "."),
-    (["target", "centre"], [0, 0, 0]), (["target", "centre"], [1e4, 0, 0]), (["target", "centre"], [1e5, 0, 0]),
-    (["target", "radius"], 3.0), (["target", "radius"], 1e4), (["target", "period"], 0.1),
-    (["target", "seed"], 3), (["predator", "path"], "path.csv"), (["predator", "path"], "figure8"),
-    (["predator", "radius"], 0.01), (["predator", "period"], 1e6), (["predator", "centre"], [0, 1e4, 0]),
-    (["pso", "inertia"], 0.7), (["pso", "inertia"], 1e3), (["pso", "cognitive"], 1.5), (["pso", "social"], -1),
-    (["species", "count"], 1), (["species", "count"], 100_000), (["species", "count"], 100_001),
-    (["species", "speed"], 0.05), (["species", "speed"], 20.0), (["species", "file"], "threadfingoldie.txt"),
-    (["species", "file"], "missing.txt"), (["species", "file"], "../species.txt"), (["species", "file"], ""),
-    (["species", "file"], "path.csv"), (["species", "file"], "scene.toml"),
+    (["warmup"], 0.0),
+    (["warmup"], 3.0),
+    (["warmup"], 1e4),
+    (["warmup"], 10000.5),
+    (["warmup"], -1.0),
+    (["length"], 0.3),
+    (["length"], 0.01),
+    (["length"], 100.0),
+    (["length"], 1e-3),
+    (["length"], 1e9),
+    (["bounds"], [[-3.0, -1.0, -3.0], [3.0, 1.0, 3.0]]),
+    (["bounds"], [[-1e4, -1e4, -1e4], [1e4, 1e4, 1e4]]),
+    (["bounds"], [[0, 0, 0], [0, 0, 0]]),
+    (["bounds"], [[1, 1, 1], [-1, -1, -1]]),
+    (["bounds"], [1, 2, 3, 4, 5, 6]),
+    (["bounds"], [[-1e5, 0, 0], [1, 1, 1]]),
+    (["bounds"], [[0, 0], [1, 1]]),
+    (["model"], "couzin"),
+    (["model"], "pso"),
+    (["model"], "boids"),
+    (["layout"], "ring"),
+    (["frames"], 2),
+    (["frames"], 100_000),
+    (["frames"], 1),
+    (["fps"], 1),
+    (["fps"], 1000),
+    (["fps"], 0.5),
+    (["seed"], 0),
+    (["seed"], 2**63 - 1),
+    (["seed"], 2**63),
+    (["seed"], -1),
+    (["target", "path"], "path.csv"),
+    (["target", "path"], "circle"),
+    (["target", "path"], "spline"),
+    (["target", "path"], "../path.csv"),
+    (["target", "path"], "missing.csv"),
+    (["target", "path"], "."),
+    (["target", "centre"], [0, 0, 0]),
+    (["target", "centre"], [1e4, 0, 0]),
+    (["target", "centre"], [1e5, 0, 0]),
+    (["target", "radius"], 3.0),
+    (["target", "radius"], 1e4),
+    (["target", "period"], 0.1),
+    (["target", "seed"], 3),
+    (["predator", "path"], "path.csv"),
+    (["predator", "path"], "figure8"),
+    (["predator", "radius"], 0.01),
+    (["predator", "period"], 1e6),
+    (["predator", "centre"], [0, 1e4, 0]),
+    (["pso", "inertia"], 0.7),
+    (["pso", "inertia"], 1e3),
+    (["pso", "cognitive"], 1.5),
+    (["pso", "social"], -1),
+    (["species", "count"], 1),
+    (["species", "count"], 100_000),
+    (["species", "count"], 100_001),
+    (["species", "speed"], 0.05),
+    (["species", "speed"], 20.0),
+    (["species", "file"], "threadfingoldie.txt"),
+    (["species", "file"], "missing.txt"),
+    (["species", "file"], "../species.txt"),
+    (["species", "file"], ""),
+    (["species", "file"], "path.csv"),
+    (["species", "file"], "scene.toml"),
 ]
 
 
@@ -197,8 +311,33 @@ def scene_text(seeds: list[str], rng: random.Random) -> str:
     return toml_mutant(rng.choice(seeds), rng, SCENE_ADDITIONS + _zones())
 
 
-PATH_VALUES = ["0", "1", "-1", "0.5", "1e4", "10000.0001", "-1e4", "1e7", "10000001", "1e308", "-1e308",
-               "1e309", "nan", "inf", "-inf", "5e-324", "", " ", "x", "1_0", "１", "0x10", "1e-300", "+1", ".5"]
+PATH_VALUES = [
+    "0",
+    "1",
+    "-1",
+    "0.5",
+    "1e4",
+    "10000.0001",
+    "-1e4",
+    "1e7",
+    "10000001",
+    "1e308",
+    "-1e308",
+    "1e309",
+    "nan",
+    "inf",
+    "-inf",
+    "5e-324",
+    "",
+    " ",
+    "x",
+    "1_0",
+    "１",
+    "0x10",
+    "1e-300",
+    "+1",
+    ".5",
+]
 
 
 def path_csv(rng: random.Random) -> bytes:
@@ -236,20 +375,74 @@ def path_csv(rng: random.Random) -> bytes:
 # -- manifests -------------------------------------------------------------------------------------
 def manifest_additions() -> list[tuple[list[str], Any]]:
     out: list[tuple[list[str], Any]] = [
-        (["out"], v) for v in ("out", "", ".", "..", "/", "../../x", "a/b", 1, ["x"])]
-    out += [(["build", "output"], v) for v in ("x.glb", "x.gltf", "x.obj", "x.ply", "x.png", "x", "../x.glb",
-                                               "/x.glb", "", ".", "a/../../x.glb", "x.GLB", "a\\..\\x.glb",
-                                               "fish/bonybream.glb")]
+        (["out"], v) for v in ("out", "", ".", "..", "/", "../../x", "a/b", 1, ["x"])
+    ]
+    out += [
+        (["build", "output"], v)
+        for v in (
+            "x.glb",
+            "x.gltf",
+            "x.obj",
+            "x.ply",
+            "x.png",
+            "x",
+            "../x.glb",
+            "/x.glb",
+            "",
+            ".",
+            "a/../../x.glb",
+            "x.GLB",
+            "a\\..\\x.glb",
+            "fish/bonybream.glb",
+        )
+    ]
     out += [(["build", "input"], v) for v in ("bonybream.txt", "missing.txt", "../x.txt", "", "/etc/passwd")]
     out += [(["build", "inputs"], v) for v in (["bonybream.txt"], ["a.txt", "b.txt"], [], [1], "x")]
     out += [(["clouds", "inputs"], v) for v in (["clouds/table_4_4.awn", "clouds/sky.awa"], [""])]
-    out += [(["clouds", "offset"], v) for v in ([[0, 0, 0]], [[0, 0, 0], [1, 2, 3]], [0, 0, 0], [[math.nan, 0, 0]],
-                                                [[1e39, 0, 0]], [["a", 0, 0]], [])]
+    out += [
+        (["clouds", "offset"], v)
+        for v in (
+            [[0, 0, 0]],
+            [[0, 0, 0], [1, 2, 3]],
+            [0, 0, 0],
+            [[math.nan, 0, 0]],
+            [[1e39, 0, 0]],
+            [["a", 0, 0]],
+            [],
+        )
+    ]
     out += [(["school", "input"], v) for v in ("reef.toml", "bonybream.txt", "missing.toml")]
     out += [(["school", "inputs"], v) for v in (["reef.toml", "bonybream.txt"], ["bonybream.txt"] * 3)]
-    values = [0, 1, -1, 2, 0.5, 1e-3, 30, 1000, 1001, 2**63, math.nan, math.inf, True, "", "x", "8x6,4x4",
-              "swim,idle", "mask", "blend", "torus", "couzin", [1, 2, 3], [1.0, 0.4, 0.2], [1, 2, 3, 4, 5, 6],
-              ".", "..", "/", "textures"]
+    values = [
+        0,
+        1,
+        -1,
+        2,
+        0.5,
+        1e-3,
+        30,
+        1000,
+        1001,
+        2**63,
+        math.nan,
+        math.inf,
+        True,
+        "",
+        "x",
+        "8x6,4x4",
+        "swim,idle",
+        "mask",
+        "blend",
+        "torus",
+        "couzin",
+        [1, 2, 3],
+        [1.0, 0.4, 0.2],
+        [1, 2, 3, 4, 5, 6],
+        ".",
+        "..",
+        "/",
+        "textures",
+    ]
     try:
         from fishgen.batch.manifest import kinds
         from fishgen.commands import command
@@ -273,8 +466,32 @@ def manifest_text(seeds: list[str], rng: random.Random) -> str:
 
 
 # -- .FXL ------------------------------------------------------------------------------------------
-FXL_VALUES = ["0", "1", "0.5", "1.0001", "-0", "-0.0001", "nan", "inf", "1e-300", "9" * 400, "1" + "0" * 6,
-              "100000", "100001", "3.0", "2.5", "-1", "", "x", "１", "0x1", "1_0", "1e0", "0.", ".5"]
+FXL_VALUES = [
+    "0",
+    "1",
+    "0.5",
+    "1.0001",
+    "-0",
+    "-0.0001",
+    "nan",
+    "inf",
+    "1e-300",
+    "9" * 400,
+    "1" + "0" * 6,
+    "100000",
+    "100001",
+    "3.0",
+    "2.5",
+    "-1",
+    "",
+    "x",
+    "１",
+    "0x1",
+    "1_0",
+    "1e0",
+    "0.",
+    ".5",
+]
 
 
 def fxl_text(seeds: list[str], rng: random.Random) -> str:
@@ -296,8 +513,19 @@ def fxl_text(seeds: list[str], rng: random.Random) -> str:
             counts = [i for i, ln in enumerate(lines) if ln.strip().isdigit()]
             if counts:
                 i = rng.choice(counts)
-                lines[i] = rng.choice(["0", "1", str(int(lines[i]) + 1), str(max(0, int(lines[i]) - 1)),
-                                       "9" * 400, "100000", "100001", "1.0", "-1"])
+                lines[i] = rng.choice(
+                    [
+                        "0",
+                        "1",
+                        str(int(lines[i]) + 1),
+                        str(max(0, int(lines[i]) - 1)),
+                        "9" * 400,
+                        "100000",
+                        "100001",
+                        "1.0",
+                        "-1",
+                    ]
+                )
         elif roll < 0.6:  # body lines reversed, or their indices dropped
             body = [i for i, ln in enumerate(lines) if len(ln.split()) == 4]
             if body:
@@ -309,15 +537,27 @@ def fxl_text(seeds: list[str], rng: random.Random) -> str:
                     for i in body:
                         lines[i] = " ".join(lines[i].split()[2:])
         elif roll < 0.7:
-            lines[k] = rng.choice(["//body", "//caudal", "//Dorsal fin", "//tail", "//", "//unknown", "// body",
-                                   "//pectoralfin 2 0.1 0.2 0.3 0.4", "//anal 1", "//adipose"])
+            lines[k] = rng.choice(
+                [
+                    "//body",
+                    "//caudal",
+                    "//Dorsal fin",
+                    "//tail",
+                    "//",
+                    "//unknown",
+                    "// body",
+                    "//pectoralfin 2 0.1 0.2 0.3 0.4",
+                    "//anal 1",
+                    "//adipose",
+                ]
+            )
         elif roll < 0.78:
             del lines[k]
         elif roll < 0.86:
             lines.insert(k, lines[rng.randrange(len(lines))])
         elif roll < 0.92:  # OCR join: the header, count and first points on one line
             if k + 2 < len(lines):
-                lines[k:k + 3] = [" ".join(lines[k:k + 3])]
+                lines[k : k + 3] = [" ".join(lines[k : k + 3])]
         else:
             return mutate.mutate_text("\n".join(lines), rng)
     return "\n".join(lines)
@@ -340,8 +580,25 @@ def photo_bytes(seed_png: bytes, rng: random.Random) -> bytes:
     if rng.random() < 0.15:  # below the 64-pixel minimum, or a sliver
         w, h = rng.choice([(64, 32), (1, 1), (2, 1), (1, 2), (3, 200), (400, 4), (63, 64), (17, 9), (160, 4)])
     else:
-        w, h = rng.choice([(160, 80), (160, 80), (160, 80), (64, 64), (65, 64), (128, 64), (97, 71), (64, 300),
-                           (300, 64), (2000, 64), (8000, 64), (64, 8000), (120, 119), (240, 60), (320, 160)])
+        w, h = rng.choice(
+            [
+                (160, 80),
+                (160, 80),
+                (160, 80),
+                (64, 64),
+                (65, 64),
+                (128, 64),
+                (97, 71),
+                (64, 300),
+                (300, 64),
+                (2000, 64),
+                (8000, 64),
+                (64, 8000),
+                (120, 119),
+                (240, 60),
+                (320, 160),
+            ]
+        )
     im = im.resize((w, h), rng.choice([Image.Resampling.NEAREST, Image.Resampling.BILINEAR]))
     edit = rng.random()
     if edit < 0.1:
@@ -376,11 +633,32 @@ def photo_bytes(seed_png: bytes, rng: random.Random) -> bytes:
 
 
 # -- .awa texture clouds ---------------------------------------------------------------------------
-AWA_TEXTURES = ["clouds/billow.png", "clouds/cumulus.png", "clouds/wisp.png", "billow.png", "../billow.png",
-                "../../textures/clouds/billow.png", "/etc/passwd.png", "clouds/missing.png", "clouds/", "clouds",
-                "clouds/billow.PNG", "clouds/billow.txt", "clouds//billow.png", "./clouds/billow.png",
-                "clouds/../clouds/billow.png", "clouds\\billow.png", "", "x" * 300 + ".png", "c l o u d.png",
-                "clouds/link.png", "clouds/dir.png", "nul.png", ".png", "clouds/billow.png\x00"]
+AWA_TEXTURES = [
+    "clouds/billow.png",
+    "clouds/cumulus.png",
+    "clouds/wisp.png",
+    "billow.png",
+    "../billow.png",
+    "../../textures/clouds/billow.png",
+    "/etc/passwd.png",
+    "clouds/missing.png",
+    "clouds/",
+    "clouds",
+    "clouds/billow.PNG",
+    "clouds/billow.txt",
+    "clouds//billow.png",
+    "./clouds/billow.png",
+    "clouds/../clouds/billow.png",
+    "clouds\\billow.png",
+    "",
+    "x" * 300 + ".png",
+    "c l o u d.png",
+    "clouds/link.png",
+    "clouds/dir.png",
+    "nul.png",
+    ".png",
+    "clouds/billow.png\x00",
+]
 
 
 def awa_bytes(seeds: list[bytes], rng: random.Random) -> bytes:
@@ -409,12 +687,51 @@ def awa_bytes(seeds: list[bytes], rng: random.Random) -> bytes:
 # -- editor requests -------------------------------------------------------------------------------
 #: Placeholders the runner fills in: the server's port and token, a folder outside the editor's.
 PORT, TOKEN, OUTSIDE = "{PORT}", "{TOKEN}", "{OUTSIDE}"
-SAVE_NAMES = ["new.awn", "new.awa", "table_4_4.awn", "sky.awa", "../escape.awn", "../../escape.awn",
-              f"{OUTSIDE}/abs.awn", "/escape.awn", "sub/x.awn", "..", ".", "", ".awn", "x.AWN", "x.awn.txt",
-              "x.txt", "con.awn", "a" * 300 + ".awn", "x\x00.awn", "x\n.awn", "..\\escape.awn", "~/x.awn",
-              "link.awn", "x/../../escape.awn", "%2e%2e/escape.awn", 1, None, [], {"name": "x"}, True]
-TEXTURE_NAMES = ["clouds/billow.png", "clouds/cumulus.png", "../sky.awa", "../../etc/passwd", "/etc/passwd",
-                 "clouds/missing.png", "", "clouds", "clouds/billow.png%00", "%2e%2e/%2e%2e/x.png", "x" * 2000]
+SAVE_NAMES = [
+    "new.awn",
+    "new.awa",
+    "table_4_4.awn",
+    "sky.awa",
+    "../escape.awn",
+    "../../escape.awn",
+    f"{OUTSIDE}/abs.awn",
+    "/escape.awn",
+    "sub/x.awn",
+    "..",
+    ".",
+    "",
+    ".awn",
+    "x.AWN",
+    "x.awn.txt",
+    "x.txt",
+    "con.awn",
+    "a" * 300 + ".awn",
+    "x\x00.awn",
+    "x\n.awn",
+    "..\\escape.awn",
+    "~/x.awn",
+    "link.awn",
+    "x/../../escape.awn",
+    "%2e%2e/escape.awn",
+    1,
+    None,
+    [],
+    {"name": "x"},
+    True,
+]
+TEXTURE_NAMES = [
+    "clouds/billow.png",
+    "clouds/cumulus.png",
+    "../sky.awa",
+    "../../etc/passwd",
+    "/etc/passwd",
+    "clouds/missing.png",
+    "",
+    "clouds",
+    "clouds/billow.png%00",
+    "%2e%2e/%2e%2e/x.png",
+    "x" * 2000,
+]
 
 
 def _json_mutant(value: Any, rng: random.Random) -> Any:
@@ -426,9 +743,33 @@ def _json_mutant(value: Any, rng: random.Random) -> Any:
         parent, key = rng.choice(places)
         roll = rng.random()
         if roll < 0.6:
-            parent[key] = rng.choice([0, -1, 1e308, -1e308, 1e-320, 2**64, 10**400, 1.5, "1", "", None, True, [],
-                                      {}, [1, 2], [1, 2, 3, 4], "clouds/billow.png", "../x.png", 100_000, 10**7,
-                                      1e9, 2**53, 0.0])
+            parent[key] = rng.choice(
+                [
+                    0,
+                    -1,
+                    1e308,
+                    -1e308,
+                    1e-320,
+                    2**64,
+                    10**400,
+                    1.5,
+                    "1",
+                    "",
+                    None,
+                    True,
+                    [],
+                    {},
+                    [1, 2],
+                    [1, 2, 3, 4],
+                    "clouds/billow.png",
+                    "../x.png",
+                    100_000,
+                    10**7,
+                    1e9,
+                    2**53,
+                    0.0,
+                ]
+            )
         elif roll < 0.8 and isinstance(parent, dict):
             del parent[key]
         elif isinstance(parent, list):
@@ -442,15 +783,31 @@ def editor_requests(cubes_by_mode: dict[str, list[dict]], rng: random.Random) ->
 
 
 def _request(cubes_by_mode: dict[str, list[dict]], rng: random.Random) -> bytes:
-    route = rng.choices(["/", "/api/document", "/api/open", "/api/save", "/api/fill", "/api/texture",
-                         "/api/lists", "other"], [1, 2, 3, 6, 4, 3, 2, 2])[0]
+    route = rng.choices(
+        ["/", "/api/document", "/api/open", "/api/save", "/api/fill", "/api/texture", "/api/lists", "other"],
+        [1, 2, 3, 6, 4, 3, 2, 2],
+    )[0]
     method = {"/api/open": "POST", "/api/save": "POST", "/api/fill": "POST"}.get(route, "GET")
     if rng.random() < 0.08:
         method = rng.choice(["GET", "POST", "HEAD", "PUT", "DELETE", "OPTIONS", "PATCH", "get", "BREW"])
     if route == "other":
-        route = rng.choice(["/api", "/api/", "/API/save", "/api/save/", "/../api/save", "/api/%2e%2e/save",
-                            "//api/save", "/api/save;x", "*", "http://127.0.0.1/api/save", "/" + "a" * 9000,
-                            "/api/save%00", "/favicon.ico"])
+        route = rng.choice(
+            [
+                "/api",
+                "/api/",
+                "/API/save",
+                "/api/save/",
+                "/../api/save",
+                "/api/%2e%2e/save",
+                "//api/save",
+                "/api/save;x",
+                "*",
+                "http://127.0.0.1/api/save",
+                "/" + "a" * 9000,
+                "/api/save%00",
+                "/favicon.ico",
+            ]
+        )
     body: bytes = b""
     mode = rng.choice(["particles", "texture"])
     payload: Any = None
@@ -460,14 +817,26 @@ def _request(cubes_by_mode: dict[str, list[dict]], rng: random.Random) -> bytes:
             cubes = copy.deepcopy(cubes_by_mode["texture" if mode == "particles" else "particles"])
         name = rng.choice(SAVE_NAMES)
         if isinstance(name, str) and rng.random() < 0.6 and route == "/api/save":
-            name = name if name.endswith((".awn", ".awa")) else name + (".awa" if mode == "texture" else ".awn")
+            name = (
+                name if name.endswith((".awn", ".awa")) else name + (".awa" if mode == "texture" else ".awn")
+            )
         payload = {"name": name, "mode": mode, "cubes": cubes}
         if route == "/api/fill":
             if rng.random() < 0.5:
                 payload["seed"] = rng.choice([0, 7, -1, 2**63, 1.5, "1", None, True])
             if rng.random() < 0.5:
-                payload["sun"] = rng.choice([[1, 1, 0], [0, 0, 0], [1e308, 1e308, 1e308], [1, 2], ["a", 1, 1],
-                                             None, [True, 0, 1], [float("1e-320"), 0, 0]])
+                payload["sun"] = rng.choice(
+                    [
+                        [1, 1, 0],
+                        [0, 0, 0],
+                        [1e308, 1e308, 1e308],
+                        [1, 2],
+                        ["a", 1, 1],
+                        None,
+                        [True, 0, 1],
+                        [float("1e-320"), 0, 0],
+                    ]
+                )
         payload = _json_mutant(payload, rng) if rng.random() < 0.7 else payload
     elif route == "/api/open":
         payload = {"name": rng.choice(SAVE_NAMES + ["table_4_4.awn", "sky.awa", "bad.awn", "fifo.awn"])}
@@ -477,8 +846,20 @@ def _request(cubes_by_mode: dict[str, list[dict]], rng: random.Random) -> bytes:
         if roll < 0.08:  # malformed JSON
             text = text[: rng.randrange(len(text) + 1)]
         elif roll < 0.12:
-            text = rng.choice(["", "{", "null", "[]", "1e999", "NaN", '{"name": "\\ud800"}', "\ufeff{}",
-                               "[" * 100_000 + "]" * 100_000, '{"name": ' * 5000])
+            text = rng.choice(
+                [
+                    "",
+                    "{",
+                    "null",
+                    "[]",
+                    "1e999",
+                    "NaN",
+                    '{"name": "\\ud800"}',
+                    "\ufeff{}",
+                    "[" * 100_000 + "]" * 100_000,
+                    '{"name": ' * 5000,
+                ]
+            )
         body = text.encode("utf-8", "surrogatepass")
         if rng.random() < 0.03:  # a big body (the cap is 16 MiB)
             body = b'{"name": "' + b"a" * rng.choice([1 << 20, 4 << 20]) + b'"}'
@@ -492,14 +873,29 @@ def _request(cubes_by_mode: dict[str, list[dict]], rng: random.Random) -> bytes:
     if roll < 0.08:
         token = rng.choice(["", "x", TOKEN + "x", TOKEN[:-1], TOKEN.upper(), "%00", "é", "\udcff"])
     where = rng.choice(["header", "query", "query", "both"])
-    target = route + (f"?token={token}{query}" if where in ("query", "both") else ("?" + query[1:] if query else ""))
+    target = route + (
+        f"?token={token}{query}" if where in ("query", "both") else ("?" + query[1:] if query else "")
+    )
     if rng.random() < 0.02:
         target += "&token=" + rng.choice(["x", TOKEN])
     host = f"127.0.0.1:{PORT}" if rng.random() < 0.5 else f"localhost:{PORT}"
     if rng.random() < 0.08:
-        host = rng.choice(["", "evil.com", f"127.0.0.1:{PORT}.evil.com", "127.0.0.1", f"LOCALHOST:{PORT}",
-                           f"127.0.0.1:{PORT} ", "[::1]:" + PORT, "x" * 5000, f"127.0.0.1:{PORT}\x00"])
-    version = "HTTP/1.1" if rng.random() < 0.97 else rng.choice(["HTTP/1.0", "HTTP/0.9", "HTTP/2.0", "HTTP/x", ""])
+        host = rng.choice(
+            [
+                "",
+                "evil.com",
+                f"127.0.0.1:{PORT}.evil.com",
+                "127.0.0.1",
+                f"LOCALHOST:{PORT}",
+                f"127.0.0.1:{PORT} ",
+                "[::1]:" + PORT,
+                "x" * 5000,
+                f"127.0.0.1:{PORT}\x00",
+            ]
+        )
+    version = (
+        "HTTP/1.1" if rng.random() < 0.97 else rng.choice(["HTTP/1.0", "HTTP/0.9", "HTTP/2.0", "HTTP/x", ""])
+    )
     headers = [f"{method} {target} {version}".strip()]
     if rng.random() > 0.03:
         headers.append(f"Host: {host}")
@@ -510,8 +906,22 @@ def _request(cubes_by_mode: dict[str, list[dict]], rng: random.Random) -> bytes:
     length = str(len(body))
     roll = rng.random()
     if roll < 0.06:
-        length = rng.choice(["-1", "x", "1e3", "99999999999999999999", str((16 << 20) + 1), "+5", " 5", "0x10",
-                             str(len(body) + 10), str(max(0, len(body) - 5)), "٣", ""])
+        length = rng.choice(
+            [
+                "-1",
+                "x",
+                "1e3",
+                "99999999999999999999",
+                str((16 << 20) + 1),
+                "+5",
+                " 5",
+                "0x10",
+                str(len(body) + 10),
+                str(max(0, len(body) - 5)),
+                "٣",
+                "",
+            ]
+        )
     if body or method in ("POST", "PUT") or roll < 0.06:
         if rng.random() < 0.04:
             headers.append("Transfer-Encoding: chunked")
