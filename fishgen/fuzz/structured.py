@@ -101,6 +101,11 @@ TOML_VALUES: list[Any] = [
 HUGE_INT_TOKENS = ["9" * 5000, "-" + "9" * 4301, "1" + "0" * 4300, "0x" + "f" * 1200]
 
 
+MAX_TABLES = 2000
+"""Most entries an array of tables is repeated to: a manifest of 2,000 jobs tests the size, and
+the mutants stay small enough to generate in milliseconds (the generator's time is the case's)."""
+
+
 class RawToken(str):
     """A value written into the TOML text verbatim (numbers TOML parsers choke on)."""
 
@@ -204,7 +209,7 @@ def mutate_doc(doc: dict[str, Any], rng: random.Random, additions: list[tuple[li
             arrays = [k for k, v in doc.items() if isinstance(v, list) and v and isinstance(v[0], dict)]
             if arrays:
                 k = rng.choice(arrays)
-                doc[k] = rng.choice([[], doc[k] * rng.choice([2, 50, 400]), doc[k][:1]])
+                doc[k] = rng.choice([[], (doc[k] * rng.choice([2, 50, 400]))[:MAX_TABLES], doc[k][:1]])
         else:  # a table replaced by a value of another type, or a value by a table
             places = [(p, k) for p, k in places if isinstance(p, dict)]
             if places:
@@ -773,7 +778,8 @@ def _json_mutant(value: Any, rng: random.Random) -> Any:
         elif roll < 0.8 and isinstance(parent, dict):
             del parent[key]
         elif isinstance(parent, list):
-            parent.extend(parent[:1] * rng.choice([1, 10, 1000]))
+            if len(parent) < 5000:  # bounded: the generator's time counts against the case's
+                parent.extend(parent[:1] * rng.choice([1, 10, 1000]))
     return value
 
 
