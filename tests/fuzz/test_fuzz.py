@@ -63,7 +63,8 @@ def test_cases_are_reproducible():
     for target in TARGETS:
         for index in (0, 57, 1234):
             a, b = make_case(seeds, target, 7, index), make_case(seeds, target, 7, index)
-            assert (a.text, a.data, a.files, a.argv, a.requests) == (b.text, b.data, b.files, b.argv, b.requests)
+            assert (a.text, a.data, a.files, a.argv, a.requests) == \
+                (b.text, b.data, b.files, b.argv, b.requests)
 
 
 def test_seed_cases_are_the_corpus_verbatim():
