@@ -8,7 +8,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from fishgen.fuzz.cases import DEFAULT_CORPUS, TARGETS, load_seeds, make_case, run_case
+from fishgen.fuzz.cases import DEFAULT_CORPUS, NEW_TARGETS, TARGETS, load_seeds, make_case, run_case
 from fishgen.fuzz.runner import DEFAULT_BUDGET_MB, Report, run
 
 
@@ -18,7 +18,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--count", type=int, default=None,
                     help="Instead of --minutes: this many inputs per target (the seed corpus first).")
     ap.add_argument("--seed", type=int, default=None, help="Generator seed [default: from the clock].")
-    ap.add_argument("--target", default="all", choices=[*TARGETS, "all", "parsers", "readers"])
+    ap.add_argument("--target", default="all", choices=[*TARGETS, "all", "parsers", "readers", "new"])
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="Worker processes.")
     ap.add_argument("--findings", type=Path, default=Path("out/fuzz-findings"),
                     help="Folder each distinct finding's input is saved in.")
@@ -31,8 +31,8 @@ def main(argv: list[str] | None = None) -> int:
 
     if args.replay:
         return replay(args.replay, args.corpus)
-    targets = {"all": list(TARGETS), "parsers": ["species", "cubes"],
-               "readers": ["gltf", "obj", "ply"]}.get(args.target, [args.target])
+    targets = {"all": list(TARGETS), "parsers": ["species", "cubes"], "readers": ["gltf", "obj", "ply"],
+               "new": list(NEW_TARGETS)}.get(args.target, [args.target])
     seed = args.seed if args.seed is not None else int(time.time())
     if (args.minutes is None) == (args.count is None):
         ap.error("give one of --minutes or --count")

@@ -24,8 +24,11 @@ from typing import Any
 
 from fishgen.fuzz import mutate
 
-TARGETS = ("species", "cubes", "gltf", "obj", "ply", "cli")
+TARGETS = ("species", "cubes", "gltf", "obj", "ply", "cli",
+           "scene", "paths", "manifest", "fxl", "photo", "awa", "editor", "options")
 READERS = ("gltf", "obj", "ply")
+#: Issue 26's targets (the newer commands' inputs).
+NEW_TARGETS = ("scene", "paths", "manifest", "fxl", "photo", "awa", "editor", "options")
 FISHGEN_ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_CORPUS = FISHGEN_ROOT.parent / "tests" / "fuzz" / "corpus"
 
@@ -43,6 +46,7 @@ class Case:
     files: dict[str, bytes | int] = field(default_factory=dict)  # readers/CLI: name -> bytes or sparse size
     main: str = ""                          # readers: the file load_input opens
     argv: list[str] = field(default_factory=list)  # CLI
+    requests: list[bytes] = field(default_factory=list)  # editor: raw HTTP requests, one connection each
 
     def save(self, folder: Path) -> list[Path]:
         """Write this case's input(s) into ``folder`` (made); returns the paths written."""
@@ -60,6 +64,10 @@ class Case:
         if self.argv:
             p = folder / "argv.json"
             p.write_text(json.dumps(self.argv) + "\n")
+            written.append(p)
+        for k, request in enumerate(self.requests):
+            p = folder / f"request-{k}.http"
+            p.write_bytes(request)
             written.append(p)
         return written
 
@@ -86,14 +94,26 @@ class Seeds:
     species: list[str]
     cubes: list[bytes]
     assets: dict[str, list[tuple[str, dict[str, bytes | int]]]]  # target -> [(main, files)]
+    new: dict[str, dict[str, bytes]] = field(default_factory=dict)  # issue 26's: folder -> {name: bytes}
+
+    def texts(self, folder: str, suffix: str) -> list[str]:
+        return [v.decode("utf-8") for k, v in sorted(self.new[folder].items()) if k.endswith(suffix)]
 
     def count(self, target: str) -> int:
         if target == "species":
             return len(self.species)
         if target == "cubes":
             return len(self.cubes)
-        if target == "cli":
+        if target in ("cli", "options", "editor", "photo"):
             return 0
+        if target in ("scene", "manifest"):
+            return len(self.texts(target, ".toml"))
+        if target == "paths":
+            return 1
+        if target == "fxl":
+            return len(self.texts("fxl", ".fxl"))
+        if target == "awa":
+            return 1
         return len(self.assets[target])
 
 
@@ -110,9 +130,11 @@ def load_seeds(corpus: Path = DEFAULT_CORPUS) -> Seeds:
             if len(mains) != 1:
                 raise ValueError(f"{folder}: expected one {'/'.join(exts)} file, found {mains}")
             assets[target].append((mains[0], files))
-    if not species or not cubes or not all(assets.values()):
+    new = {sub: {p.name: p.read_bytes() for p in sorted((corpus / sub).iterdir()) if p.is_file()}
+           for sub in ("scene", "manifest", "fxl", "photo", "awa") if (corpus / sub).is_dir()}
+    if not species or not cubes or not all(assets.values()) or len(new) != 5 or not all(new.values()):
         raise ValueError(f"{corpus}: incomplete seed corpus")
-    return Seeds(species, cubes, assets)
+    return Seeds(species, cubes, assets, new)
 
 
 def case_rng(seed: int, target: str, index: int) -> random.Random:
@@ -139,6 +161,9 @@ def make_case(seeds: Seeds, target: str, seed: int, index: int) -> Case:
         from fishgen.fuzz.cli_gen import cli_case
         files, argv = cli_case(seeds, rng)
         return Case(target, index, files=files, argv=argv)
+    if target in NEW_TARGETS:
+        from fishgen.fuzz.new_cases import make_new_case
+        return make_new_case(seeds, target, rng, index, verbatim)
     raise ValueError(f"unknown target {target!r}")
 
 
@@ -211,6 +236,9 @@ def run_case(case: Case, workdir: Path) -> Outcome:
             return _run_cubes(case)
         if case.target in READERS:
             return _run_reader(case, workdir)
+        if case.target in NEW_TARGETS and case.target not in ("photo", "options"):
+            from fishgen.fuzz.new_cases import run_new_case
+            return run_new_case(case, workdir)
         return _run_cli(case, workdir)
     except CaseTimeout as err:
         return Outcome("finding", f"budget overrun (time) in {case.target} at "
@@ -275,11 +303,15 @@ def _run_cli(case: Case, workdir: Path) -> Outcome:
     code: Any = 0
     os.chdir(folder)
     sys.stdout, sys.stderr = out, err
+    from fishgen.fuzz.new_cases import WouldServe, no_serving
     try:
         try:
-            main(list(case.argv))
+            with no_serving(case.argv):
+                main(list(case.argv))
         except SystemExit as stop:
             code = stop.code if stop.code is not None else 0
+        except WouldServe:  # `fishgen fly` got past its checks: it would serve now
+            code = 0
     finally:
         sys.stdout, sys.stderr = old_out, old_err
         os.chdir(old_cwd)

@@ -134,6 +134,83 @@ def make_corpus(dest: Path = DEFAULT_CORPUS) -> None:
         for name, text in files.items():
             (dest / folder / name).write_text(text)
     (dest / "obj/quad/skin.png").write_bytes(png_bytes(4, 4))
+    add_new_inputs(dest)
+
+
+#: A scene file using every key of issue 24's school (couzin, variety, warm-up, length, bounds) and a
+#: target path read from a CSV.
+FULL_SCENE = """# Every scene key: couzin zones, variety, warm-up, length, bounds, a CSV target path.
+model = "couzin"
+frames = 60
+fps = 30
+seed = 3
+bounds = [[-3.0, -1.0, -3.0], [3.0, 1.0, 3.0]]
+layout = "ring"
+warmup = 1.0
+length = 0.3
+
+[[species]]
+file = "bonybream.txt"
+count = 20
+speed = 3.0
+
+[[species]]
+file = "threadfingoldie.txt"
+count = 10
+
+[target]
+path = "path.csv"
+
+[predator]
+path = "figure8"
+radius = 2.5
+period = 20.0
+centre = [0.0, 0.5, 0.0]
+
+[couzin]
+preset = "dynamic parallel"
+repulsion = 0.75
+blind_angle = 60.0
+neighbours = 20
+
+[variety]
+size = 0.1
+tints = 3
+tint = 0.2
+"""
+PATH_CSV = "t,x,y,z\n0,0,0,0\n1,1,0.2,0\n2,1,0.4,1\n3,0,0.2,1\n4,0,0,0\n"
+
+
+def add_new_inputs(dest: Path) -> None:
+    """The inputs of issue 26's targets: scene files (+ a path CSV), the batch manifest, .FXL
+    files, a small photo, the .awa texture cloud with 8x8 textures."""
+    from PIL import Image
+
+    from fishgen.authoring.photo.fxl import format_fxl
+    from fishgen.species.parser import parse_species
+
+    for sub in ("scene", "manifest", "fxl", "photo", "awa"):
+        if (dest / sub).exists():
+            shutil.rmtree(dest / sub)
+        (dest / sub).mkdir(parents=True)
+    for name in ("reef.toml", "bait-ball.toml"):
+        shutil.copy(PARAMS / name, dest / "scene" / name)
+    (dest / "scene" / "full.toml").write_text(FULL_SCENE)
+    (dest / "scene" / "path.csv").write_text(PATH_CSV)
+    for name in ("bonybream.txt", "threadfingoldie.txt"):   # the species the scene files name
+        shutil.copy(PARAMS / name, dest / "scene" / name)
+    shutil.copy(PARAMS / "assets.toml", dest / "manifest" / "assets.toml")
+    for p in sorted(PARAMS.glob("*.txt")):
+        sp = parse_species(p.read_text(), str(p))
+        if sp.texture_points is not None:
+            (dest / "fxl" / f"{p.stem}.fxl").write_text(format_fxl(sp.texture_points, sp.circle_sections))
+    with Image.open(PARAMS / "photos" / "bonybream-side.png") as im:
+        small = im.resize((160, 80), Image.Resampling.LANCZOS)
+        small.save(dest / "photo" / "bonybream-side.png", optimize=True)
+    shutil.copy(PARAMS / "clouds" / "sky.awa", dest / "awa" / "sky.awa")
+    for name in ("billow", "cumulus", "wisp"):
+        (dest / "awa" / f"{name}.png").write_bytes(png_bytes(8, 8))
+    (dest / "awa" / "small.awn").write_bytes(SMALL_CLOUD)   # the editor's and sky's particle cloud
 
 
 if __name__ == "__main__":

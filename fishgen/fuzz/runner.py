@@ -31,10 +31,14 @@ from fishgen.fuzz.cases import DEFAULT_CORPUS, CaseTimeout, Outcome, load_seeds,
 #: peaks near 1.0 GB; everything a correct run needs fits well inside 1.5 GB.
 DEFAULT_BUDGET_MB = 1536
 #: Seconds one case may take (parsers are ~1 ms, readers ~10 ms, CLI previews ~0.3 s).
-TIME_LIMITS = {"species": 2.0, "cubes": 2.0, "gltf": 5.0, "obj": 5.0, "ply": 5.0, "cli": 20.0}
+TIME_LIMITS = {"species": 2.0, "cubes": 2.0, "gltf": 5.0, "obj": 5.0, "ply": 5.0, "cli": 20.0,
+               "scene": 5.0, "paths": 5.0, "manifest": 5.0, "fxl": 2.0, "photo": 30.0, "awa": 5.0,
+               "editor": 10.0, "options": 20.0}
 #: Extra seconds the parent waits past a case's limit before killing a worker stuck in C code.
 GRACE = 10.0
-BATCH = {"species": 100, "cubes": 200, "gltf": 20, "obj": 10, "ply": 20, "cli": 2}
+BATCH = {"species": 100, "cubes": 200, "gltf": 20, "obj": 10, "ply": 20, "cli": 2,
+         "scene": 50, "paths": 10, "manifest": 50, "fxl": 200, "photo": 1, "awa": 20, "editor": 5,
+         "options": 2}
 
 
 @dataclass
@@ -75,16 +79,29 @@ class Report:
 def _worker(conn, progress, corpus: str, budget: int, workdir: str, quiet: bool = True) -> None:
     # Import everything a case may need before the memory limit, as a long-lived tool would.
     import fishgen.assembly.fish  # noqa: F401
+
+    # issue 26's targets
+    import fishgen.authoring.photo.fxl  # noqa: F401
+    import fishgen.authoring.photo.run  # noqa: F401
+    import fishgen.batch.manifest  # noqa: F401
     import fishgen.cli.adapter  # noqa: F401
     import fishgen.clouds.fill  # noqa: F401
     import fishgen.commands.build  # noqa: F401
     import fishgen.commands.clouds  # noqa: F401
+    import fishgen.commands.fly  # noqa: F401
     import fishgen.commands.preview  # noqa: F401
+    import fishgen.commands.sky  # noqa: F401
+    import fishgen.commands.texture  # noqa: F401
+    import fishgen.editor.session  # noqa: F401
     import fishgen.exchange.gltf_reader  # noqa: F401
     import fishgen.exchange.mesh_reader  # noqa: F401
+    import fishgen.fly.assets  # noqa: F401
+    import fishgen.fly.headless  # noqa: F401
     import fishgen.preview.inputs  # noqa: F401
     import fishgen.scene.pose  # noqa: F401
+    import fishgen.school.scene_file  # noqa: F401
     import fishgen.species.parser  # noqa: F401
+    import fishgen.web.server  # noqa: F401
 
     seeds = load_seeds(Path(corpus))
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles ^C
