@@ -58,7 +58,7 @@ class Numbers(click.ParamType):
         else:
             try:
                 numbers = tuple(float(part) for part in str(value).replace(" ", "").split(","))
-            except ValueError:
+            except (ValueError, OverflowError):
                 numbers = ()
         ok = (len(numbers) == self.count
               and all(_finite_number(v) and self.low <= v <= self.high for v in numbers)
@@ -79,10 +79,14 @@ class Triple(Numbers):
 
 
 class FiniteRange(click.FloatRange):
-    """click's FloatRange, refusing NaN too (it compares false with both bounds, so it passes them)."""
+    """click's FloatRange, refusing NaN too (it compares false with both bounds, so it passes them),
+    and an integer too big for a float (a TOML integer of 400 digits) as out of range."""
 
     def convert(self, value, param, ctx):
-        number = super().convert(value, param, ctx)
+        try:
+            number = super().convert(value, param, ctx)
+        except OverflowError:
+            self.fail(f"{str(value)[:20]}... is not a number a float can hold.", param, ctx)
         if not math.isfinite(number):
             self.fail(f"{value!r} is not a finite number.", param, ctx)
         return number
@@ -136,10 +140,10 @@ class Lods(click.ParamType):
 
     name = "BxC,..."
 
-    def __init__(self, most: int = 8, high: int = 1024):
-        self.most, self.high = most, high
+    def __init__(self, most: int = 8, high: int = 1024, points: int = 65_536):
+        self.most, self.high, self.points = most, high, points
         self.what = (f"levels BODIESxCIRCLES from finest to coarsest (e.g. 32x24,16x12,8x6): at most {most}, "
-                     f"each count 3 to {high}")
+                     f"each count 3 to {high}, BODIES x CIRCLES at most {points:,}")
 
     def convert(self, value, param, ctx):
         import re
@@ -150,7 +154,8 @@ class Lods(click.ParamType):
         levels = []
         for part in parts:
             m = re.fullmatch(r"(\d{1,5})\s*[xX×]\s*(\d{1,5})", part)
-            if not m or not all(3 <= int(v) <= self.high for v in m.groups()):
+            if (not m or not all(3 <= int(v) <= self.high for v in m.groups())
+                    or int(m[1]) * int(m[2]) > self.points):  # 1000x1000 took 14 s and 1 GB
                 self.fail(f"expected {self.what}, found {value!r}", param, ctx)
             levels.append((int(m[1]), int(m[2])))
         if not 1 <= len(levels) <= self.most or any(
@@ -178,7 +183,9 @@ class Names(click.ParamType):
 
 
 def _finite_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    return isinstance(value, int) or math.isfinite(value)  # an int of any size is finite; isfinite overflows
 
 
 SEED = click.IntRange(0, SEED_MAX)

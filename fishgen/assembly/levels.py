@@ -35,14 +35,14 @@ def at_level(species: Species, bodies: int, circles: int) -> Species:
     def circ(k: int) -> int:
         return _nearest(k * circles / c0) % circles
 
-    def vertical(f: VerticalFin) -> VerticalFin:
-        start, end = sec(f.start_section), sec(f.end_section)
-        return replace(f, start_section=start, end_section=max(end, min(start + 1, bodies - 1)))
+    def vertical(f: VerticalFin) -> VerticalFin:  # a fin spans at least one section's length
+        start = min(sec(f.start_section), bodies - 2)
+        return replace(f, start_section=start, end_section=max(sec(f.end_section), start + 1))
 
     p: PelvicFin = species.pelvic
-    ps = sec(p.start_section)
+    ps = min(sec(p.start_section), bodies - 2)
     pelvic = replace(p, start_circle=circ(p.start_circle), start_section=ps,
-                     end_section=max(sec(p.end_section), min(ps + 1, bodies - 1)))
+                     end_section=max(sec(p.end_section), ps + 1))
     q: PectoralFin = species.pectoral
     # the same arc of the ring: triangles span CircleSections
     pectoral = replace(q, start_section=sec(q.start_section), start_circle=circ(q.start_circle),

@@ -24,8 +24,8 @@ def click_command(cmd: Command) -> click.Command:
     params: list[click.Parameter] = []
     if cmd.inputs is not None:
         kind = click.Path(path_type=Path, exists=cmd.inputs.must_exist) if cmd.inputs.path else None
-        params.append(click.Argument(["inputs"], nargs=-1 if cmd.inputs.many else 1, required=True, type=kind,
-                                     metavar=cmd.inputs.metavar))
+        params.append(click.Argument(["inputs"], nargs=-1 if cmd.inputs.many else 1,
+                                     required=cmd.inputs.required, type=kind, metavar=cmd.inputs.metavar))
     if cmd.output is not None:
         shown = f"  [default: {cmd.output.shown_default}]" if cmd.output.shown_default else ""
         # a str, not a Path: `-o out/` keeps the slash that makes it a folder

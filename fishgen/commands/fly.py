@@ -78,7 +78,7 @@ COMMAND = Command(
     """,
     options=FlyOptions,
     run="fishgen.commands.fly:fly",
-    inputs=Inputs("[INPUT]..."),
+    inputs=Inputs("[INPUT]...", required=False),
 )
 
 

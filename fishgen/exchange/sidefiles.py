@@ -18,6 +18,16 @@ _SCHEME = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:")
 """``http:``, ``file:``, ``C:`` ... - anything but a plain relative path."""
 
 
+NAME_MAX = 255
+"""Bytes a file name's every part may have (Linux's NAME_MAX); a longer one is an OSError to ask about."""
+
+
+def too_long(name: str) -> bool:
+    """Whether a relative file name has a part longer than the file system allows."""
+    parts = name.replace("\\", "/").split("/")
+    return any(len(part.encode("utf-8", "surrogateescape")) > NAME_MAX for part in parts)
+
+
 def side_file(asset: str | Path, ref: str, *, uri: bool = False, must_exist: bool = False) -> Path:
     """The file ``ref`` (as written inside ``asset``) names, checked to lie in the asset's folder.
 
@@ -35,6 +45,9 @@ def side_file(asset: str | Path, ref: str, *, uri: bool = False, must_exist: boo
         name = unquote(name)  # glTF URIs are percent-encoded ("my%20skin.png")
         if "\0" in name or name.startswith("/"):
             raise expected("a relative file name inside the asset's folder", describe(ref), asset)
+    if too_long(name):
+        raise expected(f"a file name of at most {NAME_MAX} bytes a part", f"{describe(ref)} "
+                       f"({len(name.encode('utf-8', 'surrogateescape')):,} bytes)", asset)
     folder = asset.parent.resolve()
     try:
         target = (folder / name).resolve()  # follows symlinks: a link out of the folder is refused

@@ -13,6 +13,7 @@ The framebuffer holds premultiplied alpha, so a transparent background works.
 """
 from __future__ import annotations
 
+import weakref
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -214,16 +215,18 @@ class Renderer:
         self.point_prog: Any = self.ctx.program(vertex_shader=POINT_VS, fragment_shader=POINT_FS)
         corners = np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32)
         self.corner_buf = self.ctx.buffer(corners.tobytes())
-        self._uploaded: dict[int, tuple[Poser, list[_GpuMesh]]] = {}
-        self._textures: dict[tuple[int, int], Any] = {}
-        self._points: dict[int, list[tuple[int, Primitive]]] = {}
+        # Caches by id(scene), each entry holding a weak reference to its scene: a scene freed and
+        # another made at the same address must not find the first one's buffers (it drew the old cloud).
+        self._uploaded: dict[int, tuple[weakref.ref, Poser, list[_GpuMesh]]] = {}
+        self._textures: dict[tuple[int, int], tuple[weakref.ref, Any]] = {}
+        self._points: dict[int, tuple[weakref.ref, list[tuple[int, Primitive]]]] = {}
 
     # -- uploads -------------------------------------------------------------
     def _texture(self, scene: Scene, index: int) -> Any:
         import moderngl
 
         key = (id(scene), index)
-        if key not in self._textures:
+        if key not in self._textures or self._textures[key][0]() is not scene:
             try:
                 img = np.ascontiguousarray(scene.images[index].rgba())
             except Exception as err:  # Pillow raises anything from OSError to SyntaxError
@@ -237,13 +240,14 @@ class Renderer:
             # No anisotropic filtering: llvmpipe's takes ~0.5 s a frame on fins seen edge-on in a tiny
             # image (a 32x32 front-view loop ran 31 s instead of 1 s); trilinear mipmaps suffice here.
             tex.anisotropy = 1.0
-            self._textures[key] = tex
-        return self._textures[key]
+            self._textures[key] = (weakref.ref(scene), tex)
+        return self._textures[key][1]
 
     def _upload(self, scene: Scene, clip: str | None) -> tuple[Poser, list[_GpuMesh]]:
         key = id(scene)
-        if key in self._uploaded and self._uploaded[key][0].active is scene.clip(clip):
-            return self._uploaded[key]
+        held = self._uploaded.get(key)
+        if held is not None and held[0]() is scene and held[1].active is scene.clip(clip):
+            return held[1], held[2]
         out: list[_GpuMesh] = []
         poser = poser_for(scene, clip)
         for index, batch in enumerate(poser.batches):
@@ -261,8 +265,8 @@ class Renderer:
             tex = self._texture(scene, material.texture) if material.texture is not None else None
             out.append(_GpuMesh(index, batch, material, vbo, static, ibo, vao, tex,
                                 np.asarray(prim.positions, float).mean(0), batch.base_nrm is None))
-        self._uploaded[key] = (poser, out)
-        return self._uploaded[key]
+        self._uploaded[key] = (weakref.ref(scene), poser, out)
+        return poser, out
 
     @staticmethod
     def _static_data(prim: Primitive) -> np.ndarray:
@@ -405,10 +409,12 @@ class Renderer:
         import moderngl
 
         parts = []
-        if id(scene) not in self._points:  # drawn() walks every node: once per scene, not per frame
-            self._points[id(scene)] = [(node, prim) for node, prim in scene.drawn()
-                                       if prim.mode == "POINTS" and prim.vertex_count]
-        for node, prim in self._points[id(scene)]:
+        held = self._points.get(id(scene))
+        if held is None or held[0]() is not scene:  # drawn() walks every node: once a scene, not a frame
+            drawn = [(node, prim) for node, prim in scene.drawn()
+                     if prim.mode == "POINTS" and prim.vertex_count]
+            self._points[id(scene)] = held = (weakref.ref(scene), drawn)
+        for node, prim in held[1]:
             c, r, col = particles(scene, node, prim, posed)
             parts.append((c, r, col, _light(prim)))
         if not parts:

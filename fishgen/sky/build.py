@@ -72,6 +72,11 @@ def build_sky(mode: str = "medium", *, seed: int = 0, area: tuple[float, float] 
     if total > max_particles:
         raise FishgenError(f"expected at most {max_particles:,} particles (raise --max-particles), found "
                            f"{total:,} for a {mode} sky")
+    # every cloud needs a particle in each of its model's cubes: fewer leaves clouds empty
+    need = sky_mode.clouds * max(sum(1 for c in f.cubes if c.particles) for f in cubes)
+    if total < need:
+        raise FishgenError(f"expected at least {need:,} particles for a {mode} sky of {sky_mode.clouds} "
+                           f"clouds (one in each cube of every cloud), found {total:,}")
     plan = plan_sky(sky_mode, cubes, seed=seed, area=area, altitude=altitude, particles=total)
     clouds = light_sky(fill_sky(plan, cubes, noise=noise), lighting or Lighting(), method=shadow_map)
     scene, facts = sky_scene(plan, clouds, [p.name for p in files], billboards=billboards, lod=lod)

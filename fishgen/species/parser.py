@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, describe
 from fishgen.shape_names import SHAPE_NAMES, check_shape_params
 from fishgen.species.model import (
     Behaviour,
@@ -440,7 +440,12 @@ def texture_roots(species_path: Path, textures_dir: str | os.PathLike | None) ->
 
 def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> Path:
     """Resolve a texture name inside one of ``roots``; never outside them."""
+    from fishgen.exchange.sidefiles import NAME_MAX, too_long
+
     shown = " or ".join(str(r) for r in roots)
+    if too_long(name):
+        raise FishgenError(f"expected a texture file name of at most {NAME_MAX} bytes a part, found "
+                           f"{describe(name)}", file, line)
     escaped = False
     for root in roots:
         candidate = (root / name).resolve()

@@ -50,3 +50,16 @@ def test_a_good_report_is_received_a_bad_one_refused(session):
     status, _ = ask(session, "POST", "/report", json.dumps(page_report()).encode())
     assert status == 200 and session.received.is_set() and session.report["frames"] == 40
     assert session.got == [session.report]
+
+
+def test_mode_alone_needs_no_input_and_neither_is_one_line():
+    """`fishgen fly --mode thick` (the README's first example) takes no INPUT; nothing at all is a
+    usage error naming both."""
+    from tests.conftest import run_cli
+
+    none = run_cli("fly")
+    assert none.returncode == 2 and "expected INPUT... (cube files, .awa, .glb) or --mode" in none.stderr
+    assert "Missing argument" not in none.stderr
+    from fishgen.commands import command
+
+    assert command("fly").inputs.required is False
