@@ -31,7 +31,8 @@ Done = Callable[[Job, Result], bool]
 # job of each kind imports nothing more of fishgen, numpy, Pillow or scipy.
 _PILLOW = ["PIL.Image", "PIL.ImageOps", "PIL.PngImagePlugin", "PIL.JpegImagePlugin", "PIL.BmpImagePlugin",
            "PIL.GifImagePlugin", "PIL.PpmImagePlugin"]
-_FISH = ["fishgen.assembly.fish", "fishgen.assembly.materials", "fishgen.species.parser", *_PILLOW]
+_FISH = ["fishgen.assembly.fish", "fishgen.assembly.materials", "fishgen.species.parser",
+         "fishgen.exchange.sidefiles", *_PILLOW]
 PRELOAD = {"build": _FISH,
            "school": [*_FISH, "fishgen.school.run", "fishgen.school.simulate", "fishgen.school.bake",
                       "fishgen.school.scene_file", "fishgen.school.memory", "fishgen.school.behaviour.boids",
