@@ -184,3 +184,16 @@ def test_the_coarsest_body_sections_still_give_fins_two_sections_each(tmp_path, 
     built = run_cli("build", out, "-o", tmp_path / "coarse.glb")
     assert built.returncode == 0, built.stderr
     assert_valid_gltf(tmp_path / "coarse.glb")
+
+
+def test_an_outline_too_thin_to_place_a_fin_is_one_line(tmp_path):
+    """A 2000 x 64 photo at 3 body sections left the fins' places NaN: a traceback in _grown (fuzz
+    finding photo:15:221, issue 26)."""
+    from tests.conftest import ROOT
+
+    folder = ROOT / "tests" / "fixtures" / "thin_photo"
+    r = run_cli("texture", folder / "photo.png", "-s", folder / "base.txt", "-o", tmp_path / "new.txt",
+                "--body-sections", "3", "--circle-sections", "12")
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert "photo.png: expected a fish whose outline places its" in r.stderr
+    assert not (tmp_path / "new.txt").exists()

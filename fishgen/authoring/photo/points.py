@@ -15,6 +15,7 @@ from scipy import ndimage  # type: ignore[import-untyped]
 
 from fishgen.authoring.photo.anatomy import BodyOutline
 from fishgen.authoring.photo.sideview import SideView, circle_sines
+from fishgen.errors import FishgenError
 
 SPACINGS = ("projected", "even")
 #: A fin counts as seen when the photo shows fin pixels over this share of its expected area.
@@ -82,6 +83,9 @@ def fin_points(name: str, fin_xy: np.ndarray, faces: np.ndarray, outline: BodyOu
     """One fin's texture points; ``body`` is the body's region in the frame (bool mask). Fin
     pixels count up to ``search`` x the fin's size beyond where the base species puts it."""
     pts = thesis_to_frame(outline, view, fin_xy)
+    if not np.isfinite(pts).all():  # an outline too thin to measure (a 2000 x 64 photo at 3 sections)
+        raise FishgenError(f"expected a fish whose outline places its {name} fin, found an outline too "
+                           "thin to measure (a taller photo, or more --body-sections)")
     if name == "pectoral":  # it lies over the flank in a side view: what is there is its texture
         return FinResult(pts, True, 1.0)
     expected = _raster(pts, faces, mask.shape)
