@@ -197,3 +197,15 @@ def test_an_outline_too_thin_to_place_a_fin_is_one_line(tmp_path):
     assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
     assert "photo.png: expected a fish whose outline places its" in r.stderr
     assert not (tmp_path / "new.txt").exists()
+
+
+def test_more_body_sections_than_the_photo_has_pixels_are_refused_at_once(tmp_path):
+    """--body-sections 256 on a fish 64 px long took 31 s with --fit-shape (fuzz finding photo:13:239):
+    two pixels a section at most, said before any work."""
+    from tests.conftest import ROOT
+
+    folder = ROOT / "tests" / "fixtures" / "small_photo"
+    r = run_cli("texture", folder / "photo.png", "-s", folder / "base.txt", "-o", tmp_path / "new.txt",
+                "--body-sections", "256", "--fit-shape")
+    assert r.returncode == 2 and "expected --body-sections of at most 32 for a fish 64 px long" in r.stderr
+    assert not (tmp_path / "new.txt").exists()

@@ -227,6 +227,12 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     # and a 64-megapixel photo would otherwise need gigabytes.
     photo = working_copy(original, MEASURE_SIDE)
     sil = silhouette(photo, options.mask, original.size)
+    span = int(sil.mask.any(axis=0).sum())  # the fish's length in the working copy's pixels
+    if options.body_sections is not None and options.body_sections > max(3, span // 2):
+        # more sections than the photo has pixels measures nothing, and --fit-shape took 31 s at 256
+        raise FishgenError(f"expected --body-sections of at most {max(3, span // 2)} for a fish {span} px "
+                           f"long in the photo (two pixels a section), found {options.body_sections}",
+                           photo_path)
     base = with_counts(base, options.body_sections, options.circle_sections)
     imported = fxl.read_fxl(options.fxl_in) if options.fxl_in is not None else {}
     textures = texture_bytes(original, photo, sil.mask)
