@@ -398,6 +398,18 @@ def fins_option(shown_default: str) -> Any:
                   "opaque.", shown_default=shown_default)
 
 
+def lods_option() -> Any:
+    return option(Lods(), "Levels of detail, BodySections x CircleSections from finest to coarsest: one glTF "
+                  "holds them all (MSFT_lod on the finest, screen-coverage switch points; clients without "
+                  "levels of detail show the finest).", shown_default="the species file's own level",
+                  metavar="BxC,...")
+
+
+def merge_option() -> Any:
+    return option(click.BOOL, "One skinned mesh of two primitives (opaque body, fins): two draw calls a fish "
+                  "instead of one per part; fins swing on joints.", False, flag=True)
+
+
 def compact_option() -> Any:
     return option(click.BOOL, "Rotation keys and morph weights as normalized 16-bit integers "
                   "(core glTF 2.0), about half their size.", False, flag=True)

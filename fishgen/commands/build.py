@@ -14,10 +14,11 @@ from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output, each_
 from fishgen.exchange.registry import MESHES, extensions, formats
 from fishgen.options import (
     FiniteRange,
-    Lods,
     Names,
     compact_option,
     fins_option,
+    lods_option,
+    merge_option,
     option,
     swim_option,
     textures_option,
@@ -42,12 +43,8 @@ class BuildOptions:
                           "second; the tail beats at Strouhal number 0.3, rounded to a whole number of beats "
                           "in the loop.", DEFAULT_SPEED, metavar="BL/S")
     textures: Path | None = textures_option("the species file's folder, then the textures/ folder beside it")
-    lods: tuple[tuple[int, int], ...] | None = option(
-        Lods(), "Levels of detail, BodySections x CircleSections from finest to coarsest: one glTF holds "
-        "them all (MSFT_lod on the finest, screen-coverage switch points; clients without levels of detail "
-        "show the finest).", shown_default="the species file's own level", metavar="BxC,...")
-    merge: bool = option(click.BOOL, "One skinned mesh of two primitives (opaque body, fins): two draw calls "
-                         "a fish instead of one per part; fins swing on joints.", False, flag=True)
+    lods: tuple[tuple[int, int], ...] | None = lods_option()
+    merge: bool = merge_option()
     clips: tuple[str, ...] = option(Names(CLIP_NAMES), "Clips to write, each looping but burst: "
                                     f"{', '.join(CLIP_NAMES)}.", DEFAULT_CLIPS, metavar="NAME,...")
     compact: bool = compact_option()

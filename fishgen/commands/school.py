@@ -15,6 +15,8 @@ from fishgen.options import (
     compact_option,
     declare,
     fins_option,
+    lods_option,
+    merge_option,
     option,
     swim_option,
     textures_option,
@@ -75,6 +77,8 @@ class SchoolOptions:
                             "fins: rigid bodies, only the fins move.")
     textures: Path | None = textures_option("as `fishgen build` resolves them")
     compact: bool = compact_option()
+    lods: tuple[tuple[int, int], ...] | None = lods_option()
+    merge: bool = merge_option()
 
 
 COMMAND = Command(
@@ -141,6 +145,9 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         scene = load_scene_file(scene_files[0])
     else:
         scene = SceneFile(species=tuple(SpeciesEntry(p) for p in inputs))
+    if (options.lods or options.merge) and (options.tints or 1) > 1:
+        raise UsageError("expected --tints 1 with --lods or --merge (colour variants copy the part meshes), "
+                         f"found --tints {options.tints}")
     if options.preset is not None and options.model not in (None, "couzin"):
         raise UsageError(f"expected --preset with the couzin model, found --model {options.model}")
     variety = {key: value for key, value in (("size", options.size_variety), ("tints", options.tints),
@@ -157,7 +164,8 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
 
     with events.progress("simulating", scene.frames) as bar:
         run = run_school(scene, fins=options.fins, swim=options.swim, tolerance=options.tolerance,
-                         textures_dir=options.textures, progress=bar.update)
+                         textures_dir=options.textures, progress=bar.update, lods=options.lods,
+                         merge=options.merge)
     if options.compact:
         from fishgen.assembly.compact import compact_clips
 

@@ -245,3 +245,59 @@ def _wave_phases(fish_scenes: list[Scene], tracks: Tracks, lengths: np.ndarray,
             members = np.asarray(tracks.group) == g
             frequency[:, members] = wave.frequency(speed[:, members])
     return integrate_phase(frequency, dt, start)
+
+
+def bake_instanced(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, seed: int = 0,
+                   body_lengths: np.ndarray | None = None, wave: BodyWave | None = None) -> Scene:
+    """:func:`bake` for fish built with levels of detail or as one skinned mesh (``fishgen build
+    --lods/--merge``): every fish is a copy of its species' node tree (its levels, their MSFT_lod
+    ids, its own skin in the merged layout) over the species' shared meshes
+    (:mod:`fishgen.assembly.instance`). The same keys as :func:`bake`: roots thinned to the
+    tolerance, the wave's phase integrated at each fish's speed, fin swings phase-shifted."""
+    from fishgen.assembly.instance import add_fish, add_species, pad_weights
+
+    school = Scene(name="school")
+    templates = [add_species(school, fish) for fish in fish_scenes]
+    times = np.asarray(tracks.times, np.float64)
+    duration = float(times[-1]) if len(times) else 0.0
+    rng = np.random.default_rng(seed)
+    reach = np.ones(len(tracks.group)) if body_lengths is None else np.asarray(body_lengths, np.float64)
+    position_keys = reduce_keys(tracks.positions, tolerance)
+    rotation_keys = reduce_keys(tracks.headings * reach[None, :, None], tolerance)
+    phases = _wave_phases(fish_scenes, tracks, reach, rng, wave or BodyWave())
+    weights_all = (None if phases is None or duration <= 0
+                   else wave_weights(np.ascontiguousarray(phases.T)).astype(np.float32))
+    times32 = times.astype(np.float32)
+    channels: list[Channel] = []
+    fin_samplers: dict[tuple[int, int, int], Sampler] = {}
+    for i, group in enumerate(np.asarray(tracks.group)):
+        made = add_fish(school, templates[group], f"{fish_scenes[group].name}_{i:05d}")
+        size = float(tracks.scale[i])
+        x, y, z = (float(v) for v in tracks.positions[0, i])
+        qx, qy, qz, qw = (float(v) for v in tracks.headings[0, i])
+        for m in made.movers:
+            school.nodes[m] = replace(school.nodes[m], translation=(x, y, z), rotation=(qx, qy, qz, qw),
+                                      scale=(size, size, size))
+        k = position_keys[i]
+        move = Sampler(times32[k], tracks.positions[k, i].astype(np.float32))
+        k = rotation_keys[i]
+        turn = Sampler(times32[k], tracks.headings[k, i].astype(np.float32))
+        for m in made.movers:
+            channels += [Channel(m, "translation", move), Channel(m, "rotation", turn)]
+        phase = int(rng.integers(FIN_PHASES))
+        weights = (None if weights_all is None
+                   else Sampler(times32, pad_weights(weights_all[i], templates[group].targets)))
+        swings = dict(made.fins)
+        swim = fish_scenes[group].clip("swim")
+        for node in sorted(set(made.waving) | set(swings)):
+            if node in made.waving and weights is not None:
+                channels.append(Channel(node, "weights", weights))
+            if node in swings and swim is not None and duration > 0:
+                key = (int(group), id(swings[node]), phase)
+                if key not in fin_samplers:
+                    t, v = _fin_keys(swings[node], swim.duration * phase / FIN_PHASES, duration)
+                    fin_samplers[key] = Sampler(t.astype(np.float32), v.astype(np.float32))
+                channels.append(Channel(node, "rotation", fin_samplers[key]))
+    if duration > 0:
+        school.clips.append(Clip("school", channels))
+    return school

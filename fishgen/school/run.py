@@ -91,26 +91,33 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
                textures_dir: str | os.PathLike | None = None,
                progress: Callable[[int], None] | None = None,
                couzin: CouzinParams | None = None, variety: Variety | None = None,
-               warmup: float | None = None, length: float | None = None) -> SchoolRun:
+               warmup: float | None = None, length: float | None = None,
+               lods: tuple[tuple[int, int], ...] | None = None, merge: bool = False) -> SchoolRun:
     """Build each species once, simulate the school, and bake it into one scene.
 
     `couzin`, `variety` and `warmup` (seconds) default to the scene file's (its `couzin`,
     `variety` and `warmup` members when it has them), else CouzinParams(), Variety() and the
     default warm-up. `length`: every species' nose-to-tail length in metres (default: each
-    species file's own)."""
-    from fishgen.school.bake import bake
+    species file's own). `lods`, `merge`: each species built as `fishgen build --lods/--merge`
+    builds it, every fish a copy of its node tree over shared meshes (no colour variants then)."""
+    from fishgen.school.bake import bake, bake_instanced
     from fishgen.school.simulate import simulate
 
     variety = _given(variety, scene_file, "variety", Variety())
     warmup = _given(warmup, scene_file, "warmup", None)
     length = _given(length, scene_file, "length", None)
     config, fishes, read = plan_school(scene_file, fins=fins, swim=swim, textures_dir=textures_dir,
-                                       couzin=couzin, variety=variety, length=length)
+                                       couzin=couzin, variety=variety, length=length, lods=lods,
+                                       merge=merge)
     tracks = simulate(config, progress=progress)
     groups = config.groups
     lengths = np.array([groups[g].body_length for g in tracks.group]) * tracks.scale
-    scene = bake(fishes, tracks, tolerance=tolerance, seed=scene_file.seed, body_lengths=lengths,
-                 tints=variety.tints, tint=variety.tint)
+    if lods or merge:
+        scene = bake_instanced(fishes, tracks, tolerance=tolerance, seed=scene_file.seed,
+                               body_lengths=lengths)
+    else:
+        scene = bake(fishes, tracks, tolerance=tolerance, seed=scene_file.seed, body_lengths=lengths,
+                     tints=variety.tints, tint=variety.tint)
     settle = warmup_frames(config.frames, config.fps, warmup)
     scene.extras[EXTRAS_KEY] = {"warmup": round(settle / config.fps, 6), "model": config.model,
                                 "fps": config.fps, "frames": config.frames}
@@ -120,7 +127,8 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
 def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "body",
                 textures_dir: str | os.PathLike | None = None, couzin: CouzinParams | None = None,
                 variety: Variety | None = None,
-                length: float | None = None) -> tuple[SchoolConfig, list[Scene], tuple[Path, ...]]:
+                length: float | None = None, lods: tuple[tuple[int, int], ...] | None = None,
+                merge: bool = False) -> tuple[SchoolConfig, list[Scene], tuple[Path, ...]]:
     """What run_school simulates, each species built once (as `fishgen build` builds it), and
     the files that took (species files and the textures they name)."""
     from fishgen.assembly.fish import make_fish
@@ -134,7 +142,8 @@ def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "
     for entry in scene_file.species:
         species = load_species(entry.file, textures_dir)
         read += [Path(entry.file), *species.side_files]
-        fish = make_fish(species, fins=fins, fps=scene_file.fps, swim=swim, speed=entry.speed, length=length)
+        fish = make_fish(species, fins=fins, fps=scene_file.fps, swim=swim, speed=entry.speed, length=length,
+                         lods=lods, merge=merge)
         units = species.world_scale * species.scale[0]
         fishes.append(fish.scene)
         groups.append(Group(Path(entry.file).stem, entry.count, fish.facts.body_length, entry.speed,

@@ -167,3 +167,22 @@ def test_the_memory_estimate_is_above_what_a_run_peaks_at():
                 (2_000, 2_000): 1134, (5_000, 300): 910}
     for (fish, frames), mib in measured.items():
         assert mib * 2**20 < estimate(fish, frames) < 1.4 * mib * 2**20
+
+
+def test_lods_and_merge_give_every_fish_the_engine_layout_over_shared_meshes(tmp_path):
+    """`fishgen school --lods ... --merge` (issue 24): each fish is its species' node tree, its
+    levels tied by MSFT_lod, two draw calls a fish, the meshes shared by every fish."""
+    out = tmp_path / "school.glb"
+    result = run_cli("school", PARAMS / "bonybream.txt", "--count", "6", "--frames", "30", "--lods", "16x12,8x6",
+                     "--merge", "-o", out)
+    assert result.returncode == 0, result.stderr
+    assert_valid_gltf(out)
+    doc = pygltflib.GLTF2().load(str(out))
+    assert len(doc.meshes) == 2 and len(doc.scenes) == 2                  # one mesh a level, levels apart
+    drawn = [n for n in doc.nodes if n.mesh is not None]
+    lod0 = [n for n in drawn if (n.extensions or {}).get("MSFT_lod")]
+    assert len(lod0) == 6 and all(len(n.extensions["MSFT_lod"]["ids"]) == 1 for n in lod0)
+    assert sum(len(doc.meshes[n.mesh].primitives) for n in lod0) == 6 * 2     # two draw calls a fish
+    assert len(doc.skins) == 6 * 2                                         # each fish its own joints per level
+    refused = run_cli("school", PARAMS / "bonybream.txt", "--merge", "--tints", "3", "-o", out)
+    assert refused.returncode == 2 and "expected --tints 1 with --lods or --merge" in refused.stderr
