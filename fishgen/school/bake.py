@@ -15,7 +15,7 @@ fish that speeds up beats faster without a jump.
 """
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -135,18 +135,9 @@ def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, 
     wears = (np.random.default_rng((seed, TINT_STREAM)).integers(0, tints, len(tracks.group))
              if tints > 1 else np.zeros(len(tracks.group), np.int64))
     swims = [fish.clip("swim") for fish in fish_scenes]
-    times = np.asarray(tracks.times, np.float64)
-    duration = float(times[-1]) if len(times) else 0.0
-    rng = np.random.default_rng(seed)
-    # A rotation error of e radians moves a point one body length away by about e body lengths.
-    reach = np.ones(len(tracks.group)) if body_lengths is None else np.asarray(body_lengths, np.float64)
-    position_keys = reduce_keys(tracks.positions, tolerance)
-    rotation_keys = reduce_keys(tracks.headings * reach[None, :, None], tolerance)
-    phases = _wave_phases(fish_scenes, tracks, reach, rng, wave or BodyWave())
-    # every fish's four target weights at once, fish-major: one contiguous (F, 4) block per fish
-    weights_all = (None if phases is None or duration <= 0
-                   else wave_weights(np.ascontiguousarray(phases.T)).astype(np.float32))
-    times32 = times.astype(np.float32)
+    plan = _school_keys(fish_scenes, tracks, tolerance, seed, body_lengths, wave)
+    duration, rng, times32 = plan.duration, plan.rng, plan.times32
+    position_keys, rotation_keys, weights_all = plan.positions, plan.rotations, plan.weights
     # fish-major float32 copies: each fish's keys are then gathered from one contiguous block
     positions32 = np.ascontiguousarray(np.asarray(tracks.positions).transpose(1, 0, 2), np.float32)
     headings32 = np.ascontiguousarray(np.asarray(tracks.headings).transpose(1, 0, 2), np.float32)
@@ -258,16 +249,9 @@ def bake_instanced(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float
 
     school = Scene(name="school")
     templates = [add_species(school, fish) for fish in fish_scenes]
-    times = np.asarray(tracks.times, np.float64)
-    duration = float(times[-1]) if len(times) else 0.0
-    rng = np.random.default_rng(seed)
-    reach = np.ones(len(tracks.group)) if body_lengths is None else np.asarray(body_lengths, np.float64)
-    position_keys = reduce_keys(tracks.positions, tolerance)
-    rotation_keys = reduce_keys(tracks.headings * reach[None, :, None], tolerance)
-    phases = _wave_phases(fish_scenes, tracks, reach, rng, wave or BodyWave())
-    weights_all = (None if phases is None or duration <= 0
-                   else wave_weights(np.ascontiguousarray(phases.T)).astype(np.float32))
-    times32 = times.astype(np.float32)
+    plan = _school_keys(fish_scenes, tracks, tolerance, seed, body_lengths, wave)
+    duration, rng, times32 = plan.duration, plan.rng, plan.times32
+    position_keys, rotation_keys, weights_all = plan.positions, plan.rotations, plan.weights
     channels: list[Channel] = []
     fin_samplers: dict[tuple[int, int, int], Sampler] = {}
     for i, group in enumerate(np.asarray(tracks.group)):
@@ -301,3 +285,31 @@ def bake_instanced(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float
     if duration > 0:
         school.clips.append(Clip("school", channels))
     return school
+
+
+@dataclass
+class _Keys:
+    """What both bakes key every fish from."""
+
+    times32: np.ndarray
+    duration: float
+    rng: np.random.Generator          # after the wave phases' draws: the fin phases come next
+    positions: list[np.ndarray]       # per fish, the frames its translation keeps
+    rotations: list[np.ndarray]       # per fish, the frames its rotation keeps
+    weights: np.ndarray | None        # (fish, frames, 4) wave weights, or None without a wave
+
+
+def _school_keys(fish_scenes: list[Scene], tracks: Tracks, tolerance: float, seed: int,
+                 body_lengths: np.ndarray | None, wave: BodyWave | None) -> _Keys:
+    times = np.asarray(tracks.times, np.float64)
+    duration = float(times[-1]) if len(times) else 0.0
+    rng = np.random.default_rng(seed)
+    # A rotation error of e radians moves a point one body length away by about e body lengths.
+    reach = np.ones(len(tracks.group)) if body_lengths is None else np.asarray(body_lengths, np.float64)
+    position_keys = reduce_keys(tracks.positions, tolerance)
+    rotation_keys = reduce_keys(tracks.headings * reach[None, :, None], tolerance)
+    phases = _wave_phases(fish_scenes, tracks, reach, rng, wave or BodyWave())
+    # every fish's four target weights at once, fish-major: one contiguous (F, 4) block per fish
+    weights = (None if phases is None or duration <= 0
+               else wave_weights(np.ascontiguousarray(phases.T)).astype(np.float32))
+    return _Keys(times.astype(np.float32), duration, rng, position_keys, rotation_keys, weights)
