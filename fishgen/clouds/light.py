@@ -67,6 +67,7 @@ CHUNK = 1 << 16
 PEAK_LEVELS = 16384
 
 _F32 = np.float32
+_RECORD = np.dtype([("x", _F32), ("y", _F32), ("mass", _F32), ("class", _F32)])
 _LEVELS = np.arange(PEAK_LEVELS + 1, dtype=np.float64)
 
 
@@ -124,20 +125,24 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     else:
         count = min(n, SLABS, max(FEW_SLABS, n // 2048)) if slabs is None else max(1, min(n, int(slabs)))
         order, bounds = _slab_order(_project(centers, frame[:1], middle)[0], count)
-    across = _project(centers, frame[1:], middle, packed=True)      # a + ib, complex64
-    lo = np.array([across.real.min(), across.imag.min()], np.float64)
-    hi = np.array([across.real.max(), across.imag.max()], np.float64)
+    # a particle's record: where it is across the rays (a, b), then for the slabs where its
+    # splat goes; one record, one place in memory, for a slab to gather
+    points = np.empty((n, 4), _F32)
+    _project(centers, frame[1:], middle, out=(points[:, 0], points[:, 1]))
+    # column by column: min(axis=0) over the (N, 2) view is 10x slower
+    lo = np.array([points[:, 0].min(), points[:, 1].min()], np.float64)
+    hi = np.array([points[:, 0].max(), points[:, 1].max()], np.float64)
     grid = _Grid(lo, hi, radii, small, most=grid_cells)
     forward = _F32(lighting.forward_fraction)
     if small:
-        _one_by_one(grid, order, across, radii, density, lighting.extinction, forward, light)
+        _one_by_one(grid, order, points, radii, density, lighting.extinction, forward, light)
     else:
-        _slabs(grid, order, bounds, across, radii, density, lighting.extinction, forward, light)
+        _slabs(grid, order, bounds, points, radii, density, lighting.extinction, forward, light)
     np.clip(light, 0, 1, out=light)
     return light
 
 
-def _one_by_one(grid: _Grid, order, across, radii, density, extinction, forward, light) -> None:
+def _one_by_one(grid: _Grid, order, points, radii, density, extinction, forward, light) -> None:
     """Harris's recurrence itself, one particle after another (a small cloud).
 
     Each particle reads the direct and scattered light at its centre, then multiplies its
@@ -145,7 +150,7 @@ def _one_by_one(grid: _Grid, order, across, radii, density, extinction, forward,
     stops, of which the forward fraction goes on as scattered light. The footprints are
     computed up front in one go; the loop only reads and multiplies.
     """
-    gx, gy = grid.coordinates(across.real[order], across.imag[order])
+    gx, gy = grid.coordinates(points[order, 0], points[order, 1])
     sigma = radii[order].astype(_F32) * _F32(SIGMA / grid.cell)
     peak = _peak_depth(density[order], extinction)
     keeps = grid.footprints(gx, gy, sigma, peak)
@@ -172,7 +177,7 @@ def _one_by_one(grid: _Grid, order, across, radii, density, extinction, forward,
     light[order] = got
 
 
-def _slabs(grid: _Grid, order, bounds, across, radii, density, extinction, forward, light) -> None:
+def _slabs(grid: _Grid, order, bounds, points, radii, density, extinction, forward, light) -> None:
     """A big cloud in slabs (``order[bounds[k]:bounds[k + 1]]``), each read from and splatted
     into one light map.
 
@@ -185,42 +190,27 @@ def _slabs(grid: _Grid, order, bounds, across, radii, density, extinction, forwa
     the light before its slab passed through half the slab's depth at its centre, less its own.
     """
     slabs = len(bounds) - 1
-    packed = across                            # a + ib: one gather a slab instead of two
     width = grid.shape[1]
     cells = grid.shape[0] * width
-    scale, (x0, y0) = _F32(1 / grid.cell), (_F32(grid.corner[0] / grid.cell + 0.5),
-                                            _F32(grid.corner[1] / grid.cell + 0.5))
-    widths = _F32(SIGMA / grid.cell)
-    class_bounds = [_F32(b) for b in grid.bounds]   # class c: sigma under c of these
     spread = grid.spread
-    table = _peak_table(float(extinction), float(forward))
+    _splat_records(points, grid, radii, density, _peak_table(float(extinction), float(forward)))
+    # gathered as 16-byte records: 40x faster than fancy-indexing rows of the (N, 4) array
+    records = points.view(_RECORD)[:, 0]
 
     def prepare(k: int):
         """Everything of slab k that does not need the light map (run ahead, on worker threads):
         where each particle reads the light (corner cells and fractions), how much of the light
         there its own slab lets through to it, and what the slab lets through over the map."""
         idx = order[bounds[k]:bounds[k + 1]]
-        ab = packed[idx]
-        gx = ab.real * scale
-        gx -= x0
-        gy = ab.imag * scale
-        gy -= y0
+        record = records[idx]
+        gx, gy, mass = record["x"], record["y"], record["mass"]
+        klass = record["class"].astype(np.intp)
         ix, iy = np.floor(gx), np.floor(gy)
         fx, fy = gx - ix, gy - iy
         flat = ix.astype(np.intp)
         flat *= width
         flat += iy.astype(np.intp)
         near = flat + width * (fx >= _F32(0.5)) + (fy >= _F32(0.5))
-        sigma = radii[idx] * widths
-        klass = np.zeros(len(idx), np.intp)    # 3 compares: 15x faster than searchsorted here
-        for bound in class_bounds:
-            klass += sigma < bound
-        level = density[idx] * _F32(PEAK_LEVELS)
-        level += _F32(0.5)
-        np.clip(level, 0, PEAK_LEVELS, out=level)
-        mass = table[level.astype(np.intp)]
-        mass *= sigma
-        mass *= sigma
         depth, own = grid.slab_depth(near + klass * cells, mass * _F32(2 * math.pi), mass / spread[klass])
         half = depth.ravel()[near]                                  # at the nearest cell
         half -= own
@@ -249,6 +239,37 @@ def _slabs(grid: _Grid, order, bounds, across, radii, density, extinction, forwa
             light[idx] = got
             if keep is not None:
                 grid.direct *= keep
+
+
+def _splat_records(points: np.ndarray, grid: _Grid, radii: np.ndarray, density: np.ndarray,
+                   table: np.ndarray) -> None:
+    """Turn each record (a, b, -, -) into (grid x, grid y, splat mass, width class), in place.
+
+    The mass is the particle's effective peak depth (``table``, by density) x sigma^2 in
+    cells; the class is the nearest of the grid's widths in log scale (0 the widest).
+    """
+    scale = _F32(1 / grid.cell)
+    x0, y0 = _F32(grid.corner[0] / grid.cell + 0.5), _F32(grid.corner[1] / grid.cell + 0.5)
+    widths = _F32(SIGMA / grid.cell)
+    bounds = [_F32(b) for b in grid.bounds]
+    for start in range(0, len(points), CHUNK):
+        part = points[start:start + CHUNK]
+        part[:, 0] *= scale
+        part[:, 0] -= x0
+        part[:, 1] *= scale
+        part[:, 1] -= y0
+        sigma = radii[start:start + CHUNK] * widths
+        klass = np.zeros(len(part), _F32)
+        for bound in bounds:   # 3 compares: 15x faster than searchsorted on 3 values
+            klass += sigma < bound
+        part[:, 3] = klass
+        level = density[start:start + CHUNK] * _F32(PEAK_LEVELS)
+        level += _F32(0.5)
+        np.clip(level, 0, PEAK_LEVELS, out=level)
+        mass = table[level.astype(np.intp)]
+        mass *= sigma
+        mass *= sigma
+        part[:, 2] = mass
 
 
 def peak_optical_depth(density, extinction: float) -> np.ndarray:
@@ -334,13 +355,13 @@ def _middle(centers: np.ndarray) -> np.ndarray:
     return (sample.min(axis=0) + sample.max(axis=0)) / 2
 
 
-def _project(centers: np.ndarray, rows: np.ndarray, middle: np.ndarray, packed: bool = False) -> np.ndarray:
+def _project(centers: np.ndarray, rows: np.ndarray, middle: np.ndarray,
+             out: tuple[np.ndarray, ...] | None = None) -> np.ndarray:
     """The centres' coordinates along each of ``rows`` (unit vectors), relative to ``middle``,
-    as float32 (len(rows), N); with ``packed``, two rows as one complex64 (N,): a slab then
-    gathers both in one go."""
+    as float32 (len(rows), N), or written into ``out`` (one float32 (N,) view per row)."""
     n = len(centers)
-    store = np.empty(n, np.complex64) if packed else np.empty((len(rows), n), _F32)
-    out: list[np.ndarray] = [store.real, store.imag] if packed else list(store)
+    store = np.empty((len(rows), n), _F32) if out is None else np.empty((0, n), _F32)
+    into = list(store) if out is None else list(out)
     top = float(np.finfo(_F32).max)
     for start in range(0, n, CHUNK):
         x, y, z = (centers[start:start + CHUNK] - middle).T            # float64, chunk-sized
@@ -350,7 +371,7 @@ def _project(centers: np.ndarray, rows: np.ndarray, middle: np.ndarray, packed: 
             value += y * row[1]
             value += z * row[2]
             np.clip(value, -top, top, out=value)                      # a cloud spanning all of float32
-            out[k][start:start + CHUNK] = value
+            into[k][start:start + CHUNK] = value
     return store
 
 
@@ -381,7 +402,10 @@ def _slab_order(depth: np.ndarray, slabs: int) -> tuple[np.ndarray, list[int]]:
     del key
     counts = np.bincount(slab_of_level, weights=per_level, minlength=slabs)
     bounds = np.concatenate([[0], np.cumsum(counts[counts > 0])]).astype(np.int64).tolist()
-    return np.argsort(slab, kind="stable"), bounds
+    order = np.argsort(slab, kind="stable")
+    del slab
+    # int32 where it fits: 4 bytes a particle less while the particles' records are held
+    return (order.astype(np.int32) if n < 2**31 else order), bounds
 
 
 class _Grid:
