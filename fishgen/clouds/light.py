@@ -26,15 +26,17 @@ radius`` (the billboard sprite's) cut at ``CUT`` sigma, whose total equals the
 shadow of SkyWorks' splat (``peak_optical_depth``).
 
 A small cloud has one particle per slab (Harris's recurrence itself, up to the grid)
-and its footprints are evaluated cell by cell. A big one has ``SLABS`` slabs of
-equal count, splatted as points into a few width classes, each blurred with its own
-Gaussian (separable, mass-preserving). The order is a stable sort and every sum runs
-in a fixed order, so the result does not depend on the number of threads.
+and its footprints are evaluated cell by cell. A big one has up to ``SLABS`` slabs of
+about equal count, splatted as points into a few width classes, each blurred with its
+own Gaussian (separable, mass-preserving); its particles are visited in memory order,
+never in depth order (see ``_slabs``). The order is a stable sort and every sum runs in
+a fixed order, so the result does not depend on the number of threads.
 """
 from __future__ import annotations
 
 import functools
 import math
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
 import numpy as np
@@ -59,15 +61,14 @@ CLASSES = 4
 CUT = 3.0
 """A footprint ends at CUT x sigma (holding 98.9 % of its optical depth)."""
 WORKERS = 2
-"""Threads working out slabs ahead of the one being lit (the machine this runs on has 2 cores)."""
-AHEAD = 4
-"""Slabs worked out ahead: enough to keep WORKERS busy, few enough to hold little memory."""
+"""Threads for a big cloud's passes (the machine this runs on has 2 cores)."""
+MAP_VALUES = 1 << 23
+"""Most map values (slabs x classes x cells) held at once; a finer grid goes in groups of slabs."""
 KEY_LEVELS = 65535
 CHUNK = 1 << 16
 PEAK_LEVELS = 16384
 
 _F32 = np.float32
-_RECORD = np.dtype([("x", _F32), ("y", _F32), ("mass", _F32), ("class", _F32)])
 _LEVELS = np.arange(PEAK_LEVELS + 1, dtype=np.float64)
 
 
@@ -118,31 +119,22 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     small = n <= SMALL and slabs is None
     frame = _frame(np.array(lighting.sun_unit, np.float64))   # rows: sun, across a, across b
     middle = _middle(centers)
-    # the depth lives only until it is sorted, the coordinates across the rays only after: a
-    # cloud of 10^7 particles holds 27 bytes of its own per particle, and the sort needs 18
-    if small:
-        order, bounds = np.argsort(-_project(centers, frame[:1], middle)[0], kind="stable"), None
-    else:
-        count = min(n, SLABS, max(FEW_SLABS, n // 2048)) if slabs is None else max(1, min(n, int(slabs)))
-        order, bounds = _slab_order(_project(centers, frame[:1], middle)[0], count)
-    # a particle's record: where it is across the rays (a, b), then for the slabs where its
-    # splat goes; one record, one place in memory, for a slab to gather
-    points = np.empty((n, 4), _F32)
-    _project(centers, frame[1:], middle, out=(points[:, 0], points[:, 1]))
-    # column by column: min(axis=0) over the (N, 2) view is 10x slower
-    lo = np.array([points[:, 0].min(), points[:, 1].min()], np.float64)
-    hi = np.array([points[:, 0].max(), points[:, 1].max()], np.float64)
-    grid = _Grid(lo, hi, radii, small, most=grid_cells)
     forward = _F32(lighting.forward_fraction)
     if small:
-        _one_by_one(grid, order, points, radii, density, lighting.extinction, forward, light)
+        order = np.argsort(-_project(centers, frame[:1], middle)[0], kind="stable")
+        across = _project(centers, frame[1:], middle)
+        grid = _Grid(across.min(axis=1).astype(np.float64), across.max(axis=1).astype(np.float64),
+                     radii, True, most=grid_cells)
+        _one_by_one(grid, order, across, radii, density, lighting.extinction, forward, light)
     else:
-        _slabs(grid, order, bounds, points, radii, density, lighting.extinction, forward, light)
+        count = min(n, SLABS, max(FEW_SLABS, n // 2048)) if slabs is None else max(1, min(n, int(slabs)))
+        _slabs(centers, radii, density, frame, middle, count, lighting.extinction, forward, light,
+               grid_cells)
     np.clip(light, 0, 1, out=light)
     return light
 
 
-def _one_by_one(grid: _Grid, order, points, radii, density, extinction, forward, light) -> None:
+def _one_by_one(grid: _Grid, order, across, radii, density, extinction, forward, light) -> None:
     """Harris's recurrence itself, one particle after another (a small cloud).
 
     Each particle reads the direct and scattered light at its centre, then multiplies its
@@ -150,7 +142,7 @@ def _one_by_one(grid: _Grid, order, points, radii, density, extinction, forward,
     stops, of which the forward fraction goes on as scattered light. The footprints are
     computed up front in one go; the loop only reads and multiplies.
     """
-    gx, gy = grid.coordinates(points[order, 0], points[order, 1])
+    gx, gy = grid.coordinates(across[0, order], across[1, order])
     sigma = radii[order].astype(_F32) * _F32(SIGMA / grid.cell)
     peak = _peak_depth(density[order], extinction)
     keeps = grid.footprints(gx, gy, sigma, peak)
@@ -177,9 +169,10 @@ def _one_by_one(grid: _Grid, order, points, radii, density, extinction, forward,
     light[order] = got
 
 
-def _slabs(grid: _Grid, order, bounds, points, radii, density, extinction, forward, light) -> None:
-    """A big cloud in slabs (``order[bounds[k]:bounds[k + 1]]``), each read from and splatted
-    into one light map.
+def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forward, light,
+           grid_cells: int | None) -> None:
+    """A big cloud, in ``slabs`` slabs along the sun axis, all read from and splatted into one
+    light map.
 
     Here a particle passes on the light at each cell as it arrives there (Harris: as it
     arrives at the particle's centre): ``e^-d + F (1 - e^-d)`` of it, d its optical depth
@@ -188,88 +181,124 @@ def _slabs(grid: _Grid, order, bounds, points, radii, density, extinction, forwa
     same total (``_effective_table``), as a point into its width class, and the class maps
     blurred. A particle also sits behind about half the rest of its own slab, so it reads
     the light before its slab passed through half the slab's depth at its centre, less its own.
+
+    Nothing here visits the particles in depth order (on a big cloud, reading memory out of
+    order cost more than all the arithmetic). Three passes in memory order, each chunk on
+    its own thread: one numbers the slabs; one splats every particle into its slab's maps
+    (summed in chunk order, so threads do not change a bit); then the maps go down the slabs
+    in order, keeping the light each slab received and the depth it holds; and the last
+    pass reads each particle's light from its slab's maps.
     """
-    slabs = len(bounds) - 1
-    width = grid.shape[1]
-    cells = grid.shape[0] * width
-    spread = grid.spread
-    _splat_records(points, grid, radii, density, _peak_table(float(extinction), float(forward)))
-    # gathered as 16-byte records: 40x faster than fancy-indexing rows of the (N, 4) array
-    records = points.view(_RECORD)[:, 0]
-
-    def prepare(k: int):
-        """Everything of slab k that does not need the light map (run ahead, on worker threads):
-        where each particle reads the light (corner cells and fractions), how much of the light
-        there its own slab lets through to it, and what the slab lets through over the map."""
-        idx = order[bounds[k]:bounds[k + 1]]
-        record = records[idx]
-        gx, gy, mass = record["x"], record["y"], record["mass"]
-        klass = record["class"].astype(np.intp)
-        ix, iy = np.floor(gx), np.floor(gy)
-        fx, fy = gx - ix, gy - iy
-        flat = ix.astype(np.intp)
-        flat *= width
-        flat += iy.astype(np.intp)
-        near = flat + width * (fx >= _F32(0.5)) + (fy >= _F32(0.5))
-        depth, own = grid.slab_depth(near + klass * cells, mass * _F32(2 * math.pi), mass / spread[klass])
-        half = depth.ravel()[near]                                  # at the nearest cell
-        half -= own
-        np.maximum(half, 0, out=half)
-        half *= _F32(-0.5)
-        within = np.exp(half, out=half)
-        keep = None
-        if k + 1 < slabs:  # the last slab shadows nothing
-            np.negative(depth, out=depth)
-            keep = np.exp(depth, out=depth)
-        return idx, (flat, fx, fy), within, keep
-
-    from collections import deque
-    from concurrent.futures import ThreadPoolExecutor
-
-    # Only reading the map and multiplying the slab into it go in order; the slabs themselves
-    # are worked out ahead on WORKERS threads (numpy lets go of the GIL in their big loops).
+    n = len(centers)
+    depth, across = np.empty(n, _F32), np.empty(n, np.complex64)        # across: a + ib
+    _project(centers, frame, middle, out=(depth, across.real, across.imag))
+    slab = _slab_numbers(depth, slabs)
+    del depth
+    grid = _Grid(np.array([across.real.min(), across.imag.min()], np.float64),
+                 np.array([across.real.max(), across.imag.max()], np.float64), radii, False, most=grid_cells)
+    cells = grid.shape[0] * grid.shape[1]
+    table = _peak_table(float(extinction), float(forward))
+    # the slabs in groups whose maps fit in MAP_VALUES (one group but for a very fine grid)
+    group = max(1, min(slabs, MAP_VALUES // (CLASSES * cells)))
     with ThreadPoolExecutor(WORKERS) as pool:
-        ahead = deque(pool.submit(prepare, k) for k in range(min(slabs, AHEAD)))
-        for k in range(slabs):
-            idx, (flat, fx, fy), within, keep = ahead.popleft().result()
-            if k + AHEAD < slabs:
-                ahead.append(pool.submit(prepare, k + AHEAD))
-            got = _bilinear(grid.direct.ravel(), flat, fx, fy, width)
-            got *= within
-            light[idx] = got
-            if keep is not None:
-                grid.direct *= keep
+        for first in range(0, slabs, group):
+            last = min(slabs, first + group)
+            points = functools.partial(_chunk_points, grid, slab=slab, across=across, radii=radii,
+                                       density=density, table=table, first=first, last=last)
+            size = (last - first) * CLASSES * cells
+            # two fixed shares of the chunks, each summed in chunk order, then added: the same
+            # sums whatever runs them, and only two maps (and a chunk's) held at once
+            spans = _spans(n, CHUNK)
+            shares = [spans[:(len(spans) + 1) // 2], spans[(len(spans) + 1) // 2:]]
+            layers, other = pool.map(functools.partial(_splat_share, grid, points, size), shares)
+            layers += other
+            del other
+            depths = np.stack(list(pool.map(grid.blur, layers.reshape(last - first, CLASSES, -1))))
+            del layers
+            before = np.empty_like(depths)
+            direct = grid.direct.ravel()                        # a view: the grid's map
+            for k in range(last - first):
+                before[k] = direct
+                direct *= np.exp(-depths[k])
+            read = functools.partial(_read_chunk, grid, points, before, depths, light)
+            list(pool.map(read, _spans(n, CHUNK)))
 
 
-def _splat_records(points: np.ndarray, grid: _Grid, radii: np.ndarray, density: np.ndarray,
-                   table: np.ndarray) -> None:
-    """Turn each record (a, b, -, -) into (grid x, grid y, splat mass, width class), in place.
+def _spans(n: int, size: int) -> list[tuple[int, int]]:
+    return [(start, min(n, start + size)) for start in range(0, n, size)]
 
-    The mass is the particle's effective peak depth (``table``, by density) x sigma^2 in
-    cells; the class is the nearest of the grid's widths in log scale (0 the widest).
-    """
-    scale = _F32(1 / grid.cell)
-    x0, y0 = _F32(grid.corner[0] / grid.cell + 0.5), _F32(grid.corner[1] / grid.cell + 0.5)
-    widths = _F32(SIGMA / grid.cell)
-    bounds = [_F32(b) for b in grid.bounds]
-    for start in range(0, len(points), CHUNK):
-        part = points[start:start + CHUNK]
-        part[:, 0] *= scale
-        part[:, 0] -= x0
-        part[:, 1] *= scale
-        part[:, 1] -= y0
-        sigma = radii[start:start + CHUNK] * widths
-        klass = np.zeros(len(part), _F32)
-        for bound in bounds:   # 3 compares: 15x faster than searchsorted on 3 values
-            klass += sigma < bound
-        part[:, 3] = klass
-        level = density[start:start + CHUNK] * _F32(PEAK_LEVELS)
-        level += _F32(0.5)
-        np.clip(level, 0, PEAK_LEVELS, out=level)
-        mass = table[level.astype(np.intp)]
-        mass *= sigma
-        mass *= sigma
-        part[:, 2] = mass
+
+def _chunk_points(grid: _Grid, span, *, slab, across, radii, density, table, first: int, last: int):
+    """A chunk's particles of slabs first..last-1: which, their slab (from ``first``), grid
+    coordinates, nearest cell, width class and splat mass (effective peak depth x sigma^2)."""
+    start, stop = span
+    number = slab[start:stop]
+    pick = None
+    if first > 0 or last < int(number.max(initial=0)) + 1:
+        pick = np.flatnonzero((number >= first) & (number < last))
+        number = number[pick]
+    ab = across[start:stop] if pick is None else across[start:stop][pick]
+    gx, gy = grid.coordinates(ab.real, ab.imag)
+    ix, iy = np.floor(gx), np.floor(gy)
+    fx, fy = gx - ix, gy - iy
+    flat = ix.astype(np.intp)
+    flat *= grid.shape[1]
+    flat += iy.astype(np.intp)
+    near = flat + grid.shape[1] * (fx >= _F32(0.5)) + (fy >= _F32(0.5))
+    r = radii[start:stop] if pick is None else radii[start:stop][pick]
+    d = density[start:stop] if pick is None else density[start:stop][pick]
+    sigma = r * _F32(SIGMA / grid.cell)
+    klass = np.zeros(len(sigma), np.intp)
+    for bound in grid.bounds:     # 3 compares: 15x faster than searchsorted on 3 values
+        klass += sigma < bound
+    level = d * _F32(PEAK_LEVELS)
+    level += _F32(0.5)
+    np.clip(level, 0, PEAK_LEVELS, out=level)
+    mass = table[level.astype(np.intp)]
+    mass *= sigma
+    mass *= sigma
+    return pick, number.astype(np.intp) - first, (flat, fx, fy), near, klass, mass
+
+
+def _splat_share(grid: _Grid, points, size: int, spans: list[tuple[int, int]]) -> np.ndarray:
+    """Chunks' optical depth splats, added in order: a point per particle into its slab's
+    width-class map (``points``: ``_chunk_points`` with all but the span given).
+
+    ``np.add.at`` rather than ``bincount``: a bincount a chunk allocates the whole maps
+    (25 MB for 128 slabs) each time, and was slower."""
+    total = np.zeros(size)
+    cells = grid.shape[0] * grid.shape[1]
+    for span in spans:
+        _, number, _, near, klass, mass = points(span)
+        index = number * CLASSES
+        index += klass
+        index *= cells
+        index += near
+        mass *= _F32(2 * math.pi)
+        np.add.at(total, index, mass.astype(np.float64))
+    return total
+
+
+def _read_chunk(grid: _Grid, points, before: np.ndarray, depths: np.ndarray, light: np.ndarray,
+                span) -> None:
+    """Each particle's light: what reached its slab, at its centre, less about half of what the
+    rest of its own slab holds there."""
+    pick, number, (flat, fx, fy), near, klass, mass = points(span)
+    cells = grid.shape[0] * grid.shape[1]
+    base = number * cells
+    flat += base
+    near += base
+    got = _bilinear(before.ravel(), flat, fx, fy, grid.shape[1])
+    half = depths.ravel()[near]
+    half -= mass / grid.spread[klass]                            # less its own
+    np.maximum(half, 0, out=half)
+    half *= _F32(-0.5)
+    got *= np.exp(half, out=half)
+    start, stop = span
+    if pick is None:
+        light[start:stop] = got
+    else:
+        light[start:stop][pick] = got
 
 
 def peak_optical_depth(density, extinction: float) -> np.ndarray:
@@ -375,15 +404,11 @@ def _project(centers: np.ndarray, rows: np.ndarray, middle: np.ndarray,
     return store
 
 
-def _slab_order(depth: np.ndarray, slabs: int) -> tuple[np.ndarray, list[int]]:
-    """The particles slab by slab, nearest the sun first, and where each slab starts and ends.
+def _slab_numbers(depth: np.ndarray, slabs: int) -> np.ndarray:
+    """Each particle's slab, 0 nearest the sun (uint8, or uint16 for more than 256 slabs).
 
     The depth is cut into KEY_LEVELS + 1 levels and the levels into ``slabs`` runs of about
-    equal count (a level is never split, so a slab may be empty; those are dropped). Within a
-    slab the particles stay in input order: order does not matter inside a slab, and reading
-    them in increasing index runs several times faster than in depth order on a big cloud
-    (their memory comes in order). A stable radix sort on the slab number (one byte for up to
-    256 slabs) gives that order.
+    equal count; a level is never split, so a slab may hold more or fewer, or none.
     """
     n = len(depth)
     top, bottom = float(depth.max()), float(depth.min())
@@ -394,18 +419,10 @@ def _slab_order(depth: np.ndarray, slabs: int) -> tuple[np.ndarray, list[int]]:
         part = (_F32(top) - depth[start:start + CHUNK]) * scale
         np.clip(part, 0, KEY_LEVELS, out=part)
         key[start:start + CHUNK] = part + _F32(0.5)
-    del depth                                   # the caller holds no other reference
     per_level = np.bincount(key, minlength=KEY_LEVELS + 1)
     before = np.cumsum(per_level) - per_level                # particles on nearer levels
     slab_of_level = (before * slabs) // n                     # the slab each level begins in
-    slab = slab_of_level.astype(np.uint8 if slabs <= 256 else np.uint16)[key]
-    del key
-    counts = np.bincount(slab_of_level, weights=per_level, minlength=slabs)
-    bounds = np.concatenate([[0], np.cumsum(counts[counts > 0])]).astype(np.int64).tolist()
-    order = np.argsort(slab, kind="stable")
-    del slab
-    # int32 where it fits: 4 bytes a particle less while the particles' records are held
-    return (order.astype(np.int32) if n < 2**31 else order), bounds
+    return slab_of_level.astype(np.uint8 if slabs <= 256 else np.uint16)[key]
 
 
 class _Grid:
@@ -446,17 +463,12 @@ class _Grid:
         gy = (b - _F32(self.corner[1])) * _F32(1 / self.cell) - _F32(0.5)
         return gx, gy
 
-    def slab_depth(self, index, whole, own) -> tuple[np.ndarray, np.ndarray]:
-        """A slab's optical depth map: each particle's ``whole`` depth (peak x 2 pi sigma^2) put at
-        ``index`` (the cell nearest its centre, in the map of its width class: sigma_max / 2^c,
-        nearest in log scale), each class map blurred with its Gaussian, and summed; ``own`` (each
-        particle's own share at its centre, about peak x (sigma / class width)^2) passed through."""
-        cells = self.shape[0] * self.shape[1]
-        layers = np.bincount(index, whole, minlength=CLASSES * cells)
+    def blur(self, layers: np.ndarray) -> np.ndarray:
+        """A slab's optical depth map (flat, float32) from its point splats, one map per width
+        class (``layers``, (CLASSES, cells)), each class blurred with its Gaussian and summed."""
         spectrum = np.fft.rfft2(layers.reshape(CLASSES, *self.shape))
         spectrum *= self.spectra
-        total = np.fft.irfft2(spectrum.sum(axis=0), s=self.shape).astype(_F32)
-        return total, own
+        return np.fft.irfft2(spectrum.sum(axis=0), s=self.shape).astype(_F32).ravel()
 
     def footprints(self, gx, gy, sigma, peak) -> list[tuple[int, int, np.ndarray]]:
         """Per particle: (first row, first column, e^-depth over that window) of its footprint.
