@@ -62,6 +62,8 @@ CUT = 3.0
 """A footprint ends at CUT x sigma (holding 98.9 % of its optical depth)."""
 WORKERS = 2
 """Threads for a big cloud's passes (the machine this runs on has 2 cores)."""
+BLUR_SLABS = 8
+"""Slabs blurred in one FFT call."""
 MAP_VALUES = 1 << 23
 """Most map values (slabs x classes x cells) held at once; a finer grid goes in groups of slabs."""
 KEY_LEVELS = 65535
@@ -190,47 +192,51 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     pass reads each particle's light from its slab's maps.
     """
     n = len(centers)
-    depth, across = np.empty(n, _F32), np.empty(n, np.complex64)        # across: a + ib
-    _project(centers, frame, middle, out=(depth, across.real, across.imag))
-    slab = _slab_numbers(depth, slabs)
-    del depth
-    grid = _Grid(np.array([across.real.min(), across.imag.min()], np.float64),
-                 np.array([across.real.max(), across.imag.max()], np.float64), radii, False, most=grid_cells)
-    cells = grid.shape[0] * grid.shape[1]
-    table = _peak_table(float(extinction), float(forward))
-    # the slabs in groups whose maps fit in MAP_VALUES (one group but for a very fine grid)
-    group = max(1, min(slabs, MAP_VALUES // (CLASSES * cells)))
     with ThreadPoolExecutor(WORKERS) as pool:
+        depth, across = np.empty(n, _F32), np.empty(n, np.complex64)        # across: a + ib
+        _project(centers, frame, middle, out=(depth, across.real, across.imag), pool=pool)
+        slab = _slab_numbers(depth, slabs, pool)
+        del depth
+        grid = _Grid(np.array([across.real.min(), across.imag.min()], np.float64),
+                     np.array([across.real.max(), across.imag.max()], np.float64), radii, False,
+                     most=grid_cells)
+        cells = grid.shape[0] * grid.shape[1]
+        table = _peak_table(float(extinction), float(forward))
+        # the slabs in groups whose maps fit in MAP_VALUES (one group but for a very fine grid)
+        group = max(1, min(slabs, MAP_VALUES // (CLASSES * cells)))
+        own = np.empty(n, _F32)           # each particle's own depth at its centre, once splatted
         for first in range(0, slabs, group):
             last = min(slabs, first + group)
-            points = functools.partial(_chunk_points, grid, slab=slab, across=across, radii=radii,
-                                       density=density, table=table, first=first, last=last)
+            place = functools.partial(_place, grid, slab, across, first, last)
             size = (last - first) * CLASSES * cells
             # two fixed shares of the chunks, each summed in chunk order, then added: the same
             # sums whatever runs them, and only two maps (and a chunk's) held at once
             spans = _spans(n, CHUNK)
             shares = [spans[:(len(spans) + 1) // 2], spans[(len(spans) + 1) // 2:]]
-            layers, other = pool.map(functools.partial(_splat_share, grid, points, size), shares)
+            splat = functools.partial(_splat_share, grid, place, radii, density, table, size, own)
+            layers, other = pool.map(splat, shares)
             layers += other
             del other
-            depths = np.stack(list(pool.map(grid.blur, layers.reshape(last - first, CLASSES, -1))))
+            maps = layers.reshape(last - first, CLASSES, -1)
+            depths = np.concatenate(list(pool.map(grid.blur, (maps[k:k + BLUR_SLABS]
+                                                              for k in range(0, last - first, BLUR_SLABS)))))
             del layers
             before = np.empty_like(depths)
             direct = grid.direct.ravel()                        # a view: the grid's map
             for k in range(last - first):
                 before[k] = direct
                 direct *= np.exp(-depths[k])
-            read = functools.partial(_read_chunk, grid, points, before, depths, light)
-            list(pool.map(read, _spans(n, CHUNK)))
+            read = functools.partial(_read_chunk, grid, place, own, before, depths, light)
+            list(pool.map(read, spans))
 
 
 def _spans(n: int, size: int) -> list[tuple[int, int]]:
     return [(start, min(n, start + size)) for start in range(0, n, size)]
 
 
-def _chunk_points(grid: _Grid, span, *, slab, across, radii, density, table, first: int, last: int):
-    """A chunk's particles of slabs first..last-1: which, their slab (from ``first``), grid
-    coordinates, nearest cell, width class and splat mass (effective peak depth x sigma^2)."""
+def _place(grid: _Grid, slab, across, first: int, last: int, span: tuple[int, int]):
+    """A chunk's particles of slabs first..last-1: which of the chunk (None: all), their slab
+    (counted from ``first``), cell and fractions to read the map at, and the nearest cell."""
     start, stop = span
     number = slab[start:stop]
     pick = None
@@ -245,31 +251,40 @@ def _chunk_points(grid: _Grid, span, *, slab, across, radii, density, table, fir
     flat *= grid.shape[1]
     flat += iy.astype(np.intp)
     near = flat + grid.shape[1] * (fx >= _F32(0.5)) + (fy >= _F32(0.5))
-    r = radii[start:stop] if pick is None else radii[start:stop][pick]
-    d = density[start:stop] if pick is None else density[start:stop][pick]
-    sigma = r * _F32(SIGMA / grid.cell)
-    klass = np.zeros(len(sigma), np.intp)
-    for bound in grid.bounds:     # 3 compares: 15x faster than searchsorted on 3 values
-        klass += sigma < bound
-    level = d * _F32(PEAK_LEVELS)
-    level += _F32(0.5)
-    np.clip(level, 0, PEAK_LEVELS, out=level)
-    mass = table[level.astype(np.intp)]
-    mass *= sigma
-    mass *= sigma
-    return pick, number.astype(np.intp) - first, (flat, fx, fy), near, klass, mass
+    return pick, number.astype(np.intp) - first, (flat, fx, fy), near
 
 
-def _splat_share(grid: _Grid, points, size: int, spans: list[tuple[int, int]]) -> np.ndarray:
-    """Chunks' optical depth splats, added in order: a point per particle into its slab's
-    width-class map (``points``: ``_chunk_points`` with all but the span given).
+def _splat_share(grid: _Grid, place, radii, density, table, size: int, own: np.ndarray,
+                 spans: list[tuple[int, int]]) -> np.ndarray:
+    """Chunks' optical depth splats, added in order: each particle's effective depth
+    (``table``, by density) x 2 pi sigma^2 as a point at its nearest cell in its slab's map of
+    its width class (the nearest of the grid's widths in log scale); and into ``own``, its own
+    share of the depth at its centre.
 
     ``np.add.at`` rather than ``bincount``: a bincount a chunk allocates the whole maps
     (25 MB for 128 slabs) each time, and was slower."""
     total = np.zeros(size)
     cells = grid.shape[0] * grid.shape[1]
     for span in spans:
-        _, number, _, near, klass, mass = points(span)
+        pick, number, _, near = place(span)
+        start, stop = span
+        r = radii[start:stop] if pick is None else radii[start:stop][pick]
+        d = density[start:stop] if pick is None else density[start:stop][pick]
+        sigma = r * _F32(SIGMA / grid.cell)
+        klass = np.zeros(len(sigma), np.intp)
+        for bound in grid.bounds:     # 3 compares: 15x faster than searchsorted on 3 values
+            klass += sigma < bound
+        level = d * _F32(PEAK_LEVELS)
+        level += _F32(0.5)
+        np.clip(level, 0, PEAK_LEVELS, out=level)
+        mass = table[level.astype(np.intp)]
+        mass *= sigma
+        mass *= sigma
+        mine = mass / grid.spread[klass]
+        if pick is None:
+            own[start:stop] = mine
+        else:
+            own[start:stop][pick] = mine
         index = number * CLASSES
         index += klass
         index *= cells
@@ -279,22 +294,22 @@ def _splat_share(grid: _Grid, points, size: int, spans: list[tuple[int, int]]) -
     return total
 
 
-def _read_chunk(grid: _Grid, points, before: np.ndarray, depths: np.ndarray, light: np.ndarray,
-                span) -> None:
+def _read_chunk(grid: _Grid, place, own: np.ndarray, before: np.ndarray, depths: np.ndarray,
+                light: np.ndarray, span: tuple[int, int]) -> None:
     """Each particle's light: what reached its slab, at its centre, less about half of what the
     rest of its own slab holds there."""
-    pick, number, (flat, fx, fy), near, klass, mass = points(span)
+    pick, number, (flat, fx, fy), near = place(span)
+    start, stop = span
     cells = grid.shape[0] * grid.shape[1]
     base = number * cells
     flat += base
     near += base
     got = _bilinear(before.ravel(), flat, fx, fy, grid.shape[1])
     half = depths.ravel()[near]
-    half -= mass / grid.spread[klass]                            # less its own
+    half -= own[start:stop] if pick is None else own[start:stop][pick]          # less its own
     np.maximum(half, 0, out=half)
     half *= _F32(-0.5)
     got *= np.exp(half, out=half)
-    start, stop = span
     if pick is None:
         light[start:stop] = got
     else:
@@ -385,44 +400,68 @@ def _middle(centers: np.ndarray) -> np.ndarray:
 
 
 def _project(centers: np.ndarray, rows: np.ndarray, middle: np.ndarray,
-             out: tuple[np.ndarray, ...] | None = None) -> np.ndarray:
+             out: tuple[np.ndarray, ...] | None = None, pool: ThreadPoolExecutor | None = None) -> np.ndarray:
     """The centres' coordinates along each of ``rows`` (unit vectors), relative to ``middle``,
-    as float32 (len(rows), N), or written into ``out`` (one float32 (N,) view per row)."""
+    as float32 (len(rows), N), or written into ``out`` (one float32 (N,) view per row); the
+    chunks on ``pool``'s threads if given."""
     n = len(centers)
     store = np.empty((len(rows), n), _F32) if out is None else np.empty((0, n), _F32)
     into = list(store) if out is None else list(out)
     top = float(np.finfo(_F32).max)
-    for start in range(0, n, CHUNK):
-        x, y, z = (centers[start:start + CHUNK] - middle).T            # float64, chunk-sized
+
+    def chunk(span: tuple[int, int]) -> None:
+        start, stop = span
+        x, y, z = (centers[start:stop] - middle).T                  # float64, chunk-sized
         for k, row in enumerate(rows):
             # written out: a (65536, 3) x (3, 3) matmul took 40 ms a chunk here (BLAS threads)
             value = x * row[0]
             value += y * row[1]
             value += z * row[2]
             np.clip(value, -top, top, out=value)                      # a cloud spanning all of float32
-            into[k][start:start + CHUNK] = value
+            into[k][start:stop] = value
+
+    _each(pool, chunk, _spans(n, CHUNK))
     return store
 
 
-def _slab_numbers(depth: np.ndarray, slabs: int) -> np.ndarray:
+def _each(pool: ThreadPoolExecutor | None, work, spans: list[tuple[int, int]]) -> list:
+    """``work`` of each span, in order; on the pool's threads if there is one."""
+    return list(pool.map(work, spans)) if pool is not None else [work(span) for span in spans]
+
+
+def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None = None) -> np.ndarray:
     """Each particle's slab, 0 nearest the sun (uint8, or uint16 for more than 256 slabs).
 
     The depth is cut into KEY_LEVELS + 1 levels and the levels into ``slabs`` runs of about
     equal count; a level is never split, so a slab may hold more or fewer, or none.
     """
     n = len(depth)
-    top, bottom = float(depth.max()), float(depth.min())
+    spans = _spans(n, CHUNK)
+    ends = np.array(_each(pool, lambda span: (depth[span[0]:span[1]].min(), depth[span[0]:span[1]].max()),
+                          spans))
+    top, bottom = float(ends[:, 1].max()), float(ends[:, 0].min())
     span = top - bottom
     scale = _F32(KEY_LEVELS / span) if span > 0 else _F32(0)
     key = np.empty(n, np.uint16)
-    for start in range(0, n, CHUNK):
-        part = (_F32(top) - depth[start:start + CHUNK]) * scale
+
+    def level(span: tuple[int, int]) -> np.ndarray:
+        part = (_F32(top) - depth[span[0]:span[1]]) * scale
         np.clip(part, 0, KEY_LEVELS, out=part)
-        key[start:start + CHUNK] = part + _F32(0.5)
-    per_level = np.bincount(key, minlength=KEY_LEVELS + 1)
+        part += _F32(0.5)
+        key[span[0]:span[1]] = part
+        return np.bincount(key[span[0]:span[1]], minlength=KEY_LEVELS + 1)
+
+    per_level = np.sum(_each(pool, level, spans), axis=0)    # whole numbers: any order is exact
     before = np.cumsum(per_level) - per_level                # particles on nearer levels
     slab_of_level = (before * slabs) // n                     # the slab each level begins in
-    return slab_of_level.astype(np.uint8 if slabs <= 256 else np.uint16)[key]
+    table = slab_of_level.astype(np.uint8 if slabs <= 256 else np.uint16)
+    slab = np.empty(n, table.dtype)
+
+    def number(span: tuple[int, int]) -> None:
+        slab[span[0]:span[1]] = table[key[span[0]:span[1]]]
+
+    _each(pool, number, spans)
+    return slab
 
 
 class _Grid:
@@ -459,16 +498,28 @@ class _Grid:
 
     def coordinates(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Grid coordinates of points across the rays (float32 cells; cell centres at whole numbers)."""
-        gx = (a - _F32(self.corner[0])) * _F32(1 / self.cell) - _F32(0.5)
-        gy = (b - _F32(self.corner[1])) * _F32(1 / self.cell) - _F32(0.5)
+        gx = a * _F32(1 / self.cell)
+        gx -= _F32(self.corner[0] / self.cell + 0.5)
+        gy = b * _F32(1 / self.cell)
+        gy -= _F32(self.corner[1] / self.cell + 0.5)
         return gx, gy
 
     def blur(self, layers: np.ndarray) -> np.ndarray:
-        """A slab's optical depth map (flat, float32) from its point splats, one map per width
-        class (``layers``, (CLASSES, cells)), each class blurred with its Gaussian and summed."""
-        spectrum = np.fft.rfft2(layers.reshape(CLASSES, *self.shape))
-        spectrum *= self.spectra
-        return np.fft.irfft2(spectrum.sum(axis=0), s=self.shape).astype(_F32).ravel()
+        """Slabs' optical depth maps (float32, (slabs, cells)) from their point splats, one map
+        per width class (``layers``, (slabs, CLASSES, cells)), each class blurred with its
+        Gaussian and summed. A few slabs a call: one FFT per class for all of them (a call per
+        map cost more than its FFT), and none for a class they do not use."""
+        maps = layers.reshape(len(layers), CLASSES, *self.shape)
+        total = None
+        for c in range(CLASSES):
+            if not maps[:, c].any():
+                continue
+            spectrum = np.fft.rfft2(maps[:, c])
+            spectrum *= self.spectra[c]
+            total = spectrum if total is None else total.__iadd__(spectrum)
+        if total is None:
+            return np.zeros((len(layers), self.shape[0] * self.shape[1]), _F32)
+        return np.fft.irfft2(total, s=self.shape).astype(_F32).reshape(len(layers), -1)
 
     def footprints(self, gx, gy, sigma, peak) -> list[tuple[int, int, np.ndarray]]:
         """Per particle: (first row, first column, e^-depth over that window) of its footprint.
