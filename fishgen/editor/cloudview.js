@@ -1,82 +1,16 @@
 // The editor's preview: a filled, lit cloud as `fishgen clouds` writes it (a GLB from the server's
 // /api/fill), drawn as fishgen's viewer draws it. The first pass of Harris's method (the sunlight
-// reaching each particle, `_LIGHT`) is baked by the server; the shaders here do the second pass:
-// the light scattered towards the eye by the phase function, over the sky's ambient light.
-// (The second pass is fishgen/web/cloudlight.js, as in fishgen view and fly.)
+// reaching each particle, `_LIGHT`) is baked by the server; the materials of fishgen/web/cloudlight.js
+// (fishgen view's too) do the second pass: the light scattered towards the eye by the phase
+// function, over the sky's ambient light.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { SECOND_PASS, cloudUniforms, readCloudLight } from '../web/cloudlight.js';
+import { billboardMaterial, cloudUniforms, particleMaterial as makeParticleMaterial, readCloudLight } from '../web/cloudlight.js';
 
 export { cloudUniforms };
 
-// Particles: each a soft disc of its world radius with the billboard sprite's Gaussian profile.
-const particleMaterial = new THREE.ShaderMaterial( {
-	uniforms: { viewportHeight: { value: 1 }, ...cloudUniforms },
-	transparent: true, depthWrite: false,
-	vertexShader: /* glsl */`
-		attribute float _radius;
-		attribute float _density;
-		attribute float _light;
-		uniform float viewportHeight;
-		varying vec3 vColor;
-		varying float vAlpha;
-		${ SECOND_PASS }
-		void main() {
-			vec4 world = modelMatrix * vec4( position, 1.0 );
-			vec4 mv = viewMatrix * world;
-			gl_Position = projectionMatrix * mv;
-			gl_PointSize = 2.0 * _radius * projectionMatrix[ 1 ][ 1 ] * 0.5 * viewportHeight / max( - mv.z, 1e-4 );
-			vColor = scattered( _light, world.xyz );
-			vAlpha = 0.7 * clamp( _density, 0.0, 1.0 );
-		}`,
-	fragmentShader: /* glsl */`
-		varying vec3 vColor;
-		varying float vAlpha;
-		void main() {
-			vec2 p = gl_PointCoord * 2.0 - 1.0;
-			float r2 = dot( p, p );
-			if ( r2 > 1.0 ) discard;
-			float a = vAlpha * max( ( exp( - r2 / 0.32 ) - 0.04394 ) / 0.95606, 0.0 );
-			gl_FragColor = vec4( vColor, a );
-			#include <colorspace_fragment>
-		}`,
-} );
-
-const WHITE = new THREE.DataTexture( new Uint8Array( [ 255, 255, 255, 255 ] ), 1, 1 );
-WHITE.needsUpdate = true;
-
-// A texture cloud's billboards, three crossed quads each as fishgen writes them: the texture's colour
-// and alpha (or, with Show Texture off, a plain quad) times the vertex alpha, lit by the second pass.
-function billboardMaterial( source, textured ) {
-	const material = new THREE.ShaderMaterial( {
-		uniforms: { map: { value: textured && source.map || WHITE }, plain: { value: textured ? 0 : 1 }, ...cloudUniforms },
-		vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide,
-		vertexShader: /* glsl */`
-			attribute float _light;
-			varying vec2 vUv;
-			varying vec4 vColor;
-			${ SECOND_PASS }
-			void main() {
-				vec4 world = modelMatrix * vec4( position, 1.0 );
-				gl_Position = projectionMatrix * viewMatrix * world;
-				vUv = uv;
-				vColor = vec4( scattered( _light, world.xyz ), color.a );
-			}`,
-		fragmentShader: /* glsl */`
-			uniform sampler2D map;
-			uniform float plain;
-			varying vec2 vUv;
-			varying vec4 vColor;
-			void main() {
-				vec4 t = texture2D( map, vUv );
-				float a = plain > 0.5 ? 0.6 : vColor.a * t.a;
-				gl_FragColor = vec4( vColor.rgb * t.rgb, a );
-				#include <colorspace_fragment>
-			}`,
-	} );
-	material.userData.source = source;
-	return material;
-}
+// Particles and billboards as fishgen view draws them (fishgen/web/cloudlight.js).
+const particleMaterial = makeParticleMaterial();
 
 // Transparent things are drawn farthest first: each primitive's centroid, sorted along the view.
 class Sorted {

@@ -6,7 +6,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { PLYLoader } from 'three/addons/loaders/PLYLoader.js';
 import { OBJLoader } from 'three/addons/loaders/OBJLoader.js';
 import { MTLLoader } from 'three/addons/loaders/MTLLoader.js';
-import { SECOND_PASS, cloudUniforms, readCloudLight } from '../web/cloudlight.js';
+import { billboardMaterial, particleMaterial as makeParticleMaterial, readCloudLight } from '../web/cloudlight.js';
 
 const state = window.fishgenViewer = {
 	loaded: false, error: null, time: 0, clip: null, clips: [], playing: false,
@@ -61,71 +61,9 @@ function readLight( extras ) {
 	return sun ? { sun: sun.toArray() } : null;
 }
 
-// Particles: each a soft disc of its world radius (`_radius`, fishgen's _RADIUS / PLY radius),
-// with the billboard sprite's Gaussian profile, drawn farthest first.
-const particleMaterial = new THREE.ShaderMaterial( {
-	uniforms: { viewportHeight: { value: 1 }, ...cloudUniforms },
-	vertexColors: true, transparent: true, depthWrite: false,
-	vertexShader: /* glsl */`
-		attribute float _radius;
-		attribute float _density;
-		attribute float _light;
-		uniform float viewportHeight;
-		varying vec3 vColor;
-		varying float vAlpha;
-		${ SECOND_PASS }
-		void main() {
-			vec4 world = modelMatrix * vec4( position, 1.0 );
-			vec4 mv = viewMatrix * world;
-			gl_Position = projectionMatrix * mv;
-			gl_PointSize = 2.0 * _radius * projectionMatrix[ 1 ][ 1 ] * 0.5 * viewportHeight / max( - mv.z, 1e-4 );
-			vColor = ( cloudLit && _light >= 0.0 ) ? scattered( _light, world.xyz ) : color;
-			vAlpha = 0.7 * clamp( _density, 0.0, 1.0 );
-		}`,
-	fragmentShader: /* glsl */`
-		varying vec3 vColor;
-		varying float vAlpha;
-		void main() {
-			vec2 p = gl_PointCoord * 2.0 - 1.0;
-			float r2 = dot( p, p );
-			if ( r2 > 1.0 ) discard;
-			float a = vAlpha * max( ( exp( - r2 / 0.32 ) - 0.04394 ) / 0.95606, 0.0 );
-			gl_FragColor = vec4( vColor, a );
-			#include <colorspace_fragment>
-		}`,
-} );
-
-// fishgen's billboards (three crossed quads a particle, or a texture cloud's): the second pass
-// too, the texture's colour and alpha times the vertex alpha, their triangles drawn farthest first.
-const WHITE = new THREE.DataTexture( new Uint8Array( [ 255, 255, 255, 255 ] ), 1, 1 );
-WHITE.needsUpdate = true;
-
-function billboardMaterial( source ) {
-	return new THREE.ShaderMaterial( {
-		uniforms: { map: { value: source.map || WHITE }, ...cloudUniforms },
-		vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide,
-		vertexShader: /* glsl */`
-			attribute float _light;
-			varying vec2 vUv;
-			varying vec4 vColor;
-			${ SECOND_PASS }
-			void main() {
-				vec4 world = modelMatrix * vec4( position, 1.0 );
-				gl_Position = projectionMatrix * viewMatrix * world;
-				vUv = uv;
-				vColor = vec4( ( cloudLit && _light >= 0.0 ) ? scattered( _light, world.xyz ) : color.rgb, color.a );
-			}`,
-		fragmentShader: /* glsl */`
-			uniform sampler2D map;
-			varying vec2 vUv;
-			varying vec4 vColor;
-			void main() {
-				vec4 t = texture2D( map, vUv );
-				gl_FragColor = vec4( vColor.rgb * t.rgb, vColor.a * t.a );
-				#include <colorspace_fragment>
-			}`,
-	} );
-}
+// Particles and billboards as fishgen edit draws them too (fishgen/web/cloudlight.js); drawn
+// farthest first.
+const particleMaterial = makeParticleMaterial();
 
 const sorted = [];   // [object, centroids (Float32Array xyz per primitive), base index (Uint32Array), size]
 
