@@ -101,8 +101,8 @@ def test_a_broken_fit_is_not_written(tmp_path, gl_available, photos, monkeypatch
     bream = load_species(PARAMS / "bonybream.txt")
     real = fit_module.fit_species
 
-    def broken(base, mask, sections_fixed=False):
-        fit = real(base, mask, sections_fixed)
+    def broken(base, mask, sections_fixed=False, turn=0.0):
+        fit = real(base, mask, sections_fixed, turn)
         c = fit.species.caudal
         return replace(fit, species=replace(fit.species, caudal=replace(c, connection=(1.1, 0.0, 0.0))))
 
@@ -114,6 +114,44 @@ def test_a_broken_fit_is_not_written(tmp_path, gl_available, photos, monkeypatch
     assert any(n.startswith("fitted shape not kept: the caudal fin is off the tail") for n in notes)
     written = load_species(tmp_path / "new.txt")
     assert (written.shape_class, written.scale, written.caudal) == (bream.shape_class, bream.scale, bream.caudal)
+
+
+def test_a_poor_fit_is_tried_at_other_levels(tmp_path, gl_available, photos, monkeypatch):
+    """A fish photographed turned has no one true level: when the fit at the measured level matches
+    under TURN_GOOD, the photo is turned a few degrees further and fitted again, until one matches
+    that well, and the best is kept (its frame turned with it) and named in a note."""
+    from fishgen.authoring.photo import fit as fit_module
+    from fishgen.authoring.photo import run as run_module
+
+    species, photo = photos["pineapplefish"]
+    photo.save(tmp_path / "p.png")
+    real, real_rendered = fit_module.fit_species, run_module._rendered
+    turns: list[float] = []
+    shapes: list[tuple] = []
+
+    def recorded(base, mask, sections_fixed=False, turn=0.0):
+        turns.append(turn)
+        fit = real(base, mask, sections_fixed, turn)
+        shapes.append((fit.species.shape_params, fit.species.scale))
+        return fit
+
+    # as the renders would measure a turned fish: poor at its measured level, good 4 degrees on
+    scores = {0.0: 0.80, 4.0: 0.90}
+
+    def rendered(photo_, candidate, out):
+        render, iou = real_rendered(photo_, candidate, out)
+        fitted = bool(shapes) and (candidate.species.shape_params, candidate.species.scale) == shapes[-1]
+        return render, (scores[turns[-1]] if fitted else 0.5)
+
+    monkeypatch.setattr(fit_module, "fit_species", recorded)
+    monkeypatch.setattr(run_module, "_rendered", rendered)
+    notes: list[str] = []
+    result = make_texture(tmp_path / "p.png", species, tmp_path / "new.txt", TextureOptions(fit_shape=True),
+                          notes.append)
+    assert turns == [0.0, 4.0]          # 0.90 is good enough: no more levels tried
+    assert result.fitted and result.shape_fit.turn == 4.0
+    assert abs(result.frame.angle - real(species, photo.rgba[:, :, 3] >= 64).frame.angle - 4.0) < 1e-6
+    assert any("turned +4 degrees" in n for n in notes)
 
 
 def test_plain_texture_advises_fit_shape_below_085(tmp_path, gl_available, photos):

@@ -17,6 +17,9 @@ from fishgen.authoring.photo.sideview import SideView, rasterize
 
 #: How far in from the ends the tail base is looked for, as a share of the fish's length.
 TAIL_SEARCH = 0.4
+#: ...and never in the last this share of it: a neck there is a caudal lobe's 1-px thread (or a gap
+#: in it) beside the other lobe, not the peduncle.
+TAIL_END = 0.05
 #: The snout, as a share of the body length from the nose: never taken for fin.
 SNOUT = 0.1
 #: An outline column stands out as fin when it exceeds the body model by this share (+ 1.5 px).
@@ -50,6 +53,7 @@ def nose_and_tail_base(mask: np.ndarray, rows: np.ndarray | None = None,
     depth = columns.neck_depth(thick)
     lo = x0 + int(TAIL_SEARCH * length)
     depth[:lo] = 0.0
+    depth[x_end + 1 - int(TAIL_END * length):] = 0.0
     ped = int(np.argmax(depth))
     tip = slice(x0, x0 + max(2, int(0.01 * length)))
     nose = np.array([float(x0), float(np.nanmean((top[tip] + bottom[tip]) / 2))])

@@ -79,6 +79,7 @@ class ShapeFit:
     work: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((1, 1), bool))
     frame: Any = field(default=None, repr=False)              # the levelled frame (:class:`.frame.Frame`)
     frame_map: tuple[float, float, float, float] | None = None   # thesis -> frame: x0, y0, x scale, y scale
+    turn: float = 0.0          # degrees the measured level was turned before fitting
 
 
 @dataclass(frozen=True)
@@ -96,11 +97,12 @@ def fit_shape(base: Species, mask: np.ndarray) -> Species:
     return fit_species(base, mask).species
 
 
-def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False) -> ShapeFit:
-    """Fit ``base``'s geometry to the silhouette ``mask`` (any orientation; it is levelled here)."""
-    from fishgen.authoring.photo.frame import fish_frame
+def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False, turn: float = 0.0) -> ShapeFit:
+    """Fit ``base``'s geometry to the silhouette ``mask`` (any orientation; it is levelled here,
+    then turned ``turn`` degrees further: see :data:`.run.TURNS`)."""
+    from fishgen.authoring.photo.frame import fish_frame, turned
 
-    frame = fish_frame(mask)
+    frame = turned(mask, fish_frame(mask), turn)
     work, to_frame, offset = _working_mask(frame.mask)
     body = _measure_body(work)
     base = replace(base, texture_points=None, colour_texture=None, mask_texture=None)
@@ -122,7 +124,7 @@ def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False) -
     p = fit.species.pelvic
     if p.start_length == 0 and p.end_length == 0 and (base.pelvic.start_length or base.pelvic.end_length):
         notes.append("no pelvic fin in the photo: kept at zero size (a species file cannot leave it out)")
-    fit = replace(fit, notes=tuple(notes))
+    fit = replace(fit, notes=tuple(notes), turn=turn)
     if fit.species.body_sections != base.body_sections:
         fit = replace(fit, notes=fit.notes + (
             f"BodySections {base.body_sections} -> {fit.species.body_sections}: the base's rings "

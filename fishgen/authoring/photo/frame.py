@@ -96,6 +96,17 @@ def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
     return Frame(linear, shift, out, phi, mirrored)
 
 
+def turned(mask: np.ndarray, frame: Frame, degrees: float) -> Frame:
+    """``frame`` (of ``mask``) turned ``degrees`` further, counter-clockwise in the frame."""
+    if degrees == 0.0:
+        return frame
+    linear = _rotation(-degrees) @ frame.linear
+    out, shift = _resample(mask, linear)
+    # R(-d) F = F R(d) for the mirror F: a mirrored fish's turn on the photo is the other way
+    angle = frame.angle - degrees if frame.mirrored else frame.angle + degrees
+    return Frame(linear, shift, out, angle, frame.mirrored)
+
+
 def _neck(mask: np.ndarray) -> float:
     """The deepest neck near either end of the silhouette, column by column (a tail's peduncle)."""
     _, _, has = columns.extent(mask)

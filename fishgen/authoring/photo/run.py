@@ -25,6 +25,13 @@ from fishgen.species.model import PectoralFin, PelvicFin, Species, TexturePoints
 MAX_TEXTURE_SIDE = 4096
 #: Below this silhouette IoU the rebuilt fish does not look like the photographed one: say so.
 ADVICE_IOU = 0.85
+#: --fit-shape: a fish photographed turned off side-on has no one true level (its nose-to-tail line
+#: is foreshortened, its far fins show): when the fit at the measured level matches under TURN_GOOD,
+#: it is tried again with the photo turned these degrees further, in order, until one matches that
+#: well; a level is kept only when its rebuilt fish matches at least TURN_GAIN better.
+TURNS = (4.0, -4.0, 2.0, -2.0)
+TURN_GOOD = 0.87
+TURN_GAIN = 0.01
 
 
 @dataclass(frozen=True)
@@ -243,19 +250,38 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         from fishgen.authoring.photo.checks import fit_problems
         from fishgen.authoring.photo.fit import fit_species
 
-        fit = fit_species(base, sil.mask, sections_fixed=options.body_sections is not None)
-        problems = fit_problems(fit.species, fit.work, fit.placement)
-        if problems:
+        tried: tuple[np.ndarray, float] | None = None
+        chosen_fit: tuple[_Candidate, Any] | None = None
+        for turn in (0.0, *TURNS):
+            if tried is not None and tried[1] >= TURN_GOOD:
+                break
+            attempt = fit_species(base, sil.mask, sections_fixed=options.body_sections is not None, turn=turn)
+            found = fit_problems(attempt.species, attempt.work, attempt.placement)
+            if turn == 0.0:
+                fit, problems = attempt, found
+            if found:
+                continue
+            candidate = _candidate(photo, sil.mask, attempt.species, out, options, imported, textures,
+                                   attempt)
+            rendered = _rendered(photo, candidate, out)
+            # another level is kept only for a clear gain: the renders differ by a little anyway
+            if tried is None or rendered[1] >= tried[1] + TURN_GAIN:
+                tried, chosen_fit, fit, problems = rendered, (candidate, attempt), attempt, []
+        if chosen_fit is None:
             # A broken fish is never written: the base's geometry stays, and the command says why.
             note(f"fitted shape not kept: {problems[0]}")
         else:
-            candidate = _candidate(photo, sil.mask, fit.species, out, options, imported, textures, fit)
+            candidate, kept = chosen_fit
+            assert tried is not None
             # Keep the fit only if the rebuilt fish matches the photo better than the base's geometry.
-            shown, tried = (_rendered(photo, c, out) for c in (chosen, candidate))
+            shown = _rendered(photo, chosen, out)
             iou_base, iou_fit = shown[1], tried[1]
             if iou_fit >= iou_base:
                 note(f"fitted shape: silhouette IoU {iou_base:.3f} with the base's geometry -> {iou_fit:.3f}")
-                for line in fit.notes:
+                if kept.turn:
+                    note(f"note: the photographed fish is taken as turned {kept.turn:+.0f} degrees from "
+                         "its nose-to-tail line (it is not side-on): that level matched best")
+                for line in kept.notes:
                     note(f"note: {line}")
                 chosen, shown, fitted = candidate, tried, True
             else:

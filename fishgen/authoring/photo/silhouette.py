@@ -21,6 +21,7 @@ MIN_FISH_FRACTION = 0.002  # of the frame; less is "no fish"
 SECOND_OBJECT = 0.25       # a second blob this big relative to the fish is "several objects"
 NOISE_SIGMAS = 5.0         # colour distance, in border standard deviations, that is surely not background
 MIN_CONTRAST = 20.0        # ... and never less than this (0-255 units), for flat synthetic backgrounds
+THREAD_REACH = 6           # px: how near the fish a fin's thread is judged against its contrast
 
 
 @dataclass(frozen=True)
@@ -39,13 +40,41 @@ def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None,
         raw, source = photo.alpha >= ALPHA_CUTOFF, "alpha"
     else:
         raw, source = background_model_mask(photo.rgb), "background model"
-    return Silhouette(_one_fish(raw, photo, source), source)
+    fish = _one_fish(raw, photo, source)
+    if source == "background model":
+        fish |= _slivers(thread_mask(photo.rgb, fish) & ~fish, fish)
+    return Silhouette(fish, source)
 
 
 def background_model_mask(rgb: np.ndarray) -> np.ndarray:
     """Pixels whose colour the border's planar colour model does not explain."""
-    h, w = rgb.shape[:2]
     img = ndimage.uniform_filter(rgb.astype(np.float32), size=(3, 3, 1))   # float32 halves the memory
+    contrast, distance = _off_backdrop(img)
+    raw = (distance > NOISE_SIGMAS) & (contrast > MIN_CONTRAST)
+    # The outline's own pixels are partly fish: keep one when it carries at least half the
+    # contrast of the solid fish just inside it -- the 50 % line of an anti-aliased or
+    # JPEG-smeared edge rather than its faint halo. Only that one rim layer is judged, so
+    # a pale patch beside a dark one inside the fish (an eye) is never cut out.
+    core = ndimage.binary_erosion(raw, structure=np.ones((3, 3), bool))
+    inside = ndimage.maximum_filter(np.where(core, contrast, 0.0), size=5)
+    rim = raw & ~core
+    return core | (rim & ((contrast >= 0.5 * inside) | (inside == 0)))
+
+
+def thread_mask(rgb: np.ndarray, fish: np.ndarray) -> np.ndarray:
+    """Pixels of the unfiltered photo that stand out from the backdrop as surely as the fish's do
+    and carry at least half the contrast of the fish near them (``fish``: within THREAD_REACH px):
+    a fin's last 1-px thread, which the box filter before :func:`background_model_mask` averages
+    into the backdrop, and not the faint halo round an anti-aliased edge."""
+    contrast, distance = _off_backdrop(rgb.astype(np.float32))
+    near = ndimage.maximum_filter(np.where(fish, contrast, 0.0), size=2 * THREAD_REACH + 1)
+    return (distance > NOISE_SIGMAS) & (contrast > MIN_CONTRAST) & (contrast >= 0.5 * near)
+
+
+def _off_backdrop(img: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(contrast, distance) of every pixel from the border's planar colour model: the colour
+    difference in 0-255 units, and in the border's own standard deviations."""
+    h, w = img.shape[:2]
     b = max(2, round(0.02 * min(h, w)))
     border = np.zeros((h, w), bool)
     border[:b], border[-b:], border[:, :b], border[:, -b:] = True, True, True, True
@@ -65,16 +94,7 @@ def background_model_mask(rgb: np.ndarray) -> np.ndarray:
     contrast = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
     scaled = diff / mad.astype(np.float32)
     distance = np.sqrt(np.einsum("ijk,ijk->ij", scaled, scaled))
-    del diff, scaled
-    raw = (distance > NOISE_SIGMAS) & (contrast > MIN_CONTRAST)
-    # The outline's own pixels are partly fish: keep one when it carries at least half the
-    # contrast of the solid fish just inside it -- the 50 % line of an anti-aliased or
-    # JPEG-smeared edge rather than its faint halo. Only that one rim layer is judged, so
-    # a pale patch beside a dark one inside the fish (an eye) is never cut out.
-    core = ndimage.binary_erosion(raw, structure=np.ones((3, 3), bool))
-    inside = ndimage.maximum_filter(np.where(core, contrast, 0.0), size=5)
-    rim = raw & ~core
-    return core | (rim & ((contrast >= 0.5 * inside) | (inside == 0)))
+    return contrast, distance
 
 
 def _mask_file(path: str | os.PathLike, size: tuple[int, int], work: tuple[int, int]) -> np.ndarray:
@@ -116,6 +136,8 @@ def _one_fish(raw: np.ndarray, photo: Photo, source: str) -> np.ndarray:
     closed = labels == order[0] + 1
     holes = ndimage.binary_fill_holes(closed) & ~closed
     fish = ndimage.binary_fill_holes((clean & closed) | holes)
+    if source != "alpha":
+        fish = fish | _slivers(raw & ~fish, fish)
     edges = {"top": fish[0].sum(), "bottom": fish[-1].sum(), "left": fish[:, 0].sum(),
              "right": fish[:, -1].sum()}
     cut = [name for name, n in edges.items() if n >= 2]
@@ -123,6 +145,21 @@ def _one_fish(raw: np.ndarray, photo: Photo, source: str) -> np.ndarray:
         raise FishgenError(f"expected the whole fish inside the frame, found it cut off at the "
                            f"{' and '.join(cut)} edge{'s' if len(cut) > 1 else ''}", photo.path)
     return fish
+
+
+def _slivers(dropped: np.ndarray, fish: np.ndarray) -> np.ndarray:
+    """What the opening took off the fish and belongs to it: runs of ``dropped`` touching ``fish``.
+    A fin seen almost edge-on, or the tapering tip of a long fin, is 1-2 px wide, and the opening
+    that clears sensor noise clears it too; yet its tip sets the fish's height, which every
+    measure normalises by. A speck of noise touching the outline comes back with it, but adds a
+    pixel, not a fin."""
+    labels, count = ndimage.label(dropped, structure=np.ones((3, 3), bool))
+    if count == 0:
+        return dropped
+    # within two pixels: where a thread leaves its fin the two may blur apart by a pixel
+    rim = ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=2) & dropped
+    touching = np.unique(labels[rim])
+    return np.isin(labels, touching[touching > 0])
 
 
 def _hint(source: str) -> str:

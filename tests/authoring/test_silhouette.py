@@ -1,0 +1,61 @@
+"""The silhouette cut from a photo's backdrop keeps thin fins: their tips set the fish's size."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from PIL import Image, ImageDraw
+
+from fishgen.authoring.photo.image import Photo
+from fishgen.authoring.photo.silhouette import silhouette
+
+SIZE = (400, 240)
+FISH = np.array([220.0, 200.0, 150.0])
+
+
+def _photo(fin: float = 0.45, with_speck: bool = False, noise: float = 0.0) -> Photo:
+    """A pale fish on a vertical water-like gradient: an ellipse body and, above its back, a fin
+    (``fin``: its opacity over the backdrop) tapering from 12 px to a 1-px thread reaching row 40."""
+    w, h = SIZE
+    ys = np.linspace(0.0, 1.0, h)[:, None, None]
+    top, bottom = np.array([60.0, 140.0, 170.0]), np.array([20.0, 60.0, 110.0])
+    rgb = (top * (1 - ys) + bottom * ys) * np.ones((1, w, 1))
+    body, fin_layer = Image.new("L", SIZE, 0), Image.new("L", SIZE, 0)
+    ImageDraw.Draw(body).ellipse((100, 100, 300, 160), fill=255)
+    pen = ImageDraw.Draw(fin_layer)
+    pen.polygon([(180, 105), (192, 105), (187, 80)], fill=255)
+    pen.line([(187, 80), (196, 40)], fill=255, width=1)
+    if with_speck:
+        ImageDraw.Draw(body).rectangle((40, 40, 41, 41), fill=255)
+    on_fin = (np.asarray(fin_layer) > 0)[:, :, None]
+    rgb = np.where(on_fin, rgb + fin * (FISH - rgb), rgb)
+    rgb = np.where((np.asarray(body) > 0)[:, :, None], FISH, rgb)
+    if noise:
+        rgb += np.random.default_rng(3).normal(0.0, noise, rgb.shape)
+    return Photo(np.clip(rgb, 0, 255).astype(np.uint8), None, Path("photo.png"))
+
+
+def _top(mask: np.ndarray) -> int:
+    return int(np.flatnonzero(mask.any(axis=1))[0])
+
+
+def test_a_thread_thin_fin_tip_stays_on_the_fish():
+    """The noise-clearing opening takes off anything under 3 px wide; a fin's 1-px thread touching
+    the fish comes back, so the silhouette reaches the tip's row."""
+    mask = silhouette(_photo(fin=0.45)).mask
+    assert _top(mask) <= 43, f"the fin's tip (row 40) was cut at row {_top(mask)}"
+    assert mask[41:80].sum() >= 30     # the thread itself, not one stray pixel
+
+
+def test_a_faint_thread_the_box_filter_averages_away_stays_too():
+    """A translucent fin's thread has a third of its contrast after the 3x3 box filter, under the
+    backdrop's threshold; judged on the photo's own pixels it is still the fish's."""
+    mask = silhouette(_photo(fin=0.28)).mask
+    assert _top(mask) <= 43, f"the faint fin's tip (row 40) was cut at row {_top(mask)}"
+
+
+def test_specks_apart_from_the_fish_stay_out():
+    mask = silhouette(_photo(with_speck=True, noise=4.0)).mask
+    assert not mask[30:50, 30:50].any()
+    ys, xs = np.nonzero(mask)
+    assert xs.min() >= 98 and xs.max() <= 302 and ys.max() <= 162
