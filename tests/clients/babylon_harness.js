@@ -84,6 +84,8 @@ function meshInfo(mesh) {
     enabled: mesh.isEnabled(), visible: mesh.isVisible,
     world: boxOf(positions, world), local: boxOf(positions, null), targets,
     morphManager: mtm ? mtm.uniqueId : null,
+    targetNames: mtm ? Array.from({ length: mtm.numTargets }, (_, i) => mtm.getTarget(i).name) : [],
+    bones: source.skeleton ? source.skeleton.bones.map((b) => (b.getTransformNode() || b).name) : null,
     material: materialInfo(mesh.material),
   };
 }
