@@ -62,6 +62,15 @@ class BabylonClient(HarnessPage):
         self.page.wait_for_timeout(50)  # let late console messages and responses land
         return result
 
+    def append(self, asset: Asset) -> dict:
+        """Babylon.js's report of ``asset`` loaded by AppendSceneAsync (a whole scene, no container)."""
+        self._clear()
+        url = f"{self.base}/assets/{asset.path.resolve().relative_to(self.asset_dir).as_posix()}"
+        result = self.page.evaluate("(u) => window.appendAsset(u)", url)
+        expect("error" not in result, f"loader error: {result.get('error')}")
+        expect(not self._problems(), "; ".join(self._problems()[:3]))
+        return result
+
     def screenshot(self, path: Path, alpha: float, beta: float) -> None:
         """The asset inspected last, seen from (alpha, beta) radians about its centre, as a PNG."""
         self.page.evaluate("([a, b]) => window.viewFrom(a, b)", [alpha, beta])

@@ -198,4 +198,17 @@ window.viewFrom = (alpha, beta) => {
   camera.beta = beta;
   scene.render();
 };
+// The way a scene is loaded whole: AppendSceneAsync into a fresh scene; each mesh and its material.
+window.appendAsset = async (url) => {
+  try {
+    if (scene) scene.dispose();
+    scene = new BABYLON.Scene(engine);
+    await BABYLON.AppendSceneAsync(url, scene);
+    const meshes = scene.meshes.filter((m) => m.getTotalVertices() > 0);
+    const settled = await texturesSettled(meshes);
+    return { settled, meshes: meshes.map((m) => ({ name: m.name, path: pathOf(m), material: materialInfo(m.material) })) };
+  } catch (e) {
+    return { error: String(e && e.message ? e.message : e) };
+  }
+};
 window.harnessReady = true;
