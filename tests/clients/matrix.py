@@ -220,7 +220,6 @@ def _scenes() -> dict[str, Scene]:
     species = fishgen.load_species(FISH_SOURCE)
     return {"fish": fishgen.build_fish(species),
             "engine": make_fish(species, lods=ENGINE_LODS, merge=True, clips=ENGINE_CLIPS).scene,
-            "engine school": make_fish(species, lods=ENGINE_LODS, merge=True).scene,
             "points": cloud_scene(cloud), "billboards": cloud_scene(cloud, billboards=True)}
 
 
@@ -253,9 +252,7 @@ def make_assets(folder: Path) -> dict[str, Asset]:
         assets = {a.label: a for a in (job.result() for job in jobs)}
     points = scenes["points"].counts()
     for a in assets.values():
-        fish_scene = scenes["engine" if a.fmt.engine else "fish"]
-        if a.fmt.kind == "school" and a.fmt.engine:
-            fish_scene = scenes["engine school"]
+        fish_scene = scenes["engine" if a.fmt.engine else "fish"]   # a school's fish: the same levels
         fish = fish_scene.counts()
         if a.fmt.kind == "fish":
             if a.reported.get("triangles") != fish["triangles"]:
