@@ -65,7 +65,9 @@ def _bpy_python(explicit: str | None) -> str | None:
 
 def _judge_blender(asset: Asset, r: dict) -> str:
     expect("error" not in r, f"import failed: {r.get('error')}")
-    meshes = [o for o in r["objects"] if o["type"] == "MESH"]
+    # what the scene shows: not the coarser levels (an excluded collection), nor the importer's bone shapes
+    meshes = [o for o in r["objects"]
+              if o["type"] == "MESH" and o.get("visible", True) and not o.get("bone_shape")]
     expect(bool(meshes), "no mesh objects")
     exp = asset.expected
     tris = sum(o["triangles"] for o in meshes)
@@ -96,7 +98,9 @@ def _judge_blender(asset: Asset, r: dict) -> str:
         notes.append("point attrs " + ", ".join(sorted(want)))
     if "--billboards" in asset.fmt.flags:
         expect(tris == 2 * exp["quads"], "quads != particles")
-    if asset.fmt.kind == "fish" and asset.fmt.ext in ("glb", "gltf"):
+    if asset.engine is not None:
+        notes += _judge_blender_engine(asset, r, meshes)
+    elif asset.fmt.kind == "fish" and asset.fmt.ext in ("glb", "gltf"):
         swim = [a for a in r["actions"] if a["name"].startswith("swim")]
         expect(bool(swim), f"no swim action (actions: {[a['name'] for a in r['actions']]})")
         animated = [o["name"] for o in r["objects"] if (o.get("action") or "").startswith("swim")]
@@ -107,6 +111,26 @@ def _judge_blender(asset: Asset, r: dict) -> str:
         notes.append(f"action swim: {swim[0]['channels']} F-curves on {len(animated)} fins; "
                      f"4 shape keys animated on {len(waving)} meshes")
     return "; ".join(notes)
+
+
+def _judge_blender_engine(asset: Asset, r: dict, meshes: list[dict]) -> list[str]:
+    """An engine fish: the finest level shown, skinned by an armature, its shape keys fishgen's
+    targets, and an action for each clip."""
+    engine = asset.engine
+    assert engine is not None
+    hidden = [o["name"] for o in r["objects"] if o["type"] == "MESH" and not o.get("visible", True)
+              and not o.get("bone_shape")]
+    expect(len(hidden) == len(engine.levels) - 1,
+           f"{len(hidden)} hidden meshes, expected one a coarser level")
+    for o in meshes:
+        expect(o.get("armature") is not None, f"{o['name']}: no armature modifier")
+        expect(o.get("shape_keys") == len(engine.targets), f"{o['name']}: {o.get('shape_keys')} shape keys, "
+                                                            f"fishgen made {len(engine.targets)}")
+    names = {a["name"] for a in r["actions"]}
+    missing = [c for c in engine.clips if not any(n == c or n.startswith(f"{c}_") for n in names)]
+    expect(not missing, f"no action for {missing} (actions: {sorted(names)})")
+    return [f"LOD0 shown, {len(hidden)} coarser level(s) in an excluded collection",
+            f"actions {', '.join(engine.clips)}"]
 
 
 def run_blender(assets: dict[str, Asset], bpy_python: str) -> tuple[dict, str]:

@@ -19,9 +19,11 @@ import json
 from pathlib import Path
 
 from tests.clients.bounds import (
+    ClipBounds,
     ClipTruth,
     as_box,
     box_close,
+    clip_bounds,
     expect_same_keys,
     key_errors,
     pair_primitives,
@@ -58,6 +60,15 @@ class BabylonClient(HarnessPage):
         result = json.loads(self.page.evaluate("async ([u, o]) => JSON.stringify(await window.inspectAsset(u, o))",
                                                [url, {}]))
         self.page.wait_for_timeout(50)  # let late console messages and responses land
+        return result
+
+    def append(self, asset: Asset) -> dict:
+        """Babylon.js's report of ``asset`` loaded by AppendSceneAsync (a whole scene, no container)."""
+        self._clear()
+        url = f"{self.base}/assets/{asset.path.resolve().relative_to(self.asset_dir).as_posix()}"
+        result = self.page.evaluate("(u) => window.appendAsset(u)", url)
+        expect("error" not in result, f"loader error: {result.get('error')}")
+        expect(not self._problems(), "; ".join(self._problems()[:3]))
         return result
 
     def screenshot(self, path: Path, alpha: float, beta: float) -> None:
@@ -112,7 +123,9 @@ def judge(asset: Asset, r: dict) -> str:
             expect(len(found) == len(want), f"{m['path']}: {len(found)} morph targets, fishgen made {len(want)}")
             for k, (a, b) in enumerate(zip(found, want, strict=True)):
                 expect(box_close(a, b, tol), f"{m['path']}: morph target {k} bounds {show(a)}, fishgen's {show(b)}")
-    if asset.clip:
+    if asset.engine is not None:
+        notes += _judge_engine(asset, r, tol)
+    elif asset.clip:
         notes += _judge_clip(asset, r, tol)
 
     # every texture arrives, and the materials say what fishgen's say
@@ -138,28 +151,80 @@ def judge(asset: Asset, r: dict) -> str:
     return "; ".join(notes)
 
 
-def _judge_clip(asset: Asset, r: dict, tol: float) -> list[str]:
+def _judge_engine(asset: Asset, r: dict, tol: float) -> list[str]:
+    """An engine row: the finest level only (Babylon's MSFT_lod loader loads the levels coarsest
+    first and disposes each when the next is ready), every mesh skinned on the skin's joints with
+    every blend shape by name, and every clip checked as the plain fish's swim is."""
+    engine, bounds = asset.engine, asset.bounds
+    assert engine is not None and bounds is not None and bounds.scene is not None
+    coarse = sorted({m["path"] for m in r["meshes"]
+                     if any(engine.level(part) > 0 for part in m["path"].split("/"))})
+    expect(not coarse, f"coarser levels shown: {coarse[:3]}")
+    for m in r["meshes"]:
+        expect(m["bones"] is not None, f"{m['path']}: no skeleton")
+        expect(engine.same_joints(m["bones"]), f"{m['path']}: bones {m['bones']}, the skin's joints are "
+                                               f"{list(engine.joints)}")
+        expect(m["targetNames"] == list(engine.targets), f"{m['path']}: morph targets {m['targetNames']}, "
+                                                         f"fishgen's {list(engine.targets)}")
+    names = [g["name"] for g in r["groups"]]
+    missing = [c for c in engine.clips if c not in names]
+    expect(not missing, f"animation groups missing: {missing} (found {names})")
+    dangling = 0
+    for name in engine.clips:
+        clip = clip_bounds(bounds.scene, name)
+        dangling = max(dangling, len(_judge_clip(asset, r, tol, clip, lods=len(engine.levels))))
+    return [f"MSFT_lod: LOD0 kept{f', {dangling} weight tracks of disposed LOD1+ left' if dangling else ''}"]
+
+
+def _judge_clip(asset: Asset, r: dict, tol: float, clip: ClipBounds | None = None, lods: int = 1) -> list:
+    """The clip (asset.clip's, else ``clip``) is there, a track per channel and morph target, each
+    bound and each key fishgen's. With ``lods`` levels, the morph weight tracks of all but the finest
+    may target nothing (meshes a client disposed): they are returned, the rest checked."""
     assert asset.clip is not None and asset.bounds is not None and asset.bounds.clip is not None
-    name, _ = asset.clip
-    clip = asset.bounds.clip
+    clip = clip or asset.bounds.clip
+    name = clip.name
     groups = [g for g in r["groups"] if g["name"] == name]
     expect(bool(groups), f"no animation group named {name} (found {[g['name'] for g in r['groups']]})")
     group = groups[0]
-    want = clip.rotation_channels + clip.translation_channels + clip.scale_channels + clip.weight_tracks
+    # Babylon makes a mesh of each primitive, with its own morph targets: a weights track for each
+    per_mesh = asset.engine.primitives if asset.engine is not None else 1
+    weights = clip.weight_tracks * per_mesh
+    want = clip.rotation_channels + clip.translation_channels + clip.scale_channels + weights
     expect(len(group["tracks"]) == want, f"{name} has {len(group['tracks'])} tracks, expected {want} "
-                                         f"({clip.weight_channels} weights channels x their morph targets)")
-    unbound = [t["node"] or t["property"] for t in group["tracks"] if not t["inScene"]]
+                                         f"({clip.weight_channels} weights channels x their morph targets"
+                                         f"{f' x {per_mesh} primitives' if per_mesh > 1 else ''})")
+    dangling = [t for t in group["tracks"]
+                if not t["inScene"] and t["property"] == "influence" and t["node"] is None]
+    if lods > 1:  # the coarser levels' weights tracks, at most: (lods - 1) / lods of them
+        expect(len(dangling) * lods <= weights * (lods - 1), f"{name}: {len(dangling)} weight tracks "
+                                                                        f"target nothing")
+    else:
+        dangling = []
+    live = [t for t in group["tracks"] if t not in dangling]
+    unbound = [t["node"] or t["property"] for t in live if not t["inScene"]]
     expect(not unbound, f"tracks target nothing in the scene: {unbound[:3]}")
     length = (group["to"] - group["from"]) / group["fps"]
     expect(abs(length - clip.duration) < 1e-3, f"{name} lasts {length:.4f} s, fishgen's {clip.duration:.4f} s")
     assert asset.bounds.scene is not None
     truth = ClipTruth(asset.bounds.scene, name)
-    tracks = [{"node": t["node"], "kind": "weight" if t["property"] == "influence" else "trs",
-               "target": t["target"], "keys": t["keys"]} for t in group["tracks"]]
+    tracks = [{"node": _node_of(t["node"]), "kind": "weight" if t["property"] == "influence" else "trs",
+               "target": t["target"], "keys": t["keys"]} for t in live]
     expect_same_keys(key_errors(truth, tracks), tol)
-    played = key_errors(truth, [{**k, "keys": t["played"]} for k, t in zip(tracks, group["tracks"], strict=True)])
-    expect(played.weight < 1e-3, f"plays morph weights off by {played.weight:.3g} ({played.worst['weight']})")
+    played = key_errors(truth, [{**k, "keys": t["played"]} for k, t in zip(tracks, live, strict=True)])
+    expect(played.weight < 1e-3,
+           f"plays morph weights off by {played.weight:.3g} ({played.worst.get('weight')})")
     expect(played.translation < 1e-4 and played.rotation < 0.1,
            f"plays nodes off by {played.translation * 1000:.2f} mm, {played.rotation:.2f}° "
            f"({played.worst.get('translation') or played.worst.get('rotation')})")
-    return []
+    return dangling
+
+
+def _node_of(path: str) -> str:
+    """The glTF node a Babylon mesh path stands for: a node of several primitives becomes a parent
+    with a child mesh per primitive, ``node/node_primitive0``."""
+    import re
+
+    parts = path.split("/")
+    if len(parts) > 1 and re.fullmatch(rf"{re.escape(parts[-2])}_primitive\d+", parts[-1]):
+        parts.pop()
+    return "/".join(parts)

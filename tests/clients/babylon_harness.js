@@ -84,6 +84,8 @@ function meshInfo(mesh) {
     enabled: mesh.isEnabled(), visible: mesh.isVisible,
     world: boxOf(positions, world), local: boxOf(positions, null), targets,
     morphManager: mtm ? mtm.uniqueId : null,
+    targetNames: mtm ? Array.from({ length: mtm.numTargets }, (_, i) => mtm.getTarget(i).name) : [],
+    bones: source.skeleton ? source.skeleton.bones.map((b) => (b.getTransformNode() || b).name) : null,
     material: materialInfo(mesh.material),
   };
 }
@@ -195,5 +197,18 @@ window.viewFrom = (alpha, beta) => {
   camera.alpha = alpha;
   camera.beta = beta;
   scene.render();
+};
+// The way a scene is loaded whole: AppendSceneAsync into a fresh scene; each mesh and its material.
+window.appendAsset = async (url) => {
+  try {
+    if (scene) scene.dispose();
+    scene = new BABYLON.Scene(engine);
+    await BABYLON.AppendSceneAsync(url, scene);
+    const meshes = scene.meshes.filter((m) => m.getTotalVertices() > 0);
+    const settled = await texturesSettled(meshes);
+    return { settled, meshes: meshes.map((m) => ({ name: m.name, path: pathOf(m), material: materialInfo(m.material) })) };
+  } catch (e) {
+    return { error: String(e && e.message ? e.message : e) };
+  }
 };
 window.harnessReady = true;

@@ -66,7 +66,10 @@ def inspect(path: Path) -> dict:
         return {"file": path.name, "error": f"{type(e).__name__}: {e}"}
     objects = []
     for ob in bpy.context.scene.objects:
-        info = {"name": ob.name, "type": ob.type}
+        info = {"name": ob.name, "type": ob.type, "visible": ob.visible_get(), "render": not ob.hide_render,
+                "parent": ob.parent.name if ob.parent else None,
+                "armature": next((m.object.name for m in ob.modifiers
+                                  if m.type == "ARMATURE" and m.object), None)}
         if ob.type == "MESH":
             me = ob.data
             me.calc_loop_triangles()
@@ -88,6 +91,11 @@ def inspect(path: Path) -> dict:
             if keys.animation_data and keys.animation_data.action:
                 info["shape_key_action"] = keys.animation_data.action.name
         objects.append(info)
+    # meshes only an armature's bones are drawn with (the importer's bone shapes), not the asset's
+    shapes = {b.custom_shape.name for ob in bpy.context.scene.objects if ob.type == "ARMATURE"
+              for b in ob.pose.bones if b.custom_shape is not None}
+    for info in objects:
+        info["bone_shape"] = info["name"] in shapes
     actions = [{"name": a.name, "channels": _channels(a), "users": a.users} for a in bpy.data.actions]
     return {"file": path.name, "blender": bpy.app.version_string, "objects": objects, "actions": actions,
             "images": sorted(i.name for i in bpy.data.images)}

@@ -98,6 +98,13 @@ def merged(bounds: Bounds, name: str) -> Bounds:
     return Bounds((one,), bounds.world, None, bounds.scene)
 
 
+def clip_bounds(scene: Scene, name: str) -> ClipBounds:
+    """The counts of the scene's clip ``name`` (an engine fish carries several)."""
+    clip = scene.clip(name)
+    assert clip is not None, f"no clip {name}"
+    return _clip_bounds(scene, clip)
+
+
 def _clip_bounds(scene: Scene, clip) -> ClipBounds:
     paths = [ch.path for ch in clip.channels]
     targets = 0
@@ -123,7 +130,10 @@ class ClipTruth:
         assert clip is not None, f"no clip {clip_name}"
         self.channels: dict[tuple[int, str], Channel] = {(ch.node, ch.path): ch for ch in clip.channels}
         self.paths: dict[str, int] = {}
-        stack = [(i, scene.nodes[i].name) for i in scene.roots]
+        # the coarser levels of detail (MSFT_lod) hang outside the default scene: their tracks name them too
+        children = {c for n in scene.nodes for c in n.children}
+        outside = [i for i in range(len(scene.nodes)) if i not in children and i not in scene.roots]
+        stack = [(i, scene.nodes[i].name) for i in [*outside, *scene.roots]]   # the scene's own first
         while stack:
             i, path = stack.pop()
             self.paths.setdefault(path, i)

@@ -32,9 +32,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from tests.clients.bounds import (
+    ClipBounds,
     ClipTruth,
     as_box,
     box_close,
+    clip_bounds,
     expect_same_keys,
     key_errors,
     pair_primitives,
@@ -186,6 +188,14 @@ def judge(asset: Asset, r: dict) -> str:
     notes: list[str] = []
     surfaces = [(m, s) for m in r["meshes"] for s in m["surfaces"]]
     expect(bool(surfaces), "no mesh surfaces")
+    limits: list[str] = []    # what a client cannot do, said last: it must not hide a wrong number
+    if asset.engine is not None:  # Godot 3 knows no MSFT_lod: the finest level is checked, the rest noted
+        engine = asset.engine
+        coarse = sorted({m["name"] for m, _ in surfaces
+                         if engine.level(m["name"]) > 0 and m.get("visible", True)})
+        if coarse:
+            limits.append(f"coarser levels imported visible ({len(coarse)} meshes, {coarse[0]} first)")
+        surfaces = [(m, s) for m, s in surfaces if engine.level(m["name"]) == 0]
     triangles = [s for _, s in surfaces if s["primitive"] == PRIMITIVE_TRIANGLES]
     points = [s for _, s in surfaces if s["primitive"] == PRIMITIVE_POINTS]
     counts = {"triangles": sum((s["indices"] or s["vertices"]) // 3 for s in triangles),
@@ -215,7 +225,13 @@ def judge(asset: Asset, r: dict) -> str:
         for k, (a, b) in enumerate(zip(found, want, strict=True)):
             expect(box_close(a, b, tol), f"{mesh['name']}: blend shape {k} bounds {show(a)}, fishgen's {show(b)}")
     if asset.clip:
-        notes += _judge_clip(asset, r["animations"], tol)
+        if asset.engine is not None:
+            limits += _judge_engine(asset, r)
+            assert expected.scene is not None
+            for name in asset.engine.clips:
+                notes += _judge_clip(asset, r["animations"], tol, clip_bounds(expected.scene, name))
+        else:
+            notes += _judge_clip(asset, r["animations"], tol)
 
     # every texture arrives, and the materials say what fishgen's say
     textured = asset.fmt.kind in ("fish", "school") or "--billboards" in asset.fmt.flags
@@ -240,15 +256,37 @@ def judge(asset: Asset, r: dict) -> str:
         else:
             expect(all(m["alpha_scissor"] and abs(m["alpha_scissor_threshold"] - 0.5) < 1e-6
                        and m["cull_mode"] == CULL_DISABLED for m in fins), "fins lost MASK 0.5/double-sided")
-    return "; ".join(notes)
+    expect(not limits, "; ".join(limits))
+    return "; ".join(dict.fromkeys(notes))
 
 
-def _judge_clip(asset: Asset, animations: list[dict], tol: float) -> list[str]:
+def _judge_engine(asset: Asset, r: dict) -> list[str]:
+    """An engine row's skin and blend shapes: each finest-level mesh on a Skeleton, its skin's
+    binds the skin's joints, its blend shapes named as fishgen's. Returns what Godot gets wrong
+    without an error: the fish of a school bound to one fish's bones."""
+    engine = asset.engine
+    assert engine is not None
+    meshes = [m for m in r["meshes"] if engine.level(m["name"]) == 0]
+    for m in meshes:
+        expect(m.get("skeleton") is not None, f"{m['name']}: not on a Skeleton")
+        expect(engine.same_joints(m["bones"]), f"{m['name']}: bones {m['bones']}, the skin's joints are "
+                                               f"{list(engine.joints)}")
+        expect(m["blend_shape_names"] == list(engine.targets),
+               f"{m['name']}: blend shapes {m['blend_shape_names']}, fishgen's {list(engine.targets)}")
+    binds = {tuple(m["bones"]) for m in meshes}
+    if len(binds) < len(meshes):  # one skin a fish in the file, each on its own joints
+        return [f"{len(meshes)} fish's skins bind {len(binds)} set of bones: every fish drawn on "
+                f"{meshes[0]['bones'][0]}'s"]
+    return []
+
+
+def _judge_clip(asset: Asset, animations: list[dict], tol: float,
+                clip: ClipBounds | None = None) -> list[str]:
     """The clip is there, each glTF channel became its tracks, every track is bound, and every key
     Godot kept is fishgen's clip at that time."""
     assert asset.clip is not None and asset.bounds is not None and asset.bounds.clip is not None
-    name, _ = asset.clip
-    clip = asset.bounds.clip
+    clip = clip or asset.bounds.clip
+    name = clip.name
     found = [a for a in animations if a["name"] == name]
     expect(bool(found), f"no animation named {name} (found {[a['name'] for a in animations]})")
     anim = found[0]
@@ -262,7 +300,8 @@ def _judge_clip(asset: Asset, animations: list[dict], tol: float) -> list[str]:
     expect(abs(anim["length"] - clip.duration) < 1e-3, f"{name} lasts {anim['length']} s, fishgen's {clip.duration:.4f} s")
     assert asset.bounds.scene is not None
     truth = ClipTruth(asset.bounds.scene, name)
-    keys = [{"node": t["path"], "kind": "trs", "keys": t["keys"]} for t in transform]
+    keys = [{"node": _transform_node(truth, t, i, clip), "kind": "trs", "keys": t["keys"]}
+            for i, t in enumerate(transform)]
     for t in value:
         node, prop = t["path"].split(":", 1)
         keys.append({"node": node, "kind": "weight", "target": _target_index(truth, t["path"], node, prop),
@@ -424,3 +463,25 @@ def _target_index(truth: ClipTruth, path: str, node: str, prop: str) -> int:
     if m[1] not in names:
         raise CellFailure(f"{path}: a blend shape the file's targetNames do not name")
     return list(names).index(m[1])
+
+
+def _transform_node(truth: ClipTruth, track: dict, index: int, clip: ClipBounds) -> str:
+    """The node path of fishgen's that a transform track drives. A node track names it; a bone
+    track (``Skeleton:bone``, its keys made rest * pose by inspect.gd) names a bone Godot renamed
+    to be unique in a skeleton that may hold several skins' joints, so it is the ``index``-th of
+    the clip's animated nodes in file order, the order the importer makes tracks in (checked
+    against the bone's name, less Godot's numbers and case)."""
+    if "bone" not in track:
+        return track["path"]
+    scene = truth.scene
+    animated = sorted({node for node, path in truth.channels if path != "weights"})
+    expect(len(animated) == clip.trs_nodes and index < len(animated),
+           f"{track['path']}: no animated node {index}")
+    node = animated[index]
+
+    def plain(name: str) -> str:
+        return re.sub(r"[\d_]", "", name).lower()
+
+    name = scene.nodes[node].name
+    expect(plain(track["bone"]) == plain(name), f"{track['path']}: bone {track['bone']} for node {name}")
+    return next(path for path, i in truth.paths.items() if i == node)

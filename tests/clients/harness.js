@@ -34,6 +34,18 @@ function geometryInfo(obj) {
   if (obj.isMesh) {
     info.triangles = geo.index ? geo.index.count / 3 : positions / 3;
   }
+  // the engine rows: the skin, the blend shapes by name, and the box at rest in the file's space
+  info.bones = obj.isSkinnedMesh && obj.skeleton ? obj.skeleton.bones.map((b) => b.name) : null;
+  info.morphTargets = obj.morphTargetInfluences ? obj.morphTargetInfluences.length : 0;
+  info.morphNames = obj.morphTargetDictionary
+    ? Object.entries(obj.morphTargetDictionary).sort((a, b) => a[1] - b[1]).map((e) => e[0]) : [];
+  if (geo.attributes.position && positions > 0) {
+    // the file's positions through the node's matrix (not skinned: a skin's bind pose is the engine's)
+    const box = new THREE.Box3();
+    const v = new THREE.Vector3();
+    for (let i = 0; i < positions; i++) box.expandByPoint(v.fromBufferAttribute(geo.attributes.position, i).applyMatrix4(obj.matrixWorld));
+    info.world = [box.min.toArray(), box.max.toArray()];
+  }
   return info;
 }
 

@@ -31,7 +31,7 @@ from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from tests.clients.bounds import Bounds, merged, scene_bounds
+from tests.clients.bounds import Bounds, ClipBounds, merged, scene_bounds
 
 if TYPE_CHECKING:
     from fishgen.scene.model import Scene
@@ -47,6 +47,10 @@ SWIM_TRACKS = 13  # 4 fin swings (pectoral, pelvic) + the body wave's weights on
 SCHOOL_FISH, SCHOOL_FRAMES = 10, 30
 SCHOOL_TRACKS = 2 + SWIM_TRACKS  # each fish: its path (translation, rotation) and its own swim
 CLOUD_COLUMNS = ("x", "y", "z", "radius", "density", "red", "green", "blue")
+# The engine rows (issue 24): levels of detail, one skinned mesh a level, every clip
+ENGINE_LODS = ((16, 12), (8, 6))
+ENGINE_CLIPS = ("swim", "idle", "sprint", "turn_left", "turn_right", "burst")
+ENGINE_FLAGS = ("--lods", ",".join(f"{b}x{c}" for b, c in ENGINE_LODS), "--merge")
 
 
 @dataclass(frozen=True)
@@ -64,6 +68,10 @@ class Format:
     def slug(self) -> str:
         return self.label.replace(" ", "-")
 
+    @property
+    def engine(self) -> bool:
+        return "--merge" in self.flags
+
 
 FORMATS = (
     Format("fish glb", "fish", "fish.glb"),
@@ -71,6 +79,9 @@ FORMATS = (
     Format("fish obj", "fish", "fish.obj"),
     Format("fish ply", "fish", "fish.ply"),
     Format("school glb", "school", "school.glb", ("--count", str(SCHOOL_FISH), "--frames", str(SCHOOL_FRAMES))),
+    Format("engine fish glb", "fish", "engine.glb", (*ENGINE_FLAGS, "--clips", ",".join(ENGINE_CLIPS))),
+    Format("engine school glb", "school", "engine_school.glb",
+           ("--count", str(SCHOOL_FISH), "--frames", str(SCHOOL_FRAMES), *ENGINE_FLAGS)),
     Format("cloud ply", "cloud", "cloud.ply"),
     Format("cloud glb points", "cloud", "points.glb"),
     Format("cloud glb billboards", "cloud", "billboards.glb", ("--billboards",)),
@@ -99,6 +110,21 @@ KNOWN_LIMITS: dict[tuple[str, str], tuple[str, str]] = {
     ("cloud glb billboards", "Godot 3"): ("COLOR_0 imported but not shown, KHR_materials_unlit ignored",
                                           "COLOR_0 not shown, KHR_materials_unlit ignored: particles white and lit"),
     ("fish obj", "trimesh"): ("map_d", "trimesh ignores map_d (fins keep the skin png's alpha)"),
+    # Babylon's MSFT_lod loader disposes a replaced level's materials when no mesh of the *scene* uses
+    # them; a container's meshes are not the scene's yet, so the levels' shared materials go with LOD1
+    # (AppendSceneAsync keeps them: test_babylon_appends_the_engine_fish_textured)
+    ("engine fish glb", "Babylon.js"): ("material has no texture",
+                                        "LoadAssetContainerAsync + MSFT_lod dispose the levels' shared "
+                                        "materials: LOD0 untextured (AppendSceneAsync is right)"),
+    ("engine school glb", "Babylon.js"): ("material has no texture",
+                                          "as the engine fish: LOD0 untextured in an asset container"),
+    ("engine fish glb", "Godot 3"): ("coarser levels imported visible",
+                                     "MSFT_lod ignored: LOD1 imported as a second visible mesh over LOD0"),
+    # the fish of a school share one mesh, so their skins' bind poses are equal; Godot 3.2.3 keeps one
+    # such skin and binds every fish to the first fish's bones (the bones and tracks are all there)
+    ("engine school glb", "Godot 3"): ("first); 10 fish's skins bind 1 set of bones",
+                                       "LOD1 visible too, and the importer keeps one of the fish's equal "
+                                       "skins: all 10 fish drawn on the first fish's bones"),
 }
 
 
@@ -112,6 +138,48 @@ def cells() -> list[tuple[str, str]]:
 
 # --------------------------------------------------------------------------- assets
 
+@dataclass(frozen=True)
+class Engine:
+    """What an engine row's file holds beyond the plain fish's (issue 24), from fishgen's own scene."""
+
+    clips: tuple[str, ...]          # every clip, by name
+    levels: tuple[str, ...]         # one fish's mesh node a level, finest first ("bonybream_LOD0", ...)
+    joints: tuple[str, ...]         # the finest level's skin joints, by node name
+    targets: tuple[str, ...]        # blend shape names (the meshes' extras.targetNames)
+    primitives: int                 # primitives of one level's mesh (body, fins)
+
+    @classmethod
+    def of(cls, scene: Scene) -> Engine:
+        """From a scene fishgen built, or read back from the file (whose reader keeps the coarser
+        levels as nodes outside the scene, named ``<name>_LOD1``, ...)."""
+        meshed = [n for n in scene.nodes if n.mesh is not None]
+        node = meshed[0]
+        assert node.mesh is not None and node.skin is not None, "an engine row's fish is one skinned mesh"
+        stem = re.sub(r"_LOD0$", "", node.name)
+        levels = tuple(n.name for n in meshed if re.fullmatch(rf"{re.escape(stem)}_LOD\d+", n.name))
+        mesh = scene.meshes[node.mesh]
+        joints = tuple(scene.nodes[j].name for j in scene.skins[node.skin].joints)
+        return cls(tuple(c.name for c in scene.clips), levels, joints, tuple(mesh.target_names),
+                   len(mesh.primitives))
+
+    def client_tracks(self, clip: ClipBounds) -> int:
+        """Tracks of ``clip`` in a client that splits a weights channel per primitive (three.js)."""
+        return clip.rotation_channels + clip.translation_channels + clip.scale_channels \
+            + clip.weight_channels * self.primitives
+
+    def same_joints(self, names: list[str]) -> bool:
+        """A client's bones are the skin's joints, in order, up to the numbers clients (and a school's
+        fish) append to repeated names: ``pectoral_fin_left_1``, ``bonybream_00003``."""
+        def plain(name: str) -> str:
+            return re.sub(r"(_\d+)+$", "", name)
+        return [plain(n) for n in names] == [plain(n) for n in self.joints]
+
+    def level(self, name: str) -> int:
+        """The level a node or mesh named ``name`` belongs to (0 unless it ends in _LODn, n > 0)."""
+        m = re.search(r"_LOD(\d+)(?:_\d+)?$", name)
+        return int(m[1]) if m else 0
+
+
 @dataclass
 class Asset:
     fmt: Format
@@ -122,6 +190,7 @@ class Asset:
     expected: dict[str, int]    # vertices / triangles / particles a loader must find
     clip: tuple[str, int] | None = None     # the clip's name and glTF channels, where the format holds it
     bounds: Bounds | None = None            # fishgen's bounds (tests/clients/bounds.py)
+    engine: Engine | None = None            # the engine rows' levels, skin, blend shapes and clips
 
     @property
     def label(self) -> str:
@@ -143,11 +212,14 @@ def _scenes() -> dict[str, Scene]:
     """The scenes fishgen builds in-process for the fish and cloud rows, as the CLI builds them
     (the summary line has no vertex count, and the bounds come from these)."""
     import fishgen
+    from fishgen.assembly.fish import make_fish
     from fishgen.clouds import fill_cloud, load_cubes
     from fishgen.clouds.scene import cloud_scene
 
     cloud = fill_cloud(load_cubes(CLOUD_SOURCE), seed=0)
-    return {"fish": fishgen.build_fish(fishgen.load_species(FISH_SOURCE)),
+    species = fishgen.load_species(FISH_SOURCE)
+    return {"fish": fishgen.build_fish(species),
+            "engine": make_fish(species, lods=ENGINE_LODS, merge=True, clips=ENGINE_CLIPS).scene,
             "points": cloud_scene(cloud), "billboards": cloud_scene(cloud, billboards=True)}
 
 
@@ -178,17 +250,22 @@ def make_assets(folder: Path) -> dict[str, Asset]:
         jobs = [pool.submit(build, fmt) for fmt in FORMATS]
         scenes = _scenes()
         assets = {a.label: a for a in (job.result() for job in jobs)}
-    fish = scenes["fish"].counts()
     points = scenes["points"].counts()
     for a in assets.values():
+        fish_scene = scenes["engine" if a.fmt.engine else "fish"]   # a school's fish: the same levels
+        fish = fish_scene.counts()
         if a.fmt.kind == "fish":
             if a.reported.get("triangles") != fish["triangles"]:
                 raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, the scene has {fish['triangles']} triangles")
             a.expected = {"vertices": fish["vertices"], "triangles": a.reported["triangles"], "particles": 0}
-            a.bounds = scene_bounds(scenes["fish"])
+            a.bounds = scene_bounds(fish_scene)
             if a.fmt.ext == "ply":  # one mesh of every part
                 a.bounds = merged(a.bounds, "fish")
-            if a.fmt.ext in ("glb", "gltf"):
+            if a.fmt.engine:
+                a.engine = Engine.of(fish_scene)
+                assert a.bounds.clip is not None
+                a.clip = ("swim", a.bounds.clip.rotation_channels + a.bounds.clip.weight_channels)
+            elif a.fmt.ext in ("glb", "gltf"):
                 a.clip = ("swim", SWIM_TRACKS)
         elif a.fmt.kind == "school":
             n = a.reported.get("fish")
@@ -197,10 +274,15 @@ def make_assets(folder: Path) -> dict[str, Asset]:
                                    f"and {SCHOOL_FRAMES} frames")
             a.expected = {"vertices": n * fish["vertices"], "triangles": n * fish["triangles"], "particles": 0,
                           "fish": n}
-            a.clip = ("school", n * SCHOOL_TRACKS)
             from fishgen.exchange.gltf_reader import read_gltf
 
-            a.bounds = scene_bounds(read_gltf(a.path))
+            school = read_gltf(a.path)
+            a.bounds = scene_bounds(school)
+            if a.fmt.engine:  # each fish: its path, 4 fin joints and one weights channel a level
+                a.engine = Engine.of(school)
+                a.clip = ("school", n * (2 + 5 * len(ENGINE_LODS)))
+            else:
+                a.clip = ("school", n * SCHOOL_TRACKS)
         else:
             n = a.reported["particles"]
             if n != points["particles"]:
@@ -648,11 +730,14 @@ class ThreeClient(HarnessPage):
             fins = [m for o in meshes for m in o["materials"] if m["name"].endswith("_fins")]
             expect(bool(fins) and all(m["alphaMap"] and m["alphaMap"]["arrived"] for m in fins),
                    "fins material has no alphaMap")
-        if asset.clip:
+        if asset.engine is not None:
+            notes += _judge_three_engine(asset, r, meshes)
+        elif asset.clip:
             clips = r["clips"]
             _check_clip(asset, [(c["name"], len(c["tracks"])) for c in clips])
             unbound = [t["name"] for c in clips for t in c["tracks"] if not t["bound"]]
             expect(not unbound, f"tracks target no node: {unbound}")
+        if asset.clip:
             fins = [m for o in meshes for m in o["materials"] if m["name"].endswith("_fins")]
             expect(all(m["alphaTest"] == 0.5 and m["side"] == 2 for m in fins), "fins lost MASK/double-sided")
         if asset.fmt.kind == "cloud" and asset.fmt.ext == "glb":  # COLOR_0 shown; billboards unlit
@@ -667,6 +752,45 @@ class ThreeClient(HarnessPage):
             if asset.fmt.ext == "ply":
                 notes.append("radius/density need setCustomPropertyNameMapping")
         return "; ".join(notes)
+
+
+def _judge_three_engine(asset: Asset, r: dict, meshes: list[dict]) -> list[str]:
+    """An engine row in three.js: the finest level only (GLTFLoader knows no MSFT_lod and loads the
+    default scene), each primitive a SkinnedMesh on the skin's joints with every blend shape by name,
+    the bounds fishgen's, and every clip by name with a track per channel and primitive, bound to a
+    node but the coarser levels' morph weights (their meshes are not loaded)."""
+    from tests.clients.bounds import as_box, clip_bounds, pair_primitives
+
+    engine, bounds = asset.engine, asset.bounds
+    assert engine is not None and bounds is not None and bounds.scene is not None
+    coarse = sorted({o["name"] for o in meshes if engine.level(o["name"]) > 0})
+    expect(not coarse, f"coarser levels shown: {coarse[:3]}")
+    pair_primitives([as_box(o["world"]) for o in meshes], bounds, "mesh")
+    for o in meshes:
+        expect(o["bones"] is not None, f"{o['name']}: not a SkinnedMesh")
+        expect(engine.same_joints(o["bones"]), f"{o['name']}: bones {o['bones']}, the skin's joints are "
+                                               f"{list(engine.joints)}")
+        expect(o["morphNames"] == list(engine.targets), f"{o['name']}: blend shapes {o['morphNames']}, "
+                                                          f"fishgen's {list(engine.targets)}")
+    clips = {c["name"]: c for c in r["clips"]}
+    missing = [c for c in engine.clips if c not in clips]
+    expect(not missing, f"clips missing: {missing} (found {sorted(clips)})")
+    hidden = 0
+    for name in engine.clips:
+        clip = clip_bounds(bounds.scene, name)
+        found = clips[name]
+        want = engine.client_tracks(clip)
+        expect(len(found["tracks"]) == want, f"{name} has {len(found['tracks'])} tracks, expected {want}")
+        expect(abs(found["duration"] - clip.duration) < 1e-3, f"{name} lasts {found['duration']:.4f} s, "
+                                                               f"fishgen's {clip.duration:.4f} s")
+        unbound = [t["name"] for t in found["tracks"] if not t["bound"]]
+        wrong = [t for t in unbound
+                 if not (engine.level(t.split(".")[0]) > 0 and t.endswith(".morphTargetInfluences"))]
+        expect(not wrong, f"{name}: tracks target no node: {wrong[:3]}")
+        hidden = max(hidden, len(unbound))
+    if len(engine.levels) < 2:
+        return []
+    return [f"LOD0 only (no MSFT_lod){f'; {hidden} weight tracks of LOD1+ unbound' if hidden else ''}"]
 
 
 # --------------------------------------------------------------------------- running

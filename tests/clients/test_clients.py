@@ -42,7 +42,7 @@ def _broken_copy(matrix, label: str, name: str) -> Asset:
         shutil.rmtree(folder)
     shutil.copytree(good.path.parent, folder)
     return Asset(fmt, folder / fmt.filename, list(good.files), good.summary, dict(good.reported), dict(good.expected),
-                 good.clip, good.bounds)
+                 good.clip, good.bounds, good.engine)
 
 
 @pytest.fixture
@@ -124,6 +124,42 @@ def test_babylon_fails_a_clip_with_a_wrong_key(matrix, babylon):
     asset = _broken_copy(matrix, "fish gltf", "babylon gltf bad key")
     spoil_weight_key(asset.path)
     with pytest.raises(AssertionError, match="key weight off by"):
+        babylon.check(asset)
+
+
+def test_babylon_appends_the_engine_fish_textured(matrix, babylon):
+    """The engine fish's Babylon.js cell is a known limit of asset containers (KNOWN_LIMITS): a scene
+    loaded whole keeps the materials the levels share, and shows the finest level only."""
+    result = babylon.append(matrix.assets["engine fish glb"])
+    names = {m["path"].split("/")[0] for m in result["meshes"]}
+    assert names == {"bonybream_LOD0"}
+    assert result["settled"]
+    materials = [m["material"] for m in result["meshes"]]
+    assert all(m is not None and m["albedo"] and m["albedo"]["ready"] for m in materials)
+    assert {m["name"] for m in materials} == {"bonybream_body", "bonybream_fins"}
+
+
+def _without_clip(matrix, label: str, name: str, clip: str) -> Asset:
+    """A copy of an engine row's .glb whose clip ``clip`` is renamed: every count still right."""
+    from tests.clients.godot import read_glb, write_glb
+
+    asset = _broken_copy(matrix, label, name)
+    doc, blob = read_glb(asset.path)
+    (anim,) = [a for a in doc["animations"] if a["name"] == clip]
+    anim["name"] = f"{clip}_renamed"
+    write_glb(asset.path, doc, blob)
+    return asset
+
+
+def test_three_fails_an_engine_fish_without_a_clip(matrix, three):
+    asset = _without_clip(matrix, "engine fish glb", "engine no burst three", "burst")
+    with pytest.raises(AssertionError, match=r"clips missing: \['burst'\]"):
+        three.check(asset)
+
+
+def test_babylon_fails_an_engine_fish_without_a_clip(matrix, babylon):
+    asset = _without_clip(matrix, "engine fish glb", "engine no burst babylon", "burst")
+    with pytest.raises(AssertionError, match=r"animation groups missing: \['burst'\]"):
         babylon.check(asset)
 
 

@@ -108,6 +108,22 @@ func mesh_info(mi):
 				"blend_shapes": mesh.get_blend_shape_count(), "surfaces": []}
 	if mesh is ArrayMesh:
 		info["blend_shape_mode"] = mesh.blend_shape_mode
+	info["blend_shape_names"] = []
+	for b in range(mesh.get_blend_shape_count()):
+		info["blend_shape_names"].append(mesh.get_blend_shape_name(b))
+	# a skinned mesh: the bones of its skin (the skin's binds, by bone name), on the skeleton it names
+	var skel = mi.get_node_or_null(mi.skeleton) if not mi.skeleton.is_empty() else null
+	if skel is Skeleton:
+		info["skeleton"] = str(skel.get_path())
+		info["bones"] = []
+		if mi.skin != null:
+			for b in range(mi.skin.get_bind_count()):
+				var bone = mi.skin.get_bind_bone(b)
+				info["bones"].append(mi.skin.get_bind_name(b) if bone < 0 else skel.get_bone_name(bone))
+		else:
+			for b in range(skel.get_bone_count()):
+				info["bones"].append(skel.get_bone_name(b))
+	info["visible"] = mi.is_visible_in_tree()
 	for s in range(mesh.get_surface_count()):
 		var arrays = mesh.surface_get_arrays(s)
 		var verts = arrays[Mesh.ARRAY_VERTEX]
@@ -138,14 +154,20 @@ func animation_info(player, name):
 		var path = str(anim.track_get_path(t))
 		var target = base.get_node_or_null(NodePath(path.split(":")[0]))
 		var track = {"path": path, "type": anim.track_get_type(t), "bound": target != null, "keys": []}
+		# a bone's keys are poses relative to its rest: as the glTF node's transform, rest * pose
+		var bone = bone_of(target, path)
+		if bone >= 0:
+			track["bone"] = target.get_bone_name(bone)
+		elif target is Skeleton:
+			track["bound"] = false
 		for k in range(anim.track_get_key_count(t)):
 			var time = anim.track_get_key_time(t, k)
 			var v = anim.track_get_key_value(t, k)
 			if anim.track_get_type(t) == Animation.TYPE_TRANSFORM:
-				var l = v["location"]
-				var q = v["rotation"]
-				var sc = v["scale"]
-				track["keys"].append([time, l.x, l.y, l.z, q.x, q.y, q.z, q.w, sc.x, sc.y, sc.z])
+				var xf = Transform(Basis(v["rotation"]).scaled(v["scale"]), v["location"])
+				if bone >= 0:
+					xf = target.get_bone_rest(bone) * xf
+				track["keys"].append(transform_key(time, xf))
 			else:
 				track["keys"].append([time, v])
 		if anim.track_get_type(t) == Animation.TYPE_VALUE and target != null and path.find(":") >= 0:
@@ -166,10 +188,24 @@ func animation_info(player, name):
 				continue
 			if track["type"] == Animation.TYPE_TRANSFORM:
 				var xf = target.transform
-				var q = Quat(xf.basis.orthonormalized())
-				var sc = xf.basis.get_scale()
-				track["played"].append([time, xf.origin.x, xf.origin.y, xf.origin.z, q.x, q.y, q.z, q.w, sc.x, sc.y, sc.z])
+				if track.has("bone"):
+					var b = target.find_bone(track["bone"])
+					xf = target.get_bone_rest(b) * target.get_bone_custom_pose(b) * target.get_bone_pose(b)
+				track["played"].append(transform_key(time, xf))
 			else:
 				track["played"].append([time, target.get(parts[1])])
 	player.stop()
 	return info
+
+
+func bone_of(target, path):
+	# the bone a track `Skeleton:bone` drives, else -1
+	if not (target is Skeleton) or path.find(":") < 0:
+		return -1
+	return target.find_bone(path.split(":", true, 1)[1])
+
+
+func transform_key(time, xf):
+	var q = Quat(xf.basis.orthonormalized())
+	var sc = xf.basis.get_scale()
+	return [time, xf.origin.x, xf.origin.y, xf.origin.z, q.x, q.y, q.z, q.w, sc.x, sc.y, sc.z]
