@@ -37,10 +37,8 @@ sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks")]
 from fishgen.assembly.clips import C_START_DEGREES, TURN_DEGREES  # noqa: E402
 from fishgen.assembly.compact import compact_clips  # noqa: E402
 from fishgen.assembly.fish import make_fish  # noqa: E402
-from fishgen.assembly.instance import add_fish, add_species, pad_weights  # noqa: E402
 from fishgen.exchange.gltf import glb_bytes  # noqa: E402
-from fishgen.geometry.body_wave import BodyWave  # noqa: E402
-from fishgen.scene.model import Channel, Clip, Sampler, Scene  # noqa: E402
+from fishgen.scene.model import Scene  # noqa: E402
 from fishgen.species.parser import load_species  # noqa: E402
 from tests.assembly import engine_clients as ec  # noqa: E402
 
@@ -155,60 +153,8 @@ def school_tracks(count: int, frames: int, length: float):
     return simulate(config)
 
 
-def bake_school(fish, tracks, *, tolerance: float = 0.002, seed: int = 0) -> Scene:
-    """`fishgen school`'s bake (fishgen.school.bake) done through fishgen.assembly.instance, so that it
-    takes either layout and levels of detail: per fish, root keys thinned to the tolerance, the body
-    wave's phase integrated at the fish's own speed, the fins' swing phase-shifted (one of 16)."""
-    from fishgen.assembly.body_wave import weight_sampler
-    from fishgen.school.bake import FIN_PHASES, _fin_keys, _wave_phases, reduce_keys
-
-    school = Scene(name="school")
-    template = add_species(school, fish.scene)
-    times = np.asarray(tracks.times, np.float64)
-    duration = float(times[-1])
-    rng = np.random.default_rng(seed)
-    reach = fish.facts.body_length * np.asarray(tracks.scale, np.float64)
-    position_keys = reduce_keys(tracks.positions, tolerance)
-    rotation_keys = reduce_keys(tracks.headings * reach[None, :, None], tolerance)
-    phases = _wave_phases([fish.scene], tracks, reach, rng, BodyWave())
-    swim = fish.scene.clip("swim")
-    channels: list[Channel] = []
-    fin_samplers: dict[tuple[int, int], Sampler] = {}
-    for i in range(len(tracks.group)):
-        made = add_fish(school, template, f"bonybream_{i:05d}")
-        size = float(tracks.scale[i])
-        x, y, z = (float(v) for v in tracks.positions[0, i])
-        qx, qy, qz, qw = (float(v) for v in tracks.headings[0, i])
-        for m in made.movers:
-            school.nodes[m] = replace(school.nodes[m], translation=(x, y, z), rotation=(qx, qy, qz, qw),
-                                      scale=(size, size, size))
-        k = position_keys[i]
-        move = Sampler(times[k].astype(np.float32), tracks.positions[k, i].astype(np.float32))
-        k = rotation_keys[i]
-        turn = Sampler(times[k].astype(np.float32), tracks.headings[k, i].astype(np.float32))
-        for m in made.movers:
-            channels += [Channel(m, "translation", move), Channel(m, "rotation", turn)]
-        phase = int(rng.integers(FIN_PHASES))
-        weights = None
-        if phases is not None:
-            wave = weight_sampler(times, phases[:, i])
-            weights = Sampler(wave.times, pad_weights(wave.values, template.targets))
-        swings = dict(made.fins)
-        for node in sorted(set(made.waving) | set(swings)):      # per part, weights then swing: as today
-            if node in made.waving and weights is not None:
-                channels.append(Channel(node, "weights", weights))
-            if node in swings:
-                key = (id(swings[node]), phase)
-                if key not in fin_samplers:
-                    t, v = _fin_keys(swings[node], swim.duration * phase / FIN_PHASES, duration)
-                    fin_samplers[key] = Sampler(t.astype(np.float32), v.astype(np.float32))
-                channels.append(Channel(node, "rotation", fin_samplers[key]))
-    school.clips.append(Clip("school", channels))
-    return school
-
-
 def schools(folder: Path, species, count: int, frames: int, repeat: int, fps_frames: int) -> None:
-    from fishgen.school.bake import bake
+    from fishgen.school.bake import bake, bake_instanced
 
     print(f"3. a school of {count:,} BonyBream x {frames} frames (the species' own level, swim)")
     fish = {merge: make_fish(species, merge=merge) for merge in (False, True)}
@@ -217,7 +163,7 @@ def schools(folder: Path, species, count: int, frames: int, repeat: int, fps_fra
     rows = [("today (fishgen.school.bake)", bake([fish[False].scene], tracks, body_lengths=lengths), None)]
     for merge in (False, True):
         for compact in (False, True):
-            scene = bake_school(fish[merge], tracks)
+            scene = bake_instanced([fish[merge].scene], tracks, body_lengths=lengths)
             error = compact_clips(scene) if compact else None
             rows.append((f"{'merged' if merge else 'parts'}{' --compact' if compact else ''}", scene, error))
     three = None
