@@ -486,7 +486,6 @@ class _Grid:
         self.corner = lo - margin - 3 * cell      # world (a, b) of cell (0, 0)'s lower corner
         self.direct = np.ones(self.shape, _F32)
         self.scattered = np.zeros(self.shape, _F32)
-        self.scattered_any = False
         self.kernels = _class_kernels(sigma_max / cell)
         widths = [w for w, _ in self.kernels]
         # a particle's class: the nearest width in log scale
@@ -597,14 +596,6 @@ def _spectrum(kernel: np.ndarray | None, shape: tuple[int, int]) -> np.ndarray:
         taps = np.arange(-reach, reach + 1)
         image[np.ix_(taps % shape[0], taps % shape[1])] = np.outer(kernel, kernel)
     return np.fft.rfft2(image)
-
-
-def _bilinear_splat(flat, fx, fy, values, w: int, cells: int) -> np.ndarray:
-    """``values`` shared out over the four cells around each point (float64 map of ``cells``)."""
-    fx1, fy1 = _F32(1) - fx, _F32(1) - fy
-    index = np.concatenate([flat, flat + 1, flat + w, flat + w + 1])
-    share = np.concatenate([values * fx1 * fy1, values * fx1 * fy, values * fx * fy1, values * fx * fy])
-    return np.bincount(index, share.astype(np.float64), minlength=cells)
 
 
 def _bilinear(values: np.ndarray, flat: np.ndarray, fx: np.ndarray, fy: np.ndarray, w: int) -> np.ndarray:
