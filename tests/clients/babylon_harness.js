@@ -211,4 +211,49 @@ window.appendAsset = async (url) => {
     return { error: String(e && e.message ? e.message : e) };
   }
 };
+// Plays clip `clipName` of a whole scene (AppendSceneAsync, every level of detail loaded) and reports,
+// for each drawn mesh at each of `times` (seconds), the posed positions and normals Babylon computes
+// on the CPU (getPositionData / getNormalsData with skeleton and morph targets: the same sums as its
+// shaders), in the mesh's own space, with its triangles.
+window.poseMeshes = async (url, clipName, times) => {
+  try {
+    if (scene) scene.dispose();
+    scene = new BABYLON.Scene(engine);
+    camera = new BABYLON.ArcRotateCamera('camera', 1, 1.2, 2, BABYLON.Vector3.Zero(), scene);
+    // MSFT_lod: the promise resolves on the coarsest level; the loader completes on the finest
+    const complete = new Promise((resolve) => {
+      BABYLON.SceneLoader.OnPluginActivatedObservable.addOnce((plugin) => {
+        if (plugin.onCompleteObservable) plugin.onCompleteObservable.addOnce(() => resolve());
+        else resolve();
+      });
+    });
+    await BABYLON.AppendSceneAsync(url, scene);
+    await complete;
+    const group = scene.animationGroups.find((g) => g.name === clipName);
+    if (!group) return { error: `no animation group ${clipName}: ${scene.animationGroups.map((g) => g.name)}` };
+    for (const g of scene.animationGroups) g.stop();
+    const meshes = scene.meshes.filter((m) => m.getTotalVertices() > 0 && m.isEnabled());
+    const out = meshes.map((m) => ({ name: m.name, path: pathOf(m), index: Array.from(m.getIndices()),
+      morphTargets: m.morphTargetManager ? m.morphTargetManager.numTargets : 0,
+      skinned: !!m.skeleton, positions: [], normals: [] }));
+    const fps = group.targetedAnimations[0].animation.framePerSecond;
+    group.start(false);
+    group.pause();
+    for (const t of times) {
+      group.goToFrame(group.from + t * fps);
+      // bones follow their linked nodes: world matrices first, then the skeletons' matrices
+      for (const n of scene.transformNodes) n.computeWorldMatrix(true);
+      for (const m of scene.meshes) m.computeWorldMatrix(true);
+      for (const s of scene.skeletons) s.prepare(true);
+      meshes.forEach((m, k) => {
+        out[k].positions.push(Array.from(m.getPositionData(true, true)));
+        out[k].normals.push(Array.from(m.getNormalsData(true, true)));
+      });
+    }
+    group.stop();
+    return { meshes: out, fps };
+  } catch (e) {
+    return { error: String(e && e.stack ? e.stack : e) };
+  }
+};
 window.harnessReady = true;
