@@ -102,6 +102,30 @@ def _messages(log: str) -> dict[str, list[str]]:
     return out
 
 
+def new_project(folder: Path, script: Path, name: str) -> Path:
+    """A fresh Godot project at ``folder``/project (``folder`` emptied first), with ``script`` as res://``name``."""
+    project = folder / "project"
+    if folder.exists():
+        shutil.rmtree(folder)
+    project.mkdir(parents=True)
+    for template in ("project.godot", "export_presets.cfg"):
+        shutil.copy(TEMPLATE / template, project / template)
+    shutil.copy(script, project / name)
+    return project
+
+
+def import_project(project: Path, folder: Path) -> str:
+    """Import every file of ``project`` (settings and caches under ``folder``); Godot's log."""
+    assert GODOT is not None, godot_unavailable()
+    imported = subprocess.run([GODOT, "--path", str(project), "--export-pack", "import-only",
+                               str(folder / "import-only.pck")],
+                              capture_output=True, text=True, env=_env(folder), timeout=IMPORT_TIMEOUT)
+    log = imported.stdout + imported.stderr
+    if imported.returncode != 0:
+        raise RuntimeError(f"godot3-server --export-pack exited {imported.returncode}: {log.strip()[-500:]}")
+    return log
+
+
 @dataclass
 class GodotRun:
     """One import of all the files into one project, and what Godot made of each."""
@@ -122,13 +146,7 @@ class GodotRun:
 
         assert GODOT is not None, godot_unavailable()
 
-        project = folder / "project"
-        if folder.exists():
-            shutil.rmtree(folder)
-        project.mkdir(parents=True)
-        for name in ("project.godot", "export_presets.cfg"):
-            shutil.copy(TEMPLATE / name, project / name)
-        shutil.copy(TEMPLATE / "inspect.gd", project / "fishgen_inspect.gd")
+        project = new_project(folder, TEMPLATE / "inspect.gd", "fishgen_inspect.gd")
         files = {}
         for label, asset in assets.items():  # each folder once: assets may share one
             where = asset.path.parent.name
@@ -139,12 +157,7 @@ class GodotRun:
         run = cls(project, files, assets)
         env = _env(folder)
         start = time.perf_counter()
-        imported = subprocess.run([GODOT, "--path", str(project), "--export-pack", "import-only",
-                                   str(folder / "import-only.pck")],
-                                  capture_output=True, text=True, env=env, timeout=IMPORT_TIMEOUT)
-        log = imported.stdout + imported.stderr
-        if imported.returncode != 0:
-            raise RuntimeError(f"godot3-server --export-pack exited {imported.returncode}: {log.strip()[-500:]}")
+        log = import_project(project, folder)
         run.import_seconds = time.perf_counter() - start
         start = time.perf_counter()
         inspected = subprocess.run([GODOT, "--path", str(project), "-s", "res://fishgen_inspect.gd"],
