@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import tempfile
 from dataclasses import dataclass
@@ -135,12 +136,27 @@ def fin_swing(tip: np.ndarray, base: np.ndarray) -> np.ndarray:
 
 
 def normal_error(positions: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """Degrees between each vertex's client normal and the area-weighted normal of its posed triangles."""
+    """Degrees between each vertex's client normal and the area-weighted normal of its posed triangles
+    (0 for a vertex no triangle uses: nothing is shaded with it)."""
     ref = area_normals(positions, faces)
     ok = np.linalg.norm(ref, axis=1) > 0
     ref = ref[ok] / np.linalg.norm(ref[ok], axis=1, keepdims=True)
     n = normals[ok] / np.linalg.norm(normals[ok], axis=1, keepdims=True)
-    return np.degrees(np.arccos(np.clip(np.sum(ref * n, axis=1), -1.0, 1.0)))
+    out = np.zeros(len(positions))
+    out[ok] = np.degrees(np.arccos(np.clip(np.sum(ref * n, axis=1), -1.0, 1.0)))
+    return out
+
+
+def worst_normal_error(played: Played, keep: dict[str, np.ndarray] | None = None) -> dict[str, float]:
+    """Per mesh, the largest :func:`normal_error` over the played times (of the vertices ``keep``
+    selects, by mesh, where given)."""
+    out = {}
+    for name, (faces, positions, normals) in played.meshes.items():
+        errors = np.array([normal_error(positions[i], faces, normals[i]) for i in range(len(positions))])
+        if keep is not None:
+            errors = errors[:, keep[name]]
+        out[name] = float(errors.max()) if errors.size else 0.0
+    return out
 
 
 # -- clients -------------------------------------------------------------------------------------
@@ -228,13 +244,112 @@ class ThreeEngine:
         self.browser.close()
 
 
-def blender_play(path: Path, clips: dict[str, np.ndarray], probe_points: np.ndarray) -> dict:
-    """Blender's importer and its own evaluated meshes (tests/assembly/engine/blender_engine.py)."""
+class BabylonEngine:
+    """Babylon.js (the client matrix's npm build) in headless Chromium, playing files from ``folder``
+    (tests/clients/babylon_harness.js, ``poseMeshes``)."""
+
+    def __init__(self, folder: Path):
+        from tests.clients.babylon import BabylonClient
+
+        self.client = BabylonClient(folder)
+
+    def play(self, name: str, clip: str, times: np.ndarray) -> Played:
+        """Every drawn mesh's posed positions and normals, as Babylon's CPU skinning and morphing give
+        them."""
+        self.client._clear()
+        url = f"{self.client.base}/assets/{name}"
+        result = json.loads(self.client.page.evaluate(
+            "async ([u, c, t]) => JSON.stringify(await window.poseMeshes(u, c, t))",
+            [url, clip, [float(t) for t in times]]))
+        if "error" in result:
+            raise AssertionError(f"Babylon.js: {result['error']}")
+        problems = self.client._problems()
+        if problems:
+            raise AssertionError(f"Babylon.js: {problems[:3]}")
+        meshes = {}
+        for k, m in enumerate(result["meshes"]):
+            positions = np.array(m["positions"], float).reshape(len(times), -1, 3)
+            normals = np.array(m["normals"], float).reshape(len(times), -1, 3)
+            meshes[f"{m['path']}#{k}"] = (np.array(m["index"]).reshape(-1, 3), positions, normals)
+        self.last = result
+        return Played(times, meshes, np.zeros((len(times), 0, 3)))
+
+    def close(self) -> None:
+        self.client.close()
+
+
+def godot_play(path: Path, clips: dict[str, np.ndarray], folder: Path,
+               compress: bool = True) -> dict[str, Played]:
+    """Godot 3 (godot3-server): ``path`` imported into a fresh project under ``folder``, each clip played
+    by its AnimationPlayer (engine/godot_engine.gd), and every surface posed with what Godot left:
+    its imported blend shapes mixed by the player's weights as Godot's blend shape modes say, then
+    skinned by the player's bone poses times the skin's binds (linear blend, as Godot's shader does).
+    Godot's front faces are clockwise, so its triangles are turned back to glTF's order here.
+    ``compress``: the scene importer's `meshes/compress` (Godot's default, on: normals in bytes)."""
+    from tests.clients.godot import GODOT, _env, import_project, new_project
+
+    if GODOT is None:
+        raise RuntimeError("no godot3-server")
+    project = new_project(folder, HERE / "godot_engine.gd", "fishgen_pose.gd")
+    shutil.copy(path, project / path.name)
+    if not compress:   # the import dock's Meshes > Compress, as its .import file keeps it
+        (project / f"{path.name}.import").write_text(
+            f'[remap]\n\nimporter="scene"\ntype="PackedScene"\n\n[deps]\n\nsource_file="res://{path.name}"\n\n'
+            '[params]\n\nmeshes/compress=false\n')
+    (project / "fishgen_pose.json").write_text(json.dumps(
+        {"file": f"res://{path.name}", "clips": {k: [float(t) for t in v] for k, v in clips.items()}}))
+    import_project(project, folder)
+    run = subprocess.run([GODOT, "--path", str(project), "-s", "res://fishgen_pose.gd"],
+                         capture_output=True, text=True, env=_env(folder), timeout=600)
+    line = next((x for x in run.stdout.splitlines() if x.startswith("FISHGEN_POSE ")), None)
+    if run.returncode != 0 or line is None or "SCRIPT ERROR" in run.stdout + run.stderr:
+        raise RuntimeError(f"godot3-server -s fishgen_pose.gd exited {run.returncode}: "
+                           f"{(run.stdout + run.stderr).strip()[-800:]}")
+    report = json.loads(line.split(" ", 1)[1])
+    out = {}
+    for clip, frames in report["clips"].items():
+        meshes = {}
+        for m, mesh in enumerate(report["meshes"]):
+            for k, surf in enumerate(mesh["surfaces"]):
+                faces = np.array(surf["index"], np.int64).reshape(-1, 3)[:, [0, 2, 1]]
+                base = [np.array(surf[key], float).reshape(-1, 3) for key in ("vertices", "normals")]
+                shapes = [[np.array(b[key], float).reshape(-1, 3) for b in surf["blend"]]
+                          for key in ("vertices", "normals")]
+                positions, normals = [], []
+                for state in (f[m] for f in frames):
+                    w = np.array(state["weights"], float)
+                    posed = []
+                    for b, sh in zip(base, shapes, strict=True):
+                        mixed = b * (1.0 - w.sum()) if mesh["mode"] == 0 else b.copy()   # 0: NORMALIZED
+                        for wk, shape in zip(w, sh, strict=True):
+                            mixed += wk * shape
+                        posed.append(mixed)
+                    if surf["bones"] is not None and state["binds"]:
+                        binds = np.array(state["binds"], float)
+                        cols, origin = binds[:, :9].reshape(-1, 3, 3), binds[:, 9:]
+                        bones = np.array(surf["bones"], np.int64).reshape(-1, 4)
+                        weights = np.array(surf["weights"], float).reshape(-1, 4)
+                        blend = np.einsum("vj,vjab->vab", weights, cols[bones])       # rows: the basis' axes
+                        shift = np.einsum("vj,vjc->vc", weights, origin[bones])
+                        posed = [np.einsum("va,vab->vb", posed[0], blend) + shift,
+                                 np.einsum("va,vab->vb", posed[1], blend)]
+                    positions.append(posed[0])
+                    normals.append(posed[1])
+                meshes[f"{mesh['path']}/{k}#{m}"] = (faces, np.array(positions), np.array(normals))
+        out[clip] = Played(np.asarray(clips[clip], float), meshes, np.zeros((len(clips[clip]), 0, 3)))
+    return out
+
+
+def blender_play(path: Path, clips: dict[str, np.ndarray], probe_points: np.ndarray,
+                 shading: bool = False) -> dict:
+    """Blender's importer and its own evaluated meshes (tests/assembly/engine/blender_engine.py).
+    With ``shading``, ``report["shading"]`` holds a :class:`Played` per clip (no probes), and one of
+    the rest pose as ``__rest__``, and ``report["fins"]`` the fin vertices of each mesh."""
     if BPY is None:
         raise RuntimeError("no Python with bpy ($FISHGEN_BPY_PYTHON)")
     with tempfile.TemporaryDirectory() as tmp:
         spec = Path(tmp) / "spec.json"
-        spec.write_text(json.dumps({"probes": probe_points.tolist(),
+        spec.write_text(json.dumps({"probes": probe_points.tolist(), "shading": shading,
                                     "clips": {k: [float(t) for t in v] for k, v in clips.items()}}))
         run = subprocess.run([BPY, str(HERE / "blender_engine.py"), str(path), str(spec)],
                              capture_output=True, text=True, timeout=1200)
@@ -242,6 +357,20 @@ def blender_play(path: Path, clips: dict[str, np.ndarray], probe_points: np.ndar
         raise RuntimeError(run.stderr[-2000:])
     report = json.loads(next(line for line in run.stdout.splitlines() if line.startswith("{")))
     report["clips"] = {k: np.array(v, float) for k, v in report["clips"].items()}
+    played = {}
+    report["fins"] = {f"{m['name']}#{k}": np.array(m["fin"], bool)
+                      for k, m in enumerate(report["shading"].get("__rest__", [[]])[0])}
+    for clip, frames in report["shading"].items():
+        meshes = {}
+        for k, first in enumerate(frames[0]):
+            meshes[f"{first['name']}#{k}"] = (
+                np.array(first["faces"], np.int64).reshape(-1, 3),
+                np.array([f[k]["positions"] for f in frames], float).reshape(len(frames), -1, 3),
+                np.array([f[k]["normals"] for f in frames], float).reshape(len(frames), -1, 3))
+        report["spread"] = max([report.get("spread", 0.0)] + [f[k]["corner_spread"] for f in frames
+                                                               for k in range(len(f))])
+        played[clip] = Played(clips.get(clip, np.zeros(1)), meshes, np.zeros((len(frames), 0, 3)))
+    report["shading"] = played
     return report
 
 

@@ -7,7 +7,11 @@ Run with a Python that has PyPI's `bpy` (3.11 only; see docs/clients.md):
 SPEC holds ``probes`` (rest positions in glTF axes: each is matched to the nearest vertex of the
 visible meshes at rest) and ``clips`` ({name: [times in seconds]}). The output: which mesh objects
 are visible, the actions, and per clip each probe's posed position (glTF axes) at each time, taken
-from Blender's own evaluated meshes (shape keys, armature and parents applied by Blender).
+from Blender's own evaluated meshes (shape keys, armature and parents applied by Blender). With
+``"shading": true`` in SPEC, also ``shading``: per clip, per visible mesh, its triangles and at each
+time its evaluated vertices and the normals Blender shades them with (its corner normals, one per
+vertex: fishgen's vertices are already split where normals differ; ``corner_spread`` says how far
+a vertex's corners disagree; ``fin`` marks the vertices of fins), all in the object's own space.
 """
 from __future__ import annotations
 
@@ -93,21 +97,57 @@ def main(path: Path, spec: dict) -> dict:
     nearest = [int(np.argmin(np.linalg.norm(every - p, axis=1))) for p in probes]
     gaps = [np.linalg.norm(every[n] - p) for n, p in zip(nearest, probes, strict=True)]
     found = float(max(gaps)) if gaps else 0.0
-    clips = {}
+    def shaded() -> list[dict]:
+        out = []
+        for ob in meshes:
+            ev = ob.evaluated_get(depsgraph)
+            mesh = ev.to_mesh()
+            co = np.empty(len(mesh.vertices) * 3)
+            mesh.vertices.foreach_get("co", co)
+            corners = np.empty(len(mesh.loops), np.int64)
+            mesh.loops.foreach_get("vertex_index", corners)
+            normals = np.empty(len(mesh.loops) * 3)
+            mesh.corner_normals.foreach_get("vector", normals)
+            normals = normals.reshape(-1, 3)
+            per_vertex = np.zeros((len(mesh.vertices), 3))
+            per_vertex[corners[::-1]] = normals[::-1]          # each vertex's first corner
+            cos = np.sum(per_vertex[corners] * normals, axis=1)
+            tris = np.empty(len(mesh.loop_triangles) * 3, np.int64)
+            mesh.loop_triangles.foreach_get("vertices", tris)
+            slots = np.empty(len(mesh.loop_triangles), np.int64)
+            mesh.loop_triangles.foreach_get("material_index", slots)
+            names = [s.material.name if s.material else "" for s in ob.material_slots] or [""]
+            fins = np.array([n.endswith("_fins") for n in names])[slots] | ("_fin" in ob.name)
+            fin_vertex = np.zeros(len(mesh.vertices), bool)
+            fin_vertex[tris.reshape(-1, 3)[fins].ravel()] = True
+            spread = float(np.degrees(np.arccos(np.clip(cos.min(), -1, 1)))) if len(cos) else 0.0
+            out.append({"name": ob.name, "faces": tris.tolist(), "positions": co.tolist(),
+                        "normals": per_vertex.ravel().tolist(), "fin": fin_vertex.tolist(),
+                        "corner_spread": spread})
+            ev.to_mesh_clear()
+        return out
+
+    clips, shading = {}, {}
+    if spec.get("shading"):    # the rest pose: the normals the importer made of the file's
+        shading["__rest__"] = [shaded()]
     for name, times in spec["clips"].items():
         _use_clip(name)
-        track = []
+        track, shades = [], []
         for t in times:
             frame = t * fps
             scene.frame_set(int(np.floor(frame)), subframe=float(frame - np.floor(frame)))
             depsgraph = bpy.context.evaluated_depsgraph_get()
             posed = np.concatenate([_to_gltf(part) for part in world_vertices()])
             track.append(posed[nearest].tolist())
+            if spec.get("shading"):
+                shades.append(shaded())
         clips[name] = track
+        if shades:
+            shading[name] = shades
     actions = sorted(a.name for a in bpy.data.actions)
     return {"file": path.name, "blender": bpy.app.version_string, "visible": sorted(ob.name for ob in meshes),
             "hidden": hidden, "actions": actions, "probe_distance": found, "fps": fps,
-            "owners": [meshes[int(owners[n])].name for n in nearest], "clips": clips}
+            "owners": [meshes[int(owners[n])].name for n in nearest], "clips": clips, "shading": shading}
 
 
 if __name__ == "__main__":
