@@ -75,13 +75,19 @@ def main(path: Path, spec: dict) -> dict:
     hidden = sorted(ob.name for ob in bpy.data.objects if ob.type == "MESH" and not ob.visible_get())
     depsgraph = bpy.context.evaluated_depsgraph_get()
 
+    def evaluated(ob):
+        """The object as the depsgraph evaluates it, its mesh (free with ``to_mesh_clear``) and the
+        mesh's vertices in the object's own space."""
+        ev = ob.evaluated_get(depsgraph)
+        mesh = ev.to_mesh()
+        co = np.empty(len(mesh.vertices) * 3)
+        mesh.vertices.foreach_get("co", co)
+        return ev, mesh, co
+
     def world_vertices() -> list[np.ndarray]:
         out = []
         for ob in meshes:
-            ev = ob.evaluated_get(depsgraph)
-            mesh = ev.to_mesh()
-            co = np.empty(len(mesh.vertices) * 3)
-            mesh.vertices.foreach_get("co", co)
+            ev, _, co = evaluated(ob)
             m = np.array(ev.matrix_world)
             out.append(co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3])
             ev.to_mesh_clear()
@@ -97,13 +103,11 @@ def main(path: Path, spec: dict) -> dict:
     nearest = [int(np.argmin(np.linalg.norm(every - p, axis=1))) for p in probes]
     gaps = [np.linalg.norm(every[n] - p) for n, p in zip(nearest, probes, strict=True)]
     found = float(max(gaps)) if gaps else 0.0
+
     def shaded() -> list[dict]:
         out = []
         for ob in meshes:
-            ev = ob.evaluated_get(depsgraph)
-            mesh = ev.to_mesh()
-            co = np.empty(len(mesh.vertices) * 3)
-            mesh.vertices.foreach_get("co", co)
+            ev, mesh, co = evaluated(ob)
             corners = np.empty(len(mesh.loops), np.int64)
             mesh.loops.foreach_get("vertex_index", corners)
             normals = np.empty(len(mesh.loops) * 3)
