@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from fishgen.assembly.body_wave import wave_nodes
+from fishgen.assembly.instance import add_species
 from fishgen.geometry.body_wave import BodyWave, integrate_phase, wave_weights
 from fishgen.scene.model import Channel, Clip, Node, Path_, Sampler, Scene
 from fishgen.scene.pose import sample
@@ -38,15 +39,7 @@ def merge_species(school: Scene, fish: Scene) -> list[tuple[Node, int | None, bo
     """Add one built fish's meshes, materials and images to ``school``; return its part nodes
     (as templates with re-indexed meshes), the index of each part's fin swing channel in the swim
     clip, and whether the part carries the body-wave targets."""
-    image_base, material_base, mesh_base = len(school.images), len(school.materials), len(school.meshes)
-    school.images += fish.images
-    for material in fish.materials:
-        texture = None if material.texture is None else material.texture + image_base
-        school.materials.append(replace(material, texture=texture))
-    for mesh in fish.meshes:
-        prims = [replace(p, material=None if p.material is None else p.material + material_base)
-                 for p in mesh.primitives]
-        school.meshes.append(replace(mesh, primitives=prims))
+    mesh_base = add_species(school, fish).mesh_base
     (root,) = fish.roots
     swim = fish.clip("swim")
     channel_of = ({c.node: k for k, c in enumerate(swim.channels) if c.path == "rotation"}
