@@ -262,3 +262,18 @@ def test_fin_tips_are_settled_at_the_scale_the_fish_is_rendered_at():
     after = silhouette_iou(mask, _drawn(settled.species, render))
     assert after >= before + 0.01, f"{before:.3f} -> {after:.3f}"
     assert settled.species.body_sections == fit.species.body_sections
+
+
+def test_a_belly_strip_does_not_join_the_pelvic_fin_to_the_anal_fin():
+    """Centroberyx's lit+water photo: its measured body fell 4-5 px short of the belly, so the
+    pelvic and anal fins made one run of columns, all taken for the pelvic fin, and the anal fin was
+    left out. The valley between their peaks parts them; a fin falling away to its end keeps its
+    low part."""
+    from fishgen.authoring.photo.fit import _runs, _valleys_out
+
+    pelvic, strip, anal = [30, 47, 50, 48, 40, 20], [5, 4, 4, 5, 4], [15, 25, 46, 61, 40, 30, 20, 16, 15]
+    counts = np.array([0, *pelvic, *strip, *anal, 0])
+    runs = _runs(_valleys_out(counts, counts > 3))
+    assert runs == [(1, 7), (12, 21)]
+    falling = np.array([0, 60, 50, 30, 12, 6, 5, 4, 4, 0])   # a dorsal's long low end
+    assert _runs(_valleys_out(falling, falling > 3)) == [(1, 9)]

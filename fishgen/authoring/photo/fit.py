@@ -61,6 +61,9 @@ MIN_STEP = 0.25
 #: Where fins may stand, as shares of the body: (first, last) section share.
 PLACES = {"dorsal": (0.08, 0.97), "adipose": (0.3, 0.97), "anal": (0.3, 0.97), "pelvic": (0.1, 0.75)}
 MAX_PELVIC_SPAN = 0.35
+#: Fin runs under the belly part where the fin pixels per column fall under this share of the
+#: peaks on both sides (:func:`_valleys_out`).
+VALLEY = 0.25
 #: settled_tips: relative steps of a fin length, halved from the first down to the last
 TIP_STEPS = (0.04, 0.005)
 
@@ -510,7 +513,8 @@ def _measured_fins(sp: Species, work: np.ndarray, body: _Body, place: Placement)
     up = np.where(span, above.sum(axis=0), 0)
     down = np.where(span, below.sum(axis=0), 0)
     runs_up = [r for r in _runs(up > tol) if up[r[0]:r[1]].sum() >= SPECK * body.area]
-    runs_down = [r for r in _runs(down > tol) if down[r[0]:r[1]].sum() >= SPECK * body.area]
+    runs_down = [r for r in _runs(_valleys_out(down, down > tol))
+                 if down[r[0]:r[1]].sum() >= SPECK * body.area]
     runs_up.sort(key=lambda r: -int(up[r[0]:r[1]].sum()))
     dorsal = runs_up[0] if runs_up else None
     adipose = next((r for r in runs_up[1:] if dorsal is not None and r[0] > dorsal[1]), None)
@@ -530,6 +534,20 @@ def _measured_fins(sp: Species, work: np.ndarray, body: _Body, place: Placement)
     sp = _vertical_from(sp, "anal", anal, below, place, -1.0)
     sp = _pelvic_from(sp, pelvic, below, place)
     return sp
+
+
+def _valleys_out(counts: np.ndarray, flags: np.ndarray) -> np.ndarray:
+    """``flags`` without the columns of a valley: fin pixels under VALLEY x the lower of the
+    highest counts on either side. Where the measured body falls a few pixels short of the
+    photo's, a strip of its belly joins the pelvic fin to the anal fin in one run of columns; the
+    valley between their peaks parts them. A fin falling away to its end has no peak behind it,
+    and keeps its low part."""
+    out = flags.copy()
+    for a, b in _runs(flags):
+        seg = counts[a:b].astype(float)
+        peaks = np.minimum(np.maximum.accumulate(seg), np.maximum.accumulate(seg[::-1])[::-1])
+        out[a:b] &= ~(seg < VALLEY * peaks)
+    return out
 
 
 def _body_mask(sp: Species, place: Placement, shape: tuple[int, int]) -> np.ndarray:
