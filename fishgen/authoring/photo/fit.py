@@ -66,6 +66,8 @@ MAX_PELVIC_SPAN = 0.35
 VALLEY = 0.25
 #: settled_tips: relative steps of a fin length, halved from the first down to the last
 TIP_STEPS = (0.04, 0.005)
+#: ...and of a fin angle, in degrees per unit of those steps (2 degrees down to 0.25)
+TIP_DEGREES = 50.0
 
 
 @dataclass(frozen=True)
@@ -210,15 +212,17 @@ def settled_tips(fit: ShapeFit, px_per_unit: float) -> ShapeFit:
     drawer = _Drawer(first, place, shape)
     best = score(drawer.whole())
     sp, step = first, TIP_STEPS[0]
-    lengths = [(r, n) for r, n, kind in PARAMETERS if kind == "length" and r != "pectoral"]
+    tuned = [(r, n, kind) for r, n, kind in PARAMETERS if kind in ("length", "angle") and r != "pectoral"]
     while step >= TIP_STEPS[1]:
         improved = False
-        for record, name in lengths:
+        for record, name, kind in tuned:
             fin = getattr(sp, record)
             if record in ("dorsal", "anal", "adipose") and not fin.present:
                 continue
-            for k in (1.0 - step, 1.0 + step):
-                trial = _with(sp, record, replace(fin, **{name: getattr(fin, name) * k}))
+            for k in (-step, step):
+                value = getattr(fin, name)
+                trial = _with(sp, record, replace(fin, **{
+                    name: value * (1.0 + k) if kind == "length" else value + k * TIP_DEGREES}))
                 if not valid(trial):
                     continue
                 changed = {record: drawer.fin(trial, record)}
