@@ -1,8 +1,8 @@
 """Round trip: render a shipped species side-on as a photo, make a species from it, rebuild.
 
-Checks (issue 12): the rebuilt fish's silhouette overlaps the photo's with IoU >= 0.95;
-body texture points lie within 2 % of the texture size of the true ones; every fin's
-points within 5 %. Measures with tolerances, never pixel diffs.
+Checks (issue 12): the rebuilt fish's silhouette overlaps the photo's with IoU >= 0.95 (issue 25:
+>= 0.965 on its own species); body texture points lie within 2 % of the texture size of the true
+ones; every fin's points within 5 %. Measures with tolerances, never pixel diffs.
 """
 from __future__ import annotations
 
@@ -18,6 +18,8 @@ from tests.authoring.conftest import SHIPPED
 BODY_TOLERANCE = 0.02
 FIN_TOLERANCE = 0.05
 MIN_IOU = 0.95
+#: Issue 25: a photo on its own species' geometry (a same-base round trip) stays at this or better.
+SAME_BASE_IOU = 0.965
 
 KINDS = {
     "transparent": lambda p: p,
@@ -59,7 +61,7 @@ def test_round_trip_silhouette(tmp_path, gl_available, photos, name, kind):
     species, photo = photos[name]
     result, rebuilt, _, _ = run_round_trip(tmp_path, species, KINDS[kind](photo))
     iou = silhouette_iou(result.level_mask, ph.rendered_mask(rebuilt))
-    assert iou >= MIN_IOU, f"{name}/{kind}: IoU {iou:.3f}"
+    assert iou >= SAME_BASE_IOU, f"{name}/{kind}: IoU {iou:.3f}"
 
 
 def test_texture_is_the_photo_upside_down(tmp_path, gl_available, photos):

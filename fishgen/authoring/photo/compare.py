@@ -22,6 +22,22 @@ def render_side(species: Species, width: int, height: int) -> np.ndarray:
         renderer.release()
 
 
+def render_scale(species: Species, width: int, height: int) -> float:
+    """Pixels a thesis unit spans in :func:`render_side`'s picture of ``species`` at this size:
+    the camera frames the whole fish, so this follows from its extents alone (nothing is drawn)."""
+    from fishgen.assembly.fish import METRES_PER_WORLD_UNIT, THESIS_TO_GLTF, build_fish
+    from fishgen.preview.camera import frame
+    from fishgen.preview.pipeline import subject_points
+
+    camera = frame(subject_points(build_fish(species), [None], None), "side", width / height, ortho=True)
+    vp = camera.projection() @ camera.view()
+    # one thesis unit along the body, from the origin, in clip space (orthographic: w stays 1)
+    ends = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]) @ THESIS_TO_GLTF.T
+    ends *= species.world_scale * METRES_PER_WORLD_UNIT
+    clip = np.c_[ends, np.ones(2)] @ vp.T
+    return float(abs(clip[1, 0] - clip[0, 0]) / 2 * width)
+
+
 def _crop(mask: np.ndarray) -> np.ndarray:
     ys, xs = np.nonzero(mask)
     return mask[ys.min():ys.max() + 1, xs.min():xs.max() + 1]

@@ -18,7 +18,13 @@ Measured first, then refined:
    silhouette, drawn at about 360 px in the fish's frame: the body's length, depth and axis,
    each fin's sections, lengths, angles and proportion. Moves that would break the fish (a fin
    off its body's span, a caudal fin pointing forward, angles past the vertical) are refused.
-4. **Level of detail.** When the base's BodySections cannot hold the body or place the fins
+4. **Fin tips at the measuring scale** (:func:`settled_tips`). A thin fin tip narrower than a
+   pixel is no longer drawn (a renderer fills the pixels whose centres it covers), so a
+   silhouette's tips already end short, and the rebuilt fish, rendered again, loses them once
+   more; the tips that bound the fish (the dorsal's thread, the pelvic's point) then shift every
+   outline in the bounding-box overlap by pixels. So the fin lengths are settled last, drawn at
+   the scale the rebuilt fish is rendered at and compared with the silhouette at its own.
+5. **Level of detail.** When the base's BodySections cannot hold the body or place the fins
    (the measured body outline is matched with IoU under 0.97, or a fin would span under two
    sections), more sections are used (up to 32) unless the caller fixed them.
 
@@ -55,6 +61,13 @@ MIN_STEP = 0.25
 #: Where fins may stand, as shares of the body: (first, last) section share.
 PLACES = {"dorsal": (0.08, 0.97), "adipose": (0.3, 0.97), "anal": (0.3, 0.97), "pelvic": (0.1, 0.75)}
 MAX_PELVIC_SPAN = 0.35
+#: Fin runs under the belly part where the fin pixels per column fall under this share of the
+#: peaks on both sides (:func:`_valleys_out`).
+VALLEY = 0.25
+#: settled_tips: relative steps of a fin length, halved from the first down to the last
+TIP_STEPS = (0.04, 0.005)
+#: ...and of a fin angle, in degrees per unit of those steps (2 degrees down to 0.25)
+TIP_DEGREES = 50.0
 
 
 @dataclass(frozen=True)
@@ -174,6 +187,64 @@ def _attached(fit: ShapeFit) -> tuple[ShapeFit, list[str]]:
         if after != before:
             notes.append(f"the {name} fin swings {after:.3g} degrees, not {before:.3g}, to stay on the body")
     return replace(fit, species=sp), notes
+
+
+def settled_tips(fit: ShapeFit, px_per_unit: float) -> ShapeFit:
+    """``fit`` with its fin lengths searched again (a pattern search in steps of 4 % down to 0.5 %),
+    the species drawn at ``px_per_unit`` pixels a thesis unit (the scale its render is measured
+    at: :func:`.compare.render_scale`) against the levelled silhouette ``fit.frame.mask`` at its
+    own scale, by the overlap the command reports. A fin this makes taller than the photographed
+    fish keeps its length from before."""
+    from fishgen.authoring.photo.checks import height_problems
+
+    if fit.frame is None or fit.frame_map is None:
+        return fit
+    target = fit.frame.mask
+    first = fit.species
+    outline, fins = _parts(first)
+    pts = np.concatenate([outline, *[f for f, _ in fins]])
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    margin = 0.25 * float((hi - lo).max()) * px_per_unit + 8   # room for fins to grow
+    place = Placement(margin - lo[0] * px_per_unit, margin + hi[1] * px_per_unit, px_per_unit)
+    shape = (int(np.ceil((hi[1] - lo[1]) * px_per_unit + 2 * margin)),
+             int(np.ceil((hi[0] - lo[0]) * px_per_unit + 2 * margin)))
+    score = _shape_score(target)
+    drawer = _Drawer(first, place, shape)
+    best = score(drawer.whole())
+    sp, step = first, TIP_STEPS[0]
+    tuned = [(r, n, kind) for r, n, kind in PARAMETERS if kind in ("length", "angle") and r != "pectoral"]
+    while step >= TIP_STEPS[1]:
+        improved = False
+        for record, name, kind in tuned:
+            fin = getattr(sp, record)
+            if record in ("dorsal", "anal", "adipose") and not fin.present:
+                continue
+            for k in (-step, step):
+                value = getattr(fin, name)
+                trial = _with(sp, record, replace(fin, **{
+                    name: value * (1.0 + k) if kind == "length" else value + k * TIP_DEGREES}))
+                if not valid(trial):
+                    continue
+                changed = {record: drawer.fin(trial, record)}
+                if record == "caudal":   # the vertical fins end in front of it
+                    changed.update({n: drawer.fin(trial, n) for n in ("dorsal", "adipose", "anal")})
+                value = score(drawer.whole(changed))
+                if value > best + 1e-4:
+                    sp, best, improved = trial, value, True
+                    drawer.layers.update(changed)
+                    fin = getattr(sp, record)
+        if not improved:
+            step /= 2
+    if sp is first:
+        return fit
+    before = height_problems(first, fit.work, fit.placement)
+    for problem in height_problems(sp, fit.work, fit.placement):
+        tall = next((n for n in FIN_RECORDS if f" {n} fin " in problem), None)
+        if problem not in before and tall is not None:
+            sp = _with(sp, tall, getattr(first, tall))
+    settled = replace(fit, species=sp, iou=_shape_score(fit.work)(draw(sp, fit.placement, fit.work.shape)))
+    _, to_frame, offset = _working_mask(target)
+    return replace(settled, frame_map=_frame_map(settled, to_frame, offset))
 
 
 def _trimmed(fit: ShapeFit) -> ShapeFit:
@@ -446,7 +517,8 @@ def _measured_fins(sp: Species, work: np.ndarray, body: _Body, place: Placement)
     up = np.where(span, above.sum(axis=0), 0)
     down = np.where(span, below.sum(axis=0), 0)
     runs_up = [r for r in _runs(up > tol) if up[r[0]:r[1]].sum() >= SPECK * body.area]
-    runs_down = [r for r in _runs(down > tol) if down[r[0]:r[1]].sum() >= SPECK * body.area]
+    runs_down = [r for r in _runs(_valleys_out(down, down > tol))
+                 if down[r[0]:r[1]].sum() >= SPECK * body.area]
     runs_up.sort(key=lambda r: -int(up[r[0]:r[1]].sum()))
     dorsal = runs_up[0] if runs_up else None
     adipose = next((r for r in runs_up[1:] if dorsal is not None and r[0] > dorsal[1]), None)
@@ -466,6 +538,20 @@ def _measured_fins(sp: Species, work: np.ndarray, body: _Body, place: Placement)
     sp = _vertical_from(sp, "anal", anal, below, place, -1.0)
     sp = _pelvic_from(sp, pelvic, below, place)
     return sp
+
+
+def _valleys_out(counts: np.ndarray, flags: np.ndarray) -> np.ndarray:
+    """``flags`` without the columns of a valley: fin pixels under VALLEY x the lower of the
+    highest counts on either side. Where the measured body falls a few pixels short of the
+    photo's, a strip of its belly joins the pelvic fin to the anal fin in one run of columns; the
+    valley between their peaks parts them. A fin falling away to its end has no peak behind it,
+    and keeps its low part."""
+    out = flags.copy()
+    for a, b in _runs(flags):
+        seg = counts[a:b].astype(float)
+        peaks = np.minimum(np.maximum.accumulate(seg), np.maximum.accumulate(seg[::-1])[::-1])
+        out[a:b] &= ~(seg < VALLEY * peaks)
+    return out
 
 
 def _body_mask(sp: Species, place: Placement, shape: tuple[int, int]) -> np.ndarray:

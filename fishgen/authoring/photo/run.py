@@ -248,7 +248,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     fitted, problems, fit = False, [], None
     if options.fit_shape:
         from fishgen.authoring.photo.checks import fit_problems
-        from fishgen.authoring.photo.fit import fit_species
+        from fishgen.authoring.photo.compare import render_scale
+        from fishgen.authoring.photo.fit import fit_species, settled_tips
 
         tried: tuple[np.ndarray, float] | None = None
         chosen_fit: tuple[_Candidate, Any] | None = None
@@ -256,6 +257,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
             if tried is not None and tried[1] >= TURN_GOOD:
                 break
             attempt = fit_species(base, sil.mask, sections_fixed=options.body_sections is not None, turn=turn)
+            attempt = settled_tips(attempt, render_scale(attempt.species, *_render_size(photo)))
             found = fit_problems(attempt.species, attempt.work, attempt.placement)
             if turn == 0.0:
                 fit, problems = attempt, found
@@ -367,10 +369,15 @@ def _rendered(photo: Photo, candidate: _Candidate, out: Path) -> tuple[np.ndarra
             except OSError as err:  # a full scratch disk: say which output it was for, and where
                 raise cannot(f"check {path} in the scratch folder", tmp, err) from None
         rebuilt = load_species(Path(tmp) / out.name)
-        w, h = photo.size
-        k = min(1.0, 1024 / max(w, h))
-        render = render_side(rebuilt, max(64, round(w * k)), max(64, round(h * k)))
+        render = render_side(rebuilt, *_render_size(photo))
     return render, silhouette_iou(candidate.measured.frame_mask, render[:, :, 3] >= 64)
+
+
+def _render_size(photo: Photo) -> tuple[int, int]:
+    """(width, height) the rebuilt fish is rendered at to measure it: the photo's, at most 1024 px."""
+    w, h = photo.size
+    k = min(1.0, 1024 / max(w, h))
+    return max(64, round(w * k)), max(64, round(h * k))
 
 
 def _compare_png(photo: Photo, render: np.ndarray, iou: float) -> tuple[bytes, float]:
