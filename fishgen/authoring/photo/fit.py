@@ -225,9 +225,7 @@ def settled_tips(fit: ShapeFit, px_per_unit: float) -> ShapeFit:
                     name: value * (1.0 + k) if kind == "length" else value + k * TIP_DEGREES}))
                 if not valid(trial):
                     continue
-                changed = {record: drawer.fin(trial, record)}
-                if record == "caudal":   # the vertical fins end in front of it
-                    changed.update({n: drawer.fin(trial, n) for n in ("dorsal", "adipose", "anal")})
+                changed = _redrawn(drawer, trial, record)
                 value = score(drawer.whole(changed))
                 if value > best + 1e-4:
                     sp, best, improved = trial, value, True
@@ -857,9 +855,7 @@ def _refine(sp: Species, work: np.ndarray, body: _Body,
                 trial = _with(sp, record, replace(fin, **{name: new_value}))
                 if not valid(trial):
                     continue
-                changed = {record: drawer.fin(trial, record)}
-                if record == "caudal":   # the vertical fins end in front of it
-                    changed.update({n: drawer.fin(trial, n) for n in ("dorsal", "adipose", "anal")})
+                changed = _redrawn(drawer, trial, record)
                 s = shape_score(drawer.whole(changed))
                 if s > best + 1e-4:
                     sp, best, improved = trial, s, True
@@ -870,6 +866,15 @@ def _refine(sp: Species, work: np.ndarray, body: _Body,
             if scale < MIN_STEP:
                 break
     return sp, place, depth, best
+
+
+def _redrawn(drawer: _Drawer, trial: Species, record: str) -> dict[str, np.ndarray]:
+    """The layers a change to fin ``record`` redraws: the caudal fin's moves the vertical fins too,
+    which end in front of it."""
+    changed = {record: drawer.fin(trial, record)}
+    if record == "caudal":
+        changed.update({n: drawer.fin(trial, n) for n in ("dorsal", "adipose", "anal")})
+    return changed
 
 
 def _drop_hidden(sp: Species, work: np.ndarray, place: Placement) -> Species:
