@@ -6,7 +6,7 @@ This wraps the geometry modules so the photo code depends on one small surface
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -27,8 +27,8 @@ class SideView:
     fin_faces: dict[str, np.ndarray]
     # The fins as a built fish shows them (vertical fins end in front of the caudal fin): what a
     # photo of this species holds. ``fins`` has every section the file names, one per texture point.
-    shown_fins: dict[str, np.ndarray] = field(default_factory=dict)
-    shown_faces: dict[str, np.ndarray] = field(default_factory=dict)
+    shown_fins: dict[str, np.ndarray]
+    shown_faces: dict[str, np.ndarray]
 
     @property
     def sections(self) -> int:
