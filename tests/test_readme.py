@@ -101,3 +101,40 @@ def test_the_exit_status_table_is_what_the_errors_say():
     said |= {(cls.status, cls.kind) for cls in (FishgenError, UsageError, SystemFailure, MissingDependency)}
     assert said <= rows and {(s, k) for s, k in rows if k not in ("worker", "internal")} <= said
     assert (WorkerLost.status, InternalError.status) == (1, 1)
+
+
+def _anchors(markdown: str) -> set[str]:
+    """The anchors GitHub gives a page's headings: lower case, punctuation dropped, spaces to
+    hyphens, and -1, -2, … after a repeated one."""
+    anchors: set[str] = set()
+    for heading in re.findall(r"^#{1,6} +(.+?) *#*$", _FENCED.sub("", markdown), re.M):
+        slug = re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
+        repeat = next(n for n in range(len(anchors) + 1) if (f"{slug}-{n}" if n else slug) not in anchors)
+        anchors.add(f"{slug}-{repeat}" if repeat else slug)
+    return anchors
+
+
+_FENCED = re.compile(r"^```.*?^```", re.S | re.M)
+
+
+def _prose(markdown: str) -> str:
+    """The page without its fenced code blocks and code spans, where brackets are not links."""
+    return re.sub(r"`[^`\n]*`", "", _FENCED.sub("", markdown))
+
+
+def test_every_relative_link_and_image_resolves():
+    """Each relative link or image in the README and docs/*.md names a file that exists, and a
+    heading of that page where it names one."""
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    broken = []
+    for page in pages:
+        for target in re.findall(r"\]\(([^()\s]+)\)", _prose(page.read_text(encoding="utf-8"))):
+            if re.match(r"[a-z]+:", target):
+                continue
+            path, _, anchor = target.partition("#")
+            file = (page.parent / path).resolve() if path else page
+            if not file.exists():
+                broken.append(f"{page.name}: {target} (no such file)")
+            elif anchor and file.suffix == ".md" and anchor not in _anchors(file.read_text(encoding="utf-8")):
+                broken.append(f"{page.name}: {target} (no such heading)")
+    assert not broken, "\n".join(broken)
