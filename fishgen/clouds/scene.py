@@ -17,6 +17,7 @@ import numpy as np
 
 from fishgen.clouds.lighting import EXTRAS_KEY, Lighting
 from fishgen.clouds.model import Cloud
+from fishgen.clouds.pipeline import PREVIEW_PARTICLES
 from fishgen.clouds.sprite import gaussian_sprite_png
 from fishgen.numeric import srgb8_to_linear16
 from fishgen.scene.model import Image, Material, Mesh, Node, Primitive, Scene
@@ -145,37 +146,22 @@ def turns(n: int) -> np.ndarray:
     return rot.reshape(n, 3, 3).astype(np.float32)
 
 
-PREVIEW_PARTICLES = 100_000
-"""Most particles a preview fills: a picture shows no more, a CPU rasterizer draws 10^5 soft discs in
-about 2.5 s, and a 46-byte file of 2x10^7 particles took 6.6 GB and 42 s before this cap."""
-
-
 def cube_file_scene(path: str | os.PathLike, *, seed: int = 0, most: int = PREVIEW_PARTICLES,
                     lighting: Lighting | None = None, textures_dir: str | os.PathLike | None = None) -> Scene:
     """A cube file (.awn) or texture cloud file (.awa) filled and lit as `fishgen clouds` does it,
     as points or textured billboards (what the preview and the viewer draw).
 
-    A file of more than ``most`` particles is filled with every cube's count
-    scaled down alike (its shape and density pattern kept), and the scene's
-    ``note`` says so.
+    A file of more than ``most`` particles is filled with every cube's count scaled
+    down alike (its shape and density pattern kept), and the scene's ``note`` says so.
     """
-    from dataclasses import replace
     from pathlib import Path
 
-    from fishgen.clouds import fill_cloud, load_cubes
-    from fishgen.clouds.light import light_cloud
+    from fishgen.clouds.pipeline import cube_clouds, read_cube_files
 
-    cubes = load_cubes(path, textures_dir=textures_dir)
-    note = None
-    if cubes.total > most:
-        whole = cubes.total
-        ratio = most / whole
-        cubes = replace(cubes, cubes=tuple(replace(c, particles=max(1, int(c.particles * ratio)))
-                                           for c in cubes.cubes))
-        note = f"{path}: previewing {cubes.total:,} of its {whole:,} particles"
+    made = cube_clouds(read_cube_files([path], textures_dir=textures_dir), seed=seed, most=most,
+                       lighting=lighting)
     # a texture cloud is its textured billboards; a particle cloud is points, drawn as soft discs
-    scene = cloud_scene(light_cloud(fill_cloud(cubes, seed=seed), lighting), name=Path(path).stem,
-                        billboards=bool(cubes.cubes[0].texture))
-    if note:
-        scene.note = note
+    scene = cloud_scene(made.cloud, name=Path(path).stem, billboards=made.textured)
+    if made.note:
+        scene.note = f"{path}: {made.note}"
     return scene

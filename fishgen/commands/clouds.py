@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import os
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -80,9 +79,7 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     """Fill every cube file, light them together (so clouds shadow each other) and write them as one
     scene; input i is filled with seed + i. A texture cloud (.awa) becomes textured billboards."""
     from fishgen.clouds.export import check_output, export_cloud
-    from fishgen.clouds.fill import fill_cloud, merge_clouds
-    from fishgen.clouds.light import light_cloud
-    from fishgen.clouds.parser import CubeFileWarning, load_cubes
+    from fishgen.clouds.pipeline import cloud_textures, cube_clouds, read_cube_files
     from fishgen.commands.paths import check_inputs, check_targets
     from fishgen.errors import UsageError
     from fishgen.exchange.registry import FORMATS
@@ -97,33 +94,21 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     check_targets([output], inputs)
     if options.offset and len(options.offset) != len(inputs):
         raise UsageError(f"expected one --offset per input ({len(inputs)}), found {len(options.offset)}")
-    places = list(options.offset) or [(0.0, 0.0, 0.0)] * len(inputs)
-    limit = options.max_particles
-    files = []
-    for path in inputs:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", CubeFileWarning)
-            files.append(load_cubes(path, max_particles=limit, textures_dir=options.textures))
-        for note in caught:
-            events.note(str(note.message))
-    textures = list(dict.fromkeys(Path(c.texture) for f in files for c in f.cubes if c.texture))
+    files = read_cube_files(inputs, max_particles=options.max_particles, textures_dir=options.textures,
+                            note=events.note)
+    textures = cloud_textures(files)
     if textures and not billboards:
         events.note(f"{output}: {output.suffix.upper()[1:]} holds no textures; the billboards' centres are "
                     "written as particles")
     check_targets([output], textures)
-    total = sum(f.total for f in files)
-    if total > limit:
-        raise UsageError(f"expected at most {limit:,} particles in the scene (raise the limit with "
-                         f"--max-particles), found {total:,} in {len(files)} files")
-    check_output(output, billboards, particles=total)  # before filling: a glTF buffer holds 4 GiB
+    check_output(output, billboards, particles=sum(f.total for f in files))  # a glTF buffer holds 4 GiB
     seed = options.seed or 0
-    cloud = merge_clouds([fill_cloud(f, seed=seed + i, method=options.method, offset=place)
-                          for i, (f, place) in enumerate(zip(files, places, strict=True))])
-    cloud = light_cloud(cloud, options.lighting)
+    made = cube_clouds(files, seed=seed, method=options.method, offsets=options.offset,
+                       lighting=options.lighting, max_particles=options.max_particles)
+    cloud = made.cloud
     written = export_cloud(cloud, output, billboards=billboards)
     sun = ",".join(f"{v:g}" for v in options.lighting.sun)
-    noun = "billboard" if textured else "particle"
-    line = (f"{output}: {_plural(len(cloud), noun)} in {_plural(len(cloud.cube_bounds), 'cube')} "
+    line = (f"{output}: {_plural(len(cloud), made.noun)} in {_plural(len(cloud.cube_bounds), 'cube')} "
             f"from {_plural(len(files), 'file')} ({options.method} fill, seed {seed}, sun {sun})")
     facts = CloudFacts(len(cloud), len(cloud.cube_bounds), len(files), billboards, options.lighting)
     return Made(tuple(written), (*inputs, *textures), (line,), facts)

@@ -28,7 +28,8 @@ from pathlib import Path
 from typing import Any
 
 from fishgen.clouds.lighting import Lighting
-from fishgen.clouds.model import DEFAULT_MAX_PARTICLES
+from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, CubeFile
+from fishgen.clouds.pipeline import PREVIEW_PARTICLES
 from fishgen.editor.document import (
     MODES,
     PARTICLES,
@@ -45,11 +46,10 @@ from fishgen.errors import describe, expected
 from fishgen.options import SEED_MAX
 from fishgen.web.server import MAX_BODY, LocalServer, Request, Response
 
-PREVIEW_PARTICLES = 100_000
-"""Most particles a fill for the page holds (as `fishgen preview`: fishgen.clouds.scene.PREVIEW_PARTICLES);
-a bigger cloud is previewed with every cube's count scaled down alike, and the page says so."""
 PREVIEW_BILLBOARDS = 20_000
-"""Most billboards a texture fill for the page holds: each is three textured quads, 408 bytes of GLB."""
+"""Most billboards a texture fill for the page holds: each is three textured quads, 408 bytes of GLB.
+(A particle fill holds at most PREVIEW_PARTICLES, as `fishgen preview`'s.) A bigger cloud is previewed
+with every cube's count scaled down alike, and the page says so."""
 MAX_REQUEST = MAX_BODY
 """Largest request body (16 MiB): a cube file is at most 16 MiB and 100,000 cubes."""
 
@@ -179,35 +179,20 @@ class Session:
                 "limits": {"particles": PREVIEW_PARTICLES, "billboards": PREVIEW_BILLBOARDS}}
 
 
-def fill_glb(cube_file, mode: str, seed: int, lighting: Lighting) -> tuple[bytes, dict[str, Any]]:
+def fill_glb(cube_file: CubeFile, mode: str, seed: int, lighting: Lighting) -> tuple[bytes, dict[str, Any]]:
     """Fill and light ``cube_file`` as `fishgen clouds` does (one input: seed ``seed``), as the GLB
     `fishgen clouds -o x.glb` would hold (points; billboards for a texture cloud), and its facts.
     Above the preview's limits every cube's count is scaled down alike, and ``note`` says so."""
-    from fishgen.clouds.fill import fill_cloud
-    from fishgen.clouds.light import light_cloud
+    from fishgen.clouds.pipeline import cube_clouds
     from fishgen.clouds.scene import cloud_scene
     from fishgen.exchange.gltf import glb_bytes
 
     most = PREVIEW_BILLBOARDS if mode == TEXTURE else PREVIEW_PARTICLES
-    whole = cube_file.total
-    note = None
-    if whole > most:
-        cube_file = scaled(cube_file, most)
-        noun = "billboards" if mode == TEXTURE else "particles"
-        note = f"previewing {cube_file.total:,} of its {whole:,} {noun}, every cube scaled alike"
-    cloud = light_cloud(fill_cloud(cube_file, seed=seed), lighting)
-    glb = glb_bytes(cloud_scene(cloud, billboards=mode == TEXTURE, name="cloud"))
-    return glb, {"particles": len(cloud), "whole": whole, "cubes": len(cube_file.cubes), "note": note,
-                 "seed": seed, "mode": mode}
-
-
-def scaled(cube_file, most: int):
-    """``cube_file`` with every count scaled by ``most / total`` (a cube that had any keeps at least
-    1), as :func:`fishgen.clouds.scene.cube_file_scene` previews a big file."""
-    ratio = most / cube_file.total
-    counts = [max(1, int(c.particles * ratio)) if c.particles else 0 for c in cube_file.cubes]
-    return replace(cube_file, cubes=tuple(replace(c, particles=n) for c, n in zip(cube_file.cubes, counts,
-                                                                                  strict=True)))
+    made = cube_clouds([cube_file], seed=seed, most=most, lighting=lighting)
+    glb = glb_bytes(cloud_scene(made.cloud, billboards=mode == TEXTURE, name="cloud"))
+    note = made.note and f"{made.note}, every cube scaled alike"
+    return glb, {"particles": made.particles, "whole": made.whole, "cubes": len(cube_file.cubes),
+                 "note": note, "seed": seed, "mode": mode}
 
 
 def _shown(folder: Path) -> str:

@@ -105,28 +105,23 @@ def cube_files_scene(paths: Sequence[Path], *, seed: int = 0, lighting: Lighting
                      max_particles: int = DEFAULT_MAX_PARTICLES):
     """Each cube file one cloud (input i filled with seed + i), side by side along +x, lit together
     (clouds shadow clouds), each its own node with a lower level: the scene and the files read."""
-    from fishgen.clouds.fill import fill_cloud
-    from fishgen.sky.build import load_models
+    from fishgen.clouds.pipeline import cube_clouds, read_cube_files
     from fishgen.sky.compose import Placement, SkyCloud, model_box
     from fishgen.sky.light import light_sky
     from fishgen.sky.scene import sky_scene
 
-    models, files = load_models(paths, max_particles=max_particles, textures_dir=textures_dir)
-    total = sum(m.total for m in models)
-    if total > max_particles:
-        raise FishgenError(f"expected at most {max_particles:,} particles (raise --max-particles), found "
-                           f"{total:,} in {len(models)} files")
+    files = [Path(p) for p in paths]
+    # filled each in its own frame (no offsets) and lit as a sky: each cloud on its own shadow map
+    made = cube_clouds(read_cube_files(files, max_particles=max_particles, textures_dir=textures_dir),
+                       seed=seed, light=False, max_particles=max_particles)
     clouds, edge = [], None
-    for i, (model, path) in enumerate(zip(models, files, strict=True)):
-        if model.total == 0:
-            raise FishgenError("expected a cube file with at least one particle, found none", path)
+    for i, (model, cloud, path) in enumerate(zip(made.models, made.clouds, files, strict=True)):
         lo, hi = model_box(model)
         shift = 0.0 if edge is None else edge - float(lo[0]) + GAP * float(hi[0] - lo[0])
         placement = Placement(name=path.stem, source=i, scale=(1.0, 1.0, 1.0), yaw=0.0,
                               position=(shift, 0.0, 0.0), particles=model.total, seed=seed + i)
-        clouds.append(SkyCloud(placement, fill_cloud(model, seed=seed + i)))
+        clouds.append(SkyCloud(placement, cloud))
         edge = shift + float(hi[0])
     lit = light_sky(clouds, lighting or Lighting())
     scene, _ = sky_scene(None, lit, [p.name for p in files])
-    textures = list(dict.fromkeys(Path(c.texture) for m in models for c in m.cubes if c.texture))
-    return scene, [*files, *textures]
+    return scene, [*files, *made.textures]

@@ -44,10 +44,10 @@ class Sky:
 def load_models(paths: Sequence[str | os.PathLike] = (), *, max_particles: int = DEFAULT_MAX_PARTICLES,
                 textures_dir: str | os.PathLike | None = None) -> tuple[list[CubeFile], list[Path]]:
     """The cube files a sky draws its clouds from: ``paths``, or the shipped models."""
-    from fishgen.clouds.parser import load_cubes
+    from fishgen.clouds.pipeline import read_cube_files
 
     files = [Path(p) for p in paths] or shipped_models()
-    return [load_cubes(p, max_particles=max_particles, textures_dir=textures_dir) for p in files], files
+    return read_cube_files(files, max_particles=max_particles, textures_dir=textures_dir), files
 
 
 def build_sky(mode: str = "medium", *, seed: int = 0, area: tuple[float, float] = AREA,
@@ -58,15 +58,14 @@ def build_sky(mode: str = "medium", *, seed: int = 0, area: tuple[float, float] 
               max_particles: int = DEFAULT_MAX_PARTICLES) -> Sky:
     """Compose, fill, light and level a sky of ``mode`` (thin, medium, thick) from ``models`` (cube
     files, .awn or .awa; default: the shipped ones). Same arguments, same scene, bit for bit."""
+    from fishgen.clouds.pipeline import cloud_textures
     from fishgen.errors import FishgenError
     from fishgen.sky.compose import fill_sky, plan_sky
     from fishgen.sky.light import light_sky
     from fishgen.sky.scene import sky_scene
 
+    # the parser refuses a file without particles, so every model has some
     cubes, files = load_models(models, max_particles=max_particles, textures_dir=textures_dir)
-    for cube_file, path in zip(cubes, files, strict=True):
-        if cube_file.total == 0:
-            raise FishgenError("expected a cloud model with at least one particle, found none", path)
     sky_mode = MODES[mode]
     total = sky_mode.particles if particles is None else particles
     if total > max_particles:
@@ -80,5 +79,4 @@ def build_sky(mode: str = "medium", *, seed: int = 0, area: tuple[float, float] 
     plan = plan_sky(sky_mode, cubes, seed=seed, area=area, altitude=altitude, particles=total)
     clouds = light_sky(fill_sky(plan, cubes, noise=noise), lighting or Lighting(), method=shadow_map)
     scene, facts = sky_scene(plan, clouds, [p.name for p in files], billboards=billboards, lod=lod)
-    textures = tuple(dict.fromkeys(Path(c.texture) for f in cubes for c in f.cubes if c.texture))
-    return Sky(scene, tuple(facts), mode, seed, tuple(files), textures)
+    return Sky(scene, tuple(facts), mode, seed, tuple(files), cloud_textures(cubes))
