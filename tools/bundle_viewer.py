@@ -8,8 +8,8 @@ Run after `npm ci` whenever a page's JavaScript or package.json (three's or esbu
     python tools/bundle_viewer.py --check-hashes  # no node needed: exit 1 if a committed bundle
                                                   # or a source differs from what manifest.json records
 
-esbuild (pinned in package.json) bundles fishgen/web/kit.js - the parts of three.js the pages use,
-its addons and fishgen/web/cloudlight.js - into `kit.min.js`, a classic script that sets
+esbuild (pinned in package.json) bundles fishgen/web/kit.js - the parts of three.js the pages use
+(three-parts.js), its addons and fishgen/web/cloudlight.js - into `kit.min.js`, a classic script that sets
 `window.fishgenKit`, and each page's app.js (with its own modules) into `<page>.min.js`, which takes
 three.js from that kit and so holds none of it. The bundles are committed in fishgen/web/static/
 with `manifest.json` (sha256 of every bundle and of every input file esbuild read, the tool versions
@@ -48,7 +48,9 @@ FORMAT = {KIT: ["--format=iife", "--global-name=fishgenKit"]}
 APP_FORMAT = ["--format=esm"]
 # The page inlines each bundle in a <script> element: these would end or confuse it.
 UNSAFE_IN_SCRIPT = re.compile(r"</script|<!--|<script", re.I)
-_KIT_THREE = re.compile(r"export const THREE = Object\.freeze\( \{(.*?)\} \);", re.S)
+THREE_PARTS = "fishgen/web/three-parts.js"
+"""The kit's THREE: the names of three.js the pages may use."""
+_EXPORTS = re.compile(r"export \{(.*?)\} from 'three';", re.S)
 _USES_THREE = re.compile(r"\bTHREE\.([A-Za-z_$][\w$]*)")
 
 
@@ -84,10 +86,10 @@ def _esbuild(name: str, tmp: Path) -> tuple[bytes, list[str]]:
 
 def _check_apps(inputs: dict[str, list[str]]) -> None:
     """Each app takes three.js from the kit: it bundles none of it and uses no THREE name the kit lacks."""
-    kit = _KIT_THREE.search((ROOT / BUNDLES[KIT]).read_text(encoding="utf-8"))
-    if kit is None:
-        raise SystemExit(f"{BUNDLES[KIT]}: expected `export const THREE = Object.freeze( {{ ... }} );`")
-    exported = set(re.findall(r"\w+", kit[1]))
+    parts = _EXPORTS.search((ROOT / THREE_PARTS).read_text(encoding="utf-8"))
+    if parts is None:
+        raise SystemExit(f"{THREE_PARTS}: expected `export {{ ... }} from 'three';`")
+    exported = set(re.findall(r"\w+", parts[1]))
     for name, files in inputs.items():
         if name == KIT:
             continue
@@ -97,7 +99,7 @@ def _check_apps(inputs: dict[str, list[str]]) -> None:
         used = {m for f in files for m in _USES_THREE.findall((ROOT / f).read_text(encoding="utf-8"))}
         if used - exported:
             raise SystemExit(f"{name} uses THREE.{', THREE.'.join(sorted(used - exported))}: "
-                             f"add to THREE in {BUNDLES[KIT]}")
+                             f"add to {THREE_PARTS}")
 
 
 def build() -> dict[str, bytes]:

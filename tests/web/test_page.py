@@ -35,7 +35,7 @@ def test_one_kit_holds_three_and_every_app_takes_it_from_there():
         ["THREE-LICENSE", "manifest.json", "kit.min.js", *(f"{p}.min.js" for p in PAGES)])
     bundles = manifest["bundles"]
     kit = bundles["kit"]["inputs"]
-    for part in ("fishgen/web/kit.js", "fishgen/web/cloudlight.js",
+    for part in ("fishgen/web/kit.js", "fishgen/web/three-parts.js", "fishgen/web/cloudlight.js",
                  "node_modules/three/build/three.module.js",
                  "node_modules/three/examples/jsm/loaders/GLTFLoader.js",
                  "node_modules/three/examples/jsm/controls/TransformControls.js"):
@@ -134,11 +134,11 @@ def test_the_bundler_refuses_an_app_that_would_bundle_three_or_miss_a_name(tmp_p
     monkeypatch.setattr(tool, "ROOT", tmp_path)
     web = tmp_path / "fishgen" / "web"
     web.mkdir(parents=True)
-    (web / "kit.js").write_text("export const THREE = Object.freeze( {\n\tColor, Scene,\n} );\n")
+    (web / "three-parts.js").write_text("export {\n\tColor, Scene,\n} from 'three';\n")
     (tmp_path / "app.js").write_text("const a = new THREE.Color(), s = new THREE.Scene();\n")
     (tmp_path / "bad.js").write_text("const m = new THREE.Mesh();\n")
     tool._check_apps({"kit": [], "viewer": ["app.js"]})
-    with pytest.raises(SystemExit, match="THREE.Mesh: add to THREE in fishgen/web/kit.js"):
+    with pytest.raises(SystemExit, match="THREE.Mesh: add to fishgen/web/three-parts.js"):
         tool._check_apps({"kit": [], "viewer": ["app.js", "bad.js"]})
     with pytest.raises(SystemExit, match="imports node_modules/three/build/three.module.js"):
         tool._check_apps({"kit": [], "fly": ["app.js", "node_modules/three/build/three.module.js"]})
