@@ -1,10 +1,9 @@
 // fishgen edit: RekAwan's cloud cube editor (report 004, Appendix A and its user manual) in a page.
 // The page holds the cubes; the server parses, fills, lights and saves them with fishgen's own code.
 // State for people and tests alike: window.fishgenEditor (see `state` below).
-import * as THREE from 'three';
-import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { TransformControls } from 'three/addons/controls/TransformControls.js';
 import { CloudView } from './cloudview.js';
+
+const { THREE, OrbitControls, TransformControls } = window.fishgenKit;   // fishgen/web/kit.js
 
 const $ = ( id ) => document.getElementById( id );
 const TOKEN = new URLSearchParams( location.search ).get( 'token' ) || '';

@@ -3,9 +3,8 @@
 // reaching each particle, `_LIGHT`) is baked by the server; the materials of fishgen/web/cloudlight.js
 // (fishgen view's too) do the second pass: the light scattered towards the eye by the phase
 // function, over the sky's ambient light.
-import * as THREE from 'three';
-import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { billboardMaterial, cloudUniforms, particleMaterial as makeParticleMaterial, readCloudLight } from '../web/cloudlight.js';
+const { THREE, GLTFLoader, cloudlight } = window.fishgenKit;   // fishgen/web/kit.js
+const { billboardMaterial, cloudUniforms, particleMaterial: makeParticleMaterial, readCloudLight } = cloudlight;
 
 export { cloudUniforms };
 
@@ -79,7 +78,7 @@ export class CloudView {
 				this.points = o;
 				this.sorted.push( new Sorted( o, 1 ) );
 			} else if ( o.isMesh ) {
-				o.material = billboardMaterial( o.material, this.textured );
+				o.material = billboardMaterial( o.material, { textured: this.textured } );
 				o.frustumCulled = false;
 				this.billboards.push( o );
 				this.sorted.push( new Sorted( o, 3 ) );
@@ -92,7 +91,7 @@ export class CloudView {
 		this.textured = on;
 		for ( const mesh of this.billboards ) {
 			const old = mesh.material;
-			mesh.material = billboardMaterial( old.userData.source, on );
+			mesh.material = billboardMaterial( old.userData.source, { textured: on } );
 			old.dispose();
 		}
 	}

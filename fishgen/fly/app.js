@@ -2,9 +2,8 @@
 // Keys as Pakawan's: W/S forward/back, A/D left/right, arrows look up/down and turn, 1/2/3 speed;
 // the mouse (drag) looks around. The upper left shows the window size, the time and the FPS.
 // State for tests and the headless driver: window.fishgenFly = {loaded, error, camera, frames, done, report}.
-import * as THREE from 'three';
-import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { SECOND_PASS, cloudUniforms, readCloudLight } from '../web/cloudlight.js';
+const { THREE, GLTFLoader, cloudlight } = window.fishgenKit;   // fishgen/web/kit.js
+const { PREMULTIPLIED, billboardMaterial: cloudBillboardMaterial, particleMaterial: cloudParticleMaterial, readCloudLight } = cloudlight;
 
 const config = JSON.parse( document.getElementById( 'fishgen-fly' ).textContent );
 const token = new URLSearchParams( location.search ).get( 'token' ) || '';
@@ -73,94 +72,17 @@ function draw() {
 	camera.layers.set( 0 );
 }
 
-// -- Harris's second pass, from each particle's baked _LIGHT (as fishgen view does) ---------------
-const ENCODE_SRGB = /* glsl */`
-	vec3 encodeSRGB( vec3 c ) {   // linear to the window's sRGB, as three's output conversion does it
-		c = clamp( c, 0.0, 1.0 );
-		return mix( pow( c, vec3( 0.41666 ) ) * 1.055 - vec3( 0.055 ), c * 12.92, vec3( lessThanEqual( c, vec3( 0.0031308 ) ) ) );
-	}`;
-
+// -- Harris's second pass, from each particle's baked _LIGHT (fishgen/web/cloudlight.js) ----------
 function readLight( extras ) {   // the sun lights the page's meshes too
 	const sun = readCloudLight( extras );
 	if ( sun ) sunLight.position.copy( sun );
 	return sun !== null;
 }
 
-// A particle: a soft disc of its world radius with the billboard sprite's Gaussian profile, drawn
-// to SPRITE_CUT of its radius (the faint rim beyond, under 10 % of its opacity, would cost a third of
-// the pixels), its profile renormalised to reach 0 there. A sprite taller than NEAR_FADE of the view
-// fades out as the camera flies into it (its inside shows as a fog of smaller particles, not one
-// particle filling the screen) and is not drawn at all at twice that. Colours are sRGB-encoded per
-// particle and written premultiplied, so the clouds can be drawn into a smaller buffer (see `cloudBuffer`)
-// and laid over the view with the same result as drawn on it: "over" is associative.
-const NEAR_FADE = 0.5, SPRITE_CUT = 0.8, EDGE = Math.exp( - SPRITE_CUT * SPRITE_CUT / 0.32 );
-const PREMULTIPLIED = { blending: THREE.CustomBlending, blendSrc: THREE.OneFactor, blendDst: THREE.OneMinusSrcAlphaFactor,
-	blendSrcAlpha: THREE.OneFactor, blendDstAlpha: THREE.OneMinusSrcAlphaFactor };
-const particleMaterial = new THREE.ShaderMaterial( {
-	uniforms: { viewportHeight: { value: 1 }, ...cloudUniforms },
-	vertexColors: true, transparent: true, depthWrite: false, depthTest: false, ...PREMULTIPLIED,
-	vertexShader: /* glsl */`
-		attribute float _radius;
-		attribute float _density;
-		attribute float _light;
-		uniform float viewportHeight;
-		varying vec3 vColor;
-		varying float vAlpha;
-		${ SECOND_PASS }
-${ ENCODE_SRGB }
-		void main() {
-			vec4 world = modelMatrix * vec4( position, 1.0 );
-			vec4 mv = viewMatrix * world;
-			gl_Position = projectionMatrix * mv;
-			float size = _radius * projectionMatrix[ 1 ][ 1 ] * viewportHeight / max( - mv.z, 1e-4 );   // diameter, pixels
-			float limit = ${ NEAR_FADE.toFixed( 3 ) } * viewportHeight;
-			gl_PointSize = min( size, limit ) * ${ SPRITE_CUT.toFixed( 3 ) };
-			vec3 lit = ( cloudLit && _light >= 0.0 ) ? scattered( _light, world.xyz ) : color;
-			vColor = encodeSRGB( lit );
-			vAlpha = 0.7 * clamp( _density, 0.0, 1.0 ) * clamp( 2.0 - size / limit, 0.0, 1.0 );
-			if ( vAlpha <= 0.0 || - mv.z <= 0.0 ) gl_Position = vec4( 2.0, 2.0, 2.0, 1.0 );   // not rasterized at all
-		}`,
-	fragmentShader: /* glsl */`
-		varying vec3 vColor;
-		varying float vAlpha;
-		void main() {
-			vec2 p = ( gl_PointCoord * 2.0 - 1.0 ) * ${ SPRITE_CUT.toFixed( 3 ) };
-			float a = vAlpha * ( exp( - dot( p, p ) / 0.32 ) - ${ EDGE.toFixed( 6 ) } ) / ${ ( 1 - EDGE ).toFixed( 6 ) };
-			if ( a <= 0.0 ) discard;
-			gl_FragColor = vec4( vColor * a, a );
-		}`,
-} );
-
-const WHITE = new THREE.DataTexture( new Uint8Array( [ 255, 255, 255, 255 ] ), 1, 1 );
-WHITE.needsUpdate = true;
-
-function billboardMaterial( source ) {
-	return new THREE.ShaderMaterial( {
-		uniforms: { map: { value: source.map || WHITE }, ...cloudUniforms },
-		vertexColors: true, transparent: true, depthWrite: false, depthTest: false, side: THREE.DoubleSide, ...PREMULTIPLIED,
-		vertexShader: /* glsl */`
-			attribute float _light;
-			varying vec2 vUv;
-			varying vec4 vColor;
-			${ SECOND_PASS }
-${ ENCODE_SRGB }
-			void main() {
-				vec4 world = modelMatrix * vec4( position, 1.0 );
-				gl_Position = projectionMatrix * viewMatrix * world;
-				vUv = uv;
-				vColor = vec4( ( cloudLit && _light >= 0.0 ) ? scattered( _light, world.xyz ) : color.rgb, color.a );
-			}`,
-		fragmentShader: /* glsl */`
-			uniform sampler2D map;
-			varying vec2 vUv;
-			varying vec4 vColor;
-			void main() {
-				vec4 t = texture2D( map, vUv );
-				float a = vColor.a * t.a;
-				gl_FragColor = vec4( encodeSRGB( vColor.rgb * t.rgb ) * a, a );
-			}`,
-	} );
-}
+// Particles and billboards as fishgen view draws them, but faded near the eye and written
+// premultiplied, to be drawn into the clouds' own buffer (`cloudBuffer`, below).
+const particleMaterial = cloudParticleMaterial( { flying: true } );
+const billboardMaterial = ( source ) => cloudBillboardMaterial( source, { flying: true } );
 
 // The chapter 5 baseline (benchmarks/fly.py): the same particles as three.js Points, one colour
 // each, unsorted, unculled, no second pass.

@@ -2,25 +2,21 @@
 
 Routes (every request carries the run's token; fishgen.web.server checks it):
 
-* ``GET /``: the page (three.js and the app inlined, the run's settings as JSON);
+* ``GET /``: the page (fishgen/web/page.py: three.js and the app inlined, the run's settings as JSON);
 * ``GET /asset/K``: the K-th asset's glb bytes;
 * ``POST /report``: the page's report at its time-out, checked (a bad one is a 422), kept, written
   to the report file if one was asked for, and ``received`` is set.
 """
 from __future__ import annotations
 
-import json
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 from fishgen.fly.assets import Asset
 from fishgen.web.server import LocalServer, Request, Response, Route
 
-HERE = Path(__file__).resolve().parent
-BUNDLE = HERE / "static" / "fly.min.js"
 MAX_REPORT_BYTES = 4 << 20
 """A day of per-second rows is about 8 MB of JSON; an hour fits well within this."""
 
@@ -55,18 +51,10 @@ class FlyConfig:
 
 
 def page_html(assets: Sequence[Asset], config: FlyConfig, title: str) -> str:
-    """The page: the bundled app inlined as a module script, the settings as JSON."""
-    import re
+    """The page (fishgen/web/page.py) with the run's settings as JSON."""
+    from fishgen.web import page
 
-    from fishgen.errors import FishgenError
-
-    app = BUNDLE.read_text(encoding="ascii")
-    if re.search(r"</script|<!--|<script", app, re.I):
-        raise FishgenError("expected a fly bundle that can sit inside a <script> element", BUNDLE)
-    settings = json.dumps(config.page_settings(assets)).replace("<", "\\u003c")
-    fields = {"CONFIG": settings, "APP": app, "TITLE": title.replace("&", "&amp;").replace("<", "&lt;")}
-    template = (HERE / "template.html").read_text(encoding="utf-8")
-    return re.sub(r"\{\{(CONFIG|APP|TITLE)\}\}", lambda m: fields[m[1]], template)
+    return page.page_html("fly", title, ("fishgen-fly", config.page_settings(assets)))
 
 
 class FlySession:

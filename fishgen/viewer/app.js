@@ -1,12 +1,7 @@
 // fishgen viewer: shows one embedded asset with three.js; nothing is fetched from the network.
 // State for people and tests alike: window.fishgenViewer = {loaded, error, time, clip, clips, playing, counts}.
-import * as THREE from 'three';
-import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { PLYLoader } from 'three/addons/loaders/PLYLoader.js';
-import { OBJLoader } from 'three/addons/loaders/OBJLoader.js';
-import { MTLLoader } from 'three/addons/loaders/MTLLoader.js';
-import { billboardMaterial, particleMaterial as makeParticleMaterial, readCloudLight } from '../web/cloudlight.js';
+const { THREE, OrbitControls, GLTFLoader, PLYLoader, OBJLoader, MTLLoader, cloudlight } = window.fishgenKit;   // fishgen/web/kit.js
+const { billboardMaterial, particleMaterial: makeParticleMaterial, readCloudLight } = cloudlight;
 
 const state = window.fishgenViewer = {
 	loaded: false, error: null, time: 0, clip: null, clips: [], playing: false,

@@ -42,15 +42,47 @@ export function readCloudLight( extras ) {
 	return sun;
 }
 
-// A cloud's particles as fishgen view and edit draw them: each a soft disc of its world radius
-// (`_radius`: fishgen's _RADIUS, a PLY's radius) with the billboard sprite's Gaussian profile, lit
+// fishgen fly's materials (`flying`) draw the clouds into their own buffer, smaller than the window
+// and laid over the view (fishgen/fly/app.js), or on the view itself: they write colours
+// sRGB-encoded and premultiplied, so that both give the same picture ("over" is associative), and
+// test no depth (the buffer has none). The buffer is laid over with the same blending.
+export const PREMULTIPLIED = { blending: THREE.CustomBlending, blendSrc: THREE.OneFactor, blendDst: THREE.OneMinusSrcAlphaFactor,
+	blendSrcAlpha: THREE.OneFactor, blendDstAlpha: THREE.OneMinusSrcAlphaFactor };
+const FLYING = { depthTest: false, ...PREMULTIPLIED };
+
+const ENCODE_SRGB = /* glsl */`
+	#ifdef FLYING
+	vec3 encodeSRGB( vec3 c ) {   // linear to the window's sRGB, as three's output conversion does it
+		c = clamp( c, 0.0, 1.0 );
+		return mix( pow( c, vec3( 0.41666 ) ) * 1.055 - vec3( 0.055 ), c * 12.92, vec3( lessThanEqual( c, vec3( 0.0031308 ) ) ) );
+	}
+	#endif`;
+
+// The end of a fragment shader: linear colour `rgb` with alpha `a`, as the material's target takes it.
+const OUTPUT = /* glsl */`
+	#ifdef FLYING
+		gl_FragColor = vec4( encodeSRGB( rgb ) * a, a );
+	#else
+		gl_FragColor = vec4( rgb, a );
+		#include <colorspace_fragment>
+	#endif`;
+
+// Flying, a sprite taller than NEAR_FADE of the view fades out as the camera flies into it (its
+// inside shows as a fog of smaller particles, not one particle filling the screen) and is not drawn
+// at all at twice that, and it is drawn to SPRITE_CUT of its radius: the faint rim beyond, under 10 %
+// of its opacity, would cost a third of the pixels.
+const NEAR_FADE = 0.5, SPRITE_CUT = 0.8;
+
+// A cloud's particles: each a soft disc of its world radius (`_radius`: fishgen's _RADIUS, a PLY's
+// radius) with the billboard sprite's Gaussian profile, renormalised to reach 0 where it is cut, lit
 // by the second pass where the file is lit, in its own colour where not. One a page: set
-// `uniforms.viewportHeight` to the drawing buffer's height. (fishgen fly draws its own, faded near
-// the eye and premultiplied for its half-size buffer.)
-export function particleMaterial() {
+// `uniforms.viewportHeight` to the height of the buffer it is drawn into.
+export function particleMaterial( { flying = false } = {} ) {
+	const cut = flying ? SPRITE_CUT : 1, edge = Math.exp( - cut * cut / 0.32 );
 	return new THREE.ShaderMaterial( {
 		uniforms: { viewportHeight: { value: 1 }, ...cloudUniforms },
-		vertexColors: true, transparent: true, depthWrite: false,
+		defines: flying ? { FLYING: 1 } : {},
+		vertexColors: true, transparent: true, depthWrite: false, ...( flying ? FLYING : {} ),
 		vertexShader: /* glsl */`
 			attribute float _radius;
 			attribute float _density;
@@ -63,20 +95,28 @@ export function particleMaterial() {
 				vec4 world = modelMatrix * vec4( position, 1.0 );
 				vec4 mv = viewMatrix * world;
 				gl_Position = projectionMatrix * mv;
-				gl_PointSize = 2.0 * _radius * projectionMatrix[ 1 ][ 1 ] * 0.5 * viewportHeight / max( - mv.z, 1e-4 );
+				float size = _radius * projectionMatrix[ 1 ][ 1 ] * viewportHeight / max( - mv.z, 1e-4 );   // diameter, pixels
 				vColor = ( cloudLit && _light >= 0.0 ) ? scattered( _light, world.xyz ) : color;
 				vAlpha = 0.7 * clamp( _density, 0.0, 1.0 );
+			#ifdef FLYING
+				float limit = ${ NEAR_FADE.toFixed( 3 ) } * viewportHeight;
+				gl_PointSize = min( size, limit ) * ${ cut.toFixed( 3 ) };
+				vAlpha *= clamp( 2.0 - size / limit, 0.0, 1.0 );
+				if ( vAlpha <= 0.0 || - mv.z <= 0.0 ) gl_Position = vec4( 2.0, 2.0, 2.0, 1.0 );   // not rasterized at all
+			#else
+				gl_PointSize = size;
+			#endif
 			}`,
 		fragmentShader: /* glsl */`
 			varying vec3 vColor;
 			varying float vAlpha;
+			${ ENCODE_SRGB }
 			void main() {
-				vec2 p = gl_PointCoord * 2.0 - 1.0;
-				float r2 = dot( p, p );
-				if ( r2 > 1.0 ) discard;
-				float a = vAlpha * max( ( exp( - r2 / 0.32 ) - 0.04394 ) / 0.95606, 0.0 );
-				gl_FragColor = vec4( vColor, a );
-				#include <colorspace_fragment>
+				vec2 p = ( gl_PointCoord * 2.0 - 1.0 ) * ${ cut.toFixed( 3 ) };
+				float a = vAlpha * ( exp( - dot( p, p ) / 0.32 ) - ${ edge.toFixed( 6 ) } ) / ${ ( 1 - edge ).toFixed( 6 ) };
+				if ( a <= 0.0 ) discard;
+				vec3 rgb = vColor;
+				${ OUTPUT }
 			}`,
 	} );
 }
@@ -95,10 +135,11 @@ function whiteTexture() {
 // material `source` the file gave them: the texture's colour and alpha times the vertex alpha, lit
 // by the second pass where the file is lit. `textured` false draws plain quads instead (the
 // editor's Show Texture off). The source stays in `userData.source`.
-export function billboardMaterial( source, textured = true ) {
+export function billboardMaterial( source, { textured = true, flying = false } = {} ) {
 	const material = new THREE.ShaderMaterial( {
 		uniforms: { map: { value: textured && source.map || whiteTexture() }, plain: { value: textured ? 0 : 1 }, ...cloudUniforms },
-		vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide,
+		defines: flying ? { FLYING: 1 } : {},
+		vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide, ...( flying ? FLYING : {} ),
 		vertexShader: /* glsl */`
 			attribute float _light;
 			varying vec2 vUv;
@@ -115,11 +156,12 @@ export function billboardMaterial( source, textured = true ) {
 			uniform float plain;
 			varying vec2 vUv;
 			varying vec4 vColor;
+			${ ENCODE_SRGB }
 			void main() {
 				vec4 t = texture2D( map, vUv );
 				float a = plain > 0.5 ? 0.6 : vColor.a * t.a;
-				gl_FragColor = vec4( vColor.rgb * t.rgb, a );
-				#include <colorspace_fragment>
+				vec3 rgb = vColor.rgb * t.rgb;
+				${ OUTPUT }
 			}`,
 	} );
 	material.userData.source = source;

@@ -57,6 +57,22 @@ def test_a_mode_alone_flies_a_sky_of_that_mode():
     assert made.facts["frames"] > 0 and made.facts["mode"] == "thin"
 
 
+
+def test_a_texture_cloud_flies_with_its_billboards_drawn(tmp_path):
+    # fly's billboard material once called, in its fragment shader, a function only its vertex shader had
+    import numpy as np
+    from PIL import Image
+
+    from fishgen.fly.headless import run_headless
+
+    assets, _ = prepare_assets([PARAMS / "clouds" / "sky.awa"])
+    session = FlySession(assets, FlyConfig(timeout=1, warmup=1, path="still", report=True))
+    run_headless(session, screenshot=tmp_path / "fly.png")
+    assert session.report["scene"]["billboards"] > 0 and session.report["frames"] > 0
+    sky = np.asarray(Image.open(tmp_path / "fly.png").convert("RGB"), np.float32)[60:]   # below the overlay
+    cloud = np.abs(sky - np.median(sky.reshape(-1, 3), axis=0)).max(-1) > 20
+    assert 0.005 < cloud.mean() < 0.5, "the billboards should show as clouds on the sky"
+
 @pytest.fixture
 def page(thin_sky):
     """An interactive page of the thin sky (no path: the keys steer), in headless Chromium."""
