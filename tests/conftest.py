@@ -43,10 +43,57 @@ def gltf_validator():
     return assert_valid_gltf
 
 
-def run_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    """Run the real `fishgen` command line in a subprocess (exit codes, stderr, no traceback)."""
+def run_cli_process(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    """Run the real `fishgen` command line in a subprocess: for what only a process shows (the
+    exit status the shell sees, signals, start-up imports)."""
     return subprocess.run([sys.executable, "-m", "fishgen", *map(str, args)], cwd=cwd or ROOT,
                           capture_output=True, text=True)
+
+
+def run_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    """Run the `fishgen` command line in this process, as the console script does
+    (:func:`fishgen.cli.main`): its exit status, stdout and stderr, and a traceback on stderr with
+    status 1 where one would escape, so tests read it as they would a subprocess's. A process
+    costs 0.3-1 s of imports per call; the exit-status and signal tests use :func:`run_cli_process`."""
+    import io
+    import logging
+    import os
+    import signal
+    import traceback
+    from contextlib import redirect_stderr, redirect_stdout
+
+    from fishgen.cli import main
+
+    argv = [str(a) for a in args]
+    if "fly" in argv and "tests.browser" in sys.modules:
+        sys.modules["tests.browser"].close()  # fishgen's own Playwright may run in this thread
+    out, err = io.StringIO(), io.StringIO()
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    logger = logging.getLogger("fishgen")
+    log_handlers, log_level = list(logger.handlers), logger.level
+    here = os.getcwd()
+    status = 0
+    try:
+        os.chdir(cwd or ROOT)
+        with redirect_stdout(out), redirect_stderr(err):
+            try:
+                main(argv)
+            except SystemExit as stop:
+                if stop.code is None or isinstance(stop.code, int):
+                    status = stop.code or 0
+                else:
+                    print(stop.code, file=sys.stderr)
+                    status = 1
+            except Exception:  # what Python itself would print, had it escaped the console script
+                traceback.print_exc()
+                status = 1
+    finally:
+        os.chdir(here)
+        for signum, handler in handlers.items():
+            signal.signal(signum, handler)
+        logger.handlers[:] = log_handlers  # --verbose's handler holds this call's stderr
+        logger.setLevel(log_level)
+    return subprocess.CompletedProcess(["fishgen", *argv], status, out.getvalue(), err.getvalue())
 
 
 @pytest.fixture
@@ -63,3 +110,50 @@ def gl_available():
         moderngl.create_context(standalone=True, backend="egl").release()
     except Exception as err:  # noqa: BLE001 - any failure means no context
         pytest.fail(f"no headless OpenGL: install libegl1 libegl-mesa0 libgl1-mesa-dri ({err})")
+
+
+#: Session fixtures cheap enough that sharing them is no reason to keep their tests together.
+_CHEAP_SHARED = {"gl_available", "tmp_path_factory", "worker_id", "testrun_uid"}
+#: Modules run first (their groups go to the workers before anything else): each is one long
+#: stretch (the README's examples in order; the fuzz run) that would otherwise end the run alone.
+_FIRST = ("tests/test_readme.py", "tests/fuzz/test_fuzz.py")
+
+
+@pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups
+def pytest_collection_modifyitems(config, items):
+    """Tests that share a fixture wider than a function (a built asset, a browser page, a server,
+    the fuzz run) stay on one pytest-xdist worker, so it is made once, not once per worker: one
+    `xdist_group` for each set of tests joined by such fixtures (``--dist loadgroup``); every other
+    test is scheduled alone."""
+    parent: dict[str, str] = {}
+
+    def root(key: str) -> str:
+        while parent.setdefault(key, key) != key:
+            parent[key] = parent[parent[key]]
+            key = parent[key]
+        return key
+
+    keys: dict[int, list[str]] = {}
+    for item in items:
+        defs = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {})
+        mine = []
+        for name, fixturedefs in defs.items():
+            scope = fixturedefs[-1].scope
+            if scope == "function" or name in _CHEAP_SHARED:
+                continue
+            where = item.nodeid.split("::")[0] if scope in ("module", "class") else fixturedefs[-1].baseid
+            mine.append(f"{name}@{where}")
+        keys[id(item)] = mine
+        for key in mine[1:]:
+            parent[root(key)] = root(mine[0])
+    for item in items:
+        mine = keys[id(item)]
+        if mine and not item.get_closest_marker("xdist_group"):
+            item.add_marker(pytest.mark.xdist_group(root(mine[0])))
+    items.sort(key=lambda item: not item.nodeid.startswith(_FIRST))
+
+
+def pytest_sessionfinish(session, exitstatus):
+    shared = sys.modules.get("tests.browser")
+    if shared is not None:
+        shared.close()

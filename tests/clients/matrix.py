@@ -31,6 +31,8 @@ from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from tests.browser import CHROMIUM
+from tests.browser import browser as shared_browser
 from tests.clients.bounds import Bounds, ClipBounds, merged, scene_bounds
 
 if TYPE_CHECKING:
@@ -510,11 +512,6 @@ PY_CHECKS: dict[str, Callable[[Asset], str]] = {
 
 # ---- three.js in headless Chromium
 
-CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium", shutil.which("chromium"))
-                 if p and Path(p).is_file()), None)
-CHROMIUM_ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                 "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 THREE_DIR = ROOT / "node_modules" / "three"
 
 
@@ -559,39 +556,6 @@ class _Handler(SimpleHTTPRequestHandler):
         pass
 
 
-class _Chromium:
-    """One playwright and one headless Chromium per process, shared by every LocalBrowser open at
-    once (playwright's sync API allows one instance per thread); closed with the last of them."""
-
-    users = 0
-    playwright: Any = None
-    browser: Any = None
-
-    @classmethod
-    def acquire(cls):
-        if cls.users == 0:
-            from playwright.sync_api import sync_playwright
-
-            cls.playwright = sync_playwright().start()
-            try:
-                cls.browser = cls.playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-            except Exception:
-                cls.playwright.stop()
-                raise
-        cls.users += 1
-        return cls.browser
-
-    @classmethod
-    def release(cls) -> None:
-        cls.users -= 1
-        if cls.users == 0:
-            try:
-                cls.browser.close()
-            finally:
-                cls.playwright.stop()
-                cls.browser = cls.playwright = None
-
-
 class LocalBrowser:
     """A local HTTP server for ``mounts`` (URL prefix -> folder) on loopback, and one headless
     Chromium page of its own (in the process's shared Chromium); ``close()`` stops both."""
@@ -605,7 +569,7 @@ class LocalBrowser:
         self.base = f"http://127.0.0.1:{self.server.server_address[1]}"
         threading.Thread(target=self.server.serve_forever, daemon=True).start()
         try:
-            self.browser = _Chromium.acquire()
+            self.browser = shared_browser()
         except Exception:
             self.server.shutdown()
             self.server.server_close()
@@ -616,7 +580,6 @@ class LocalBrowser:
     def close(self) -> None:
         try:
             self.context.close()
-            _Chromium.release()
         finally:
             self.server.shutdown()
             self.server.server_close()

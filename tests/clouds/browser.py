@@ -3,8 +3,6 @@ this folder's pages and an asset folder, and one Playwright page (the system Chr
 from __future__ import annotations
 
 import base64
-import os
-import shutil
 import threading
 from functools import partial
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
@@ -12,28 +10,19 @@ from pathlib import Path
 
 import numpy as np
 
+from tests.browser import browser as shared_browser
+from tests.browser import unavailable as no_browser
+
 ROOT = Path(__file__).resolve().parents[2]
 THREE = ROOT / "node_modules" / "three"
 PAGES = Path(__file__).resolve().parent / "threejs"
-CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium", shutil.which("chromium"))
-                 if p and Path(p).is_file()), None)
-# no network, no GPU: WebGL on SwiftShader
-ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-        "--disable-background-networking", "--disable-component-update", "--disable-sync",
-        "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 
 
 def unavailable() -> str | None:
     """Why three.js cannot run here, or None."""
-    if CHROMIUM is None:
-        return "no chromium (Debian: apt-get install chromium)"
     if not (THREE / "build" / "three.module.js").is_file():
         return "three.js not installed (npm ci)"
-    try:
-        import playwright  # noqa: F401
-    except ImportError:
-        return "playwright not installed (the test extra)"
-    return None
+    return no_browser()
 
 
 class _Handler(SimpleHTTPRequestHandler):
@@ -59,17 +48,13 @@ class ThreePage:
     """``page(name)`` opens PAGES/name; ``url(path)`` serves a file of ``assets``."""
 
     def __init__(self, assets: Path):
-        from playwright.sync_api import sync_playwright
-
         handler = type("Handler", (_Handler,), {"mounts": {"/three/": THREE.resolve(), "/page/": PAGES.resolve(),
                                                            "/assets/": assets.resolve()}})
         self.assets = assets.resolve()
         self.server = ThreadingHTTPServer(("127.0.0.1", 0), partial(handler))
         self.base = f"http://127.0.0.1:{self.server.server_address[1]}"
         threading.Thread(target=self.server.serve_forever, daemon=True).start()
-        self._pw = sync_playwright().start()
-        self.browser = self._pw.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        self.page = self.browser.new_page()
+        self.page = shared_browser().new_page()
         self.errors: list[str] = []
         self.page.on("pageerror", lambda e: self.errors.append(str(e)))
         self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
@@ -90,8 +75,7 @@ class ThreePage:
 
     def close(self) -> None:
         try:
-            self.browser.close()
-            self._pw.stop()
+            self.page.close()
         finally:
             self.server.shutdown()
             self.server.server_close()

@@ -2,46 +2,28 @@
 tests, the README's screenshot and the benchmark."""
 from __future__ import annotations
 
-import os
 import queue
-import shutil
 import subprocess
 import sys
 import threading
 from contextlib import contextmanager
 from pathlib import Path
 
+from tests.browser import browser as shared_browser
+from tests.browser import close as close_browser
+from tests.browser import unavailable  # noqa: F401 - the editor tests ask here
+
 ROOT = Path(__file__).resolve().parents[2]
-CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium",
-                             shutil.which("chromium")) if p and Path(p).is_file()), None)
-# The machine has no network and no GPU: no background services, WebGL on SwiftShader.
-ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-        "--disable-background-networking", "--disable-component-update", "--disable-sync",
-        "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 TIMEOUT_MS = 60_000
-
-
-def unavailable() -> str | None:
-    """Why the page cannot be driven here, or None."""
-    if CHROMIUM is None:
-        return "chromium is not installed (Debian: apt-get install chromium)"
-    try:
-        import playwright  # noqa: F401
-    except ImportError:
-        return "playwright is not installed (the test extra)"
-    return None
 
 
 @contextmanager
 def chromium():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        try:
-            yield browser
-        finally:
-            browser.close()
+    """The shared Chromium (:mod:`tests.browser`) for a script outside pytest, closed after."""
+    try:
+        yield shared_browser()
+    finally:
+        close_browser()
 
 
 class EditorPage:

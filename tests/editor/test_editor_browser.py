@@ -12,16 +12,16 @@ import numpy as np
 import pytest
 
 from fishgen.clouds.parser import load_cubes
+from tests.browser import browser as shared_browser
 from tests.conftest import run_cli
-from tests.editor.browser import EditorPage, chromium, unavailable
+from tests.editor.browser import EditorPage, unavailable
 
 pytestmark = pytest.mark.skipif(unavailable() is not None, reason=str(unavailable()))
 
 
 @pytest.fixture(scope="module")
 def browser():
-    with chromium() as b:
-        yield b
+    return shared_browser()
 
 
 @pytest.fixture

@@ -12,10 +12,12 @@ from fishgen.commands.fly import FlyOptions, fly
 from fishgen.commands.sky import SkyOptions, sky
 from fishgen.errors import MissingDependency
 from fishgen.fly.assets import prepare_assets
-from fishgen.fly.headless import COMMON, WEBGL
 from fishgen.fly.session import FlyConfig, FlySession
+from tests.browser import browser as shared_browser
+from tests.browser import close as close_browser
+from tests.browser import frames
 from tests.conftest import PARAMS
-from tests.fly.conftest import CHROMIUM, needs_chromium
+from tests.fly.conftest import needs_chromium
 
 pytestmark = needs_chromium
 
@@ -29,11 +31,12 @@ def thin_sky(tmp_path_factory):
 
 def test_a_cube_file_flown_headless_reports_its_particles_and_frames(tmp_path, cli):
     report = tmp_path / "r.json"
-    run = cli("fly", PARAMS / "clouds" / "table_4_4.awn", "--headless", "--timeout", "3", "--report", report)
+    run = cli("fly", PARAMS / "clouds" / "table_4_4.awn", "--headless", "--timeout", "1", "--warmup", "0.5",
+              "--report", report)
     assert run.returncode == 0, run.stderr
     r = json.loads(report.read_text())
     assert r["scene"]["particles"] == 615 and r["scene"]["clouds"] == 1 and r["frames"] > 0
-    assert r["window"] == {"width": 800, "height": 600} and r["seconds"] >= 3
+    assert r["window"] == {"width": 800, "height": 600} and r["seconds"] >= 1
     assert r["fps"]["min"] <= r["fps"]["p5"] <= r["fps"]["median"] <= r["fps"]["max"]
     assert r["renderer"] and r["fishgen"] and r["headless"] is True and "--disable-gpu-vsync" in r["flags"]
     assert "FPS median" in run.stdout and "615 particles" in run.stdout
@@ -42,17 +45,19 @@ def test_a_cube_file_flown_headless_reports_its_particles_and_frames(tmp_path, c
 def test_a_sky_flown_headless_reports_its_particles_per_second_in_csv(tmp_path, cli, thin_sky):
     path, facts = thin_sky
     report = tmp_path / "r.csv"
-    run = cli("fly", path, "--headless", "--timeout", "3", "--size", "640x480", "--report", report)
+    run = cli("fly", path, "--headless", "--timeout", "2", "--warmup", "0.5", "--size", "640x480",
+              "--report", report)
     assert run.returncode == 0, run.stderr
     rows = list(csv.DictReader(report.open()))
-    assert len(rows) >= 3 and [r["second"] for r in rows[:3]] == ["0", "1", "2"]
+    assert len(rows) >= 2 and [r["second"] for r in rows[:2]] == ["0", "1"]
     assert all(r["particles_in_scene"] == str(facts.particles) for r in rows)
     assert sum(int(r["frames"]) for r in rows) > 0
     assert rows[0]["width"] == "640" and rows[0]["height"] == "480"
 
 
 def test_a_mode_alone_flies_a_sky_of_that_mode():
-    made = fly((), None, FlyOptions(mode="thin", headless=True, timeout=2, warmup=1))
+    close_browser()  # fishgen's own Playwright runs in this thread now
+    made = fly((), None, FlyOptions(mode="thin", headless=True, timeout=1, warmup=0.5))
     assert made.facts["scene"]["particles"] == 20_000 and made.facts["scene"]["clouds"] == 16
     assert made.facts["frames"] > 0 and made.facts["mode"] == "thin"
 
@@ -66,40 +71,43 @@ def test_a_texture_cloud_flies_with_its_billboards_drawn(tmp_path):
     from fishgen.fly.headless import run_headless
 
     assets, _ = prepare_assets([PARAMS / "clouds" / "sky.awa"])
-    session = FlySession(assets, FlyConfig(timeout=1, warmup=1, path="still", report=True))
+    session = FlySession(assets, FlyConfig(timeout=1, warmup=0.5, path="still", report=True))
+    close_browser()  # fishgen's own Playwright runs in this thread now
     run_headless(session, screenshot=tmp_path / "fly.png")
     assert session.report["scene"]["billboards"] > 0 and session.report["frames"] > 0
     sky = np.asarray(Image.open(tmp_path / "fly.png").convert("RGB"), np.float32)[60:]   # below the overlay
     cloud = np.abs(sky - np.median(sky.reshape(-1, 3), axis=0)).max(-1) > 20
     assert 0.005 < cloud.mean() < 0.5, "the billboards should show as clouds on the sky"
 
-@pytest.fixture
-def page(thin_sky):
-    """An interactive page of the thin sky (no path: the keys steer), in headless Chromium."""
-    from playwright.sync_api import sync_playwright
-
+@pytest.fixture(scope="module")
+def served_sky(thin_sky):
+    """The thin sky served for interactive flights (no path: the keys steer)."""
     assets, _ = prepare_assets([thin_sky[0]])
     session = FlySession(assets, FlyConfig(size=(640, 480), warmup=0.5))
     session.serve_in_background()
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=CHROMIUM, args=[*COMMON, *WEBGL["swiftshader"]])
-        tab = browser.new_page(viewport={"width": 640, "height": 480})
-        tab.goto(session.url())
-        tab.wait_for_function("window.fishgenFly.loaded && window.fishgenFly.frames > 2", timeout=120_000)
-        yield tab
-        browser.close()
+    yield session
     session.close()
+
+
+@pytest.fixture
+def page(served_sky):
+    """A fresh page of the served thin sky, in the shared headless Chromium, drawing."""
+    tab = shared_browser().new_page(viewport={"width": 640, "height": 480})
+    tab.goto(served_sky.url())
+    tab.wait_for_function("window.fishgenFly.loaded && window.fishgenFly.frames > 2", timeout=120_000)
+    yield tab
+    tab.close()
 
 
 def camera(tab) -> dict:
     return tab.evaluate("({...window.fishgenFly.camera, speed: window.fishgenFly.speed})")
 
 
-def hold(tab, key: str, seconds: float = 1.5) -> None:
-    frames = tab.evaluate("window.fishgenFly.frames")
+def hold(tab, key: str, count: int = 6) -> None:
+    """Hold a key down while the page draws ``count`` frames."""
+    drawn = tab.evaluate("window.fishgenFly.frames")
     tab.keyboard.down(key)
-    tab.wait_for_timeout(seconds * 1000)
-    tab.wait_for_function(f"window.fishgenFly.frames > {frames + 2}", timeout=60_000)
+    tab.wait_for_function(f"window.fishgenFly.frames > {drawn + count}", timeout=60_000)
     tab.keyboard.up(key)
 
 
@@ -110,14 +118,14 @@ def test_pakawans_keys_move_and_turn_the_camera(page):
     ahead = camera(page)
     dx, dy, dz = (a - b for a, b in zip(ahead["position"], start["position"], strict=True))
     assert dz < 0 and abs(dx) < 1e-6 * abs(dz) + 1e-9 and abs(dy) < 1e-6 * abs(dz) + 1e-9   # forward
-    hold(page, "s", 0.5)
+    hold(page, "s", 3)
     assert camera(page)["position"][2] > ahead["position"][2]                                  # back
     before = camera(page)
-    hold(page, "d", 0.5)
+    hold(page, "d", 3)
     assert camera(page)["position"][0] > before["position"][0]                                 # right
-    hold(page, "ArrowLeft", 0.5)
+    hold(page, "ArrowLeft", 3)
     assert camera(page)["yaw"] > 0                                                             # turned left
-    hold(page, "ArrowUp", 0.5)
+    hold(page, "ArrowUp", 3)
     assert camera(page)["pitch"] > 0                                                           # looks up
     page.keyboard.press("3")
     assert camera(page)["speed"] == 3
@@ -131,12 +139,12 @@ def test_the_mouse_looks_around(page):
     page.mouse.down()
     page.mouse.move(220, 240, steps=5)
     page.mouse.up()
-    page.wait_for_timeout(300)
+    frames(page)
     assert camera(page)["yaw"] > before["yaw"]
 
 
 def test_the_overlay_shows_window_size_time_and_fps(page):
-    page.wait_for_timeout(600)
+    page.wait_for_function("document.querySelector('#hud').innerText.includes('FPS')", timeout=60_000)
     text = page.inner_text("#hud")
     assert text.startswith("640 × 480") and " s " in text and "FPS" in text
 
@@ -158,8 +166,6 @@ def test_clouds_out_of_view_are_culled_far_ones_levelled_and_the_rest_sorted_bac
 
 
 def test_with_a_timeout_the_page_reports_writes_the_file_and_stops_serving(tmp_path, thin_sky):
-    from playwright.sync_api import sync_playwright
-
     from fishgen.commands import Events
 
     report = tmp_path / "r.json"
@@ -170,12 +176,11 @@ def test_with_a_timeout_the_page_reports_writes_the_file_and_stops_serving(tmp_p
     assert made.lines[0].startswith("http://127.0.0.1:") and made.written == ()
     served = threading.Thread(target=made.server.serve_forever, daemon=True)
     served.start()
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=CHROMIUM, args=[*COMMON, *WEBGL["swiftshader"]])
-        tab = browser.new_page()
-        tab.goto(made.lines[0])
-        served.join(timeout=120)
-        browser.close()
+    tab = shared_browser().new_page()
+    tab.goto(made.lines[0])
+    served.join(timeout=120)
+    if not tab.is_closed():
+        tab.close()
     made.server.server_close()
     assert not served.is_alive()                             # Pakawan closed its window at the time-out
     r = json.loads(report.read_text())

@@ -6,10 +6,8 @@ from the test extra; Playwright drives the system browser, never a downloaded on
 from __future__ import annotations
 
 import io
-import os
 import queue
 import re
-import shutil
 import subprocess
 import sys
 import threading
@@ -19,27 +17,17 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from tests.browser import browser as shared_browser
+from tests.browser import frames, unavailable
 from tests.conftest import ROOT, run_cli
 
-CHROMIUM = next((p for p in (os.environ.get("FISHGEN_CHROMIUM"), "/usr/bin/chromium",
-                             shutil.which("chromium")) if p and Path(p).is_file()), None)
-pytestmark = pytest.mark.skipif(CHROMIUM is None,
-                                reason="chromium is not installed (Debian: apt-get install chromium)")
-# The machine has no network and no GPU: no background services, WebGL on SwiftShader.
-ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-        "--disable-background-networking", "--disable-component-update", "--disable-sync",
-        "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+pytestmark = pytest.mark.skipif(unavailable() is not None, reason=str(unavailable()))
 LOAD_TIMEOUT_MS = 30_000
 
 
 @pytest.fixture(scope="module")
 def browser():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        yield b
-        b.close()
+    return shared_browser()
 
 
 @pytest.fixture
@@ -110,21 +98,20 @@ def test_fish_loads_plays_scrubs_and_toggles_wireframe(browser, served, viewer_a
         assert state["clips"] == ["swim"] and state["playing"]
         assert page.locator("#counts").inner_text().startswith(f"{expected['vertices']} vertices")
         t0 = page.evaluate("window.fishgenViewer.time")
-        page.wait_for_timeout(600)
-        assert page.evaluate("window.fishgenViewer.time") != t0, "the animation should advance"
+        page.wait_for_function(f"window.fishgenViewer.time != {t0}", timeout=LOAD_TIMEOUT_MS)  # it advances
         img = _canvas(page)
         _assert_not_blank(img)
 
         page.click("#play")  # pause holds the time still
         paused = page.evaluate("window.fishgenViewer.time")
-        page.wait_for_timeout(300)
+        frames(page, 10)
         assert page.evaluate("window.fishgenViewer.time") == paused
         page.fill("#time", "2")  # the scrubber poses the clip
         page.dispatch_event("#time", "input")
         assert page.evaluate("window.fishgenViewer.time") == pytest.approx(2.0)
 
         page.check("#wireframe")
-        page.wait_for_timeout(200)
+        frames(page)
         assert np.abs(_canvas(page) - img).mean() > 1, "wireframe should change the picture"
         assert problems == []
         _assert_offline(requests)
@@ -138,7 +125,7 @@ def test_cloud_shows_its_particles(browser, served, viewer_assets):
         state = page.evaluate("window.fishgenViewer")
         assert state["counts"] == {"vertices": 0, "triangles": 0, "particles": viewer_assets["particles"]}
         assert state["clips"] == [] and page.locator("#play").is_disabled()
-        page.wait_for_timeout(200)
+        frames(page)
         _assert_not_blank(_canvas(page))
         assert problems == []
         _assert_offline(requests)
@@ -169,7 +156,7 @@ def test_cloud_from_the_cli_shows_the_particle_count_it_printed(browser, served,
         expected = {"vertices": 0, "triangles": 0, "particles": particles}
         assert page.evaluate("window.fishgenViewer.counts") == expected
         assert page.locator("#counts").inner_text() == f"0 vertices · 0 triangles · {particles} particles"
-        page.wait_for_timeout(200)
+        frames(page)
         _assert_not_blank(_canvas(page))
         assert problems == []
         _assert_offline(requests)
@@ -232,14 +219,14 @@ def test_a_school_plays_and_its_fish_move_in_three_js(browser, served, tmp_path)
         state = page.evaluate("window.fishgenViewer")
         assert state["clips"] == ["school"] and state["counts"] == load_input(school).counts()
         page.click("#play")                       # pause, then pose two moments of the clip
-        frames = []
+        shots = []
         for t in ("0.5", "4.5"):
             page.fill("#time", t)
             page.dispatch_event("#time", "input")
-            page.wait_for_timeout(200)
-            frames.append(_canvas(page))
-        _assert_not_blank(frames[0])
-        moved = np.abs(frames[1] - frames[0]).max(-1) > 30
+            frames(page)
+            shots.append(_canvas(page))
+        _assert_not_blank(shots[0])
+        moved = np.abs(shots[1] - shots[0]).max(-1) > 30
         assert moved.mean() > 0.01, "the fish should be elsewhere four seconds later"
         assert problems == []
         _assert_offline(requests)
