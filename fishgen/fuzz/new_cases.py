@@ -123,10 +123,11 @@ def run_new_case(case: Case, workdir: Path) -> Outcome:
         return Outcome("ok")
     if case.target == "manifest":
         from fishgen.batch.manifest import load_manifest
+        from fishgen.commands.batch import job_kinds
 
         folder = fresh_folder(workdir)
         write_files(folder, case.files)
-        load_manifest(folder / case.main)
+        load_manifest(folder / case.main, kinds=job_kinds())
         return Outcome("ok")
     if case.target == "fxl":
         from fishgen.authoring.photo.fxl import parse_fxl
