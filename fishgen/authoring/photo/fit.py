@@ -46,12 +46,11 @@ from fishgen.authoring.photo.draw import (
     Placement,
     draw,
     parts,
-    redrawn,
     shape_score,
     with_fin,
 )
 from fishgen.authoring.photo.measure import Body, holds, measure_body, measured, working_mask
-from fishgen.authoring.photo.optimise import PARAMETERS, drop_hidden, refine, valid
+from fishgen.authoring.photo.optimise import PARAMETERS, better, drop_hidden, refine
 from fishgen.authoring.photo.sideview import with_counts
 from fishgen.species.model import Species
 
@@ -194,17 +193,13 @@ def settled_tips(fit: ShapeFit, px_per_unit: float) -> ShapeFit:
             if record in ("dorsal", "anal", "adipose") and not fin.present:
                 continue
             for k in (-step, step):
+                fin = getattr(sp, record)
                 value = getattr(fin, name)
                 trial = with_fin(sp, record, replace(fin, **{
                     name: value * (1.0 + k) if kind == "length" else value + k * TIP_DEGREES}))
-                if not valid(trial):
-                    continue
-                changed = redrawn(drawer, trial, record)
-                value = score(drawer.whole(changed))
-                if value > best + 1e-4:
-                    sp, best, improved = trial, value, True
-                    drawer.layers.update(changed)
-                    fin = getattr(sp, record)
+                kept, best = better(drawer, score, sp, best, trial, record)
+                improved |= kept is not sp
+                sp = kept
         if not improved:
             step /= 2
     if sp is first:

@@ -131,20 +131,29 @@ def refine(sp: Species, work: np.ndarray, body: Body,
                 new_value = int(value) if kind == "section" else value
                 if kind == "angle" and name == "start_angle" and current < 0:
                     new_value = min(value, -1e-3)
-                trial = with_fin(sp, record, replace(fin, **{name: new_value}))
-                if not valid(trial):
-                    continue
-                changed = redrawn(drawer, trial, record)
-                s = score(drawer.whole(changed))
-                if s > best + 1e-4:
-                    sp, best, improved = trial, s, True
-                    drawer.layers.update(changed)
-                    fin = getattr(sp, record)
+                trial = with_fin(sp, record, replace(getattr(sp, record), **{name: new_value}))
+                kept, best = better(drawer, score, sp, best, trial, record)
+                improved |= kept is not sp
+                sp = kept
         if not improved:
             scale /= 2
             if scale < MIN_STEP:
                 break
     return sp, place, depth, best
+
+
+def better(drawer: Drawer, score, sp: Species, best: float, trial: Species,
+           record: str) -> tuple[Species, float]:
+    """``trial`` (``sp`` with fin ``record`` moved) and its score when it is valid and scores over
+    ``best`` (``drawer`` then keeps its layers); else ``sp`` and ``best``."""
+    if not valid(trial):
+        return sp, best
+    changed = redrawn(drawer, trial, record)
+    value = score(drawer.whole(changed))
+    if not value > best + 1e-4:
+        return sp, best
+    drawer.layers.update(changed)
+    return trial, value
 
 
 def drop_hidden(sp: Species, work: np.ndarray, place: Placement) -> Species:
