@@ -392,7 +392,7 @@ def field_default(f: Field) -> Any:
 # -- options several commands share (each call declares one field) -----------------------------
 
 def fins_option(shown_default: str) -> Any:
-    from fishgen.assembly.fin_modes import FIN_MODES
+    from fishgen.fish_modes import FIN_MODES
 
     return option(click.Choice(FIN_MODES), "Fin technique (thesis ch. 5): translucent, mask cut-out or "
                   "opaque.", shown_default=shown_default)
@@ -416,7 +416,7 @@ def compact_option() -> Any:
 
 
 def swim_option(help_text: str) -> Any:
-    from fishgen.assembly.swim_modes import SWIM_MODES
+    from fishgen.fish_modes import SWIM_MODES
 
     return option(click.Choice(SWIM_MODES), help_text, "body")
 

@@ -38,12 +38,11 @@ from fishgen.assembly.clips import (
     targets_for,
     wave_loop,
 )
-from fishgen.assembly.fin_modes import FIN_MODES
 from fishgen.assembly.fins import build_fins
 from fishgen.assembly.levels import at_level
 from fishgen.assembly.materials import default_fin_mode, load_textures, make_materials
-from fishgen.assembly.swim_modes import DEFAULT_SPEED, SWIM_MODES
 from fishgen.errors import FishgenError
+from fishgen.fish_modes import DEFAULT_SPEED, FIN_MODES, SWIM_MODES
 from fishgen.geometry.bend import arc_offsets
 from fishgen.geometry.body import build_body
 from fishgen.geometry.body_wave import BodyWave, check_wave, wave_targets

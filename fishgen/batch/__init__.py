@@ -2,21 +2,24 @@
 
     from fishgen.batch import run_batch
     from fishgen.batch.manifest import load_manifest
-    outcomes = run_batch(load_manifest("params/assets.toml"), workers=2)
+    outcomes = run_batch(load_manifest("params/assets.toml", kinds=kinds), work, workers=2)
 
+A service below the commands: it knows no command. What a manifest's jobs may be (``kinds``: each
+a command's name, options record and output) and how one runs (``work``) are handed in by the
+batch command, :mod:`fishgen.commands.batch`, which is what `fishgen batch` and library users call.
 A job whose inputs, options and fishgen version are unchanged and whose outputs are intact is
-skipped (:mod:`fishgen.batch.record`); the others run in this process, a local process pool or
-on a Dask cluster (:mod:`fishgen.batch.runner`), each through the library API
-(:mod:`fishgen.batch.jobs`). Nothing here imports numpy: a batch where nothing changed never
-loads it.
+skipped (:mod:`fishgen.batch.record`); the others run in this process, a local process pool or on
+a Dask cluster (:mod:`fishgen.batch.runner`), each through ``work`` (:mod:`fishgen.batch.jobs`).
+Nothing here imports numpy: a batch where nothing changed never loads it.
 """
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from fishgen.batch.jobs import Work
 from fishgen.batch.manifest import Job, Manifest
 from fishgen.batch.record import Hashes, Record, relative
 from fishgen.errors import FishgenError, SystemFailure
@@ -39,10 +42,13 @@ class Outcome:
     notes: list[str] = field(default_factory=list)
 
 
-def run_batch(manifest: Manifest, *, workers: int = 1, force: bool = False, fail_fast: bool = False,
-              scheduler: str | None = None, started: Callable[[int], None] | None = None,
+def run_batch(manifest: Manifest, work: Work, *, workers: int = 1, force: bool = False,
+              fail_fast: bool = False, scheduler: str | None = None, preload: Sequence[str] = (),
+              started: Callable[[int], None] | None = None,
               finished: Callable[[Outcome], None] | None = None) -> list[Outcome]:
-    """Bring every output of ``manifest`` up to date; returns one outcome per job, in manifest order.
+    """Bring every output of ``manifest`` up to date, running each job that is not through ``work``;
+    returns one outcome per job, in manifest order. ``preload``: the modules ``work`` imports (see
+    :func:`fishgen.batch.runner.run_jobs`).
 
     ``started(n)`` is called once with the number of jobs that will run; ``finished`` with each
     job's outcome as it is known (skipped ones first).
@@ -83,8 +89,8 @@ def run_batch(manifest: Manifest, *, workers: int = 1, force: bool = False, fail
 
         unsaved: FishgenError | None = None
         try:
-            run_jobs([job for job, _ in todo], done, workers=workers, scheduler=scheduler,
-                     fail_fast=fail_fast)
+            run_jobs([job for job, _ in todo], work, done, workers=workers, scheduler=scheduler,
+                     fail_fast=fail_fast, preload=preload)
         finally:
             # once, durably, however the run ended; an unreadable record is replaced once this run
             # has something to put in its place (it started empty)

@@ -1,10 +1,10 @@
-"""Run one batch job through the command's library function, in whatever process or Dask worker
-it lands on.
+"""Run one batch job through the work the batch command hands in (its command's library
+function), in whatever process or Dask worker it lands on.
 
 A job returns a :class:`Result` and never raises for bad input: a species file's ``FILE:LINE``
 error fails its own job and the batch goes on. Every file the job read (the manifest's inputs, the
 textures a species names, the species of a school's scene, a path CSV: what the command's
-:class:`~fishgen.commands.Made` says it read) and every file it wrote come back with their
+work says it read) and every file it wrote come back with their
 SHA-256, so the record can tell later whether anything changed without parsing anything.
 """
 from __future__ import annotations
@@ -13,13 +13,19 @@ import os
 import time
 import traceback
 import warnings
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from fishgen.batch.manifest import Job
 from fishgen.batch.record import file_sha256
-from fishgen.commands import Events, command, run
 from fishgen.errors import FishgenError, SystemFailure, cannot
+
+Work = Callable[[Job, Callable[[str], None]], tuple[Iterable[Path], Iterable[Path]]]
+"""Runs one job, telling each warning about its inputs to the callable it is given; returns the
+files the job read and those it wrote. A module-level function: it is pickled by name into the
+worker processes and onto Dask workers."""
 
 
 class InternalError(FishgenError):
@@ -54,20 +60,19 @@ class Result:
     notes: list[str] = field(default_factory=list)  # warnings about the inputs, one line each
 
 
-def run_job(job: Job) -> Result:
-    """Run one job's command (its outputs written atomically); its errors become a failed :class:`Result`."""
+def run_job(job: Job, work: Work) -> Result:
+    """Run one job (its outputs written atomically); its errors become a failed :class:`Result`."""
     start = time.perf_counter()
     result = Result(job.name, "failed")
     notes: list[str] = []
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            made = run(command(job.kind), job.inputs, job.output, job.options, Events(note=notes.append,
-                                                                                      summary=False))
+            read, written = work(job, notes.append)
         notes += [str(w.message) for w in caught if issubclass(w.category, UserWarning)]
         result.notes = notes
-        result.inputs = {os.fspath(p): file_sha256(p) for p in dict.fromkeys(made.read)}
-        result.outputs = {os.fspath(p): file_sha256(p) for p in made.written}
+        result.inputs = {os.fspath(p): file_sha256(p) for p in dict.fromkeys(read)}
+        result.outputs = {os.fspath(p): file_sha256(p) for p in written}
         result.status = "built"
     except FishgenError as err:
         result.error = err
@@ -142,7 +147,7 @@ def alive(pid: int) -> bool:
         return True
 
 
-def run_in_worker(jobs: tuple[Job, ...], fail_fast: bool = False) -> list[Result]:
+def run_in_worker(jobs: tuple[Job, ...], work: Work, fail_fast: bool = False) -> list[Result]:
     """:func:`run_job` for a chunk of jobs in a local pool worker, which exits once a SIGTERM has
     unwound the job. Under ``fail_fast`` the chunk stops at a failed job, and at the next job once
     any worker's job failed: the results are then fewer than the jobs."""
@@ -153,7 +158,7 @@ def run_in_worker(jobs: tuple[Job, ...], fail_fast: bool = False) -> list[Result
         for job in jobs:
             if _failure_flag is not None and _failure_flag.value:
                 break
-            results.append(run_job(job))
+            results.append(run_job(job, work))
             if _orphan:  # nobody is waiting for the results; the outputs are whole either way
                 os._exit(1)
             if fail_fast and results[-1].status == "failed":

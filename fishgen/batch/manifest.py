@@ -24,23 +24,27 @@ from __future__ import annotations
 
 import hashlib
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-from fishgen.commands import MODULES, command
 from fishgen.errors import FishgenError
 from fishgen.exchange.registry import output_format
 from fishgen.options import build, check_value, manifest_options
 from fishgen.tomlfile import Where, loads
 
-
-def kinds() -> tuple[str, ...]:
-    """The commands a manifest may list jobs of (their tables' names)."""
-    return tuple(name for name in MODULES if command(name).batch)
-
 MAX_MANIFEST_BYTES = 16 << 20
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A command a manifest may list jobs of, as the batch command declares it: the batch itself
+    knows no command."""
+
+    name: str                        # its [[table]] in a manifest, and Job.kind
+    options: type                    # its frozen options record, whose manifest keys a job may set
+    holds: tuple[str, ...] = ()      # what its output's format must hold
 
 
 @dataclass(frozen=True)
@@ -75,8 +79,10 @@ def derived_seed(name: str) -> int:
     return int.from_bytes(digest[:4], "big")
 
 
-def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None) -> Manifest:
-    """Read and check a manifest; ``out`` (the command's ``--out``) overrides its ``out`` key."""
+def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None, *,
+                  kinds: Sequence[Kind]) -> Manifest:
+    """Read and check a manifest of jobs of ``kinds``; ``out`` (the command's ``--out``) overrides its
+    ``out`` key."""
     path = Path(path)
     file = os.fspath(path)
     if not path.is_file():
@@ -87,9 +93,10 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None)
     text = path.read_bytes().decode("utf-8", errors="replace").removeprefix("\ufeff")
     data = loads(text, file)
     where = Where(text, file)
+    tables = ", ".join(f"[[{k.name}]]" for k in kinds)
+    known = ("out", *[k.name for k in kinds])
     for key in data:
-        if key not in ("out", *kinds()):  # a misspelt key, or a misspelt [[table]] (its header line)
-            tables = ", ".join(f"[[{k}]]" for k in kinds())
+        if key not in known:  # a misspelt key, or a misspelt [[table]] (its header line)
             raise FishgenError(f"expected one of out, {tables}, found {key!r}",
                                file, where.line(key) or where.line("", key))
     folder = path.resolve().parent
@@ -100,28 +107,29 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None)
     out_dir = Path(os.path.abspath(out if out is not None else "out"))
     jobs: list[Job] = []
     seen: dict[str, str] = {}
-    for kind in kinds():
-        entries = data.get(kind, [])
+    for kind in kinds:
+        entries = data.get(kind.name, [])
         if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
-            raise where.fail(f"[[{kind}]] tables", entries, kind)
+            raise where.fail(f"[[{kind.name}]] tables", entries, kind.name)
         for nth, entry in enumerate(entries):
             job = _job(where, kind, nth, entry, folder, out_dir)
             if job.name in seen:
                 raise where.fail(f"one job per output, the first at {seen[job.name]}", job.name, "output",
-                                 kind, nth)
+                                 kind.name, nth)
             seen[job.name] = job.where
             jobs.append(job)
     if not jobs:
-        tables = ", ".join(f"[[{k}]]" for k in kinds())
         raise FishgenError(f"expected at least one job ({tables}), found none", file)
     return Manifest(path, out_dir, tuple(jobs))
 
 
-def _job(where: Where, kind: str, nth: int, entry: dict[str, Any], folder: Path, out: Path) -> Job:
+def _job(where: Where, of: Kind, nth: int, entry: dict[str, Any], folder: Path, out: Path) -> Job:
+    kind = of.name
+
     def fail_at(key: str) -> Callable[[str], FishgenError]:
         return lambda what: where.fail(f"{key} as {what}", entry.get(key, "no value"), key, kind, nth)
 
-    record = command(kind).options
+    record = of.options
     declared = manifest_options(record)
     known = {"input", "inputs", "output", *declared}
     for key in entry:
@@ -146,7 +154,7 @@ def _job(where: Where, kind: str, nth: int, entry: dict[str, Any], folder: Path,
     if relative.is_absolute() or ".." in relative.parts or relative.name in ("", "."):
         raise fail_at("output")("a file name inside the out folder (no absolute path, no ..)")
     try:
-        output_format(relative, command(kind).holds)
+        output_format(relative, of.holds)
     except FishgenError as err:
         raise FishgenError(err.message, where.file, where.line("output", kind, nth)) from None
     name = relative.as_posix()
@@ -171,15 +179,16 @@ def _seeded(kind: str, options: Any, inputs: tuple[Path, ...], name: str) -> Any
     return options
 
 
-def scan_folder(folder: str | os.PathLike, out: str | os.PathLike) -> Manifest:
+def scan_folder(folder: str | os.PathLike, out: str | os.PathLike, *, kinds: Sequence[Kind]) -> Manifest:
     """Every species file (.txt), cube file (.awn) and texture cloud (.awa) under ``folder``, default
-    options, as ``.glb`` in ``out`` at the same relative place. Hidden folders and ``out`` itself are
-    not searched."""
+    options (of ``kinds``' records), as ``.glb`` in ``out`` at the same relative place. Hidden folders
+    and ``out`` itself are not searched."""
     from fishgen.exchange.registry import FORMATS
 
     # the source formats a single file makes an asset from: species files, cube and texture clouds
     scanned = {ext: fmt.command for fmt in FORMATS.values() if fmt.command in ("build", "clouds")
                for ext in fmt.extensions}
+    records = {k.name: k.options for k in kinds}
     root = Path(os.path.abspath(folder))
     out_dir = Path(os.path.abspath(out))
     jobs: list[Job] = []
@@ -198,7 +207,7 @@ def scan_folder(folder: str | os.PathLike, out: str | os.PathLike) -> Manifest:
                 raise FishgenError(f"expected one source per output, found {seen[name].name} and {filename} "
                                    f"both making {name}", source)
             seen[name] = source
-            options = _seeded(kind, command(kind).options(), (source,), name)
+            options = _seeded(kind, records[kind](), (source,), name)
             jobs.append(Job(kind, name, (source,), out_dir / name, options, os.fspath(source)))
     if not jobs:
         raise FishgenError(f"expected species files or cube files ({', '.join(scanned)}) in the folder, "

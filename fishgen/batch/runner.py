@@ -18,59 +18,34 @@ from collections import deque
 from collections.abc import Callable, Sequence
 
 # light: the jobs import the library only when one runs
-from fishgen.batch.jobs import Result, WorkerLost, alive, init_worker, run_in_worker, run_job
+from fishgen.batch.jobs import Result, Work, WorkerLost, alive, init_worker, run_in_worker, run_job
 from fishgen.batch.manifest import Job
 from fishgen.errors import MissingDependency, SystemFailure
 
 Done = Callable[[Job, Result], bool]
 """Called with each finished job; returns True to stop starting new jobs (--fail-fast)."""
 
-# What a worker needs loaded before its first job: imported once where the workers start (the
-# command before it forks them, or the forkserver), so each worker starts with them instead of
-# importing them itself (0.1 s of CPU per worker here). tests/batch/test_runner.py checks that a
-# job of each kind imports nothing more of fishgen, numpy, Pillow or scipy.
-_PILLOW = ["PIL.Image", "PIL.ImageOps", "PIL.PngImagePlugin", "PIL.JpegImagePlugin", "PIL.BmpImagePlugin",
-           "PIL.GifImagePlugin", "PIL.PpmImagePlugin"]
-_FISH = ["fishgen.assembly.fish", "fishgen.assembly.materials", "fishgen.species.parser",
-         "fishgen.exchange.sidefiles", *_PILLOW]
-PRELOAD = {"build": _FISH,
-           "school": [*_FISH, "fishgen.school.run", "fishgen.school.simulate", "fishgen.school.bake",
-                      "fishgen.school.scene_file", "fishgen.school.memory", "fishgen.school.behaviour.boids",
-                      "fishgen.school.behaviour.pso", "fishgen.school.behaviour.couzin",
-                      "fishgen.exchange.sidefiles"],
-           "clouds": ["fishgen.clouds.parser", "fishgen.clouds.fill", "fishgen.clouds.export",
-                      "fishgen.clouds.scene", "fishgen.clouds.light", "fishgen.exchange.sidefiles",
-                      # np.median reaches for numpy.ma on first use
-                      "numpy.random", "numpy.fft", "numpy.ma"]}
-
-
-def preload(kinds: set[str]) -> list[str]:
-    """The modules the jobs of these kinds need, in import order."""
-    from fishgen.commands import MODULES
-
-    jobs = [m for kind in sorted(kinds) for m in (MODULES[kind], *PRELOAD[kind])]
-    return list(dict.fromkeys(["fishgen.batch.jobs", "fishgen.commands.paths", *jobs,
-                               "fishgen.exchange.gltf"]))
-
-
-def run_jobs(jobs: Sequence[Job], done: Done, *, workers: int = 1, scheduler: str | None = None,
-             fail_fast: bool = False) -> None:
-    """Run ``jobs``, calling ``done`` for each as it finishes. ``fail_fast``: a local pool's
-    workers start no job after a failed one (``done`` decides what the caller stops)."""
+def run_jobs(jobs: Sequence[Job], work: Work, done: Done, *, workers: int = 1, scheduler: str | None = None,
+             fail_fast: bool = False, preload: Sequence[str] = ()) -> None:
+    """Run each of ``jobs`` through ``work``, calling ``done`` for each as it finishes. ``fail_fast``: a
+    local pool's workers start no job after a failed one (``done`` decides what the caller stops).
+    ``preload``: the modules ``work`` imports, loaded once where a local pool's workers start (the
+    command before it forks them, or the forkserver), so that each worker starts with them instead of
+    importing them itself (0.1 s of CPU per worker here)."""
     if not jobs:
         return
     if scheduler is not None:
-        _dask(jobs, done, scheduler)
+        _dask(jobs, work, done, scheduler)
     elif workers <= 1 or len(jobs) == 1:
-        _here(jobs, done)
+        _here(jobs, work, done)
     else:
-        _pool(jobs, done, workers, fail_fast)
+        _pool(jobs, work, done, workers, fail_fast, preload)
 
 
-def _here(jobs: Sequence[Job], done: Done) -> None:
+def _here(jobs: Sequence[Job], work: Work, done: Done) -> None:
     """One job after another in this process: no worker start-up to pay for (``-j 1``)."""
     for job in jobs:
-        if done(job, run_job(job)):
+        if done(job, run_job(job, work)):
             return
 
 
@@ -78,20 +53,21 @@ def _failed(job: Job, message: str) -> Result:
     return Result(job.name, "failed", error=WorkerLost(message))
 
 
-def _context(kinds: set[str]):
+def _context(preload: Sequence[str]):
     import importlib
     import multiprocessing
 
+    modules = list(dict.fromkeys(["fishgen.batch.jobs", *preload]))
     # fork while this process has one thread (no lock can be held by another thread), with the
     # jobs' modules imported here first so each worker starts with them; else a forkserver, a clean
     # single-threaded server that imports them. Both start a worker in milliseconds.
     if sys.platform.startswith("linux") and threading.active_count() == 1:
-        for module in preload(kinds):
+        for module in modules:
             importlib.import_module(module)
         return multiprocessing.get_context("fork")
     if sys.platform.startswith("linux"):
         context = multiprocessing.get_context("forkserver")
-        context.set_forkserver_preload(preload(kinds))
+        context.set_forkserver_preload(modules)
         return context
     return multiprocessing.get_context("spawn")
 
@@ -109,7 +85,8 @@ def chunk_size(left: int, workers: int) -> int:
     return max(1, min(MAX_CHUNK, left // (CHUNKS_PER_WORKER * workers)))
 
 
-def _pool(jobs: Sequence[Job], done: Done, workers: int, fail_fast: bool = False) -> None:
+def _pool(jobs: Sequence[Job], work: Work, done: Done, workers: int, fail_fast: bool = False,
+          preload: Sequence[str] = ()) -> None:
     """A local process pool with two chunks queued per worker (a worker never waits for this
     process to hand it the next one). A pool a dead worker broke is replaced, and the jobs it held
     (the dead worker's, and those merely queued behind it) are suspects: each runs again alone,
@@ -121,7 +98,7 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int, fail_fast: bool = False
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")  # before numpy is imported: the pool is the parallelism
     pending = deque(jobs)
-    context = _context({job.kind for job in jobs})
+    context = _context(preload)
     stop = False
     lost: set[str] = set()  # suspects: jobs a broken pool held
     struck: set[str] = set()  # suspects that were running alone when their pool broke
@@ -155,7 +132,7 @@ def _pool(jobs: Sequence[Job], done: Done, workers: int, fail_fast: bool = False
                        and not (stop or broken or suspect_alone(running))):
                     chunk = next_chunk()
                     try:
-                        running[pool.submit(run_in_worker, chunk, fail_fast)] = chunk
+                        running[pool.submit(run_in_worker, chunk, work, fail_fast)] = chunk
                     except BrokenProcessPool:
                         pending.extendleft(reversed(chunk))
                         broken = True
@@ -231,7 +208,7 @@ def _gone(pid: int, seconds: float) -> bool:
     return True
 
 
-def _dask(jobs: Sequence[Job], done: Done, address: str) -> None:
+def _dask(jobs: Sequence[Job], work: Work, done: Done, address: str) -> None:
     """Dask distributed: the scheduler places each job on a worker; outputs go to their shared paths."""
     try:
         from distributed import Client, as_completed
@@ -247,7 +224,7 @@ def _dask(jobs: Sequence[Job], done: Done, address: str) -> None:
     try:
         for index, job in enumerate(jobs):
             # pure=False: two runs of the same job are two builds (the outputs may have been removed)
-            futures[client.submit(run_job, job, pure=False, key=f"fishgen-batch-{index}-{os.getpid()}-"
+            futures[client.submit(run_job, job, work, pure=False, key=f"fishgen-batch-{index}-{os.getpid()}-"
                                   f"{job.name}")] = job
         for future in as_completed(list(futures), loop=client.loop):
             job = futures[future]

@@ -6,8 +6,8 @@
 
 Each module declares its :class:`Command`: the options record (whose fields are the option
 declarations, :mod:`fishgen.commands.options`), its inputs and output, its help, and the function.
-The command line (:mod:`fishgen.cli`) and batch jobs (:mod:`fishgen.batch.jobs`) are thin adapters
-over these; neither knows what a command does.
+The command line (:mod:`fishgen.cli`) and batch jobs (:func:`fishgen.commands.batch.run_job`) are
+thin adapters over these; neither knows what a command does.
 
 The modules import nothing heavy at the top (numpy loads inside the functions), so ``fishgen
 --help`` and a batch run where nothing changed stay fast.

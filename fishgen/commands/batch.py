@@ -2,16 +2,20 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
-from fishgen.commands import QUIET, Command, Events, Inputs, Made, Progress
+from fishgen.commands import MODULES, QUIET, Command, Events, Inputs, Made, Progress, command, run
 from fishgen.errors import FishgenError
 from fishgen.options import FILE, FOLDER, option
+
+if TYPE_CHECKING:
+    from fishgen.batch.manifest import Job, Kind
 
 
 @dataclass(frozen=True)
@@ -59,6 +63,44 @@ COMMAND = Command(
 )
 
 
+def job_kinds() -> tuple[Kind, ...]:
+    """The commands a manifest may list jobs of, as the batch reads them."""
+    from fishgen.batch.manifest import Kind
+
+    return tuple(Kind(name, cmd.options, cmd.holds) for name in MODULES if (cmd := command(name)).batch)
+
+
+def run_job(job: Job, note: Callable[[str], None]) -> tuple[tuple[Path, ...], tuple[Path, ...]]:
+    """One batch job: its command's library function, run as the CLI runs it, quiet but for its notes
+    (the batch's :data:`~fishgen.batch.jobs.Work`); the files it read and wrote."""
+    made = run(command(job.kind), job.inputs, job.output, job.options, Events(note=note, summary=False))
+    return made.read, made.written
+
+
+# What a batch worker needs loaded before its first job (the batch's preload), beyond each kind's
+# command module. tests/batch/test_runner.py checks that a job of each kind imports nothing more of
+# fishgen, numpy, Pillow or scipy.
+_PILLOW = ["PIL.Image", "PIL.ImageOps", "PIL.PngImagePlugin", "PIL.JpegImagePlugin", "PIL.BmpImagePlugin",
+           "PIL.GifImagePlugin", "PIL.PpmImagePlugin"]
+_FISH = ["fishgen.assembly.fish", "fishgen.assembly.materials", "fishgen.species.parser",
+         "fishgen.exchange.sidefiles", *_PILLOW]
+PRELOAD = {"build": _FISH,
+           "school": [*_FISH, "fishgen.school.run", "fishgen.school.simulate", "fishgen.school.bake",
+                      "fishgen.school.scene_file", "fishgen.school.memory", "fishgen.school.behaviour.boids",
+                      "fishgen.school.behaviour.pso", "fishgen.school.behaviour.couzin",
+                      "fishgen.exchange.sidefiles"],
+           "clouds": ["fishgen.clouds.parser", "fishgen.clouds.fill", "fishgen.clouds.export",
+                      "fishgen.clouds.scene", "fishgen.clouds.light", "fishgen.exchange.sidefiles",
+                      # np.median reaches for numpy.ma on first use
+                      "numpy.random", "numpy.fft", "numpy.ma"]}
+
+
+def preload(kinds: set[str]) -> list[str]:
+    """The modules jobs of these kinds need, in import order."""
+    jobs = [m for kind in sorted(kinds) for m in (MODULES[kind], *PRELOAD[kind])]
+    return list(dict.fromkeys([__name__, "fishgen.commands.paths", *jobs, "fishgen.exchange.gltf"]))
+
+
 @dataclass(frozen=True)
 class BatchFacts:
     outcomes: tuple          # one fishgen.batch.Outcome per job, in manifest order
@@ -74,8 +116,8 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
 
     from fishgen.batch import RecordNotSaved, run_batch
     from fishgen.batch.manifest import load_manifest, scan_folder
-    from fishgen.commands.paths import needs
     from fishgen.errors import JobsFailed, UsageError
+    from fishgen.extras import needs
 
     start = time.perf_counter()
     (source,) = inputs
@@ -84,9 +126,9 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
     if source.is_dir():
         if options.out is None:
             raise UsageError("expected --out FOLDER with a folder of inputs, found none", source)
-        manifest = scan_folder(source, options.out)
+        manifest = scan_folder(source, options.out, kinds=job_kinds())
     else:
-        manifest = load_manifest(source, options.out)
+        manifest = load_manifest(source, options.out, kinds=job_kinds())
     workers = options.jobs or os.cpu_count() or 1
     with ExitStack() as stack:
         bar: list[Progress] = []
@@ -100,8 +142,10 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
 
         unsaved: FishgenError | None = None
         try:
-            outcomes = run_batch(manifest, workers=workers, force=options.force, fail_fast=options.fail_fast,
-                                 scheduler=options.scheduler, started=started, finished=finished)
+            outcomes = run_batch(manifest, run_job, workers=workers, force=options.force,
+                                 fail_fast=options.fail_fast, scheduler=options.scheduler,
+                                 preload=preload({job.kind for job in manifest.jobs}), started=started,
+                                 finished=finished)
         except RecordNotSaved as err:  # the summary still says what ran, then why the record did not
             outcomes, unsaved = err.outcomes, err
     seconds = time.perf_counter() - start

@@ -9,9 +9,9 @@ from pathlib import Path
 import click
 
 from fishgen.assembly.clip_names import CLIP_NAMES, DEFAULT_CLIPS
-from fishgen.assembly.swim_modes import DEFAULT_SPEED
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output, each_input
 from fishgen.exchange.registry import MESHES, extensions, formats
+from fishgen.fish_modes import DEFAULT_SPEED
 from fishgen.options import (
     FiniteRange,
     Names,

@@ -9,19 +9,19 @@ The ``-o`` rule, for every command:
 - an output that exists must be a regular file (never a FIFO or ``/dev/null``);
 - no output may be one of the command's inputs.
 
-Optional dependencies a chosen feature needs are checked here too, so that a run that would
-fail at its end fails in its first second, having written nothing.
+Optional dependencies a chosen feature needs are checked before any work too (:func:`needs`, from
+:mod:`fishgen.extras`, which the layers below the commands use as well).
 """
 from __future__ import annotations
 
-import importlib.util
 import os
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from fishgen.atomic import check_target, protecting
-from fishgen.errors import FishgenError, MissingDependency, UsageError
+from fishgen.errors import FishgenError, UsageError
+from fishgen.extras import needs as needs  # the commands' one place for their checks
 
 if TYPE_CHECKING:
     from fishgen.exchange.registry import Format
@@ -93,9 +93,3 @@ def suffix_of(path: Path, allowed: Sequence[str], what: str) -> None:
         raise UsageError(f"expected {what} ending in {' or '.join(allowed)}, found "
                          f"{path.suffix or 'no extension'!r}", path)
 
-
-def needs(module: str, extra: str, feature: str) -> None:
-    """``feature`` needs ``module``: refuse now, in one line, if it is not installed."""
-    if importlib.util.find_spec(module) is None:
-        raise MissingDependency(f"{feature} needs {module}, which is not installed; install it with "
-                                f"pip install 'fishgen[{extra}]'")

@@ -50,7 +50,7 @@ def find_chromium() -> str | None:
 
 def check_headless() -> str | None:
     """Refuse now, in one line, if headless flying cannot work here; the Chromium to use."""
-    from fishgen.commands.paths import needs
+    from fishgen.extras import needs
 
     needs("playwright", "fly", "--headless")
     chromium = find_chromium()

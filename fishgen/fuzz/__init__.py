@@ -7,7 +7,9 @@ See docs/fuzzing.md; run ``python -m fishgen.fuzz --help``.
 """
 from __future__ import annotations
 
-from fishgen.fuzz.cases import TARGETS, Case, Outcome, load_seeds, make_case, run_case
+from fishgen.fuzz.cases import TARGETS, make_case, run_case
+from fishgen.fuzz.inputs import Case, load_seeds
 from fishgen.fuzz.runner import Finding, Report, run
+from fishgen.fuzz.verdict import Outcome
 
 __all__ = ["TARGETS", "Case", "Finding", "Outcome", "Report", "load_seeds", "make_case", "run", "run_case"]

@@ -8,7 +8,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from fishgen.fuzz.cases import DEFAULT_CORPUS, NEW_TARGETS, TARGETS, load_seeds, make_case, run_case
+from fishgen.fuzz.cases import NEW_TARGETS, TARGETS, make_case, run_case
+from fishgen.fuzz.inputs import DEFAULT_CORPUS, load_seeds
 from fishgen.fuzz.runner import DEFAULT_BUDGET_MB, Report, run
 
 

@@ -1,4 +1,5 @@
-"""Make the committed seed corpus (tests/fuzz/corpus/) from the shipped parameter files.
+"""Make the committed seed corpus (fishgen/fuzz/seeds/, shipped as package data) from the
+parameter files of a source checkout.
 
     python -m fishgen.fuzz.corpus [DEST]
 
@@ -13,10 +14,11 @@ import sys
 import tempfile
 from pathlib import Path
 
-from fishgen.fuzz.cases import DEFAULT_CORPUS, FISHGEN_ROOT
+from fishgen.fuzz.inputs import DEFAULT_CORPUS
 from fishgen.fuzz.mutate import png_bytes
 
-PARAMS = FISHGEN_ROOT.parent / "params"
+#: The source checkout's params/ (an installed fishgen has none: it fuzzes with the corpus it ships).
+PARAMS = Path(__file__).resolve().parents[2] / "params"
 SMALL_CLOUD = b"60\n3\n20, 4.0, 3.0, 2.0, 0.0, 0.0, 0.0, 1.0\n20, 2.0, 2.0, 2.0, 5.0, 1.0, -2.0, 0.8\n" \
               b"20 3.0, 1.0, 1.0, -4.0, 0.5, 1.0, 0.5\n"
 ASCII_PLY_CLOUD = """ply
@@ -87,6 +89,9 @@ d 0.4
 def make_corpus(dest: Path = DEFAULT_CORPUS) -> None:
     from fishgen.cli import main
 
+    if not (PARAMS / "assets.toml").is_file():
+        raise SystemExit(f"expected a source checkout's params/ at {PARAMS}, found none: the corpus is "
+                         "made from it")
     if dest.exists():
         shutil.rmtree(dest)
     for sub in ("species", "cubes"):

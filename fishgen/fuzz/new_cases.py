@@ -1,4 +1,4 @@
-"""Issue 26's targets: how a case is generated and run (the judging is :mod:`fishgen.fuzz.cases`').
+"""Issue 26's targets: how a case is generated and run (the judging is :mod:`fishgen.fuzz.verdict`').
 
 | target   | runs |
 |----------|------|
@@ -20,10 +20,11 @@ import random
 import socket
 import threading
 from pathlib import Path
-from typing import Any
 
 from fishgen.fuzz import structured
-from fishgen.fuzz.cases import Case, Outcome, Seeds, _fresh, _run_cli, innermost_fishgen_frame, write_files
+from fishgen.fuzz.cli_run import run_cli
+from fishgen.fuzz.inputs import Case, Seeds, fresh_folder, write_files
+from fishgen.fuzz.verdict import Outcome, classify, innermost_fishgen_frame
 
 
 def make_new_case(seeds: Seeds, target: str, rng: random.Random, index: int, verbatim: bool) -> Case:
@@ -116,16 +117,17 @@ def run_new_case(case: Case, workdir: Path) -> Outcome:
     if case.target in ("scene", "paths"):
         from fishgen.school.scene_file import load_scene_file
 
-        folder = _fresh(workdir)
+        folder = fresh_folder(workdir)
         write_files(folder, case.files)
         load_scene_file(folder / case.main)
         return Outcome("ok")
     if case.target == "manifest":
         from fishgen.batch.manifest import load_manifest
+        from fishgen.commands.batch import job_kinds
 
-        folder = _fresh(workdir)
+        folder = fresh_folder(workdir)
         write_files(folder, case.files)
-        load_manifest(folder / case.main)
+        load_manifest(folder / case.main, kinds=job_kinds())
         return Outcome("ok")
     if case.target == "fxl":
         from fishgen.authoring.photo.fxl import parse_fxl
@@ -136,7 +138,7 @@ def run_new_case(case: Case, workdir: Path) -> Outcome:
         return _run_awa(case, workdir)
     if case.target == "editor":
         return _run_editor(case, workdir)
-    return _run_cli(case, workdir)
+    return run_cli(case, workdir)
 
 
 def _awa_layout(folder: Path, files: dict[str, bytes | int]) -> None:
@@ -162,7 +164,7 @@ def _run_awa(case: Case, workdir: Path) -> Outcome:
     from fishgen.clouds.fill import fill_cloud
     from fishgen.clouds.parser import load_cubes
 
-    folder = _fresh(workdir)
+    folder = fresh_folder(workdir)
     _awa_layout(folder, {**_awa_textures(), **case.files})
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -212,7 +214,7 @@ def _run_editor(case: Case, workdir: Path) -> Outcome:
     from fishgen.editor.session import MAX_REQUEST, Session
     from fishgen.web.server import LocalServer, _Handler
 
-    folder = _fresh(workdir)
+    folder = fresh_folder(workdir)
     edit = folder / "edit"
     edit.mkdir()
     outside = folder / "outside"
@@ -238,7 +240,6 @@ def _run_editor(case: Case, workdir: Path) -> Outcome:
             answer, err = _exchange(server, _Handler, data)
             if err is not None:
                 where = innermost_fishgen_frame(err.__traceback__)
-                from fishgen.fuzz.cases import classify
 
                 judged = classify(err)
                 key = (
@@ -323,37 +324,3 @@ def _protocol_answer(status: int, data: bytes) -> bool:
 def _route_of(data: bytes) -> str:
     words = data.split(b"\r\n", 1)[0].split()
     return " ".join(w.decode("latin-1")[:40].split("?")[0] for w in words[:2])
-
-
-class WouldServe(BaseException):
-    """Raised where `fishgen fly` would start its server or a browser: the case ends there, passed
-    (a BaseException so the CLI's guards let it through)."""
-
-
-@contextlib.contextmanager
-def no_serving(argv: list[str]) -> Any:
-    """`fishgen fly` runs its validation and reads its inputs, but never binds a server, starts
-    Chromium, or composes a --mode sky (minutes of work)."""
-    if not argv or argv[0] != "fly":
-        yield
-        return
-    import fishgen.commands.fly as fly_command
-    import fishgen.fly.assets as fly_assets
-    import fishgen.fly.headless as headless
-
-    saved = (fly_command._session, headless.check_headless, fly_assets.prepare_assets)
-    original = fly_assets.prepare_assets
-
-    def stop(*_a, **_k):
-        raise WouldServe
-
-    def prepare(inputs, *, mode=None, **kw):
-        if mode is not None:
-            raise WouldServe
-        return original(inputs, mode=mode, **kw)
-
-    fly_command._session, headless.check_headless, fly_assets.prepare_assets = stop, stop, prepare
-    try:
-        yield
-    finally:
-        fly_command._session, headless.check_headless, fly_assets.prepare_assets = saved

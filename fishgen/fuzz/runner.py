@@ -24,7 +24,9 @@ from dataclasses import dataclass, field
 from multiprocessing.connection import wait
 from pathlib import Path
 
-from fishgen.fuzz.cases import DEFAULT_CORPUS, CaseTimeout, Outcome, load_seeds, make_case, run_case
+from fishgen.fuzz.cases import make_case, run_case
+from fishgen.fuzz.inputs import DEFAULT_CORPUS, load_seeds
+from fishgen.fuzz.verdict import CaseTimeout, Outcome
 
 #: Address space a worker may use. Imports take ~360 MB of address space, an EGL preview
 #: context another ~650 MB (measured with /proc/self/status VmPeak), so a correct CLI preview

@@ -449,13 +449,12 @@ def manifest_additions() -> list[tuple[list[str], Any]]:
         "textures",
     ]
     try:
-        from fishgen.batch.manifest import kinds
-        from fishgen.commands import command
+        from fishgen.commands.batch import job_kinds
         from fishgen.options import manifest_options
 
-        for kind in kinds():
-            for key in manifest_options(command(kind).options):
-                out += [([kind, key], v) for v in values]
+        for kind in job_kinds():
+            for key in manifest_options(kind.options):
+                out += [([kind.name, key], v) for v in values]
     except Exception:  # noqa: BLE001 - the generator works without the declarations too
         pass
     return out

@@ -192,7 +192,8 @@ def test_paired_fins_are_kept_on_the_body_while_swimming():
     from dataclasses import replace
 
     from fishgen.authoring.photo.checks import attachment_problems
-    from fishgen.authoring.photo.fit import Placement, ShapeFit, _attached
+    from fishgen.authoring.photo.draw import Placement
+    from fishgen.authoring.photo.fit import ShapeFit, _attached
 
     bream = replace(load_species(PARAMS / "bonybream.txt"), texture_points=None)
     wide = replace(bream, pectoral=replace(bream.pectoral, triangles=6, movement_angle=45.0, step_size=3.0))
@@ -234,9 +235,9 @@ def test_a_photo_too_long_for_its_height_is_refused_before_measuring(tmp_path):
 
 def _drawn(sp, px_per_unit: float) -> np.ndarray:
     """``sp``'s side view as a renderer fills it (pixels whose centres it covers), 40 px margins."""
-    from fishgen.authoring.photo.fit import Placement, _parts, draw
+    from fishgen.authoring.photo.draw import Placement, draw, parts
 
-    outline, fins = _parts(sp)
+    outline, fins = parts(sp)
     pts = np.concatenate([outline, *[f for f, _ in fins]])
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     place = Placement(40 - lo[0] * px_per_unit, 40 + hi[1] * px_per_unit, px_per_unit)
@@ -269,7 +270,7 @@ def test_a_belly_strip_does_not_join_the_pelvic_fin_to_the_anal_fin():
     pelvic and anal fins made one run of columns, all taken for the pelvic fin, and the anal fin was
     left out. The valley between their peaks parts them; a fin falling away to its end keeps its
     low part."""
-    from fishgen.authoring.photo.fit import _runs, _valleys_out
+    from fishgen.authoring.photo.measure import _runs, _valleys_out
 
     pelvic, strip, anal = [30, 47, 50, 48, 40, 20], [5, 4, 4, 5, 4], [15, 25, 46, 61, 40, 30, 20, 16, 15]
     counts = np.array([0, *pelvic, *strip, *anal, 0])

@@ -3,10 +3,21 @@ from __future__ import annotations
 
 import pytest
 
-from fishgen.batch.manifest import derived_seed, load_manifest, scan_folder
+from fishgen.batch import manifest
+from fishgen.batch.manifest import derived_seed
+from fishgen.commands.batch import job_kinds
 from fishgen.commands.build import BuildOptions
 from fishgen.errors import FishgenError
 from tests.conftest import PARAMS
+
+
+def load_manifest(path, out=None):
+    """A manifest as `fishgen batch` reads it: of the commands' jobs."""
+    return manifest.load_manifest(path, out, kinds=job_kinds())
+
+
+def scan_folder(folder, out):
+    return manifest.scan_folder(folder, out, kinds=job_kinds())
 
 
 def write(tmp_path, text: str):

@@ -97,7 +97,7 @@ class SlowToSend:
         return (str, ("slow",))
 
 
-def fake_run_job(job: Job) -> Result:
+def fake_run_job(job: Job, work) -> Result:
     """Jobs named for what they do to their worker, for the pool's tests (forked workers inherit it)."""
     import fishgen.batch.jobs as jobs
 
@@ -128,6 +128,7 @@ def fake_pool(tmp_path, monkeypatch, names: list[str], fail_fast: bool = False) 
 
     import fishgen.batch.jobs as jobs
     from fishgen.batch.runner import _pool
+    from fishgen.commands.batch import run_job  # picklable; the fake run_job never calls it
 
     if threading.active_count() > 1 or not sys.platform.startswith("linux"):
         pytest.skip("the workers must be forked to inherit the fake jobs")
@@ -138,7 +139,7 @@ def fake_pool(tmp_path, monkeypatch, names: list[str], fail_fast: bool = False) 
         reported.setdefault(job.name, []).append((result.status, result.error.message if result.error else None))
         return fail_fast and result.status == "failed"
 
-    _pool([Job("build", name, (), tmp_path / f"{name}.glb") for name in names], done, 2, fail_fast)
+    _pool([Job("build", name, (), tmp_path / f"{name}.glb") for name in names], run_job, done, 2, fail_fast)
     return reported
 
 
@@ -171,13 +172,13 @@ def test_a_worker_starts_with_every_module_its_jobs_import(shipped, kind):
 import importlib, sys
 from pathlib import Path
 from fishgen.batch.manifest import load_manifest
-from fishgen.batch.runner import preload
 from fishgen.batch.jobs import run_job
-job = next(j for j in load_manifest(Path("assets.toml")).jobs if j.kind == {kind!r})
-for module in preload({{{kind!r}}}):
+from fishgen.commands.batch import job_kinds, preload, run_job as work
+job = next(j for j in load_manifest(Path("assets.toml"), kinds=job_kinds()).jobs if j.kind == {kind!r})
+for module in ["fishgen.batch.jobs", *preload({{{kind!r}}})]:
     importlib.import_module(module)
 before = set(sys.modules)
-assert run_job(job).status == "built"
+assert run_job(job, work).status == "built"
 print(sorted(m for m in set(sys.modules) - before if m.split(".")[0] in ("fishgen", "numpy", "PIL", "scipy")))
 """
     run = subprocess.run([sys.executable, "-c", code], cwd=shipped / "params", capture_output=True, text=True)

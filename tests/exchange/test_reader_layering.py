@@ -12,7 +12,7 @@ from tests.geometry.test_layering import modules_loaded_by
 
 STEPS = ("fishgen.exchange.gltf_container", "fishgen.exchange.gltf_checks",
          "fishgen.exchange.gltf_accessors", "fishgen.exchange.gltf_scene", "fishgen.exchange.gltf_reader")
-CORPUS = "tests/fuzz/corpus"
+CORPUS = "fishgen/fuzz/seeds"
 GLTF = f"{CORPUS}/gltf/pineapplefish_gltf/pineapplefish.gltf"
 
 

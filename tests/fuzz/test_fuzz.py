@@ -19,7 +19,9 @@ from hypothesis import strategies as st
 
 from fishgen.errors import FishgenError
 from fishgen.fuzz import TARGETS, load_seeds, make_case, run
-from fishgen.fuzz.cases import DEFAULT_CORPUS, NEW_TARGETS, Case, classify, run_case
+from fishgen.fuzz.cases import NEW_TARGETS, run_case
+from fishgen.fuzz.inputs import DEFAULT_CORPUS, Case
+from fishgen.fuzz.verdict import classify
 from fishgen.fuzz.mutate import NUMBERS, pack_glb, unpack_glb
 
 CI_SEED = 20240601

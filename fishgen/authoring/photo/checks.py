@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from fishgen.authoring.photo.draw import FIN_RECORDS, Drawer
 from fishgen.species.model import Species
 
 #: Fin vertices this close to the body at rest (share of the body length) count as attached.
@@ -183,9 +184,7 @@ def _dot(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 def height_problems(species: Species, work: np.ndarray, placement) -> list[str]:
     """Fins reaching farther from the axis than the photographed fish does where they stand, in the
     fit's levelled frame."""
-    from fishgen.authoring.photo.fit import FIN_RECORDS, _Drawer
-
-    drawer = _Drawer(species, placement, work.shape)
+    drawer = Drawer(species, placement, work.shape)
     rows = np.arange(work.shape[0])[:, None] + 0.5
     off_axis = np.abs(rows - placement.y0)
     length = species.scale[0] * placement.s

@@ -16,10 +16,10 @@ from fishgen.authoring.photo import points as fixel
 from fishgen.authoring.photo.anatomy import BodyOutline, body_outline, body_region, calibrate
 from fishgen.authoring.photo.frame import Frame, fish_frame
 from fishgen.authoring.photo.image import MEASURE_SIDE, Photo, load_photo, working_copy
-from fishgen.authoring.photo.sideview import SideView, side_view
+from fishgen.authoring.photo.sideview import SideView, side_view, with_counts
 from fishgen.authoring.photo.silhouette import silhouette
 from fishgen.errors import FishgenError, UsageError, cannot
-from fishgen.species.model import PectoralFin, PelvicFin, Species, TexturePoints, VerticalFin
+from fishgen.species.model import Species, TexturePoints
 
 #: Largest texture written; a bigger photo is scaled down (texture points are fractions, unchanged).
 MAX_TEXTURE_SIDE = 4096
@@ -71,36 +71,6 @@ class Measured:
     mirrored: bool
     unseen: tuple[str, ...]
     frame: Frame | None = None
-
-
-def with_counts(base: Species, sections: int | None, circles: int | None) -> Species:
-    """``base`` at another level of detail: fin sections and circle points move with the body."""
-    b0, c0 = base.body_sections, base.circle_sections
-    b, c = sections or b0, circles or c0
-    if (b, c) == (b0, c0):
-        return base
-
-    def sec(k: int) -> int:
-        return int(np.clip(round(k * (b - 1) / (b0 - 1)), 0, b - 1))
-
-    def circ(k: int) -> int:
-        return int(round(k * c / c0)) % c
-
-    def vertical(f: VerticalFin) -> VerticalFin:  # a fin spans at least one section's length
-        start = min(sec(f.start_section), b - 2)
-        return replace(f, start_section=start, end_section=max(sec(f.end_section), start + 1))
-
-    p: PelvicFin = base.pelvic
-    ps = min(sec(p.start_section), b - 2)
-    pe = max(sec(p.end_section), ps + 1)
-    q: PectoralFin = base.pectoral
-    return replace(base, body_sections=b, circle_sections=c, dorsal=vertical(base.dorsal),
-                   adipose=vertical(base.adipose), anal=vertical(base.anal),
-                   pelvic=replace(p, start_circle=circ(p.start_circle), start_section=ps,
-                                  end_section=pe),
-                   pectoral=replace(q, start_section=sec(q.start_section), start_circle=circ(q.start_circle),
-                                    triangles=max(1, min(q.triangles, c // 2))),
-                   texture_points=None)
 
 
 @dataclass(frozen=True)
