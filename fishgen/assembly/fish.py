@@ -457,7 +457,7 @@ def _separate(scene: Scene, name: str, parts: list[list[Part]], look: _Look, cov
         lay.wave_nodes.append(waves)
         lay.fin_nodes.append(fins)
         lay.axes.append(axes)
-    _link_levels(scene, roots, coverage)
+    scene.add_levels(roots[0], roots[1:], coverage)
     return lay
 
 
@@ -498,7 +498,7 @@ def _merged(scene: Scene, name: str, parts: list[list[Part]], look: _Look, cover
         lay.wave_nodes.append([node] if scene.meshes[mesh].weights else [])
         lay.fin_nodes.append(fins)
         lay.axes.append(axes)
-    _link_levels(scene, meshes, coverage, also=[root])
+    scene.add_levels(meshes[0], meshes[1:], coverage, needs=[root])  # a scene holds a skin's joints
     return lay
 
 
@@ -527,21 +527,8 @@ def _merged_primitive(group: list[Part], joints: list[int], fins: dict[str, int]
 
 
 def _add_level_root(scene: Scene, node: Node, level: int) -> int:
-    """The finest level's node among the scene's roots; a coarser level's outside them, for now."""
-    if level == 0:
-        return scene.add_node(node)
-    scene.nodes.append(node)
-    return len(scene.nodes) - 1
-
-
-def _link_levels(scene: Scene, nodes: list[int], coverage: list[float], also: Sequence[int] = ()) -> None:
-    """The finest level's node names the coarser ones (MSFT_lod); these stand in the second scene,
-    with ``also`` (the joints their skins use: a scene must hold a skinned mesh's joints)."""
-    if len(nodes) > 1:
-        scene.hidden_roots += [*also, *nodes[1:]]
-    if len(nodes) > 1:
-        scene.nodes[nodes[0]].lods = list(nodes[1:])
-        scene.nodes[nodes[0]].screen_coverage = [float(c) for c in coverage]
+    """The finest level's node among the scene's roots; a coarser level's in no tree until linked."""
+    return scene.add_node(node, root=level == 0)
 
 
 # -- clips ----------------------------------------------------------------------------------------
