@@ -148,8 +148,11 @@ class Lods(click.ParamType):
     def convert(self, value, param, ctx):
         import re
 
-        if isinstance(value, tuple):
-            return value
+        if isinstance(value, (tuple, list)):  # from Python (or click's converted value): checked as its text
+            try:
+                value = ",".join(f"{b}x{c}" for b, c in value)
+            except (TypeError, ValueError):
+                self.fail(f"expected {self.what}, found {value!r}", param, ctx)
         parts = [p.strip() for p in str(value).split(",")]
         levels = []
         for part in parts:
@@ -174,8 +177,8 @@ class Names(click.ParamType):
         self.what = f"names from {', '.join(choices)}, separated by commas, each once"
 
     def convert(self, value, param, ctx):
-        if isinstance(value, tuple):
-            return value
+        if isinstance(value, (tuple, list)):  # from Python (or click's converted value): checked as its text
+            value = ",".join(map(str, value))
         names = tuple(p.strip() for p in str(value).split(","))
         if not names or any(n not in self.choices for n in names) or len(set(names)) != len(names):
             self.fail(f"expected {self.what}, found {value!r}", param, ctx)

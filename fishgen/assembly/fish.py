@@ -25,7 +25,7 @@ import numpy as np
 
 from fishgen.assembly.animation import MAX_CLIP_FRAMES, FinMotion, axis_rotation_quaternions, clip_frames
 from fishgen.assembly.body_wave import loop_beats, loop_laps
-from fishgen.assembly.clip_names import BENDING_CLIPS, CLIP_NAMES, DEFAULT_CLIPS
+from fishgen.assembly.clip_names import DEFAULT_CLIPS
 from fishgen.assembly.clips import (
     C_START_DEGREES,
     TURN_DEGREES,
@@ -39,10 +39,11 @@ from fishgen.assembly.clips import (
     wave_loop,
 )
 from fishgen.assembly.fins import build_fins
+from fishgen.assembly.fish_options import FishOptions
 from fishgen.assembly.levels import at_level
 from fishgen.assembly.materials import default_fin_mode, load_textures, make_materials
 from fishgen.errors import FishgenError
-from fishgen.fish_modes import DEFAULT_SPEED, FIN_MODES, SWIM_MODES
+from fishgen.fish_modes import DEFAULT_SPEED
 from fishgen.geometry.bend import arc_offsets
 from fishgen.geometry.body import build_body
 from fishgen.geometry.body_wave import BodyWave, check_wave, wave_targets
@@ -61,8 +62,6 @@ THESIS_TO_GLTF = np.array([[0.0, 0.0, 1.0],
                            [0.0, 1.0, 0.0],
                            [-1.0, 0.0, 0.0]])
 
-MAX_LEVELS = 8
-MAX_LEVEL_SECTIONS = 1024
 SCREEN_PIXELS = 1080
 """Switch points are set for a screen this many pixels tall: a level takes over where the coarser
 level's error would show as one pixel."""
@@ -150,11 +149,24 @@ def make_fish(species: Species, *, fins: str | None = None, length: float | None
     frequency of the body wave (``wave``, default :class:`BodyWave`). ``lods``: levels of detail,
     (BodySections, CircleSections) from finest to coarsest (default: the file's own level only).
     ``merge``: one skinned mesh of two primitives instead of a node per part. ``clips``: names of
-    CLIP_NAMES. ``compact``: rotation and weight keys as normalized 16-bit integers.
+    CLIP_NAMES. ``compact``: rotation and weight keys as normalized 16-bit integers. Each is
+    checked as `fishgen build` checks its option (:class:`FishOptions`).
     """
-    mode = fins or default_fin_mode(species)
-    _check_options(species, mode, length, fps, swim, speed, clips)
-    levels = check_levels(lods, species)
+    options = FishOptions(fins=fins, length=length, fps=fps, swim=swim, speed=speed, merge=merge,
+                          lods=tuple(lods) if lods else None, clips=tuple(clips), compact=compact)
+    return fish_of(species, options, wave)
+
+
+def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None) -> Fish:
+    """The fish of ``species`` built as ``options`` (checked when they were made) say: what
+    `fishgen build` runs for each species file."""
+    length, fps, swim, speed = options.length, options.fps, options.swim, options.speed
+    merge, clips, compact = options.merge, options.clips, options.compact
+    mode = options.fins or default_fin_mode(species)
+    if mode == "mask" and not species.textured:
+        raise FishgenError("expected a textured species for --fins mask (the mask is a texture), "
+                           "found textured false", species.source, species.line_of("shape"))
+    levels = options.lods or ((species.body_sections, species.circle_sections),)
     wave = wave or BodyWave()
     try:
         check_wave(wave)
@@ -216,48 +228,6 @@ def make_fish(species: Species, *, fins: str | None = None, length: float | None
                       swim_clip.duration if has_swim and swim_clip is not None else None,
                       level_facts, clip_facts, merge, targets, draw_calls)
     return Fish(scene, facts)
-
-
-# -- checks ---------------------------------------------------------------------------------------
-
-def _check_options(species: Species, mode: str, length: float | None, fps: float, swim: str, speed: float,
-                   clips: Sequence[str]) -> None:
-    if mode not in FIN_MODES:
-        raise FishgenError(f"expected a fin mode ({', '.join(FIN_MODES)}), found {mode!r}")
-    if mode == "mask" and not species.textured:
-        raise FishgenError("expected a textured species for --fins mask (the mask is a texture), "
-                           "found textured false", species.source, species.line_of("shape"))
-    if not 1 <= fps <= 1000:
-        raise FishgenError(f"expected --fps from 1 to 1000, found {fps}")
-    if length is not None and not 0.001 <= length <= 1e4:
-        raise FishgenError(f"expected --length in metres from 0.001 to 10000, found {length}")
-    if swim not in SWIM_MODES:
-        raise FishgenError(f"expected a swim mode ({', '.join(SWIM_MODES)}), found {swim!r}")
-    if not 0.01 <= speed <= 100:
-        raise FishgenError(f"expected --speed in body lengths per second from 0.01 to 100, found {speed}")
-    unknown = [c for c in clips if c not in CLIP_NAMES]
-    if not clips or unknown or len(set(clips)) != len(clips):
-        raise FishgenError(f"expected --clips of distinct names from {', '.join(CLIP_NAMES)}, "
-                           f"found {','.join(clips) or 'none'}")
-    bending = [c for c in clips if c in BENDING_CLIPS]
-    if bending and swim != "body":
-        raise FishgenError(f"expected --swim body for the clips {', '.join(bending)} (a rigid body cannot "
-                           f"bend), found --swim {swim}")
-
-
-def check_levels(lods: Sequence[tuple[int, int]] | None, species: Species) -> tuple[tuple[int, int], ...]:
-    """The levels to build, finest first: ``lods`` checked, or the species file's own level."""
-    if not lods:
-        return ((species.body_sections, species.circle_sections),)
-    levels = tuple((int(b), int(c)) for b, c in lods)
-    shown = ",".join(f"{b}x{c}" for b, c in levels)
-    if len(levels) > MAX_LEVELS or not all(3 <= v <= MAX_LEVEL_SECTIONS for level in levels for v in level):
-        raise FishgenError(f"expected --lods of at most {MAX_LEVELS} levels BODIESxCIRCLES, each from 3 to "
-                           f"{MAX_LEVEL_SECTIONS}, found {shown}")
-    if any(b1 * c1 <= b2 * c2 for (b1, c1), (b2, c2) in zip(levels, levels[1:], strict=False)):
-        raise FishgenError(f"expected --lods from the finest level to the coarsest (fewer sections each), "
-                           f"found {shown}")
-    return levels
 
 
 def _fin_loop_frames(species: Species, swings: list[FinSwing]) -> int:
@@ -456,7 +426,7 @@ def _separate(scene: Scene, name: str, parts: list[list[Part]], look: _Look, cov
         lay.wave_nodes.append(waves)
         lay.fin_nodes.append(fins)
         lay.axes.append(axes)
-    _link_levels(scene, roots, coverage)
+    scene.add_levels(roots[0], roots[1:], coverage)
     return lay
 
 
@@ -497,7 +467,7 @@ def _merged(scene: Scene, name: str, parts: list[list[Part]], look: _Look, cover
         lay.wave_nodes.append([node] if scene.meshes[mesh].weights else [])
         lay.fin_nodes.append(fins)
         lay.axes.append(axes)
-    _link_levels(scene, meshes, coverage, also=[root])
+    scene.add_levels(meshes[0], meshes[1:], coverage, needs=[root])  # a scene holds a skin's joints
     return lay
 
 
@@ -526,21 +496,8 @@ def _merged_primitive(group: list[Part], joints: list[int], fins: dict[str, int]
 
 
 def _add_level_root(scene: Scene, node: Node, level: int) -> int:
-    """The finest level's node among the scene's roots; a coarser level's outside them, for now."""
-    if level == 0:
-        return scene.add_node(node)
-    scene.nodes.append(node)
-    return len(scene.nodes) - 1
-
-
-def _link_levels(scene: Scene, nodes: list[int], coverage: list[float], also: Sequence[int] = ()) -> None:
-    """The finest level's node names the coarser ones (MSFT_lod); these stand in the second scene,
-    with ``also`` (the joints their skins use: a scene must hold a skinned mesh's joints)."""
-    if len(nodes) > 1:
-        scene.hidden_roots += [*also, *nodes[1:]]
-    if len(nodes) > 1:
-        scene.nodes[nodes[0]].lods = list(nodes[1:])
-        scene.nodes[nodes[0]].screen_coverage = [float(c) for c in coverage]
+    """The finest level's node among the scene's roots; a coarser level's in no tree until linked."""
+    return scene.add_node(node, root=level == 0)
 
 
 # -- clips ----------------------------------------------------------------------------------------

@@ -75,9 +75,9 @@ def add_fish(target: Scene, template: SpeciesTemplate, name: str, clip: str = "s
             skin = skins[node.skin]
         mesh = None if node.mesh is None else node.mesh + template.mesh_base
         children = [where[c] for c in node.children]
+        lods = node.lods and replace(node.lods, nodes=tuple(where[i] for i in node.lods.nodes))
         target.nodes.append(replace(node, name=_renamed(fish, old, name), children=children,
-                                    mesh=mesh, skin=skin, lods=[where[i] for i in node.lods],
-                                    screen_coverage=list(node.screen_coverage)))
+                                    mesh=mesh, skin=skin, lods=lods))
     target.roots += [where[r] for r in fish.roots]
     target.hidden_roots += [where[r] for r in fish.hidden_roots if where[r] not in target.hidden_roots]
     tops = list(dict.fromkeys([*fish.roots, *fish.hidden_roots]))

@@ -8,46 +8,21 @@ from pathlib import Path
 
 import click
 
-from fishgen.assembly.clip_names import CLIP_NAMES, DEFAULT_CLIPS
+from fishgen.assembly.fish_options import FishOptions
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output, each_input
 from fishgen.exchange.registry import MESHES, extensions, formats
-from fishgen.fish_modes import DEFAULT_SPEED
-from fishgen.options import (
-    FiniteRange,
-    Names,
-    compact_option,
-    fins_option,
-    lods_option,
-    merge_option,
-    option,
-    swim_option,
-    textures_option,
-)
+from fishgen.options import option, textures_option
 
 FISH_FORMATS = formats(writable=True, holding=[MESHES])
 
 
 @dataclass(frozen=True)
-class BuildOptions:
+class BuildOptions(FishOptions):
+    """How each fish is built (:class:`FishOptions`, checked when made), and where its files go."""
+
     format: str = option(click.Choice([f.name for f in FISH_FORMATS]), "Format of each file written into "
                          "a folder (-o FOLDER/).", "glb", manifest=False)
-    fins: str | None = fins_option("mask if the file says masked, else blend")
-    length: float | None = option(FiniteRange(0.001, 1e4), "Nose-to-tail length in metres.",
-                                  shown_default="world scale x scaleX x 0.05 m for the body",
-                                  metavar="METRES")
-    fps: float = option(FiniteRange(1, 1000), "Frames per second; fins move step size degrees per frame.",
-                        30.0)
-    swim: str = swim_option("body: a travelling body wave (carangiform, tail-beat frequency from --speed) "
-                            "under the fin swings; fins: a rigid body, only the fins move (VRFish's fish).")
-    speed: float = option(FiniteRange(0.01, 100), "Cruising speed of the swim loop in body lengths per "
-                          "second; the tail beats at Strouhal number 0.3, rounded to a whole number of beats "
-                          "in the loop.", DEFAULT_SPEED, metavar="BL/S")
     textures: Path | None = textures_option("the species file's folder, then the textures/ folder beside it")
-    lods: tuple[tuple[int, int], ...] | None = lods_option()
-    merge: bool = merge_option()
-    clips: tuple[str, ...] = option(Names(CLIP_NAMES), "Clips to write, each looping but burst: "
-                                    f"{', '.join(CLIP_NAMES)}.", DEFAULT_CLIPS, metavar="NAME,...")
-    compact: bool = compact_option()
 
 
 COMMAND = Command(
@@ -83,7 +58,7 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
     """Build each species file into a fish asset; with several inputs, a bad one is reported
     through ``events.failed`` and the others are built."""
     inputs = tuple(Path(p) for p in inputs)
-    from fishgen.assembly.fish import make_fish
+    from fishgen.assembly.fish import fish_of
     from fishgen.commands.paths import check_inputs, check_targets, targets
     from fishgen.exchange import export
     from fishgen.exchange.registry import FORMATS
@@ -101,9 +76,7 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
         with each_input(events, errors, len(inputs) > 1):
             species = load_species(source, options.textures)
             check_targets([target], species.side_files)
-            fish = make_fish(species, fins=options.fins, length=options.length, fps=options.fps,
-                             swim=options.swim, speed=options.speed, lods=options.lods, merge=options.merge,
-                             clips=options.clips, compact=options.compact)
+            fish = fish_of(species, options)
             files = export(fish.scene, target, require=[MESHES])
             read += [source, *species.side_files]
             written += files

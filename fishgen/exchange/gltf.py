@@ -179,15 +179,14 @@ def build_document(scene: Scene, where: Path, image_uri=None) -> tuple[Document,
                 rotation = [float(v) for v in node.rotation]
             if tuple(node.scale) != (1.0, 1.0, 1.0):
                 scale = [float(v) for v in node.scale]
-        extensions, extras = dict(node.extensions), dict(node.extras)
-        if node.lods:  # levels of detail (MSFT_lod, a Microsoft vendor extension: optional, not required)
-            extensions["MSFT_lod"] = {"ids": [int(i) for i in node.lods]}
-            if node.screen_coverage:
-                extras["MSFT_screencoverage"] = [float(c) for c in node.screen_coverage]
-        for name in extensions:
-            if name not in doc["extensionsUsed"]:
-                doc["extensionsUsed"].append(name)
-        doc["nodes"].append(_obj(extensions=extensions or None, extras=extras or None,
+        extensions, extras = None, dict(node.extras)
+        if node.lods is not None:  # MSFT_lod, a Microsoft vendor extension: used, never required
+            extensions = {"MSFT_lod": {"ids": [int(i) for i in node.lods.nodes]}}
+            if node.lods.coverage:
+                extras["MSFT_screencoverage"] = [float(c) for c in node.lods.coverage]
+            if "MSFT_lod" not in doc["extensionsUsed"]:
+                doc["extensionsUsed"].append("MSFT_lod")
+        doc["nodes"].append(_obj(extensions=extensions, extras=extras or None,
                                  mesh=node.mesh, skin=node.skin, rotation=rotation, translation=translation,
                                  scale=scale, children=list(node.children), matrix=matrix,
                                  name=node.name or None))

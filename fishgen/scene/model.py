@@ -9,6 +9,7 @@ rotations as (x, y, z, w) quaternions. Nothing here knows a file format.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -122,6 +123,27 @@ class Skin:
     skeleton: int | None = None
 
 
+@dataclass(frozen=True)
+class Levels:
+    """Levels of detail of one node, the finest (glTF: the ``MSFT_lod`` node extension).
+
+    ``nodes``: the coarser levels' nodes, finest first; each stands in for the node in full, in
+    its place. ``coverage``: the screen coverage (the object's height on screen over the screen's)
+    down to which each level shows, the node's own first, so one more than ``nodes``, decreasing;
+    below the last nothing is drawn (``extras.MSFT_screencoverage``). Empty: the client decides."""
+
+    nodes: tuple[int, ...]
+    coverage: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.nodes:
+            raise ValueError("expected at least one coarser level")
+        if self.coverage and (len(self.coverage) != len(self.nodes) + 1
+                              or any(a < b for a, b in zip(self.coverage, self.coverage[1:], strict=False))):
+            raise ValueError(f"expected a decreasing screen coverage per level ({len(self.nodes) + 1}), "
+                             f"found {list(self.coverage)}")
+
+
 @dataclass
 class Node:
     name: str = ""
@@ -133,9 +155,7 @@ class Node:
     skin: int | None = None
     matrix: np.ndarray | None = None    # 4x4 column-vector local matrix; wins over TRS, not animatable
     extras: dict[str, Any] = field(default_factory=dict)       # application data (a sky cloud's bounds)
-    extensions: dict[str, Any] = field(default_factory=dict)   # glTF node extensions by name (MSFT_lod)
-    lods: list[int] = field(default_factory=list)             # MSFT_lod: coarser levels' nodes, finest first
-    screen_coverage: list[float] = field(default_factory=list)  # extras.MSFT_screencoverage, one per level
+    lods: Levels | None = None          # the coarser levels that stand in for this node (Scene.add_levels)
 
 
 @dataclass
@@ -172,8 +192,8 @@ class Scene:
     (:class:`fishgen.assembly.fish.FishFacts`), never inside it. ``extras`` is application data the
     file keeps, as JSON values (a cloud's sunlight, a school's warm-up): glTF writes it as the scene's
     ``extras``. ``hidden_roots`` are written as a second glTF scene, which clients show only when
-    asked: the coarser levels of detail a node's ``lods`` names (MSFT_lod), kept out of sight of
-    clients that know nothing of levels."""
+    asked: the coarser levels of detail a node's ``lods`` names (:meth:`add_levels`), kept out of
+    sight of clients that know nothing of levels, yet in a scene (a node in none is an orphan)."""
 
     name: str = ""
     nodes: list[Node] = field(default_factory=list)
@@ -189,14 +209,28 @@ class Scene:
     hidden_roots: list[int] = field(default_factory=list)  # a second glTF scene's: coarser levels of detail
 
     # -- building ------------------------------------------------------------------
-    def add_node(self, node: Node, parent: int | None = None) -> int:
+    def add_node(self, node: Node, parent: int | None = None, *, root: bool = True) -> int:
+        """The node's index; it is a child of ``parent``, else a root, else (``root=False``) in
+        no node tree yet: a coarser level, until :meth:`add_levels` places it."""
         self.nodes.append(node)
         index = len(self.nodes) - 1
-        if parent is None:
-            self.roots.append(index)
-        else:
+        if parent is not None:
             self.nodes[parent].children.append(index)
+        elif root:
+            self.roots.append(index)
         return index
+
+    def add_levels(self, finest: int, coarser: Sequence[int], coverage: Sequence[float] = (), *,
+                   needs: Sequence[int] = (), hidden: bool = True) -> None:
+        """Levels of detail: the nodes ``coarser`` (finest first) stand in for node ``finest``
+        (see :class:`Levels`) and go, after ``needs`` (the nodes they need in a scene: their skins'
+        joints), into the hidden scene; ``hidden=False`` leaves them in no scene (orphans, which the
+        glTF validator reports). ``coarser`` empty: nothing to do."""
+        if not coarser:
+            return
+        self.nodes[finest].lods = Levels(tuple(coarser), tuple(float(c) for c in coverage))
+        if hidden:
+            self.hidden_roots += [*needs, *coarser]
 
     def add_mesh(self, mesh: Mesh) -> int:
         self.meshes.append(mesh)

@@ -11,7 +11,7 @@ particles are the child node ``cloud_007_LOD0``. It also has lower levels, ``clo
 * a client that knows ``MSFT_lod`` (Babylon.js, UnityGLTF: a ``LODGroup``) shows level k when the
   cloud spans less than its coverage of the view's height, and nothing below 0;
 * a client that does not (three.js's stock loader, Blender) shows LOD0 only: the lower levels'
-  nodes are in no scene's node tree, so nothing is drawn twice;
+  nodes are in no scene's node tree (``LEVELS_IN_A_SCENE``), so nothing is drawn twice;
 * the names follow Unity's ``_LOD0``/``_LOD1``/``_LOD2`` convention, for pipelines that key on names.
 
 The scene's extras hold the lighting (``fishgen_light``, as `fishgen clouds` writes it) and the
@@ -30,9 +30,12 @@ from fishgen.scene.model import Mesh, Node, Scene
 from fishgen.sky.compose import SkyCloud, SkyPlan
 from fishgen.sky.modes import LOD_LEVELS, LOD_MIN_PARTICLES
 
-LOD_EXTENSION = "MSFT_lod"
-COVERAGE_KEY = "MSFT_screencoverage"
 CLOUD_KEY = "fishgen_cloud"
+LEVELS_IN_A_SCENE = False
+"""Whether a cloud's lower levels stand in the second glTF scene, as a fish's do, rather than in no
+scene (orphans: the validator's ``UNUSED_OBJECT`` info). Not yet: three.js's GLTFLoader (0.187)
+empties ``parser.associations`` of nodes when a file has a second scene, and fishgen fly's page
+finds each cloud's LOD0 there (its ``addAsset``); it would ask ``parser.getDependency`` instead."""
 SKY_KEY = "fishgen_sky"
 
 
@@ -94,14 +97,10 @@ def sky_scene(plan: SkyPlan | None, clouds: Sequence[SkyCloud], sources: Sequenc
             for k, ((_, cover), low) in enumerate(zip(LOD_LEVELS, levels(cloud), strict=False), start=1):
                 prims = cloud_primitives(low, scene, billboards=quads)
                 mesh = scene.add_mesh(Mesh(f"{p.name}_LOD{k}", prims))
-                # in no node tree: only MSFT_lod reaches it (UnityGLTF parents it under the LOD group)
-                scene.nodes.append(Node(name=f"{p.name}_LOD{k}", mesh=mesh))
-                ids.append(len(scene.nodes) - 1)
+                ids.append(scene.add_node(Node(name=f"{p.name}_LOD{k}", mesh=mesh), root=False))
                 coverage.append(cover)
                 fact[f"lod{k}"] = len(low)
-            if ids:
-                scene.nodes[lod0].extensions[LOD_EXTENSION] = {"ids": ids}
-                scene.nodes[lod0].extras[COVERAGE_KEY] = [*coverage, 0.0]
+            scene.add_levels(lod0, ids, [*coverage, 0.0], hidden=LEVELS_IN_A_SCENE)
         facts.append(fact)
     if plan is None:
         return scene, facts

@@ -383,8 +383,8 @@ def level_scene(scene: Scene, level: int) -> Scene:
 
     if level == 0:
         return scene
-    finest = next(i for i in scene.reachable() if scene.nodes[i].lods)
-    coarse = scene.nodes[finest].lods[level - 1]
+    finest = next(i for i in scene.reachable() if scene.nodes[i].lods is not None)
+    coarse = scene.nodes[finest].lods.nodes[level - 1]  # type: ignore[union-attr]
     roots = [coarse if r == finest else r for r in scene.roots]
     return replace(scene, roots=roots, hidden_roots=[])
 

@@ -60,3 +60,41 @@ def test_a_manifest_sets_them_too(tmp_path):
     outcomes = run_batch(load_manifest(manifest, tmp_path / "out"), workers=1)
     assert [o.status for o in outcomes] == ["built"]
     assert_valid_gltf(tmp_path / "out" / "fish.glb")
+
+
+def test_python_meets_the_cap_on_sections_the_command_line_meets(tmp_path):
+    """1024x1024 is 16 times the 65,536 points a level may have (1000x1000 took 14 s and 1 GB): refused
+    by the one declaration, from Python as on the command line, before any work, in the same words."""
+    from fishgen.assembly.fish import make_fish
+    from fishgen.errors import FishgenError
+    from fishgen.species.parser import load_species
+
+    run = run_cli("build", PARAMS / "bonybream.txt", "--lods", "1024x1024", "-o", tmp_path / "x.glb")
+    assert run.returncode == 2 and not (tmp_path / "x.glb").exists()
+    with pytest.raises(FishgenError) as caught:
+        make_fish(load_species(PARAMS / "bonybream.txt"), lods=[(1024, 1024)])
+    message = str(caught.value)
+    assert message.startswith("Invalid value for '--lods': ")
+    assert message.endswith("at most 65,536, found '1024x1024'")
+    assert message in run.stderr
+
+
+def test_the_build_options_check_each_value_by_its_declaration():
+    from fishgen.assembly.fish_options import FishOptions
+    from fishgen.commands.build import BuildOptions
+    from fishgen.errors import FishgenError
+
+    made = FishOptions(lods=[[32, 24], (8, 6)], clips=["idle", "swim"], fps=60)   # as Python may give them
+    assert made.lods == ((32, 24), (8, 6)) and made.clips == ("idle", "swim") and made.fps == 60.0
+    assert BuildOptions(fps=24).fps == 24.0 and isinstance(BuildOptions(), FishOptions)
+    for bad, words in (({"fps": 0}, "'--fps'"), ({"speed": 1e9}, "'--speed'"),
+                       ({"length": -1}, "'--length'"),
+                       ({"fins": "glass"}, "'--fins'"), ({"swim": "crawl"}, "'--swim'"),
+                       ({"lods": [(16, 12), (16, 12)]}, "finest to coarsest"), ({"lods": [(16,)]}, "'--lods'"),
+                       ({"lods": [(9, 8)] * 9}, "at most 8"), ({"clips": ("swim", "swim")}, "'--clips'"),
+                       ({"merge": "yes"}, "'--merge': expected true or false"),
+                       ({"swim": "fins", "clips": ("burst",)}, "--swim body")):
+        with pytest.raises(FishgenError, match=words):
+            FishOptions(**bad)
+        with pytest.raises(FishgenError, match=words):
+            BuildOptions(**bad)

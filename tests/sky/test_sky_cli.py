@@ -10,7 +10,8 @@ import pytest
 
 from fishgen.commands.sky import SkyOptions, sky
 from fishgen.sky.modes import LOD_LEVELS, MODES
-from tests.conftest import PARAMS, assert_valid_gltf
+from fishgen.sky.scene import LEVELS_IN_A_SCENE
+from tests.conftest import PARAMS, assert_valid_gltf, validate_gltf
 
 
 def glb_json(path: Path) -> dict:
@@ -45,6 +46,10 @@ def test_each_mode_is_validator_clean_with_one_node_per_cloud(skies, mode):
     out, made = skies
     path = out / f"{mode}.glb"
     assert_valid_gltf(path)
+    (report,) = validate_gltf(path)
+    # infos only: MSFT_lod, and the lower levels when they stand in no scene
+    assert {m["code"] for m in report["messages"]} == {"UNSUPPORTED_EXTENSION",
+                                                       *(() if LEVELS_IN_A_SCENE else ("UNUSED_OBJECT",))}
     doc = glb_json(path)
     roots = clouds_of(doc)
     assert len(roots) == MODES[mode].clouds == made[mode].facts.clouds
@@ -70,6 +75,8 @@ def test_each_cloud_node_carries_its_place_turn_and_bounds_and_its_levels(skies)
         k = stack.pop()
         reachable.add(k)
         stack += doc["nodes"][k].get("children", [])
+    hidden = {i for scene in doc["scenes"][1:] for i in scene["nodes"]}
+    assert len(doc["scenes"]) == (2 if LEVELS_IN_A_SCENE else 1) and not hidden & reachable
     for root in clouds_of(doc):
         assert root["name"].startswith("cloud_") and "translation" in root and "rotation" in root
         bounds = root["extras"]["fishgen_cloud"]["bounds"]
@@ -89,6 +96,7 @@ def test_each_cloud_node_carries_its_place_turn_and_bounds_and_its_levels(skies)
         for k, node in enumerate(ids, 1):
             assert doc["nodes"][node]["name"] == f"{root['name']}_LOD{k}"
             assert node not in reachable          # drawn only by clients that know MSFT_lod
+            assert (node in hidden) == LEVELS_IN_A_SCENE      # the second scene, as a fish's levels
             counts.append(sum(doc["accessors"][p["attributes"]["POSITION"]]["count"]
                               for p in doc["meshes"][doc["nodes"][node]["mesh"]]["primitives"]))
         assert counts == sorted(counts, reverse=True) and len(set(counts)) == len(counts)
@@ -118,11 +126,24 @@ def test_user_cube_files_make_the_clouds_texture_clouds_as_billboards(tmp_path):
     assert {p.name for p in made.read} >= {"table_4_3.awn", "sky.awa", "billow.png"}
 
 
+def test_in_a_scene_the_lower_levels_are_no_orphans(tmp_path, monkeypatch):
+    """The layout a sky takes once fishgen fly's page reads it (LEVELS_IN_A_SCENE): the fish's."""
+    monkeypatch.setattr("fishgen.sky.scene.LEVELS_IN_A_SCENE", True)
+    path = tmp_path / "thin.glb"
+    sky((), path, SkyOptions(mode="thin", particles=6_000))
+    (report,) = validate_gltf(path)
+    assert report["numErrors"] == report["numWarnings"] == 0
+    assert {m["code"] for m in report["messages"]} == {"UNSUPPORTED_EXTENSION"}     # no UNUSED_OBJECT
+    doc = glb_json(path)
+    named = [i for n in doc["nodes"] for i in n.get("extensions", {}).get("MSFT_lod", {}).get("ids", [])]
+    assert named and doc["scenes"][1] == {"name": "levels of detail", "nodes": named}
+
+
 def test_no_lod_writes_no_levels(tmp_path):
     sky((), tmp_path / "flat.glb", SkyOptions(mode="thin", lod=False))
     doc = glb_json(tmp_path / "flat.glb")
     assert "MSFT_lod" not in doc.get("extensionsUsed", [])
-    assert len(doc["nodes"]) == 2 * MODES["thin"].clouds
+    assert len(doc["nodes"]) == 2 * MODES["thin"].clouds and len(doc["scenes"]) == 1
 
 
 @pytest.mark.parametrize("args, words", [
