@@ -203,15 +203,17 @@ function drawable( object ) {
 
 async function addAsset( gltf, root ) {
 	readLight( gltf.scene.userData );
-	const parser = gltf.parser, json = parser.json, byNode = new Map();
-	for ( const [ object, ref ] of parser.associations ) if ( ref && ref.nodes !== undefined && object.isObject3D ) byNode.set( ref.nodes, object );
+	const parser = gltf.parser, json = parser.json;
 	root.updateMatrixWorld( true );
 	const done = new Set();
 	// a node with MSFT_lod: its own drawables are level 0, the nodes it names the lower levels
 	for ( const [ index, def ] of ( json.nodes || [] ).entries() ) {
 		const lod = def.extensions && def.extensions.MSFT_lod;
-		const top = byNode.get( index );
-		if ( ! lod || ! Array.isArray( lod.ids ) || ! top ) continue;
+		if ( ! lod || ! Array.isArray( lod.ids ) ) continue;
+		// from the parser's cache, not parser.associations: three.js empties its nodes when a file has
+		// a second scene (where the lower levels stand)
+		const top = await parser.getDependency( 'node', index );
+		if ( ! top.parent ) continue;
 		const levels = [];
 		const collect = ( object ) => {
 			const found = [];

@@ -11,7 +11,8 @@ particles are the child node ``cloud_007_LOD0``. It also has lower levels, ``clo
 * a client that knows ``MSFT_lod`` (Babylon.js, UnityGLTF: a ``LODGroup``) shows level k when the
   cloud spans less than its coverage of the view's height, and nothing below 0;
 * a client that does not (three.js's stock loader, Blender) shows LOD0 only: the lower levels'
-  nodes are in no scene's node tree (``LEVELS_IN_A_SCENE``), so nothing is drawn twice;
+  nodes stand in the second glTF scene, as a fish's do (``LEVELS_IN_A_SCENE``), so nothing is
+  drawn twice;
 * the names follow Unity's ``_LOD0``/``_LOD1``/``_LOD2`` convention, for pipelines that key on names.
 
 The scene's extras hold the lighting (``fishgen_light``, as `fishgen clouds` writes it) and the
@@ -31,11 +32,11 @@ from fishgen.sky.compose import SkyCloud, SkyPlan
 from fishgen.sky.modes import LOD_LEVELS, LOD_MIN_PARTICLES
 
 CLOUD_KEY = "fishgen_cloud"
-LEVELS_IN_A_SCENE = False
+LEVELS_IN_A_SCENE = True
 """Whether a cloud's lower levels stand in the second glTF scene, as a fish's do, rather than in no
-scene (orphans: the validator's ``UNUSED_OBJECT`` info). Not yet: three.js's GLTFLoader (0.187)
-empties ``parser.associations`` of nodes when a file has a second scene, and fishgen fly's page
-finds each cloud's LOD0 there (its ``addAsset``); it would ask ``parser.getDependency`` instead."""
+scene (orphans: the validator's ``UNUSED_OBJECT`` info). A client must not look nodes up in
+three.js's ``parser.associations``, which GLTFLoader (0.187) empties of nodes when a file has a
+second scene: fishgen fly's page asks ``parser.getDependency`` (its ``addAsset``)."""
 SKY_KEY = "fishgen_sky"
 
 
