@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Install everything the test-suite needs, then run the whole suite.
-#   bash tools/test.sh [pytest args]
+#   bash tools/test.sh [pytest args]        (e.g. -m "not slow" to skip the slowest locally)
 # System packages (software OpenGL for previews, Chromium for the viewer test)
 # come from apt when running as root and they are missing; Python packages
 # from the project's `test` extra; the Khronos glTF-Validator and three.js from npm.
@@ -24,7 +24,11 @@ fi
 
 python -m pip install -q --disable-pip-version-check -e ".[test]"
 npm ci --no-audit --no-fund --loglevel=error
-bash tools/core_smoke.sh
-python -m ruff check fishgen
-python -m mypy
-python -m pytest "$@"
+# The whole suite, lint, types and the core-install smoke test included (tests/test_house.py), on
+# every core (pytest-xdist; tests sharing a built asset, a browser page or a server stay on one
+# worker: tests/conftest.py), with the 20 slowest printed and the suite's wall time last.
+start=$(date +%s)
+status=0
+python -m pytest -n "${FISHGEN_TEST_WORKERS:-auto}" --dist loadgroup --durations=20 "$@" || status=$?
+echo "test suite: $(( $(date +%s) - start )) s wall on $(nproc) cores (pytest exit $status)"
+exit $status

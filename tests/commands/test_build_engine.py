@@ -53,11 +53,12 @@ def test_bad_engine_options_are_one_line_and_write_nothing(tmp_path, args, words
 def test_a_manifest_sets_them_too(tmp_path):
     from fishgen.batch import run_batch
     from fishgen.batch.manifest import load_manifest
+    from fishgen.commands.batch import job_kinds, run_job
 
     manifest = tmp_path / "assets.toml"
     manifest.write_text(f'[[build]]\ninput = "{PARAMS / "bonybream.txt"}"\noutput = "fish.glb"\n'
                         'lods = "16x12,8x6"\nmerge = true\nclips = "swim,burst"\ncompact = true\n')
-    outcomes = run_batch(load_manifest(manifest, tmp_path / "out"), workers=1)
+    outcomes = run_batch(load_manifest(manifest, tmp_path / "out", kinds=job_kinds()), run_job, workers=1)
     assert [o.status for o in outcomes] == ["built"]
     assert_valid_gltf(tmp_path / "out" / "fish.glb")
 

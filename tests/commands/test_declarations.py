@@ -20,6 +20,7 @@ def test_an_option_declared_once_is_in_help_in_a_manifest_and_in_the_function(wi
     from fishgen.batch import run_batch
     from fishgen.batch.manifest import load_manifest
     from fishgen.cli import cli
+    from fishgen.commands.batch import job_kinds, run_job
 
     help_text = CliRunner().invoke(cli, ["toy", "--help"]).output
     assert "--brightness" in help_text and "How bright the toy shines.  [default: 2.5]" in help_text
@@ -34,14 +35,14 @@ def test_an_option_declared_once_is_in_help_in_a_manifest_and_in_the_function(wi
 
     manifest = tmp_path / "m.toml"
     manifest.write_text('[[toy]]\ninput = "in.txt"\noutput = "b.csv"\nbrightness = 4\n')
-    outcomes = run_batch(load_manifest(manifest, tmp_path / "out"))
+    outcomes = run_batch(load_manifest(manifest, tmp_path / "out", kinds=job_kinds()), run_job)
     assert [o.status for o in outcomes] == ["built"] and (tmp_path / "out" / "b.csv").read_text() == "4.0 red\n"
     assert [o.brightness for o in toy.SEEN] == [7.0, 4.0]
 
     manifest.write_text('[[toy]]\ninput = "in.txt"\noutput = "b.csv"\n\nbrightness = 11\n')
     from fishgen.errors import FishgenError
     with pytest.raises(FishgenError) as caught:
-        load_manifest(manifest)
+        load_manifest(manifest, kinds=job_kinds())
     assert str(caught.value) == f"{manifest}:5: expected brightness as a number from 0 to 10, found '11'"
 
 
