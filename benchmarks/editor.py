@@ -51,7 +51,7 @@ def scaled_table(size: int, path: Path) -> Path:
 
 def server_ms(file: Path, runs: int) -> list[float]:
     from fishgen.editor.session import Session
-    from tests.editor.conftest import Client
+    from tests.editor.client import Client
 
     server = Session(file).server(0)
     threading.Thread(target=server.serve_forever, daemon=True).start()

@@ -29,7 +29,7 @@ from fishgen.authoring.photo.compare import silhouette_iou  # noqa: E402
 from fishgen.authoring.photo.run import make_texture  # noqa: E402
 from fishgen.species.parser import load_species  # noqa: E402
 from tests.authoring import photos as ph  # noqa: E402
-from tests.authoring.test_photo_roundtrip import KINDS  # noqa: E402
+from tests.authoring.photos import KINDS  # noqa: E402
 
 
 def main() -> None:

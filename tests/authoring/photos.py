@@ -140,3 +140,15 @@ def errors(species: Species, photo: Photo) -> tuple[np.ndarray, dict[str, float]
 def rendered_mask(species: Species) -> np.ndarray:
     """The rebuilt species' own silhouette, rendered as the photo was."""
     return render_photo(species).rgba[:, :, 3] >= 64
+
+
+#: What may happen to a photo between the camera and `fishgen texture`: each a Photo -> Photo.
+KINDS = {
+    "transparent": lambda p: p,
+    "plain": lambda p: on_background(p, (190, 205, 220), (190, 205, 220)),
+    "gradient+noise": lambda p: on_background(p, noise=6.0),
+    "jpeg": lambda p: jpeg(on_background(p, (200, 200, 200), (170, 180, 190)), 60),
+    "mirrored": mirrored,
+    "rotated+10": lambda p: rotated(p, 10.0),
+    "rotated-10": lambda p: rotated(p, -10.0),
+}

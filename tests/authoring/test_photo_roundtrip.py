@@ -21,15 +21,6 @@ MIN_IOU = 0.95
 #: Issue 25: a photo on its own species' geometry (a same-base round trip) stays at this or better.
 SAME_BASE_IOU = 0.965
 
-KINDS = {
-    "transparent": lambda p: p,
-    "plain": lambda p: ph.on_background(p, (190, 205, 220), (190, 205, 220)),
-    "gradient+noise": lambda p: ph.on_background(p, noise=6.0),
-    "jpeg": lambda p: ph.jpeg(ph.on_background(p, (200, 200, 200), (170, 180, 190)), 60),
-    "mirrored": ph.mirrored,
-    "rotated+10": lambda p: ph.rotated(p, 10.0),
-    "rotated-10": lambda p: ph.rotated(p, -10.0),
-}
 
 
 def run_round_trip(tmp_path, species, photo: ph.Photo, fmt: str = "PNG"):
@@ -41,11 +32,11 @@ def run_round_trip(tmp_path, species, photo: ph.Photo, fmt: str = "PNG"):
     return result, rebuilt, body, fins
 
 
-@pytest.mark.parametrize("kind", list(KINDS))
+@pytest.mark.parametrize("kind", list(ph.KINDS))
 @pytest.mark.parametrize("name", SHIPPED)
 def test_round_trip_points(tmp_path, gl_available, photos, name, kind):
     species, clean = photos[name]
-    photo = KINDS[kind](clean)
+    photo = ph.KINDS[kind](clean)
     result, rebuilt, body, fins = run_round_trip(tmp_path, species, photo)
     assert result.mirrored == (kind == "mirrored")
     assert body.max() <= BODY_TOLERANCE, f"{name}/{kind}: body point off by {body.max():.4f}"
@@ -59,7 +50,7 @@ def test_round_trip_points(tmp_path, gl_available, photos, name, kind):
 def test_round_trip_silhouette(tmp_path, gl_available, photos, name, kind):
     """The rebuilt fish, rendered as the photo was, against the photo's fish turned level."""
     species, photo = photos[name]
-    result, rebuilt, _, _ = run_round_trip(tmp_path, species, KINDS[kind](photo))
+    result, rebuilt, _, _ = run_round_trip(tmp_path, species, ph.KINDS[kind](photo))
     iou = silhouette_iou(result.level_mask, ph.rendered_mask(rebuilt))
     assert iou >= SAME_BASE_IOU, f"{name}/{kind}: IoU {iou:.3f}"
 
