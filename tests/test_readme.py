@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from tests.conftest import ROOT
 
 README = (ROOT / "README.md").read_text(encoding="utf-8")
@@ -45,6 +47,7 @@ def test_no_example_overwrites_another_ones_output():
             seen[path] = line
 
 
+@pytest.mark.slow
 def test_the_examples_run_as_written_in_order(tmp_path):
     """On a fresh copy of the shipped data, every example exits 0 with no traceback; the reef's
     summary is the one the README shows."""

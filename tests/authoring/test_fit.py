@@ -90,6 +90,7 @@ def test_a_fin_the_photo_does_not_show_is_left_out(gl_available):
     assert "no anal fin in the photo: left out" in fit.notes
 
 
+@pytest.mark.slow
 def test_a_broken_fit_is_not_written(tmp_path, gl_available, photos, monkeypatch):
     """When the fitted fish fails a check, the base's geometry is written and the command says why."""
     from dataclasses import replace

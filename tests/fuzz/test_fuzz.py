@@ -42,6 +42,7 @@ def ci_report():
                findings_dir=findings)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("target", TARGETS)
 def test_no_findings(ci_report, target):
     stats = ci_report.stats[target]
