@@ -2,9 +2,11 @@
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -12,6 +14,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 VALIDATOR_SCRIPT = ROOT / "tools" / "validate_gltf.mjs"
 PARAMS = ROOT / "params"
+#: Where the client matrix's table is written when its tests have run (tests/clients/conftest.py).
+CLIENT_MATRIX = Path(os.environ.get("FISHGEN_CLIENT_MATRIX", ROOT / "out" / "client-matrix.md"))
 
 
 def _validator_available() -> bool:
@@ -57,7 +61,6 @@ def run_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
     costs 0.3-1 s of imports per call; the exit-status and signal tests use :func:`run_cli_process`."""
     import io
     import logging
-    import os
     import signal
     import traceback
     from contextlib import redirect_stderr, redirect_stdout
@@ -112,6 +115,7 @@ def gl_available():
         pytest.fail(f"no headless OpenGL: install libegl1 libegl-mesa0 libgl1-mesa-dri ({err})")
 
 
+_STARTED = pytest.StashKey[float]()
 #: Session fixtures cheap enough that sharing them is no reason to keep their tests together.
 _CHEAP_SHARED = {"gl_available", "tmp_path_factory", "worker_id", "testrun_uid"}
 #: Modules run first (their groups go to the workers before anything else): each is one long
@@ -151,6 +155,19 @@ def pytest_collection_modifyitems(config, items):
         if mine and not item.get_closest_marker("xdist_group"):
             item.add_marker(pytest.mark.xdist_group(root(mine[0])))
     items.sort(key=lambda item: not item.nodeid.startswith(_FIRST))
+
+
+def pytest_sessionstart(session):
+    session.config.stash[_STARTED] = time.time()
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    """The client matrix's table, when this session's tests (on whichever worker) wrote it."""
+    started = config.stash.get(_STARTED, None)
+    if started is None or not CLIENT_MATRIX.is_file() or CLIENT_MATRIX.stat().st_mtime < started:
+        return
+    terminalreporter.write_sep("-", f"client matrix (also in {CLIENT_MATRIX})")
+    terminalreporter.write_line(CLIENT_MATRIX.read_text(encoding="utf-8").split("\n", 2)[2].rstrip())
 
 
 def pytest_sessionfinish(session, exitstatus):

@@ -4,9 +4,10 @@
     session = FlySession(assets, FlyConfig(size=(800, 600), timeout=10, headless=True))
     report = run_headless(session)        # Chromium drives the page along a seeded path
 
-The page (``app.js``, bundled by tools/bundle_viewer.py; three.js from the shared page kit) draws clouds back to front,
-culls whole clouds, switches distant ones to their lower level (MSFT_lod) and does Harris's second
-pass; it measures each frame honestly (``docs/fly.md``) and posts its report to the session.
+The page (``app.js``, bundled by tools/bundle_viewer.py; three.js comes from the page kit) draws
+clouds back to front, culls whole clouds, switches distant ones to their lower level (MSFT_lod) and
+does Harris's second pass; it measures each frame honestly (``docs/fly.md``) and posts its report to
+the session.
 """
 from __future__ import annotations
 

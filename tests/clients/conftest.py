@@ -1,36 +1,23 @@
-"""The client matrix as a session fixture: assets made once by the CLI, one browser for all cells.
+"""The client matrix as a package fixture: assets made once by the CLI, one browser for all cells.
 
-At the end of the session the table is printed and written to out/client-matrix.md
-(or $FISHGEN_CLIENT_MATRIX).
+When its tests end, the table is written to out/client-matrix.md (or $FISHGEN_CLIENT_MATRIX) by the
+worker that ran them; the session's summary prints it (tests/conftest.py).
 """
 from __future__ import annotations
 
-import os
 import time
-from pathlib import Path
 
 import pytest
 
-from tests.clients.matrix import ROOT, Matrix, write_report
+from tests.clients.matrix import Matrix, write_report
+from tests.conftest import CLIENT_MATRIX
 
-_STATE: dict = {}
 
-
-@pytest.fixture(scope="package")  # closed before other packages' browser tests start their own playwright
+@pytest.fixture(scope="package")
 def matrix(tmp_path_factory):
     start = time.perf_counter()
     m = Matrix(tmp_path_factory.mktemp("clients"))
-    _STATE["matrix"], _STATE["start"] = m, start
     yield m
     m.close()
-
-
-def pytest_terminal_summary(terminalreporter):
-    m = _STATE.get("matrix")
-    if m is None or not m.results:
-        return
-    seconds = time.perf_counter() - _STATE["start"]
-    path = Path(os.environ.get("FISHGEN_CLIENT_MATRIX", ROOT / "out" / "client-matrix.md"))
-    text = write_report(m.results, path, seconds)
-    terminalreporter.write_sep("-", f"client matrix (also in {path})")
-    terminalreporter.write_line(text.split("\n", 2)[2].rstrip())
+    if m.results:
+        write_report(m.results, CLIENT_MATRIX, time.perf_counter() - start)
