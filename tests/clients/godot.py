@@ -418,9 +418,9 @@ def extra_assets(assets: dict[str, Asset], folder: Path) -> dict[str, Asset]:
     - the fish .gltf with one morph weight key changed (the key check must catch it);
     - two species built into one folder, as a user exports a set (each must keep its own materials).
     """
-    import sys
 
-    from tests.clients.matrix import FISH_SOURCE, PARAMS, ROOT, Format
+    from tests.cli_runner import run_cli_process
+    from tests.clients.matrix import FISH_SOURCE, PARAMS, Format
 
     if folder.exists():
         shutil.rmtree(folder)
@@ -437,8 +437,7 @@ def extra_assets(assets: dict[str, Asset], folder: Path) -> dict[str, Asset]:
                              dict(fish.reported), dict(fish.expected), fish.clip, fish.bounds)
     both = folder / "two-species"
     sources = [FISH_SOURCE, PARAMS / "centroberyx.txt"]
-    result = subprocess.run([sys.executable, "-m", "fishgen", "build", *map(str, sources), "-o", f"{both}/",
-                             "--format", "glb"], cwd=ROOT, capture_output=True, text=True)
+    result = run_cli_process("build", *sources, "-o", f"{both}/", "--format", "glb")
     if result.returncode != 0:
         raise RuntimeError(f"fishgen build of two species failed: {result.stderr.strip()}")
     for label, source in zip(TWO_SPECIES, sources, strict=True):

@@ -16,11 +16,8 @@ pytest: if a client starts to manage it, the cell fails until the entry goes.
 from __future__ import annotations
 
 import json
-import os
 import re
 import shutil
-import subprocess
-import sys
 import threading
 import time
 from collections.abc import Callable
@@ -29,10 +26,11 @@ from dataclasses import dataclass, field
 from functools import partial
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from tests.browser import CHROMIUM
 from tests.browser import browser as shared_browser
+from tests.cli_runner import run_cli_process
 from tests.clients.bounds import Bounds, ClipBounds, merged, scene_bounds
 
 if TYPE_CHECKING:
@@ -237,8 +235,7 @@ def make_assets(folder: Path) -> dict[str, Asset]:
         out = out_dir / fmt.filename
         command = {"fish": "build", "school": "school", "cloud": "clouds"}[fmt.kind]
         source = CLOUD_SOURCE if fmt.kind == "cloud" else FISH_SOURCE
-        result = subprocess.run([sys.executable, "-m", "fishgen", command, str(source), "-o", str(out), *fmt.flags],
-                                cwd=ROOT, capture_output=True, text=True)
+        result = run_cli_process(command, source, "-o", out, *fmt.flags)  # from a thread pool: a process each
         if result.returncode != 0:
             raise RuntimeError(f"fishgen {command} -o {fmt.filename} failed: {result.stderr.strip()}")
         lines = result.stdout.strip().splitlines()
