@@ -429,6 +429,19 @@ def textures_option(shown_default: str) -> Any:
                   metavar="DIR", path=True)
 
 
+def cloud_textures_option() -> Any:
+    """--textures of a command reading texture clouds (.awa): where their PNGs are found."""
+    return textures_option("a .awa file's folder, then the textures/ folder beside it (or beside its parent)")
+
+
+def max_particles_option(whole: str = "scenes") -> Any:
+    """--max-particles of a command filling clouds: the particles of the whole it makes (``whole``)."""
+    from fishgen.clouds.model import DEFAULT_MAX_PARTICLES  # a dataclass module; no numpy at --help time
+
+    return option(click.IntRange(min=1), f"Refuse {whole} with more particles than this, before allocating "
+                  "anything.", DEFAULT_MAX_PARTICLES)
+
+
 def seed_option(help_text: str, default: int | None = 0, shown_default: str | None = None) -> Any:
     return option(SEED, f"Random seed (0 to 2^63-1); the same seed gives byte-identical files. {help_text}",
                   default, shown_default=shown_default)

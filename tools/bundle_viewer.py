@@ -9,12 +9,13 @@ Run after `npm ci` whenever a page's JavaScript or package.json (three's or esbu
                                                   # or a source differs from what manifest.json records
 
 esbuild (pinned in package.json) bundles fishgen/web/kit.js - the parts of three.js the pages use
-(three-parts.js), its addons and fishgen/web/cloudlight.js - into `kit.min.js`, a classic script that sets
-`window.fishgenKit`, and each page's app.js (with its own modules) into `<page>.min.js`, which takes
-three.js from that kit and so holds none of it. The bundles are committed in fishgen/web/static/
-with `manifest.json` (sha256 of every bundle and of every input file esbuild read, the tool versions
-and options) and three's licence, so `pip install` needs no node and no page fetches anything. Every
-page inlines the kit and its app (fishgen/web/page.py). A page is one line in BUNDLES.
+(three-parts.js), its addons and the modules the pages share (fishgen/web/cloudlight.js, drawing.js) -
+into `kit.min.js`, a classic script that sets `window.fishgenKit`, and each page's app.js (with its own
+modules) into `<page>.min.js`, which takes three.js from that kit and so holds none of it. The bundles
+are committed in fishgen/web/static/ with `manifest.json` (sha256 of every bundle and of every input
+file esbuild read, the tool versions and options) and three's licence, so `pip install` needs no node
+and no page fetches anything. Every page inlines the kit and its app (fishgen/web/page.py). A page is
+one line in BUNDLES.
 """
 from __future__ import annotations
 

@@ -2,7 +2,8 @@
 onto :mod:`fishgen.geometry.fins`' plain parameters and builds them."""
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, replace
+from typing import TypeVar
 
 import numpy as np
 
@@ -20,34 +21,29 @@ from fishgen.geometry.fins import (
 )
 from fishgen.species.model import CaudalFin, PectoralFin, PelvicFin, Species, VerticalFin
 
+P = TypeVar("P")
+
+
+def _params(record: type[P], fin: object) -> P:
+    """Geometry's parameter ``record`` from the species file's ``fin``: the two name the same
+    measurements alike (the file's record keeps more, such as the pectoral's test ``version``)."""
+    return record(**{f.name: getattr(fin, f.name) for f in fields(record)})  # type: ignore[arg-type]  # a dataclass
+
 
 def caudal_params(fin: CaudalFin) -> CaudalParams:
-    return CaudalParams(top_line=fin.top_line, middle_line=fin.middle_line, top_angle=fin.top_angle,
-                        top_triangles=fin.top_triangles, connection=fin.connection,
-                        rotation_angle=fin.rotation_angle, bottom_line=fin.bottom_line,
-                        bottom_angle=fin.bottom_angle, bottom_triangles=fin.bottom_triangles,
-                        movement_angle=fin.movement_angle, step_size=fin.step_size)
+    return _params(CaudalParams, fin)
 
 
 def vertical_params(fin: VerticalFin) -> VerticalParams:
-    return VerticalParams(start_section=fin.start_section, end_section=fin.end_section,
-                          start_length=fin.start_length, end_length=fin.end_length,
-                          start_angle=fin.start_angle, proportion=fin.proportion)
+    return _params(VerticalParams, fin)
 
 
 def pectoral_params(fin: PectoralFin) -> PectoralParams:
-    # ``version`` is the thesis' test value, kept only for round-tripping the file.
-    return PectoralParams(start_section=fin.start_section, start_circle=fin.start_circle,
-                          triangles=fin.triangles, start_length=fin.start_length,
-                          start_angle=fin.start_angle, proportion=fin.proportion,
-                          movement_angle=fin.movement_angle, step_size=fin.step_size)
+    return _params(PectoralParams, fin)
 
 
 def pelvic_params(fin: PelvicFin) -> PelvicParams:
-    return PelvicParams(start_circle=fin.start_circle, start_section=fin.start_section,
-                        end_section=fin.end_section, start_length=fin.start_length,
-                        end_length=fin.end_length, end_angle=fin.end_angle,
-                        movement_angle=fin.movement_angle, step_size=fin.step_size)
+    return _params(PelvicParams, fin)
 
 
 def build_fins(species: Species, rings: np.ndarray, clear_of_caudal: bool = True) -> list[Fin]:

@@ -93,20 +93,34 @@ def _resample(row: np.ndarray, count: int) -> np.ndarray:
     return np.stack([np.interp(new, old, row[:, k]) for k in range(2)], axis=1)
 
 
-def _vertical_points(points: Points, fin: VerticalFin) -> Points:
-    """Fixel order T_0, B_0, B_n, T_n, B_1..B_{n-1}, T_1..T_{n-1}, resampled to ``fin``'s sections."""
+# A fin's two rows of points (base and top, or base and outer edge) as Fixel lays them out: four
+# corners, each a row's first (0) or last (-1) point, then row 0's inner points, then row 1's.
+VERTICAL_CORNERS = ((1, 0), (0, 0), (0, -1), (1, -1))    # T_0, B_0, B_n, T_n; row 0 the base
+PELVIC_CORNERS = ((0, 0), (0, -1), (1, 0), (1, -1))      # B_0, B_n, O_0, O_n; row 1 the outer edge
+
+
+def _rows_resampled(points: Points, corners: tuple[tuple[int, int], ...], count: int) -> Points:
+    """Points laid out by ``corners`` resampled to ``count`` a row and laid out alike. A fin of one
+    section (as given, or as resampled) is each row's one point, the rows in their corners' order."""
     p = np.asarray(points, np.float64)
     n = len(p) // 2 - 1
+    order = sorted((0, 1), key=lambda row: corners.index((row, 0)))
     if n < 1:
-        base, top = p[1:2], p[0:1]
+        given = {row: p[k:k + 1] for k, row in enumerate(order)}
     else:
-        base = np.concatenate([p[1:2], p[4:4 + n - 1], p[2:3]])
-        top = np.concatenate([p[0:1], p[4 + n - 1:], p[3:4]])
-    m = fin.end_section - fin.start_section
-    base, top = _resample(base, m + 1), _resample(top, m + 1)
-    if m < 1:
-        return _as_tuple(np.concatenate([top, base]))
-    return _as_tuple(np.concatenate([top[:1], base[:1], base[-1:], top[-1:], base[1:-1], top[1:-1]]))
+        inner = (p[4:4 + n - 1], p[4 + n - 1:])
+        at = {corner: p[[k]] for k, corner in enumerate(corners)}
+        given = {row: np.concatenate([at[row, 0], inner[row], at[row, -1]]) for row in (0, 1)}
+    rows = {row: _resample(given[row], count) for row in (0, 1)}
+    if count < 2:
+        return _as_tuple(np.concatenate([rows[row] for row in order]))
+    ends = [rows[row][[end]] for row, end in corners]
+    return _as_tuple(np.concatenate(ends + [rows[0][1:-1], rows[1][1:-1]]))
+
+
+def _vertical_points(points: Points, fin: VerticalFin) -> Points:
+    """Fixel order T_0, B_0, B_n, T_n, B_1..B_{n-1}, T_1..T_{n-1}, resampled to ``fin``'s sections."""
+    return _rows_resampled(points, VERTICAL_CORNERS, fin.end_section - fin.start_section + 1)
 
 
 def _pectoral_points(points: Points, triangles: int) -> Points:
@@ -121,14 +135,4 @@ def _pectoral_points(points: Points, triangles: int) -> Points:
 
 def _pelvic_points(points: Points, count: int) -> Points:
     """Fixel order B_0, B_n, O_0, O_n, B_1..B_{n-1}, O_1..O_{n-1}, resampled to ``count`` sections."""
-    p = np.asarray(points, np.float64)
-    n = len(p) // 2 - 1
-    if n < 1:
-        base, outer = p[0:1], p[1:2]
-    else:
-        base = np.concatenate([p[0:1], p[4:4 + n - 1], p[1:2]])
-        outer = np.concatenate([p[2:3], p[4 + n - 1:], p[3:4]])
-    base, outer = _resample(base, count), _resample(outer, count)
-    if count < 2:
-        return _as_tuple(np.concatenate([base, outer]))
-    return _as_tuple(np.concatenate([base[:1], base[-1:], outer[:1], outer[-1:], base[1:-1], outer[1:-1]]))
+    return _rows_resampled(points, PELVIC_CORNERS, count)

@@ -5,9 +5,10 @@
     export_cloud(made.cloud, "sky.glb", billboards=made.textured)  # or cloud_scene(made.cloud, ...)
 
 `fishgen clouds`, its preview (:func:`fishgen.clouds.scene.cube_file_scene`), the editor's fill,
-and fly's cube files all fill through :func:`cube_clouds` (input i with seed + i, scaled down
-alike to ``most`` when asked); fly lights its clouds as a sky instead (each its own node), and
-`fishgen sky` reads its models here and re-fills them by its plan. The module imports nothing heavy.
+fly's cube files and `fishgen sky` all fill through :func:`cube_clouds` (input i with seed + i,
+scaled down alike to ``most`` when asked). Fly and the sky light their clouds as a sky instead
+(each its own node, ``light=False``): the sky reads its models here and fills each of its clouds,
+the model scaled by its plan, with the cloud's own seed. The module imports nothing heavy.
 """
 from __future__ import annotations
 
@@ -118,7 +119,7 @@ def cube_clouds(models: Sequence[CubeFile], *, seed: int = 0, method: str = "pap
 
     A file of more than ``most`` particles is filled with every cube's count scaled down alike
     (:func:`scaled`). More than ``max_particles`` in all is refused before anything is allocated.
-    ``light=False`` leaves the clouds unlit, for a caller that lights them as a sky.
+    ``light=False`` leaves the clouds unlit, for a caller that lights them as a sky (fly, `fishgen sky`).
     """
     from fishgen.clouds.fill import fill_cloud, merge_clouds
     from fishgen.clouds.light import light_cloud

@@ -9,10 +9,10 @@ from pathlib import Path
 import click
 
 from fishgen.clouds.lighting import Lighting
-from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, METHODS
+from fishgen.clouds.model import METHODS
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
 from fishgen.exchange.registry import POINTS, extensions, formats
-from fishgen.options import Triple, group, option, seed_option, textures_option
+from fishgen.options import Triple, cloud_textures_option, group, max_particles_option, option, seed_option
 
 BILLBOARD_TRIANGLES = 6  # fishgen.clouds.scene.TRIANGLES_PER_BILLBOARD, without numpy (a test checks)
 
@@ -30,10 +30,8 @@ class CloudsOptions:
                               f"glTF only: three crossed quads per particle ({BILLBOARD_TRIANGLES} "
                               "triangles, 12 vertices), an alpha-blended Gaussian sprite, instead of points; "
                               "a texture cloud (.awa) is always billboards, with its PNGs.", False, flag=True)
-    max_particles: int = option(click.IntRange(min=1), "Refuse scenes with more particles than this, "
-                                "before allocating anything.", DEFAULT_MAX_PARTICLES)
-    textures: Path | None = textures_option("a .awa file's folder, then the textures/ folder beside it (or "
-                                            "beside its parent)")
+    max_particles: int = max_particles_option()
+    textures: Path | None = cloud_textures_option()
     lighting: Lighting = group(Lighting)
 
 

@@ -10,7 +10,7 @@ import click
 
 from fishgen.clouds.lighting import Lighting
 from fishgen.commands import QUIET, Command, Events, Inputs, Made
-from fishgen.options import group, option, seed_option, textures_option
+from fishgen.options import cloud_textures_option, group, option, seed_option
 
 
 @dataclass(frozen=True)
@@ -19,8 +19,7 @@ class EditOptions:
                        "free one.", 0, manifest=False)
     no_open: bool = option(click.BOOL, "Do not open the system's web browser; only print the page's "
                            "address.", False, flag=True, manifest=False)
-    textures: Path | None = textures_option("a .awa file's folder, then the textures/ folder beside it "
-                                            "(or beside its parent)")
+    textures: Path | None = cloud_textures_option()
     seed: int = seed_option("The preview is filled as `fishgen clouds FILE --seed SEED` fills the file.", 0)
     lighting: Lighting = group(Lighting)
 

@@ -9,9 +9,17 @@ from pathlib import Path
 import click
 
 from fishgen.clouds.lighting import Lighting
-from fishgen.clouds.model import DEFAULT_MAX_PARTICLES
 from fishgen.commands import QUIET, Command, Events, Inputs, Made
-from fishgen.options import FILE, FiniteRange, Size, group, option, seed_option, textures_option
+from fishgen.options import (
+    FILE,
+    FiniteRange,
+    Size,
+    cloud_textures_option,
+    group,
+    max_particles_option,
+    option,
+    seed_option,
+)
 from fishgen.sky.modes import MODES
 
 HEADLESS_TIMEOUT = 10.0
@@ -46,10 +54,8 @@ class FlyOptions:
     seed: int = seed_option("It picks a --mode sky's clouds and the headless flight path.")
     port: int = option(click.IntRange(0, 65535), "Port on 127.0.0.1 to serve the page from; 0 picks a free "
                        "one.", 0, manifest=False)
-    max_particles: int = option(click.IntRange(min=1), "Refuse scenes with more particles than this, before "
-                                "allocating anything.", DEFAULT_MAX_PARTICLES)
-    textures: Path | None = textures_option("a .awa file's folder, then the textures/ folder beside it (or "
-                                            "beside its parent)")
+    max_particles: int = max_particles_option()
+    textures: Path | None = cloud_textures_option()
     lighting: Lighting = group(Lighting)
 
 

@@ -11,7 +11,16 @@ import click
 from fishgen.clouds.lighting import Lighting
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES
 from fishgen.commands import QUIET, Command, Events, Made, Output
-from fishgen.options import FILE, FiniteRange, Numbers, group, option, seed_option, textures_option
+from fishgen.options import (
+    FILE,
+    FiniteRange,
+    Numbers,
+    cloud_textures_option,
+    group,
+    max_particles_option,
+    option,
+    seed_option,
+)
 from fishgen.sky.modes import ALTITUDE, AREA, MODES, NOISE
 
 
@@ -48,10 +57,8 @@ class SkyOptions:
                        "_LOD0/_LOD1/_LOD2 names).", True, flag=True, off="--no-lod")
     billboards: bool = option(click.BOOL, "Particle clouds as crossed-quad billboards instead of points "
                               "(texture clouds always are).", False, flag=True)
-    max_particles: int = option(click.IntRange(min=1), "Refuse skies with more particles than this, before "
-                                "allocating anything.", DEFAULT_MAX_PARTICLES)
-    textures: Path | None = textures_option("a .awa file's folder, then the textures/ folder beside it (or "
-                                            "beside its parent)")
+    max_particles: int = max_particles_option("skies")
+    textures: Path | None = cloud_textures_option()
     lighting: Lighting = group(Lighting)
 
 

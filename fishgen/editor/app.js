@@ -3,7 +3,7 @@
 // State for people and tests alike: window.fishgenEditor (see `state` below).
 import { CloudView } from './cloudview.js';
 
-const { THREE, OrbitControls, TransformControls } = window.fishgenKit;   // fishgen/web/kit.js
+const { THREE, OrbitControls, TransformControls, drawing } = window.fishgenKit;   // fishgen/web/kit.js
 
 const $ = ( id ) => document.getElementById( id );
 const TOKEN = new URLSearchParams( location.search ).get( 'token' ) || '';
@@ -72,21 +72,16 @@ function change( mutate, key = null ) {
 	changed();
 }
 
-function undoStep() {
-	if ( ! undo.length ) return;
-	redo.push( snapshot() );
-	restore( undo.pop() );
+// Back to the last state on ``from`` (undo or redo), this one kept on ``to`` to come back to.
+function step( from, to ) {
+	if ( ! from.length ) return;
+	to.push( snapshot() );
+	restore( from.pop() );
 	lastKey = null;
 	changed();
 }
 
-function redoStep() {
-	if ( ! redo.length ) return;
-	undo.push( snapshot() );
-	restore( redo.pop() );
-	lastKey = null;
-	changed();
-}
+const undoStep = () => step( undo, redo ), redoStep = () => step( redo, undo );
 
 // -- three.js: the workspace ---------------------------------------------------------------------------
 const canvas = $( 'view' );
@@ -216,12 +211,8 @@ let dirtyFrame = true, sortNeeded = true;
 const redraw = () => { dirtyFrame = true; };
 
 function resize() {
-	const w = canvas.clientWidth, h = canvas.clientHeight;
-	if ( canvas.width !== Math.floor( w * renderer.getPixelRatio() ) || canvas.height !== Math.floor( h * renderer.getPixelRatio() ) ) {
-		renderer.setSize( w, h, false );
-		camera.aspect = w / Math.max( h, 1 );
-		camera.updateProjectionMatrix();
-		view.setViewport( h * renderer.getPixelRatio() );
+	if ( drawing.fitCanvas( renderer, camera, canvas ) ) {
+		view.setViewport( canvas.clientHeight * renderer.getPixelRatio() );
 		redraw();
 	}
 }

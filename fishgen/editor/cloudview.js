@@ -3,48 +3,14 @@
 // reaching each particle, `_LIGHT`) is baked by the server; the materials of fishgen/web/cloudlight.js
 // (fishgen view's too) do the second pass: the light scattered towards the eye by the phase
 // function, over the sky's ambient light.
-const { THREE, GLTFLoader, cloudlight } = window.fishgenKit;   // fishgen/web/kit.js
+const { THREE, GLTFLoader, cloudlight, drawing } = window.fishgenKit;   // fishgen/web/kit.js
 const { billboardMaterial, cloudUniforms, particleMaterial: makeParticleMaterial, readCloudLight } = cloudlight;
 
 export { cloudUniforms };
 
-// Particles and billboards as fishgen view draws them (fishgen/web/cloudlight.js).
+// Particles and billboards as fishgen view draws them (fishgen/web/cloudlight.js), farthest first
+// (fishgen/web/drawing.js).
 const particleMaterial = makeParticleMaterial();
-
-// Transparent things are drawn farthest first: each primitive's centroid, sorted along the view.
-class Sorted {
-
-	constructor( object, size ) {
-		const g = object.geometry, pos = g.getAttribute( 'position' );
-		const index = g.index ? g.index.array.slice() : Uint32Array.from( { length: pos.count }, ( _, i ) => i );
-		const n = index.length / size, centroids = new Float32Array( n * 3 );
-		for ( let k = 0; k < n; k ++ ) for ( let j = 0; j < size; j ++ ) {
-			const v = index[ k * size + j ];
-			centroids[ 3 * k ] += pos.getX( v ) / size;
-			centroids[ 3 * k + 1 ] += pos.getY( v ) / size;
-			centroids[ 3 * k + 2 ] += pos.getZ( v ) / size;
-		}
-		if ( ! g.index ) g.setIndex( new THREE.BufferAttribute( index.slice(), 1 ) );
-		Object.assign( this, { object, centroids, index, size, keys: new Float32Array( n ), order: new Uint32Array( n ) } );
-	}
-
-	sort( dir ) {
-		const e = this.object.matrixWorld.elements, c = this.centroids, n = this.keys.length;
-		for ( let k = 0; k < n; k ++ ) {
-			const x = c[ 3 * k ], y = c[ 3 * k + 1 ], z = c[ 3 * k + 2 ];
-			const wx = e[ 0 ] * x + e[ 4 ] * y + e[ 8 ] * z + e[ 12 ], wy = e[ 1 ] * x + e[ 5 ] * y + e[ 9 ] * z + e[ 13 ];
-			const wz = e[ 2 ] * x + e[ 6 ] * y + e[ 10 ] * z + e[ 14 ];
-			this.keys[ k ] = - ( wx * dir.x + wy * dir.y + wz * dir.z );   // farther: smaller key
-			this.order[ k ] = k;
-		}
-		const keys = this.keys;
-		this.order.sort( ( a, b ) => keys[ a ] - keys[ b ] );
-		const out = this.object.geometry.index.array, size = this.size;
-		for ( let k = 0; k < n; k ++ ) for ( let j = 0; j < size; j ++ ) out[ k * size + j ] = this.index[ this.order[ k ] * size + j ];
-		this.object.geometry.index.needsUpdate = true;
-	}
-
-}
 
 const TEXTURE_MATERIAL = 'cloud texture ';
 
@@ -76,12 +42,12 @@ export class CloudView {
 				o.material = particleMaterial;
 				o.frustumCulled = false;
 				this.points = o;
-				this.sorted.push( new Sorted( o, 1 ) );
+				this.sorted.push( new drawing.DepthSorted( o, 1 ) );
 			} else if ( o.isMesh ) {
 				o.material = billboardMaterial( o.material, { textured: this.textured } );
 				o.frustumCulled = false;
 				this.billboards.push( o );
-				this.sorted.push( new Sorted( o, 3 ) );
+				this.sorted.push( new drawing.DepthSorted( o, 3 ) );
 			}
 		} );
 		this.group.add( gltf.scene );

@@ -2,7 +2,7 @@
 // Keys as Pakawan's: W/S forward/back, A/D left/right, arrows look up/down and turn, 1/2/3 speed;
 // the mouse (drag) looks around. The upper left shows the window size, the time and the FPS.
 // State for tests and the headless driver: window.fishgenFly = {loaded, error, camera, frames, done, report}.
-const { THREE, GLTFLoader, cloudlight } = window.fishgenKit;   // fishgen/web/kit.js
+const { THREE, GLTFLoader, cloudlight, drawing } = window.fishgenKit;   // fishgen/web/kit.js
 const { PREMULTIPLIED, billboardMaterial: cloudBillboardMaterial, particleMaterial: cloudParticleMaterial, readCloudLight } = cloudlight;
 
 const config = JSON.parse( document.getElementById( 'fishgen-fly' ).textContent );
@@ -116,13 +116,7 @@ const counts = { particles: 0, billboards: 0, distantParticles: 0, distantBillbo
 // Sort one drawable's particles back to front: counting sort of quantised depths along the view (O(n)).
 const BUCKETS = 4096;
 function sorter( object, size ) {
-	const g = object.geometry, pos = g.getAttribute( 'position' );
-	const index = g.index ? g.index.array.slice() : Uint32Array.from( { length: pos.count }, ( _, i ) => i );
-	const n = index.length / size, centroids = new Float32Array( n * 3 );
-	for ( let k = 0; k < n; k ++ ) for ( let j = 0; j < size; j ++ ) {
-		const v = index[ k * size + j ];
-		centroids[ 3 * k ] += pos.getX( v ) / size; centroids[ 3 * k + 1 ] += pos.getY( v ) / size; centroids[ 3 * k + 2 ] += pos.getZ( v ) / size;
-	}
+	const g = object.geometry, { index, centroids, n } = drawing.centroids( g, size );
 	if ( ! g.index || ! ( g.index.array instanceof Uint32Array ) ) g.setIndex( new THREE.BufferAttribute( new Uint32Array( index ), 1 ) );
 	g.index.setUsage( THREE.DynamicDrawUsage );
 	return { object, centroids, index, size, n, keys: new Uint16Array( n ), depth: new Float32Array( n ), start: new Uint32Array( BUCKETS + 1 ),

@@ -77,6 +77,7 @@ def build_sky(mode: str = "medium", *, seed: int = 0, area: tuple[float, float] 
         raise FishgenError(f"expected at least {need:,} particles for a {mode} sky of {sky_mode.clouds} "
                            f"clouds (one in each cube of every cloud), found {total:,}")
     plan = plan_sky(sky_mode, cubes, seed=seed, area=area, altitude=altitude, particles=total)
-    clouds = light_sky(fill_sky(plan, cubes, noise=noise), lighting or Lighting(), method=shadow_map)
+    filled = fill_sky(plan, cubes, noise=noise, max_particles=max_particles)
+    clouds = light_sky(filled, lighting or Lighting(), method=shadow_map)
     scene, facts = sky_scene(plan, clouds, [p.name for p in files], billboards=billboards, lod=lod)
     return Sky(scene, tuple(facts), mode, seed, tuple(files), cloud_textures(cubes))

@@ -3,7 +3,8 @@
 :func:`plan_sky` decides, from a seed: which cloud model each cloud is, its scale (uniform, with
 its depth stretched: the editor's clouds are flat cards), its turn about +Y, its place in the
 area and altitude band, and its share of the particles. :func:`fill_sky` fills each cloud in its
-own frame (the model's box centred on the origin), adds the noise, and keeps where it goes; the
+own frame (the model's box centred on the origin) as `fishgen clouds` fills a file, adds the
+noise, and keeps where it goes; the
 lighting (:mod:`fishgen.sky.light`) and the scene (:mod:`fishgen.sky.scene`) follow.
 """
 from __future__ import annotations
@@ -14,7 +15,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from fishgen.clouds.model import Cloud, Cube, CubeFile
+from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, Cloud, Cube, CubeFile
 from fishgen.sky.modes import SkyMode
 
 PLACE_TRIES = 48
@@ -180,16 +181,18 @@ def scaled_model(model: CubeFile, placement: Placement, puff: float) -> CubeFile
     return replace(model, cubes=cubes, declared_total=int(counts.sum()))
 
 
-def fill_sky(plan: SkyPlan, sources: Sequence[CubeFile], *, noise: float = 0.0) -> list[SkyCloud]:
-    """Every cloud of the plan filled (the report's randomized fill) in its own frame, with
-    ``noise`` (0 to 0.9) of seeded 3D noise on its radii and densities."""
-    from fishgen.clouds.fill import fill_cloud
+def fill_sky(plan: SkyPlan, sources: Sequence[CubeFile], *, noise: float = 0.0,
+             max_particles: int = DEFAULT_MAX_PARTICLES) -> list[SkyCloud]:
+    """Every cloud of the plan filled in its own frame through the one cloud pipeline
+    (:func:`fishgen.clouds.pipeline.cube_clouds`, its placement's seed), with ``noise`` (0 to 0.9)
+    of seeded 3D noise on its radii and densities; the sky lights them (:mod:`fishgen.sky.light`)."""
     from fishgen.clouds.noise import roughen
+    from fishgen.clouds.pipeline import cube_clouds
 
     out = []
     for p in plan.placements:
         model = scaled_model(sources[p.source], p, plan.mode.puff)
-        cloud = fill_cloud(model, seed=p.seed)
+        cloud, = cube_clouds([model], seed=p.seed, light=False, max_particles=max_particles).clouds
         if noise > 0:
             lo, hi = model_box(model)
             # features about a third of the cloud's height: bumps on its top, holes in its base

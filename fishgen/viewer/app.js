@@ -1,6 +1,6 @@
 // fishgen viewer: shows one embedded asset with three.js; nothing is fetched from the network.
 // State for people and tests alike: window.fishgenViewer = {loaded, error, time, clip, clips, playing, counts}.
-const { THREE, OrbitControls, GLTFLoader, PLYLoader, OBJLoader, MTLLoader, cloudlight } = window.fishgenKit;   // fishgen/web/kit.js
+const { THREE, OrbitControls, GLTFLoader, PLYLoader, OBJLoader, MTLLoader, cloudlight, drawing } = window.fishgenKit;   // fishgen/web/kit.js
 const { billboardMaterial, particleMaterial: makeParticleMaterial, readCloudLight } = cloudlight;
 
 const state = window.fishgenViewer = {
@@ -60,38 +60,12 @@ function readLight( extras ) {
 // farthest first.
 const particleMaterial = makeParticleMaterial();
 
-const sorted = [];   // [object, centroids (Float32Array xyz per primitive), base index (Uint32Array), size]
+const sorted = [];   // drawing.DepthSorted: each drawn object's primitives
 
-function sortable( object, size ) {
-	const g = object.geometry, pos = g.getAttribute( 'position' );
-	const index = g.index ? g.index.array.slice() : Uint32Array.from( { length: pos.count }, ( _, i ) => i );
-	const n = index.length / size, centroids = new Float32Array( n * 3 );
-	for ( let k = 0; k < n; k ++ ) for ( let j = 0; j < size; j ++ ) {
-		const v = index[ k * size + j ];
-		centroids[ 3 * k ] += pos.getX( v ) / size; centroids[ 3 * k + 1 ] += pos.getY( v ) / size; centroids[ 3 * k + 2 ] += pos.getZ( v ) / size;
-	}
-	if ( ! g.index ) g.setIndex( new THREE.BufferAttribute( index.slice(), 1 ) );
-	sorted.push( { object, centroids, index, size, keys: new Float32Array( n ), order: new Uint32Array( n ) } );
-}
-
-const _dir = new THREE.Vector3(), _m = new THREE.Matrix4();
+const _dir = new THREE.Vector3();
 function sortAll() {
 	camera.getWorldDirection( _dir );
-	for ( const s of sorted ) {
-		_m.copy( s.object.matrixWorld );
-		const e = _m.elements, c = s.centroids, n = s.keys.length;
-		for ( let k = 0; k < n; k ++ ) {
-			const x = c[ 3 * k ], y = c[ 3 * k + 1 ], z = c[ 3 * k + 2 ];
-			const wx = e[ 0 ] * x + e[ 4 ] * y + e[ 8 ] * z + e[ 12 ], wy = e[ 1 ] * x + e[ 5 ] * y + e[ 9 ] * z + e[ 13 ];
-			const wz = e[ 2 ] * x + e[ 6 ] * y + e[ 10 ] * z + e[ 14 ];
-			s.keys[ k ] = - ( wx * _dir.x + wy * _dir.y + wz * _dir.z );   // farther: smaller key
-			s.order[ k ] = k;
-		}
-		s.order.sort( ( a, b ) => s.keys[ a ] - s.keys[ b ] );
-		const out = s.object.geometry.index.array;
-		for ( let k = 0; k < n; k ++ ) for ( let j = 0; j < s.size; j ++ ) out[ k * s.size + j ] = s.index[ s.order[ k ] * s.size + j ];
-		s.object.geometry.index.needsUpdate = true;
-	}
+	for ( const s of sorted ) s.sort( _dir );
 }
 
 function prepareParticles( points, diagonal ) {
@@ -102,7 +76,7 @@ function prepareParticles( points, diagonal ) {
 	if ( ! g.getAttribute( '_light' ) ) g.setAttribute( '_light', new THREE.BufferAttribute( new Float32Array( n ).fill( - 1 ), 1 ) );
 	if ( ! g.getAttribute( 'color' ) ) g.setAttribute( 'color', new THREE.BufferAttribute( new Float32Array( n * 3 ).fill( 1 ), 3 ) );
 	points.material = particleMaterial;
-	sortable( points, 1 );
+	sorted.push( new drawing.DepthSorted( points, 1 ) );
 }
 
 function prepareBillboards( mesh ) {
@@ -110,7 +84,7 @@ function prepareBillboards( mesh ) {
 	if ( ! g.getAttribute( '_light' ) ) g.setAttribute( '_light', new THREE.BufferAttribute( new Float32Array( n ).fill( - 1 ), 1 ) );
 	if ( ! g.getAttribute( 'color' ) ) g.setAttribute( 'color', new THREE.BufferAttribute( new Float32Array( n * 4 ).fill( 1 ), 4 ) );
 	mesh.material = billboardMaterial( mesh.material );
-	sortable( mesh, 3 );
+	sorted.push( new drawing.DepthSorted( mesh, 3 ) );
 }
 
 async function load() {
@@ -223,14 +197,8 @@ let dirty = true;
 const redraw = () => { dirty = true; };
 
 function resize() {
-	const w = canvas.clientWidth, h = canvas.clientHeight;
-	if ( canvas.width !== Math.floor( w * renderer.getPixelRatio() ) || canvas.height !== Math.floor( h * renderer.getPixelRatio() ) ) {
-		renderer.setSize( w, h, false );
-		camera.aspect = w / Math.max( h, 1 );
-		camera.updateProjectionMatrix();
-		dirty = true;
-	}
-	particleMaterial.uniforms.viewportHeight.value = h * renderer.getPixelRatio();
+	if ( drawing.fitCanvas( renderer, camera, canvas ) ) dirty = true;
+	particleMaterial.uniforms.viewportHeight.value = canvas.clientHeight * renderer.getPixelRatio();
 }
 
 function tick( now ) {

@@ -10,3 +10,4 @@ export { MTLLoader } from 'three/addons/loaders/MTLLoader.js';
 export { OBJLoader } from 'three/addons/loaders/OBJLoader.js';
 export { PLYLoader } from 'three/addons/loaders/PLYLoader.js';
 export * as cloudlight from './cloudlight.js';
+export * as drawing from './drawing.js';

@@ -91,5 +91,7 @@ def test_the_five_callers_go_through_the_one_pipeline_and_agree_on_an_empty_cube
     assert through["read"][-1][0].cubes == load_cubes(hollow).cubes
     counts = [per_cube(prim.attributes["_CUBE"]) for mesh in sky.scene.meshes for prim in mesh.primitives]
     assert len(counts) == 16 and all(c[1] == 0 and c[0] > c[2] > 0 for c in counts)
-    # the editor fills the page's cubes, parsed already; sky re-fills its models by its own plan
-    assert (len(through["read"]), len(through["filled"])) == (4, 4)
+    # the editor fills the page's cubes, parsed already; sky fills each cloud, its model scaled by the plan
+    assert (len(through["read"]), len(through["filled"])) == (4, 4 + 16)
+    assert [per_cube(made.clouds[0].cube_index) for made in through["filled"][4:]] == counts
+    assert all(made.lit is None for made in through["filled"][4:])

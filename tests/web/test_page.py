@@ -36,7 +36,7 @@ def test_one_kit_holds_three_and_every_app_takes_it_from_there():
     bundles = manifest["bundles"]
     kit = bundles["kit"]["inputs"]
     for part in ("fishgen/web/kit.js", "fishgen/web/three-parts.js", "fishgen/web/cloudlight.js",
-                 "node_modules/three/build/three.module.js",
+                 "fishgen/web/drawing.js", "node_modules/three/build/three.module.js",
                  "node_modules/three/examples/jsm/loaders/GLTFLoader.js",
                  "node_modules/three/examples/jsm/controls/TransformControls.js"):
         assert part in kit, part
