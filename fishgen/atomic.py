@@ -33,20 +33,22 @@ _inputs: ContextVar[dict[tuple[int, int], str] | None] = ContextVar("fishgen_inp
 
 
 @contextmanager
-def together() -> Iterator[None]:
+def together() -> Iterator[list[tuple[str, Path]]]:
     """Every file written inside is staged and renamed into place when the block ends without an
-    exception; otherwise none is."""
+    exception; otherwise none is. Inside another such block, the staged files join the outer one's
+    (the CLI prints a school's summary before anything lands, so a failed print leaves no file).
+    Yields the (temporary file, target) pairs staged so far, to be read inside the block."""
     staged: list[tuple[str, Path]] = []
     token = _staging.set(staged)
     try:
-        yield
+        yield staged
     except BaseException:
         for tmp, _ in staged:
             _discard(tmp)
         raise
     finally:
         _staging.reset(token)
-    _commit(staged)
+    _land(staged)
 
 
 @contextmanager
@@ -71,8 +73,16 @@ def _land(staged: list[tuple[str, Path]]) -> None:
     pending = _staging.get()
     if pending is None:
         _commit(staged)
-    else:
-        pending.extend(staged)
+        return
+    taken = {target.resolve() for _, target in pending}
+    for _, target in staged:
+        if target.resolve() in taken:  # the later one would silently replace the earlier
+            for tmp, _ in staged:
+                _discard(tmp)
+            raise UsageError(f"expected every output of one run to be a different file, found {target} "
+                             f"twice")
+        taken.add(target.resolve())
+    pending.extend(staged)
 
 
 def _fail(target: Path, err: OSError) -> SystemFailure:
