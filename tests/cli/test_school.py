@@ -195,11 +195,11 @@ def test_lods_and_merge_give_every_fish_the_engine_layout_over_shared_meshes(tmp
 def test_a_summary_that_cannot_be_printed_fails_the_run_and_leaves_no_file(tmp_path):
     with open("/dev/full", "w") as full:
         result = subprocess.run([sys.executable, "-m", "fishgen", "school", str(PARAMS / "bonybream.txt"),
-                                 "-o", str(tmp_path / "s.glb"), "--count", "3", "--frames", "10",
+                                 "-o", str(tmp_path / "new" / "s.glb"), "--count", "3", "--frames", "10",
                                  "--metrics", str(tmp_path / "m.json")],
                                 cwd=ROOT, stdout=full, stderr=subprocess.PIPE, text=True)
     assert result.returncode == 1 and result.stderr == "fishgen: No space left on device\n"
-    assert list(tmp_path.iterdir()) == []
+    assert list(tmp_path.iterdir()) == []  # nor the folder made for the glb
 
 
 def test_two_outputs_naming_one_file_are_refused_and_nothing_is_written(tmp_path):
