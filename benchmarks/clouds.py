@@ -103,10 +103,13 @@ def median_time(run, repeats: int) -> float:
 
 COMMANDS = {
     "fishgen": lambda awn, ply: [sys.executable, "-m", "fishgen", "clouds", str(awn), "-o", str(ply)],
+    "no-light": lambda awn, ply: [sys.executable, "-m", "fishgen", "clouds", str(awn), "-o", str(ply),
+                                  "--no-light"],
     "unlit": lambda awn, ply: [sys.executable, __file__, "--run", "unlit", str(awn), str(ply)],
     "lit": lambda awn, ply: [sys.executable, __file__, "--run", "lit", str(awn), str(ply)],
 }
-"""`fishgen clouds` as the command line runs it today, and the library steps the command runs,
+"""`fishgen clouds` as the command line runs it today (lit, and with --no-light), and the library
+steps the command runs,
 without and with lighting (load, fill, [light_cloud,] export), each a process of its own."""
 
 
@@ -167,13 +170,15 @@ def light_report(sizes: list[int], command_size: int, repeats: int, workdir: Pat
     for n in sizes:
         fill, light = lighting(n, repeats)
         print(f"| {n:,} | {fill * 1e3:,.1f} ms | {light * 1e3:,.1f} ms | {light / fill:.2f}x |")
-    runs = whole_command(command_size, workdir, 3, ("fishgen", "unlit", "lit"))
+    runs = whole_command(command_size, workdir, 3, ("fishgen", "no-light", "unlit", "lit"))
     print(f"\nwhole run, {command_size:,} particles to PLY, median of 3, interleaved:")
-    for kind, label in (("fishgen", "`fishgen clouds` (lit, as shipped)"), ("unlit", "library steps, unlit"),
+    for kind, label in (("fishgen", "`fishgen clouds` (lit, as shipped)"),
+                        ("no-light", "`fishgen clouds --no-light`"), ("unlit", "library steps, unlit"),
                         ("lit", "library steps, lit")):
         wall, peak = runs[kind]
         print(f"  {label:34s} {wall:6.2f} s, peak {peak / 2**20:,.0f} MiB = {peak / command_size:.1f} bytes/particle")
     print(f"  lit / unlit library steps: {runs['lit'][0] / runs['unlit'][0]:.2f}x (target < 2x)")
+    print(f"  `fishgen clouds` / `--no-light`: {runs['fishgen'][0] / runs['no-light'][0]:.2f}x")
 
 
 def writers(n: int, workdir: Path, repeats: int) -> None:

@@ -33,20 +33,22 @@ _inputs: ContextVar[dict[tuple[int, int], str] | None] = ContextVar("fishgen_inp
 
 
 @contextmanager
-def together() -> Iterator[None]:
+def together() -> Iterator[list[tuple[str, Path]]]:
     """Every file written inside is staged and renamed into place when the block ends without an
-    exception; otherwise none is."""
+    exception; otherwise none is. Inside another such block, the staged files join the outer one's
+    (the CLI prints a school's summary before anything lands, so a failed print leaves no file).
+    Yields the (temporary file, target) pairs staged so far, to be read inside the block."""
     staged: list[tuple[str, Path]] = []
     token = _staging.set(staged)
     try:
-        yield
+        yield staged
     except BaseException:
-        for tmp, _ in staged:
+        for tmp, _ in reversed(staged):  # the last first: a folder made for the first is then empty
             _discard(tmp)
         raise
     finally:
         _staging.reset(token)
-    _commit(staged)
+    _land(staged)
 
 
 @contextmanager
@@ -71,8 +73,16 @@ def _land(staged: list[tuple[str, Path]]) -> None:
     pending = _staging.get()
     if pending is None:
         _commit(staged)
-    else:
-        pending.extend(staged)
+        return
+    taken = {target.resolve() for _, target in pending}
+    for _, target in staged:
+        if target.resolve() in taken:  # the later one would silently replace the earlier
+            for tmp, _ in reversed(staged):
+                _discard(tmp)
+            raise UsageError(f"expected every output of one run to be a different file, found {target} "
+                             f"twice")
+        taken.add(target.resolve())
+    pending.extend(staged)
 
 
 def _fail(target: Path, err: OSError) -> SystemFailure:
@@ -105,17 +115,37 @@ STALE_SECONDS = 10.0
 """A temporary file of fishgen's naming pattern that nobody holds locked and that is this old was
 left by a killed run (SIGKILL runs no cleanup): the next write beside it removes it."""
 _held: dict[str, int] = {}  # temporary file -> the descriptor holding its lock until renamed or discarded
+_folders: dict[str, list[Path]] = {}  # temporary file -> the folders made for it, deepest first
 
 
 def _temporary(path: Path) -> tuple[int, str]:
     """A new temporary file beside ``path``, locked for as long as this run may rename it; stale
     ones of the same target are swept first."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    sweep(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    made: list[Path] = []
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        made.append(folder)
+        folder = folder.parent
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        sweep(path)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except BaseException:
+        _remove_empty(made)
+        raise
     _lock(fd)
     _held[tmp] = fd
+    if made:  # a run that fails leaves no folder it made either
+        _folders[tmp] = made
     return fd, tmp
+
+
+def _remove_empty(folders: list[Path]) -> None:
+    for folder in folders:
+        try:
+            folder.rmdir()
+        except OSError:  # not empty: another output, or a file someone else put there
+            return
 
 
 def _lock(fd: int) -> bool:
@@ -162,6 +192,7 @@ def sweep(path: Path) -> list[Path]:
 
 
 def _release(tmp: str) -> None:
+    _folders.pop(tmp, None)
     fd = _held.pop(tmp, None)
     if fd is not None:
         os.close(fd)
@@ -192,7 +223,9 @@ def _discard(tmp: str) -> None:
         os.unlink(tmp)
     except FileNotFoundError:
         pass
+    made = _folders.get(tmp, [])
     _release(tmp)
+    _remove_empty(made)
 
 
 def write_files(files: Mapping[_PathT, bytes]) -> None:
@@ -205,7 +238,7 @@ def write_files(files: Mapping[_PathT, bytes]) -> None:
         for target, data in zip(targets, files.values(), strict=True):
             staged.append((_stage(target, data), target))
     except BaseException:
-        for tmp, _ in staged:
+        for tmp, _ in reversed(staged):
             _discard(tmp)
         raise
     _land(staged)
@@ -233,7 +266,7 @@ def _commit(staged: list[tuple[str, Path]]) -> None:
                 os.replace(backup, target)
             elif target.is_file():
                 os.unlink(target)
-        for tmp, _ in staged:
+        for tmp, _ in reversed(staged):
             _discard(tmp)
         raise
     for backup, _ in backups:

@@ -5,7 +5,7 @@ import os
 
 import pytest
 
-from fishgen.atomic import atomic_open, write_bytes, write_files
+from fishgen.atomic import atomic_open, together, write_bytes, write_files
 from fishgen.errors import FishgenError
 
 
@@ -100,7 +100,7 @@ def test_a_killed_writers_temporary_file_is_swept_by_the_next_write(tmp_path):
     writer.send_signal(signal.SIGKILL)
     writer.wait()
     assert temp.exists()                                       # SIGKILL: nothing cleaned up
-    atomic.write_bytes(tmp_path / "big.bin", b"new")           # the next write of that target
+    write_bytes(tmp_path / "big.bin", b"new")           # the next write of that target
     assert not temp.exists() and target.read_bytes() == b"new"
 
 
@@ -111,3 +111,17 @@ def test_a_fresh_temporary_file_is_never_swept(tmp_path):
     fresh = tmp_path / ".a.txt.abcd.tmp"
     fresh.write_bytes(b"x")
     assert atomic.sweep(tmp_path / "a.txt") == [] and fresh.exists()
+
+
+def test_a_failed_set_of_outputs_leaves_no_folder_it_made(tmp_path):
+    with pytest.raises(RuntimeError), together():
+        write_bytes(tmp_path / "a" / "b" / "x.glb", b"glb")
+        write_bytes(tmp_path / "a" / "b" / "x.bin", b"bin")
+        write_bytes(tmp_path / "a" / "m.json", b"{}")
+        raise RuntimeError("a later output failed")
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "kept").mkdir()
+    with pytest.raises(RuntimeError), together():
+        write_bytes(tmp_path / "kept" / "new" / "x.glb", b"glb")
+        raise RuntimeError("a later output failed")
+    assert list(tmp_path.iterdir()) == [tmp_path / "kept"] and list((tmp_path / "kept").iterdir()) == []

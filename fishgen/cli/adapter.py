@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from pathlib import Path
 from typing import Any
 
@@ -45,12 +45,18 @@ def click_command(cmd: Command) -> click.Command:
 def execute(cmd: Command, inputs: tuple[Path, ...], output: str | None, options: Any) -> None:
     """Run the command's function and show what it made: the summary on stdout, notes and each
     failed input on stderr, a bar on a terminal; serve its server until Ctrl-C."""
+    from fishgen.atomic import together
     from fishgen.commands import run
 
     events = TerminalEvents()
-    made = run(cmd, inputs, output, options, events.as_events())
-    for line in made.lines:
-        click.echo(line)
+    # A summary that cannot be printed (stdout on a full disk) fails the run: with `together`, its
+    # files are still staged then, and none lands.
+    with together() if cmd.together else nullcontext():
+        made = run(cmd, inputs, output, options, events.as_events())
+        for line in made.lines:
+            click.echo(line)
+        if cmd.together:
+            sys.stdout.flush()
     if made.verdict is not None:
         raise made.verdict
     if made.failed:

@@ -76,6 +76,7 @@ class Command:
     output: Output | None = None
     batch: bool = False                 # a batch manifest may list jobs of this command
     cli: str | None = None              # "module:function" of a command-specific CLI adapter
+    together: bool = False              # the CLI lands every output only once the summary is printed
 
     @property
     def holds(self) -> tuple[str, ...]:

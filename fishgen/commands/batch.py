@@ -116,7 +116,7 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
 
     from fishgen.batch import RecordNotSaved, run_batch
     from fishgen.batch.manifest import load_manifest, scan_folder
-    from fishgen.errors import JobsFailed, UsageError
+    from fishgen.errors import JobsFailed, SystemFailure, UsageError
     from fishgen.extras import needs
 
     start = time.perf_counter()
@@ -150,11 +150,17 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
             outcomes, unsaved = err.outcomes, err
     seconds = time.perf_counter() - start
     written = []
+    # What the batch itself could not write (a full disk) goes in its one summary error, after the
+    # jobs' own lines: each said why already, and the summary on stdout still says what ran.
+    unwritten: list[FishgenError] = [unsaved] if unsaved is not None else []
     if options.report is not None:
         from fishgen.batch.report import report, write_report
 
-        write_report(options.report, report(manifest, outcomes, seconds, workers, options.scheduler))
-        written.append(options.report)
+        try:
+            write_report(options.report, report(manifest, outcomes, seconds, workers, options.scheduler))
+            written.append(options.report)
+        except SystemFailure as err:
+            unwritten.append(err)
     counts = {s: sum(o.status == s for o in outcomes) for s in ("built", "skipped", "failed", "not run")}
     where = options.scheduler or f"-j {workers}"
     line = (f"{_shown(manifest.out)}: {len(outcomes)} jobs, {counts['built']} built, "
@@ -164,13 +170,13 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
     errors = tuple(_job_error(o) for o in outcomes if o.status == "failed")
     verdict: FishgenError | None = None
     if errors:
-        verdict = JobsFailed(f"{len(errors)} of {len(outcomes)} jobs failed (each said why above)",
-                             any(e.status == 2 for e in errors))
+        verdict = JobsFailed("; ".join([f"{len(errors)} of {len(outcomes)} jobs failed (each said why above)",
+                                        *map(str, unwritten)]), any(e.status == 2 for e in errors))
+    elif len(unwritten) == 1:
+        verdict = unwritten[0]
+    elif unwritten:
+        verdict = SystemFailure("; ".join(map(str, unwritten)), unwritten[0].file)
     written += [manifest.out / p for o in outcomes if o.status == "built" for p in o.outputs]
-    if unsaved is not None:
-        verdict = verdict or unsaved
-        if verdict is not unsaved and events.failed is not None:
-            events.failed(unsaved)
     return Made(tuple(written), (manifest.file,) if manifest.file else (), (line,),
                 BatchFacts(tuple(outcomes), seconds, workers), errors, verdict)
 

@@ -33,6 +33,9 @@ class CloudsOptions:
     max_particles: int = max_particles_option()
     textures: Path | None = cloud_textures_option()
     lighting: Lighting = group(Lighting)
+    light: bool = option(click.BOOL, "Bake the sunlight into each particle's colour (and its _LIGHT "
+                         "attribute); off skips the lighting and writes the particles white, for "
+                         "positions, radii and density only.", True, flag=True, off="--no-light")
 
 
 COMMAND = Command(
@@ -90,6 +93,12 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     billboards = options.billboards or (textured and output.suffix.lower() in (".glb", ".gltf"))
     check_output(output, billboards)
     check_targets([output], inputs)
+    if not options.light and options.lighting != Lighting():
+        from dataclasses import fields
+
+        given = [f"--{f.name.replace('_', '-')}" for f in fields(Lighting)
+                 if getattr(options.lighting, f.name) != getattr(Lighting(), f.name)]
+        raise UsageError(f"expected no lighting options with --no-light, found {', '.join(given)}")
     if options.offset and len(options.offset) != len(inputs):
         raise UsageError(f"expected one --offset per input ({len(inputs)}), found {len(options.offset)}")
     files = read_cube_files(inputs, max_particles=options.max_particles, textures_dir=options.textures,
@@ -102,12 +111,17 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     check_output(output, billboards, particles=sum(f.total for f in files))  # a glTF buffer holds 4 GiB
     seed = options.seed or 0
     made = cube_clouds(files, seed=seed, method=options.method, offsets=options.offset,
-                       lighting=options.lighting, max_particles=options.max_particles)
-    cloud = made.cloud
+                       lighting=options.lighting, light=options.light, max_particles=options.max_particles)
+    if options.light:
+        cloud = made.cloud
+        sun = "sun " + ",".join(f"{v:g}" for v in options.lighting.sun)
+    else:
+        from fishgen.clouds.fill import merge_clouds
+
+        cloud, sun = merge_clouds(made.clouds), "unlit"
     written = export_cloud(cloud, output, billboards=billboards)
-    sun = ",".join(f"{v:g}" for v in options.lighting.sun)
     line = (f"{output}: {_plural(len(cloud), made.noun)} in {_plural(len(cloud.cube_bounds), 'cube')} "
-            f"from {_plural(len(files), 'file')} ({options.method} fill, seed {seed}, sun {sun})")
+            f"from {_plural(len(files), 'file')} ({options.method} fill, seed {seed}, {sun})")
     facts = CloudFacts(len(cloud), len(cloud.cube_bounds), len(files), billboards, options.lighting)
     return Made(tuple(written), (*inputs, *textures), (line,), facts)
 

@@ -103,6 +103,7 @@ COMMAND = Command(
     output=Output("Animated asset to write (.glb or .gltf: the only formats that hold node animation).",
                   holds=(MESHES, NODE_ANIMATION)),
     batch=True,
+    together=True,
 )
 
 
@@ -181,8 +182,8 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         numbers = summary(per_frame, warmup)
     if events.summary:  # else nobody reads the table: only what it prints is measured
         table = run.summary(per_frame or None)
-    files = _write_all(output, run, sides, per_frame, numbers, warmup)
-    size = sum(p.stat().st_size for p in files if p not in sides.values())
+    files, sizes = _write_all(output, run, sides, per_frame, numbers, warmup)
+    size = sum(n for p, n in sizes.items() if p not in sides.values())
     kinds_line = ", ".join(f"{e.count} {Path(e.file).stem}" for e in scene.species)
     line = (f"{output}: {kinds_line}; {scene.frames} frames ({scene.frames / scene.fps:.1f} s), "
             f"{scene.model}, {size / 1e6:.2f} MB")
@@ -193,13 +194,14 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
 
 
 def _write_all(output: Path, run, sides: dict[str, Path], per_frame: dict, numbers: dict,
-               warmup: int) -> list[Path]:
-    """The glb and every side output, all or none."""
+               warmup: int) -> tuple[list[Path], dict[Path, int]]:
+    """The glb and every side output, all or none, and each one's size (read while staged: under
+    the CLI they land only once the summary is printed)."""
     from fishgen.atomic import together, write_bytes
     from fishgen.exchange import export
     from fishgen.exchange.registry import MESHES, NODE_ANIMATION
 
-    with together():
+    with together() as staged:
         files = export(run.scene, output, require=[MESHES, NODE_ANIMATION])
         if "tracks" in sides:
             from fishgen.school.tracks import write_tracks
@@ -210,7 +212,8 @@ def _write_all(output: Path, run, sides: dict[str, Path], per_frame: dict, numbe
         if "plot" in sides:
             from fishgen.school.plot import plot_school
             files.append(plot_school(sides["plot"], run, per_frame))
-    return files
+        sizes = {target: os.path.getsize(tmp) for tmp, target in staged}
+    return files, sizes
 
 
 def _metrics_json(run, per_frame: dict, numbers: dict, warmup: int) -> bytes:

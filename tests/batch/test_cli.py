@@ -95,3 +95,29 @@ def test_two_batches_may_not_write_one_out_folder_at_once(shipped):
         fcntl.flock(lock.fileno(), fcntl.LOCK_EX)
         run = batch(shipped / "params" / "assets.toml", "--out", out)
     assert run.returncode == 2 and "found one running" in run.stderr and not (out / "fish").exists()
+
+
+def test_a_full_disk_says_one_line_per_failed_job_and_one_summary(shipped, monkeypatch):
+    """Issue 32: the record and the report that a full disk refused were lines of their own, and the
+    report's failure hid the summary; now they end the batch's one summary error."""
+    import errno
+    import os
+
+    manifest = shipped / "params" / "two.toml"
+    manifest.write_text('out = "../out"\n[[clouds]]\ninput = "clouds/table_4_3.awn"\noutput = "a.ply"\n'
+                        '[[clouds]]\ninput = "clouds/table_4_4.awn"\noutput = "b.ply"\n')
+
+    def full(fd: int) -> None:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "fsync", full)  # every durable write (-j 1: this process's) meets a full disk
+    run = batch(manifest, "-j", "1", "--report", shipped / "report.json")
+    out = shipped / "out"
+    assert run.returncode == 1, run.stderr
+    assert run.stderr.splitlines() == [
+        f"cannot write {out / 'a.ply'}: No space left on device",
+        f"cannot write {out / 'b.ply'}: No space left on device",
+        f"fishgen: 2 of 2 jobs failed (each said why above); cannot write {out / '.fishgen-batch.json'}: "
+        f"No space left on device; cannot write {shipped / 'report.json'}: No space left on device"]
+    assert run.stdout.startswith(f"{out}: 2 jobs, 0 built, 0 skipped, 2 failed in ")
+    assert [p.name for p in out.rglob("*") if p.is_file()] == [".fishgen-batch.lock"]

@@ -2,12 +2,15 @@
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 import pygltflib
 
-from tests.conftest import PARAMS, assert_valid_gltf, run_cli
+from tests.conftest import PARAMS, ROOT, assert_valid_gltf, run_cli
 
 
 def test_the_exact_form_writes_a_valid_animated_school(tmp_path):
@@ -186,3 +189,24 @@ def test_lods_and_merge_give_every_fish_the_engine_layout_over_shared_meshes(tmp
     assert len(doc.skins) == 6 * 2                                         # each fish its own joints per level
     refused = run_cli("school", PARAMS / "bonybream.txt", "--merge", "--tints", "3", "-o", out)
     assert refused.returncode == 2 and "expected --tints 1 with --lods or --merge" in refused.stderr
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full, a device that is always full")
+def test_a_summary_that_cannot_be_printed_fails_the_run_and_leaves_no_file(tmp_path):
+    with open("/dev/full", "w") as full:
+        result = subprocess.run([sys.executable, "-m", "fishgen", "school", str(PARAMS / "bonybream.txt"),
+                                 "-o", str(tmp_path / "new" / "s.glb"), "--count", "3", "--frames", "10",
+                                 "--metrics", str(tmp_path / "m.json")],
+                                cwd=ROOT, stdout=full, stderr=subprocess.PIPE, text=True)
+    assert result.returncode == 1 and result.stderr == "fishgen: No space left on device\n"
+    assert list(tmp_path.iterdir()) == []  # nor the folder made for the glb
+
+
+def test_two_outputs_naming_one_file_are_refused_and_nothing_is_written(tmp_path):
+    # A .gltf writes its texture beside it; a plot of the same name would silently replace it.
+    result = run_cli("school", PARAMS / "bonybream.txt", "-o", tmp_path / "s.gltf", "--count", "3",
+                     "--frames", "10", "--plot", tmp_path / "s_skin.png")
+    assert result.returncode == 2, result.stderr
+    assert result.stderr == (f"fishgen: expected every output of one run to be a different file, found "
+                             f"{tmp_path / 's_skin.png'} twice\n")
+    assert list(tmp_path.iterdir()) == []

@@ -203,3 +203,46 @@ def test_the_billboard_help_says_its_triangles():
     from fishgen.commands.clouds import BILLBOARD_TRIANGLES
 
     assert BILLBOARD_TRIANGLES == TRIANGLES_PER_BILLBOARD
+
+
+def _light_in_glb(path) -> tuple[bool, bool]:
+    """Whether a glb carries baked light: a _LIGHT attribute, the lighting record in its extras."""
+    import pygltflib
+
+    from fishgen.clouds.lighting import EXTRAS_KEY
+
+    doc = pygltflib.GLTF2().load(str(path))
+    attributes = any("_LIGHT" in vars(p.attributes) for m in doc.meshes for p in m.primitives)
+    record = any(EXTRAS_KEY in (s.extras or {}) for s in doc.scenes)
+    return attributes, record
+
+
+def test_no_light_writes_the_same_particles_white_and_unlit(cli, tmp_path, gltf_validator):
+    """Issue 32: --no-light for users who only want positions; the fill is the lit run's, the light is
+    not there at all (no colour from it, no _LIGHT, no lighting record), and the glTF still validates."""
+    lit, unlit = tmp_path / "lit.npy", tmp_path / "unlit.npy"
+    assert cli("clouds", TABLES["4.4"], "-o", lit, "--seed", "3").returncode == 0
+    made = cli("clouds", TABLES["4.4"], "-o", unlit, "--seed", "3", "--no-light")
+    assert made.returncode == 0 and made.stderr == "", made.stderr
+    assert made.stdout.endswith("(paper fill, seed 3, unlit)\n")
+    a, b = np.load(lit), np.load(unlit)
+    for name in ("x", "y", "z", "radius", "density", "cube"):
+        assert np.array_equal(a[name], b[name]), name
+    assert len(np.unique(a["red"])) > 10 and {int(b[c].min()) for c in ("red", "green", "blue")} == {255}
+    for billboards in ((), ("--billboards",)):
+        glb, lit_glb = tmp_path / f"unlit{len(billboards)}.glb", tmp_path / f"lit{len(billboards)}.glb"
+        assert cli("clouds", TABLES["4.4"], "-o", glb, "--no-light", *billboards).returncode == 0
+        assert cli("clouds", TABLES["4.4"], "-o", lit_glb, *billboards).returncode == 0
+        gltf_validator(glb)
+        assert _light_in_glb(lit_glb) == (True, True) and _light_in_glb(glb) == (False, False)
+
+
+def test_no_light_with_a_lighting_option_is_refused(cli, tmp_path):
+    result = cli("clouds", TABLES["4.4"], "-o", tmp_path / "c.ply", "--no-light", "--sun", "1,0,0")
+    assert_one_line_error(result, "fishgen: expected no lighting options with --no-light, found --sun")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_help_says_light_is_baked_by_default(cli):
+    text = " ".join(cli("clouds", "--help").stdout.split())
+    assert "--light / --no-light Bake the sunlight" in text and "[default: on]" in text.split("--no-light")[1]
