@@ -28,7 +28,7 @@ def run_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
     import traceback
     from contextlib import redirect_stderr, redirect_stdout
 
-    from fishgen.cli import main
+    from fishgen.cli import status_of
 
     argv = [str(a) for a in args]
     if "fly" in argv and "tests.browser" in sys.modules:
@@ -43,13 +43,7 @@ def run_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
         os.chdir(cwd or ROOT)
         with redirect_stdout(out), redirect_stderr(err):
             try:
-                main(argv)
-            except SystemExit as stop:
-                if stop.code is None or isinstance(stop.code, int):
-                    status = stop.code or 0
-                else:
-                    print(stop.code, file=sys.stderr)
-                    status = 1
+                status = status_of(argv)
             except Exception:  # what Python itself would print, had it escaped the console script
                 traceback.print_exc()
                 status = 1

@@ -99,6 +99,18 @@ def main(argv: list[str] | None = None) -> None:
         _fail(f"fishgen: {where}{err.strerror or err}", 1, err.filename, kind="os")
 
 
+def status_of(argv: list[str] | None = None) -> int:
+    """:func:`main`'s exit status as the shell sees it (a non-numeric exit's message on stderr)."""
+    try:
+        main(argv)
+        return 0
+    except SystemExit as stop:
+        if stop.code is None or isinstance(stop.code, int):
+            return stop.code or 0
+        print(stop.code, file=sys.stderr)
+        return 1
+
+
 def run() -> None:
     """The `fishgen` command (console script and ``python -m fishgen``): :func:`main`, then an exit
     that does not tear the interpreter down.
@@ -108,15 +120,7 @@ def run() -> None:
     renamed into place before :func:`main` returns. The exit handlers still run and the standard
     streams are flushed; with another thread still running, Python exits as usual and waits for it.
     """
-    try:
-        main()
-        status = 0
-    except SystemExit as stop:
-        if stop.code is None or isinstance(stop.code, int):
-            status = stop.code or 0
-        else:
-            print(stop.code, file=sys.stderr)
-            status = 1
+    status = status_of()
     if threading.active_count() > 1:
         sys.exit(status)
     for signum in (signal.SIGINT, signal.SIGTERM):  # too late to interrupt: nothing is left to stop
