@@ -434,12 +434,11 @@ def cloud_textures_option() -> Any:
     return textures_option("a .awa file's folder, then the textures/ folder beside it (or beside its parent)")
 
 
-def max_particles_option(whole: str = "scenes") -> Any:
-    """--max-particles of a command filling clouds: the particles of the whole it makes (``whole``)."""
-    from fishgen.clouds.model import DEFAULT_MAX_PARTICLES  # a dataclass module; no numpy at --help time
-
+def max_particles_option(default: int, whole: str = "scenes") -> Any:
+    """--max-particles of a command filling clouds: the particles of the whole it makes (``whole``).
+    ``default``: the cloud model's own cap, which the caller passes (options sit below the models)."""
     return option(click.IntRange(min=1), f"Refuse {whole} with more particles than this, before allocating "
-                  "anything.", DEFAULT_MAX_PARTICLES)
+                  "anything.", default)
 
 
 def seed_option(help_text: str, default: int | None = 0, shown_default: str | None = None) -> Any:

@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from fishgen.clouds.lighting import Lighting
-from fishgen.clouds.model import METHODS
+from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, METHODS
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
 from fishgen.exchange.registry import POINTS, extensions, formats
 from fishgen.options import Triple, cloud_textures_option, group, max_particles_option, option, seed_option
@@ -30,7 +30,7 @@ class CloudsOptions:
                               f"glTF only: three crossed quads per particle ({BILLBOARD_TRIANGLES} "
                               "triangles, 12 vertices), an alpha-blended Gaussian sprite, instead of points; "
                               "a texture cloud (.awa) is always billboards, with its PNGs.", False, flag=True)
-    max_particles: int = max_particles_option()
+    max_particles: int = max_particles_option(DEFAULT_MAX_PARTICLES)
     textures: Path | None = cloud_textures_option()
     lighting: Lighting = group(Lighting)
     light: bool = option(click.BOOL, "Bake the sunlight into each particle's colour (and its _LIGHT "

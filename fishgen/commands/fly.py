@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 
 from fishgen.clouds.lighting import Lighting
+from fishgen.clouds.model import DEFAULT_MAX_PARTICLES
 from fishgen.commands import QUIET, Command, Events, Inputs, Made
 from fishgen.options import (
     FILE,
@@ -54,7 +55,7 @@ class FlyOptions:
     seed: int = seed_option("It picks a --mode sky's clouds and the headless flight path.")
     port: int = option(click.IntRange(0, 65535), "Port on 127.0.0.1 to serve the page from; 0 picks a free "
                        "one.", 0, manifest=False)
-    max_particles: int = max_particles_option()
+    max_particles: int = max_particles_option(DEFAULT_MAX_PARTICLES)
     textures: Path | None = cloud_textures_option()
     lighting: Lighting = group(Lighting)
 

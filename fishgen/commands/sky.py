@@ -57,7 +57,7 @@ class SkyOptions:
                        "_LOD0/_LOD1/_LOD2 names).", True, flag=True, off="--no-lod")
     billboards: bool = option(click.BOOL, "Particle clouds as crossed-quad billboards instead of points "
                               "(texture clouds always are).", False, flag=True)
-    max_particles: int = max_particles_option("skies")
+    max_particles: int = max_particles_option(DEFAULT_MAX_PARTICLES, "skies")
     textures: Path | None = cloud_textures_option()
     lighting: Lighting = group(Lighting)
 
