@@ -21,6 +21,7 @@ from pathlib import Path
 from fishgen.clouds.parser import texture_roots
 from fishgen.editor.document import SUFFIX
 from fishgen.errors import FishgenError, describe, expected
+from fishgen.reading import read_capped
 
 SUFFIXES = tuple(SUFFIX.values())
 MAX_LISTED = 500
@@ -109,7 +110,7 @@ class Workspace:
         with open(path, "rb") as handle:
             if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):
                 raise expected("a texture file", f"{describe(name)}, a special file")
-            data = handle.read(MAX_TEXTURE_BYTES + 1)
+            data = read_capped(handle, MAX_TEXTURE_BYTES)
         if len(data) > MAX_TEXTURE_BYTES:
             raise expected(f"a texture of at most {MAX_TEXTURE_BYTES >> 20} MiB", f"{describe(name)}, larger")
         if not data.startswith(b"\x89PNG\r\n\x1a\n"):

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 from fishgen.errors import FishgenError, describe
+from fishgen.reading import read_capped
 from fishgen.shape_names import SHAPE_NAMES, check_shape_params
 from fishgen.species.model import (
     Behaviour,
@@ -491,7 +492,7 @@ def load_species(path: str | os.PathLike, textures_dir: str | os.PathLike | None
             raise FishgenError("expected a regular species file, found a device, pipe or other special file",
                                file)
         with path.open("rb") as handle:
-            data = handle.read(MAX_SPECIES_FILE_BYTES + 1)
+            data = read_capped(handle, MAX_SPECIES_FILE_BYTES)
         if len(data) > MAX_SPECIES_FILE_BYTES:
             raise FishgenError(f"expected a species file of at most {MAX_SPECIES_FILE_BYTES} bytes, "
                                "found a larger file", file, 1)

@@ -16,6 +16,7 @@ import re
 from dataclasses import fields
 
 from fishgen.errors import FishgenError
+from fishgen.reading import read_capped
 from fishgen.species.model import TexturePoints, Vec2
 
 PARTS = tuple(f.name for f in fields(TexturePoints))
@@ -158,7 +159,7 @@ def read_fxl(path: str | os.PathLike) -> dict[str, list[Vec2]]:
                 raise FishgenError("expected a regular .FXL file, found a device, pipe or other special file",
                                    path)
             with os.fdopen(os.dup(fd), "rb") as handle:
-                data = handle.read(MAX_FXL_BYTES + 1)
+                data = read_capped(handle, MAX_FXL_BYTES)
         finally:
             os.close(fd)
     except OSError as err:

@@ -1,0 +1,24 @@
+"""Reading an input with a size cap, without reserving the cap."""
+from __future__ import annotations
+
+import os
+from typing import BinaryIO
+
+
+def read_capped(handle: BinaryIO, limit: int) -> bytes:
+    """Up to ``limit + 1`` bytes of an open binary file: one byte more than ``limit`` tells the caller
+    the file is too big. ``read(n)`` allocates ``n`` bytes before it reads, so a 1 KB species file
+    read as ``read(64 MiB + 1)`` reserved 64 MiB; this asks for what the file holds (a file that
+    grows meanwhile is read on, up to the cap)."""
+    try:
+        size = os.fstat(handle.fileno()).st_size
+    except (OSError, AttributeError, ValueError):  # no descriptor (a BytesIO): ask for the cap
+        size = limit
+    data = handle.read(min(size, limit) + 1)
+    while size < len(data) <= limit:              # grew since fstat: read on, to the cap at most
+        more = handle.read(limit + 1 - len(data))
+        if not more:
+            break
+        data += more
+        size = len(data) - 1
+    return data
