@@ -309,6 +309,11 @@ def _check_ply_header(path: Path) -> None:
 
 
 def _finite(positions: np.ndarray, path: Path) -> None:
+    """Vertices of three finite coordinates each: what the scene model and every pose assume."""
+    if positions.ndim != 2 or positions.shape[1] != 3:
+        found = positions.shape[1] if positions.ndim == 2 else positions.ndim
+        raise expected("vertices of three coordinates each", f"{found} per vertex as the file was read",
+                       path)
     if len(positions) and not np.isfinite(positions).all():
         bad = int(np.argmax(~np.isfinite(positions).all(axis=1)))
         raise expected("finite vertex coordinates", f"{positions[bad].tolist()} at vertex {bad + 1}", path)

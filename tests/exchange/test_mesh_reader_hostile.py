@@ -204,3 +204,15 @@ def test_a_library_fault_is_said_about_the_file_not_named_by_its_exception():
         "content the PLY reader cannot parse")
     assert what_was_found(ValueError("could not convert string to float: 'x'"), "OBJ") == (
         "could not convert string to float: 'x'")
+
+
+def test_an_obj_that_trimesh_reads_as_flat_vertices_is_refused_in_one_line():
+    """Fuzz run seed 31, obj #21176: a mutated OBJ that trimesh loads with two coordinates a vertex;
+    posing it raised numpy's ValueError. The reader now refuses it, naming the file."""
+    from fishgen.errors import FishgenError
+    from fishgen.exchange.mesh_reader import read_mesh_file
+    from tests.conftest import ROOT
+
+    path = ROOT / "tests" / "fixtures" / "obj_read_as_2d" / "pineapplefish.obj"
+    with pytest.raises(FishgenError, match="expected vertices of three coordinates each, found 2"):
+        read_mesh_file(path)
