@@ -32,6 +32,12 @@ from fishgen.fuzz.verdict import CaseTimeout, Outcome
 #: context another ~650 MB (measured with /proc/self/status VmPeak), so a correct CLI preview
 #: peaks near 1.0 GB; everything a correct run needs fits well inside 1.5 GB.
 DEFAULT_BUDGET_MB = 1536
+#: A worker whose address space comes within this much of its budget retires after its batch and
+#: a fresh one takes its place: one process runs ~10^5 cases, and what the libraries keep (caches,
+#: an EGL context, a fragmented heap) grows until a correct case finds no room (seed 31: a
+#: MemoryError reading a 1 KB file, and one in the fuzzer's own case generation, each of which
+#: replays clean in a fresh process).
+RETIRE_HEADROOM_MB = 256
 #: Seconds one case may take (parsers are ~1 ms, readers ~10 ms, CLI previews ~0.3 s).
 TIME_LIMITS = {"species": 2.0, "cubes": 2.0, "gltf": 5.0, "obj": 5.0, "ply": 5.0, "cli": 20.0,
                "scene": 5.0, "paths": 5.0, "manifest": 5.0, "fxl": 2.0, "photo": 30.0, "awa": 5.0,
@@ -72,13 +78,15 @@ class Report:
     stats: dict[str, Stats] = field(default_factory=dict)
     findings: dict[str, Finding] = field(default_factory=dict)
     wall: float = 0.0
+    retired: int = 0    # workers replaced because they neared their memory budget
 
     @property
     def total(self) -> int:
         return sum(s.inputs for s in self.stats.values())
 
 
-def _worker(conn, progress, corpus: str, budget: int, workdir: str, quiet: bool = True) -> None:
+def _worker(conn, progress, corpus: str, budget: int, workdir: str, headroom: int,
+            quiet: bool = True) -> None:
     # Import everything a case may need before the memory limit, as a long-lived tool would.
     import fishgen.assembly.fish  # noqa: F401
 
@@ -151,12 +159,28 @@ def _worker(conn, progress, corpus: str, budget: int, workdir: str, quiet: bool 
                 found.append((index, outcome.key, outcome.detail))
             else:
                 counts[outcome.status] += 1
-        conn.send((counts, found, time.monotonic() - start))
+        retire = bool(budget) and _address_space() > budget - headroom
+        conn.send((counts, found, time.monotonic() - start, retire))
+        if retire:
+            break
+
+
+def _address_space() -> int:
+    """This process's address space in bytes (what RLIMIT_AS caps); 0 where /proc does not say."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("VmSize:"):
+                    return int(line.split()[1]) << 10
+    except OSError:
+        pass
+    return 0
 
 
 class _Worker:
-    def __init__(self, ctx, corpus: Path, budget: int, root: Path, number: int):
+    def __init__(self, ctx, corpus: Path, budget: int, root: Path, number: int, headroom: int):
         self.ctx, self.corpus, self.budget, self.number = ctx, corpus, budget, number
+        self.headroom = headroom
         self.workdir = root / f"w{number}"
         self.batch: tuple[str, int, list[int]] | None = None
         self.sent = 0.0
@@ -168,7 +192,7 @@ class _Worker:
         self.progress = self.ctx.RawArray("d", [-1.0, 0.0])
         self.proc = self.ctx.Process(target=_worker, daemon=True,
                                      args=(child, self.progress, str(self.corpus), self.budget,
-                                           str(self.workdir)))
+                                           str(self.workdir), self.headroom))
         self.proc.start()
         child.close()
 
@@ -192,6 +216,7 @@ class _Worker:
         self.proc.join(5)
         if self.proc.is_alive():
             self.kill()
+        self.conn.close()
 
 
 def _slug(key: str) -> str:
@@ -201,8 +226,9 @@ def _slug(key: str) -> str:
 def run(targets: list[str], *, seed: int = 0, minutes: float | None = None,
         counts: dict[str, int] | None = None, jobs: int = 1, corpus: Path = DEFAULT_CORPUS,
         findings_dir: Path | None = None, budget_mb: int = DEFAULT_BUDGET_MB,
-        on_finding=None) -> Report:
+        on_finding=None, headroom_mb: int = RETIRE_HEADROOM_MB) -> Report:
     """Fuzz ``targets`` for ``minutes`` (round-robin by time) or ``counts[target]`` inputs each.
+    A worker within ``headroom_mb`` of ``budget_mb`` after a batch is replaced by a fresh one.
 
     Case indices start at 0, so every run first replays the whole seed corpus verbatim.
     """
@@ -216,7 +242,7 @@ def run(targets: list[str], *, seed: int = 0, minutes: float | None = None,
     ctx = mp.get_context("forkserver")
     ctx.set_forkserver_preload(["fishgen.fuzz.runner"])
     root = Path(tempfile.mkdtemp(prefix="fishgen-fuzz-"))
-    workers = [_Worker(ctx, corpus, budget_mb << 20, root, j) for j in range(max(1, jobs))]
+    workers = [_Worker(ctx, corpus, budget_mb << 20, root, j, headroom_mb << 20) for j in range(max(1, jobs))]
     started = time.monotonic()
 
     def record(target: str, index: int, key: str, detail: str) -> None:
@@ -283,7 +309,7 @@ def run(targets: list[str], *, seed: int = 0, minutes: float | None = None,
                 target, _, indices = w.batch
                 if w.conn in ready:
                     try:
-                        done, found, elapsed = w.conn.recv()
+                        done, found, elapsed, retire = w.conn.recv()
                     except (EOFError, OSError):
                         done = None
                     if done is not None:
@@ -295,6 +321,10 @@ def run(targets: list[str], *, seed: int = 0, minutes: float | None = None,
                         for index, key, detail in found:
                             record(target, index, key, detail)
                         w.batch = None
+                        if retire:  # near its memory budget: a fresh worker takes over
+                            report.retired += 1
+                            w.stop()
+                            w.start()
                         continue
                 current = int(w.progress[0])
                 stuck = now - w.progress[1] > TIME_LIMITS[target] + GRACE

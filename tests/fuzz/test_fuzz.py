@@ -170,3 +170,12 @@ def test_the_editor_judge(monkeypatch):
     monkeypatch.setattr(Session, "lists", writing_outside)
     assert judge(lists).key == "editor: a file written outside the editor's folder"
     assert judge(bad_token).status == "ok"  # refused before the route: nothing written
+
+
+def test_a_worker_near_its_memory_budget_is_replaced_and_no_case_is_lost(tmp_path):
+    """With the headroom as large as the budget every worker retires after each batch: the run still
+    covers every input, finds nothing, and says how many workers it replaced."""
+    report = run(["species", "cubes"], seed=3, counts={"species": 250, "cubes": 250}, jobs=1,
+                 findings_dir=tmp_path, budget_mb=1536, headroom_mb=1536)
+    assert report.stats["species"].inputs == 250 and report.stats["cubes"].inputs == 250
+    assert report.findings == {} and report.retired >= 4
