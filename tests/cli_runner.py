@@ -38,7 +38,6 @@ def run_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
     logger = logging.getLogger("fishgen")
     log_handlers, log_level = list(logger.handlers), logger.level
     here = os.getcwd()
-    status = 0
     try:
         os.chdir(cwd or ROOT)
         with redirect_stdout(out), redirect_stderr(err):
