@@ -4,6 +4,8 @@
     python benchmarks/clouds.py --quick         # smoke run, small sizes only
     python benchmarks/clouds.py --writers-only  # CSV vs PLY writer, 10^6 particles
     python benchmarks/clouds.py --light-only    # lighting vs fill, and lit vs unlit whole runs
+    python benchmarks/clouds.py --cost          # issue 32: the whole command's marginal cost per
+                                                # particle, lit and --no-light, against plain loops
     chrt -f 10 python benchmarks/clouds.py --light-only   # the same, ahead of everything else
                                                           # running (root; a busy shared machine)
 
@@ -92,6 +94,22 @@ def plain_fill(cube_file: CubeFile, seed: int) -> list[tuple]:
     return out
 
 
+def plain_ply(cube_file: CubeFile, seed: int, path: str) -> None:
+    """The plain loop as a whole program: the report's fill, then each particle packed into the
+    PLY record `fishgen clouds --no-light` writes (centre, radius, density, sRGB white)."""
+    import struct
+
+    rows = plain_fill(cube_file, seed)
+    pack = struct.Struct("<5f3B").pack
+    header = ("ply\nformat binary_little_endian 1.0\n"
+              f"element vertex {len(rows)}\n"
+              + "".join(f"property float {n}\n" for n in ("x", "y", "z", "radius", "density"))
+              + "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n")
+    with open(path, "wb") as handle:
+        handle.write(header.encode("ascii"))
+        handle.write(b"".join(pack(*row, 255, 255, 255) for row in rows))
+
+
 def median_time(run, repeats: int) -> float:
     times = []
     for _ in range(repeats):
@@ -107,6 +125,8 @@ COMMANDS = {
                                   "--no-light"],
     "unlit": lambda awn, ply: [sys.executable, __file__, "--run", "unlit", str(awn), str(ply)],
     "lit": lambda awn, ply: [sys.executable, __file__, "--run", "lit", str(awn), str(ply)],
+    "plain": lambda awn, ply: [sys.executable, __file__, "--run", "plain", str(awn), str(ply)],
+    "plain-ply": lambda awn, ply: [sys.executable, __file__, "--run", "plain-ply", str(awn), str(ply)],
 }
 """`fishgen clouds` as the command line runs it today (lit, and with --no-light), and the library
 steps the command runs,
@@ -117,6 +137,13 @@ def run(kind: str, awn: str, ply: str) -> None:
     """One whole run, as the `--run` child process: what `fishgen clouds AWN -o PLY` does."""
     from fishgen.clouds import export_cloud
 
+    if kind == "plain":               # the fill only, as the issue's baseline; nothing written
+        plain_fill(load_cubes(awn), 0)
+        Path(ply).write_bytes(b"\0" * 24 * len(load_cubes(awn).cubes))  # whole_command checks a file
+        return
+    if kind == "plain-ply":
+        plain_ply(load_cubes(awn), 0, ply)
+        return
     cloud = fill_cloud(load_cubes(awn), seed=0)
     if kind == "lit":
         cloud = light_cloud(cloud, Lighting())
@@ -141,7 +168,7 @@ def whole_command(n: int, workdir: Path, repeats: int, kinds=("fishgen",)) -> di
                                  cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
             times[kind].append(float(out[0]))
             peaks[kind].append(int(out[1]) * 1024)  # ru_maxrss is in KiB on Linux
-            assert ply.stat().st_size > 23 * n
+            assert ply.stat().st_size > (0 if kind == "plain" else 23 * n)
             ply.unlink()
     return {k: (statistics.median(times[k]), max(peaks[k])) for k in kinds}
 
@@ -181,6 +208,30 @@ def light_report(sizes: list[int], command_size: int, repeats: int, workdir: Pat
     print(f"  `fishgen clouds` / `--no-light`: {runs['fishgen'][0] / runs['no-light'][0]:.2f}x")
 
 
+def cost_report(small: int, large: int, plain_size: int, repeats: int, workdir: Path) -> None:
+    """Issue 32, item 3: the whole command's marginal cost per particle between ``small`` and
+    ``large`` particles, lit (as shipped) and --no-light, against the plain loops' cost per
+    particle at ``plain_size`` (each a fresh process, so the loop's heap is its own): the fill
+    alone (the issue's baseline) and the fill plus packing and writing the same PLY. Target: the
+    lit command's marginal cost at least 50x below the plain fill's."""
+    kinds = ("fishgen", "no-light")
+    low = whole_command(small, workdir, repeats, kinds)
+    high = whole_command(large, workdir, repeats, kinds)
+    plain = whole_command(plain_size, workdir, repeats, ("plain", "plain-ply"))
+    per = {k: plain[k][0] / plain_size for k in plain}   # start-up (~30 ms) left in: < 2 %
+    print(f"\nwhole command, Table 4.4 cloud to PLY, medians of {repeats}, kinds interleaved run by run:")
+    print("| command | " + f"{small:,} | {large:,} | marginal per particle | plain fill / marginal "
+          "| plain fill+PLY / marginal |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for kind, label in (("fishgen", "`fishgen clouds` (lit)"), ("no-light", "`fishgen clouds --no-light`")):
+        marginal = (high[kind][0] - low[kind][0]) / (large - small)
+        print(f"| {label} | {low[kind][0]:.2f} s | {high[kind][0]:.2f} s | {marginal * 1e9:.0f} ns "
+              f"| {per['plain'] / marginal:.1f}x | {per['plain-ply'] / marginal:.1f}x |")
+    print(f"plain loops at {plain_size:,} particles, whole process: "
+          f"fill {per['plain'] * 1e9:,.0f} ns a particle, fill + PLY {per['plain-ply'] * 1e9:,.0f} ns")
+    print("target (issue 32): lit marginal cost >= 50x below the plain fill's")
+
+
 def writers(n: int, workdir: Path, repeats: int) -> None:
     """Median time of the CSV and PLY writers for one n-particle cloud, interleaved."""
     cloud = fill_cloud(scaled_cubes(n), seed=1)
@@ -211,10 +262,17 @@ def main() -> None:
     parser.add_argument("--light-only", action="store_true",
                         help="only the lighting figures: vs the fill at --light-sizes, whole runs at --command-size")
     parser.add_argument("--light-sizes", default="1e5,1e6", help="particle counts to light [default: %(default)s]")
+    parser.add_argument("--cost", action="store_true",
+                        help="only the whole command's marginal cost per particle against the plain loops")
     parser.add_argument("--run", nargs=3, metavar=("KIND", "AWN", "PLY"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.run:
         run(*args.run)
+        return
+    if args.cost:
+        with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:
+            cost_report(10**6, int(args.command_size), 10**6, args.repeats if args.repeats != 5 else 3,
+                        Path(tmp))
         return
     if args.light_only:
         with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:
