@@ -6,6 +6,10 @@ regenerates each case from ``(seed, target, index)``, runs it in-process with a 
 counts and findings. The parent is a watchdog: a worker that stops making progress (a hang
 in C code the timer cannot interrupt) is killed and restarted, and a worker that dies (the
 kernel's OOM killer, a crash under the memory limit) is a finding as well.
+
+A case's time budget is CPU time (the worker's, all its threads), not wall time: on a shared
+machine a loaded hour made cases that take 15 s of CPU take 30 s of wall time, and a wall-clock
+budget reported the machine's load as fishgen's overrun (seed 33's run, issue 32 item 5).
 """
 from __future__ import annotations
 
@@ -42,8 +46,11 @@ RETIRE_HEADROOM_MB = 256
 TIME_LIMITS = {"species": 2.0, "cubes": 2.0, "gltf": 5.0, "obj": 5.0, "ply": 5.0, "cli": 20.0,
                "scene": 5.0, "paths": 5.0, "manifest": 5.0, "fxl": 2.0, "photo": 30.0, "awa": 5.0,
                "editor": 10.0, "options": 20.0}
-#: Extra seconds the parent waits past a case's limit before killing a worker stuck in C code.
+#: Extra CPU seconds the parent allows past a case's limit before killing a worker stuck in C code.
 GRACE = 10.0
+#: A case still running after this many times its limit in wall time (plus GRACE) is hung even
+#: without using CPU (a wait that never ends); a loaded machine stretches wall time, so it is wide.
+WALL_FACTOR = 6.0
 BATCH = {"species": 100, "cubes": 200, "gltf": 20, "obj": 10, "ply": 20, "cli": 2,
          "scene": 50, "paths": 10, "manifest": 50, "fxl": 200, "photo": 1, "awa": 20, "editor": 5,
          "options": 2}
@@ -127,7 +134,7 @@ def _worker(conn, progress, corpus: str, budget: int, workdir: str, headroom: in
     def alarm(*_):
         raise CaseTimeout("per-case time limit")
 
-    signal.signal(signal.SIGALRM, alarm)
+    signal.signal(signal.SIGPROF, alarm)
     if budget:
         resource.setrlimit(resource.RLIMIT_AS, (budget, budget))
     work = Path(workdir)
@@ -140,9 +147,9 @@ def _worker(conn, progress, corpus: str, budget: int, workdir: str, headroom: in
         found: list[tuple[int, str, str]] = []
         start = time.monotonic()
         for index in indices:
-            progress[0], progress[1] = index, time.monotonic()
+            progress[0], progress[1], progress[2] = index, time.monotonic(), _cpu_seconds() or 0.0
             try:
-                signal.setitimer(signal.ITIMER_REAL, limit)
+                signal.setitimer(signal.ITIMER_PROF, limit)
                 try:
                     case = make_case(seeds, target, seed, index)
                 except Exception as err:  # a bug in the fuzzer itself: shown, never hidden
@@ -154,7 +161,7 @@ def _worker(conn, progress, corpus: str, budget: int, workdir: str, headroom: in
             except MemoryError:
                 outcome = Outcome("finding", f"budget overrun (memory) in {target} (outside fishgen)", "")
             finally:
-                signal.setitimer(signal.ITIMER_REAL, 0)
+                signal.setitimer(signal.ITIMER_PROF, 0)
             if outcome.status == "finding":
                 found.append((index, outcome.key, outcome.detail))
             else:
@@ -177,6 +184,31 @@ def _address_space() -> int:
     return 0
 
 
+_TICK = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+
+
+def _cpu_seconds(pid: int | str = "self") -> float | None:
+    """User + system CPU seconds of process ``pid`` so far, all its threads; None where /proc
+    does not say (the watchdog then goes by wall time alone)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
+            fields = stat.read().rsplit(")", 1)[1].split()
+    except (OSError, IndexError):
+        return None
+    return (int(fields[11]) + int(fields[12])) / _TICK    # utime, stime: fields 14, 15 of stat
+
+
+def _hung(pid: int, progress, now: float, limit: float) -> bool:
+    """Whether the worker's current case ran past its CPU limit plus GRACE (stuck in C code the
+    timer cannot interrupt), or past WALL_FACTOR times it in wall time (stuck waiting)."""
+    if now - progress[1] > WALL_FACTOR * limit + GRACE:
+        return True
+    cpu = _cpu_seconds(pid)
+    if cpu is None:
+        return now - progress[1] > limit + GRACE
+    return cpu - progress[2] > limit + GRACE
+
+
 class _Worker:
     def __init__(self, ctx, corpus: Path, budget: int, root: Path, number: int, headroom: int):
         self.ctx, self.corpus, self.budget, self.number = ctx, corpus, budget, number
@@ -189,7 +221,7 @@ class _Worker:
     def start(self) -> None:
         self.workdir.mkdir(parents=True, exist_ok=True)
         self.conn, child = self.ctx.Pipe()
-        self.progress = self.ctx.RawArray("d", [-1.0, 0.0])
+        self.progress = self.ctx.RawArray("d", [-1.0, 0.0, 0.0])  # case, its wall and CPU start
         self.proc = self.ctx.Process(target=_worker, daemon=True,
                                      args=(child, self.progress, str(self.corpus), self.budget,
                                            str(self.workdir), self.headroom))
@@ -198,7 +230,7 @@ class _Worker:
 
     def send(self, target: str, seed: int, indices: list[int]) -> None:
         self.batch = (target, seed, indices)
-        self.progress[0], self.progress[1] = -1.0, time.monotonic()
+        self.progress[0], self.progress[1], self.progress[2] = -1.0, time.monotonic(), 0.0
         self.sent = time.monotonic()
         self.conn.send((target, seed, indices, TIME_LIMITS[target]))
 
@@ -327,7 +359,7 @@ def run(targets: list[str], *, seed: int = 0, minutes: float | None = None,
                             w.start()
                         continue
                 current = int(w.progress[0])
-                stuck = now - w.progress[1] > TIME_LIMITS[target] + GRACE
+                stuck = _hung(w.proc.pid, w.progress, now, TIME_LIMITS[target])
                 if w.proc.is_alive() and not stuck:
                     continue
                 # died or hung: the current case is a finding; the rest of the batch is run again
@@ -337,7 +369,7 @@ def run(targets: list[str], *, seed: int = 0, minutes: float | None = None,
                     current = indices[0]
                 if stuck:
                     hung = TIME_LIMITS[target] + GRACE
-                    key = f"budget overrun (time: hung in C code past {hung:.0f} s) in {target}"
+                    key = f"budget overrun (time: hung in C code past {hung:.0f} CPU s) in {target}"
                 else:
                     key = f"worker died ({_death(code)}) in {target}"
                 done_before = indices.index(current) if current in indices else 0

@@ -179,3 +179,30 @@ def test_a_worker_near_its_memory_budget_is_replaced_and_no_case_is_lost(tmp_pat
                  findings_dir=tmp_path, budget_mb=1536, headroom_mb=1536)
     assert report.stats["species"].inputs == 250 and report.stats["cubes"].inputs == 250
     assert report.findings == {} and report.retired >= 4
+
+
+def test_a_case_is_timed_by_its_cpu_not_by_the_machines_load():
+    """A worker waiting three times its limit in wall time (a loaded machine) is not hung; one past
+    its limit in CPU seconds is, and one waiting past WALL_FACTOR times its limit is too."""
+    import subprocess
+    import sys
+    import time
+
+    from fishgen.fuzz.runner import GRACE, WALL_FACTOR, _cpu_seconds, _hung
+
+    sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
+    try:
+        limit, now = 2.0, time.monotonic()
+        started = _cpu_seconds(sleeper.pid)
+        assert started is not None
+        assert not _hung(sleeper.pid, [0, now - 3 * limit, started], now, limit)
+        assert _hung(sleeper.pid, [0, now - 3 * limit, started - limit - GRACE - 1], now, limit)
+        assert _hung(sleeper.pid, [0, now - WALL_FACTOR * limit - GRACE - 1, started], now, limit)
+    finally:
+        sleeper.kill()
+        sleeper.wait()
+    before = _cpu_seconds()
+    end = time.process_time() + 0.3
+    while time.process_time() < end:
+        pass
+    assert before is not None and _cpu_seconds() - before >= 0.2   # type: ignore[operator]
