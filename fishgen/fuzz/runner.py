@@ -9,7 +9,9 @@ kernel's OOM killer, a crash under the memory limit) is a finding as well.
 
 A case's time budget is CPU time (the worker's, all its threads), not wall time: on a shared
 machine a loaded hour made cases that take 15 s of CPU take 30 s of wall time, and a wall-clock
-budget reported the machine's load as fishgen's overrun (seed 33's run, issue 32 item 5).
+budget reported the machine's load as fishgen's overrun (seed 33's run, issue 32 item 5). The
+watchdog's backstop for a case that waits without using CPU leaves out the time the worker
+waited for a core: a niced run beside busy neighbours waited a minute for one.
 """
 from __future__ import annotations
 
@@ -147,7 +149,8 @@ def _worker(conn, progress, corpus: str, budget: int, workdir: str, headroom: in
         found: list[tuple[int, str, str]] = []
         start = time.monotonic()
         for index in indices:
-            progress[0], progress[1], progress[2] = index, time.monotonic(), _cpu_seconds() or 0.0
+            progress[0], progress[1] = index, time.monotonic()
+            progress[2], progress[3] = _clock() or (0.0, 0.0)
             try:
                 signal.setitimer(signal.ITIMER_PROF, limit)
                 try:
@@ -187,26 +190,30 @@ def _address_space() -> int:
 _TICK = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
 
 
-def _cpu_seconds(pid: int | str = "self") -> float | None:
-    """User + system CPU seconds of process ``pid`` so far, all its threads; None where /proc
-    does not say (the watchdog then goes by wall time alone)."""
+def _clock(pid: int | str = "self") -> tuple[float, float] | None:
+    """Process ``pid``'s CPU seconds so far (user + system, all its threads) and the seconds its
+    main thread waited for a core (runnable, not run); None where /proc does not say (the
+    watchdog then goes by wall time alone)."""
     try:
         with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
             fields = stat.read().rsplit(")", 1)[1].split()
-    except (OSError, IndexError):
+        with open(f"/proc/{pid}/schedstat", encoding="ascii") as sched:
+            waited = int(sched.read().split()[1]) / 1e9
+    except (OSError, IndexError, ValueError):
         return None
-    return (int(fields[11]) + int(fields[12])) / _TICK    # utime, stime: fields 14, 15 of stat
+    return (int(fields[11]) + int(fields[12])) / _TICK, waited   # utime, stime: stat's 14th, 15th
 
 
 def _hung(pid: int, progress, now: float, limit: float) -> bool:
-    """Whether the worker's current case ran past its CPU limit plus GRACE (stuck in C code the
-    timer cannot interrupt), or past WALL_FACTOR times it in wall time (stuck waiting)."""
-    if now - progress[1] > WALL_FACTOR * limit + GRACE:
-        return True
-    cpu = _cpu_seconds(pid)
-    if cpu is None:
+    """Whether the worker's current case ran past its limit plus GRACE in CPU seconds (stuck in C
+    code the timer cannot interrupt), or past WALL_FACTOR times it in wall time less the time it
+    waited for a core (stuck waiting; a starved worker on a busy machine is not)."""
+    clock = _clock(pid)
+    if clock is None:
         return now - progress[1] > limit + GRACE
-    return cpu - progress[2] > limit + GRACE
+    cpu, waited = clock
+    return (cpu - progress[2] > limit + GRACE
+            or now - progress[1] - (waited - progress[3]) > WALL_FACTOR * limit + GRACE)
 
 
 class _Worker:
@@ -221,7 +228,8 @@ class _Worker:
     def start(self) -> None:
         self.workdir.mkdir(parents=True, exist_ok=True)
         self.conn, child = self.ctx.Pipe()
-        self.progress = self.ctx.RawArray("d", [-1.0, 0.0, 0.0])  # case, its wall and CPU start
+        # the case, and its start: wall time, CPU time, time waited for a core
+        self.progress = self.ctx.RawArray("d", [-1.0, 0.0, 0.0, 0.0])
         self.proc = self.ctx.Process(target=_worker, daemon=True,
                                      args=(child, self.progress, str(self.corpus), self.budget,
                                            str(self.workdir), self.headroom))
@@ -230,7 +238,7 @@ class _Worker:
 
     def send(self, target: str, seed: int, indices: list[int]) -> None:
         self.batch = (target, seed, indices)
-        self.progress[0], self.progress[1], self.progress[2] = -1.0, time.monotonic(), 0.0
+        self.progress[:] = [-1.0, time.monotonic(), 0.0, 0.0]
         self.sent = time.monotonic()
         self.conn.send((target, seed, indices, TIME_LIMITS[target]))
 
