@@ -238,7 +238,8 @@ class _Worker:
 
     def send(self, target: str, seed: int, indices: list[int]) -> None:
         self.batch = (target, seed, indices)
-        self.progress[:] = [-1.0, time.monotonic(), 0.0, 0.0]
+        # until its first case starts, the worker is timed from now, on its clocks as they stand
+        self.progress[:] = [-1.0, time.monotonic(), *(_clock(self.proc.pid) or (0.0, 0.0))]
         self.sent = time.monotonic()
         self.conn.send((target, seed, indices, TIME_LIMITS[target]))
 
