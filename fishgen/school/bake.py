@@ -22,7 +22,7 @@ import numpy as np
 from fishgen.assembly.body_wave import wave_nodes
 from fishgen.assembly.instance import add_species
 from fishgen.geometry.body_wave import BodyWave, integrate_phase, wave_weights
-from fishgen.scene.model import Channel, Clip, Node, Path_, Sampler, Scene
+from fishgen.scene.model import Channel, Clip, Instancer, Node, Path_, Sampler, Scene
 from fishgen.scene.pose import sample
 from fishgen.school.model import Tracks
 
@@ -30,6 +30,8 @@ STEPS = (2, 3, 4, 6, 8, 12, 16, 24, 30)
 """Key spacings tried, in frames; the longest is a one-second horizon at 30 fps."""
 TINT_STREAM = 0x7157
 """Mixed into the seed of the generators that tint: the fin and wave phases keep their own."""
+PROTOTYPE_STREAM = 0x1A57
+"""Mixed into the seed of the generator that gives each fish its prototype (:func:`bake_prototypes`)."""
 FIN_PHASES = 16
 """Distinct fin phases per species: fish sharing one share its fin keys in the file, and 16 phases
 already keep neighbours from beating in step."""
@@ -306,3 +308,36 @@ def _school_keys(fish_scenes: list[Scene], tracks: Tracks, tolerance: float, see
     weights = (None if phases is None or duration <= 0
                else wave_weights(np.ascontiguousarray(phases.T)).astype(np.float32))
     return _Keys(times.astype(np.float32), duration, rng, position_keys, rotation_keys, weights)
+
+
+def bake_prototypes(fish_scenes: list[Scene], tracks: Tracks, *, prototypes: int = 4, seed: int = 0,
+                    fps: float = 30.0) -> Scene:
+    """The school as one :class:`Instancer`: ``prototypes`` copies of each species' fish whose swim
+    clips run phase-shifted (by 1/``prototypes`` of a loop each) over the whole run, and every fish
+    one of its species' prototypes, seeded, placed every frame by its tracks. Fish of one prototype
+    share one pose: the tail beats at the species' own speed, not the fish's (:func:`bake`'s)."""
+    times = np.asarray(tracks.times, np.float64)
+    duration = float(times[-1]) if len(times) else 0.0
+    protos = [_phase_shifted(fish, f"{fish.name}_{p}", p / prototypes, duration)
+              for fish in fish_scenes for p in range(prototypes)]
+    phase = np.random.default_rng((seed, PROTOTYPE_STREAM)).integers(0, prototypes, len(tracks.group))
+    index = np.asarray(tracks.group, np.int64) * prototypes + phase
+    crowd = Instancer("fish", protos, index, times, np.asarray(tracks.positions, np.float32),
+                      np.asarray(tracks.headings, np.float32), np.asarray(tracks.scale, np.float32))
+    return Scene(name="school", instancers=[crowd], fps=fps)
+
+
+def _phase_shifted(fish: Scene, name: str, share: float, duration: float) -> Scene:
+    """``fish`` whose swim clip starts ``share`` of a loop in and runs for ``duration`` seconds;
+    channels that shared a sampler still share one."""
+    swim = fish.clip("swim")
+    if swim is None or duration <= 0:
+        return replace(fish, name=name, clips=[])
+    shifted: dict[int, Sampler] = {}
+    channels = []
+    for channel in swim.channels:
+        if id(channel.sampler) not in shifted:
+            t, v = _fin_keys(channel, swim.duration * share, duration)
+            shifted[id(channel.sampler)] = Sampler(t.astype(np.float32), v.astype(np.float32))
+        channels.append(Channel(channel.node, channel.path, shifted[id(channel.sampler)]))
+    return replace(fish, name=name, clips=[Clip("swim", channels)])
