@@ -159,8 +159,9 @@ def _instancer(stage, where, inst: Instancer, times: np.ndarray, pictures: _Pict
     positions = np.asarray(inst.positions, np.float32)
     turns = np.asarray(inst.orientations, np.float64)
     turns = turns / np.linalg.norm(turns, axis=2, keepdims=True)
-    extents = _instance_extents(np.stack(boxes)[index], positions, turns, scales)
     halves = turns.astype(np.float16)
+    # the box of what a reader draws: from the half-precision turns the file holds
+    extents = _instance_extents(np.stack(boxes)[index], positions, halves.astype(np.float64), scales)
     position_attr, turn_attr = points.CreatePositionsAttr(), points.CreateOrientationsAttr()
     extent_attr = points.CreateExtentAttr()
     for f in range(len(positions)):  # one whole array per time sample
@@ -173,12 +174,12 @@ def _instance_extents(boxes: np.ndarray, positions: np.ndarray, turns: np.ndarra
                       scales: np.ndarray) -> np.ndarray:
     """(F, 2, 3) per frame, the box around every copy's prototype box (N, 2, 3) scaled, turned and
     moved: what UsdGeomPointInstancer::ComputeExtentAtTime gives (a turned box's corners reach
-    its turned centre plus or minus |R| times its half size)."""
+    its turned centre plus or minus |R| times its half size). ``turns`` as the file holds them."""
     from fishgen.scene.pose import quat_matrices
 
     centre = 0.5 * (boxes[:, 0] + boxes[:, 1]) * scales                             # (N, 3)
     half = 0.5 * (boxes[:, 1] - boxes[:, 0]) * scales
-    turn = quat_matrices(turns)                                                     # (F, N, 3, 3)
+    turn = quat_matrices(turns, normalize=False)    # (F, N, 3, 3), as usd-core turns the file's halves
     middle = np.einsum("fnij,nj->fni", turn, centre) + positions
     reach = np.einsum("fnij,nj->fni", np.abs(turn), half)
     return np.stack([(middle - reach).min(axis=1), (middle + reach).max(axis=1)], axis=1).astype(np.float32)

@@ -139,12 +139,15 @@ def quat_matrix(q: np.ndarray) -> np.ndarray:
     ])
 
 
-def quat_matrices(q: np.ndarray) -> np.ndarray:
-    """(..., 3, 3) rotation matrices of (..., 4) quaternions (x, y, z, w), normalized first."""
+def quat_matrices(q: np.ndarray, normalize: bool = True) -> np.ndarray:
+    """(..., 3, 3) rotation matrices of (..., 4) quaternions (x, y, z, w), normalized first unless
+    ``normalize`` is False (then the unit formula as it stands, which is what USD applies to an
+    instancer's half-precision orientations)."""
     q = np.asarray(q, float)
-    norm = np.linalg.norm(q, axis=-1, keepdims=True)
-    unit = np.where(norm > 0, q / np.where(norm > 0, norm, 1.0), [0.0, 0.0, 0.0, 1.0])
-    x, y, z, w = np.moveaxis(unit, -1, 0)
+    if normalize:
+        norm = np.linalg.norm(q, axis=-1, keepdims=True)
+        q = np.where(norm > 0, q / np.where(norm > 0, norm, 1.0), [0.0, 0.0, 0.0, 1.0])
+    x, y, z, w = np.moveaxis(q, -1, 0)
     return np.stack([
         np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
         np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
