@@ -209,9 +209,10 @@ register_format(Format("texture cubes", (".awa",), "a RekAwan texture cloud file
                                                                                              TEXTURES}),
                        reader="fishgen.clouds.scene:cube_file_scene", command="clouds",
                        reads_with=("seed", "lighting", "textures_dir")))
-register_format(Format("usd", (".usdc", ".usda", ".usdz"),
-                       "OpenUSD (binary, text or a usdz package): a fish as a skinned UsdSkel mesh, a "
-                       "school as a PointInstancer; needs usd-core",
-                       frozenset({MESHES, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS, ALPHA_CUTOFF,
-                                  DOUBLE_SIDED, INSTANCES}),
-                       "fishgen.exchange.usd:write_usd", extra=("pxr", "usd-core", "usd")))
+_USD = frozenset({MESHES, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS, ALPHA_CUTOFF, DOUBLE_SIDED,
+                  INSTANCES})
+for _name, _what in (("usdc", "binary"), ("usda", "text"),
+                     ("usdz", "a package of binary USD and its textures")):
+    register_format(Format(_name, (f".{_name}",), f"OpenUSD, {_what}: a fish as a skinned UsdSkel mesh, a "
+                           "school as a PointInstancer (needs usd-core)", _USD,
+                           "fishgen.exchange.usd:write_usd", extra=("pxr", "usd-core", "usd")))
