@@ -160,9 +160,6 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
                          seed=options.seed, model=options.model, speed=options.speed, bounds=options.bounds,
                          length=options.length, warmup=options.warmup, preset=options.preset,
                          variety=variety)
-    if instanced and scene.variety is not None and scene.variety.tints > 1:
-        raise UsageError("expected tints 1 with a USD output (a species' prototypes share its materials), "
-                         f"found tints {scene.variety.tints}")
     check_size(scene, scene_files[0] if scene_files else None)  # before anything is built
     species_files = [e.file for e in scene.species]
     check_targets([output, *sides.values()], [*inputs, *species_files, *scene.read])

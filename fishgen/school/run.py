@@ -116,7 +116,8 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
     groups = config.groups
     lengths = np.array([groups[g].body_length for g in tracks.group]) * tracks.scale
     if prototypes is not None:
-        scene = bake_prototypes(fishes, tracks, prototypes=prototypes, seed=scene_file.seed, fps=config.fps)
+        scene = bake_prototypes(fishes, tracks, prototypes=prototypes, seed=scene_file.seed, fps=config.fps,
+                                tints=variety.tints, tint=variety.tint)
     elif lods or merge:
         scene = bake_instanced(fishes, tracks, tolerance=tolerance, seed=scene_file.seed,
                                body_lengths=lengths)

@@ -213,10 +213,29 @@ def test_without_usd_core_the_command_says_so_before_any_work(tmp_path, monkeypa
     assert list(tmp_path.iterdir()) == []
 
 
-def test_colour_variants_are_refused_in_usd(tmp_path):
-    made = run_cli("school", BONYBREAM, "-o", tmp_path / "x.usdc", "--tints", "3")
-    assert made.returncode == 2 and "expected tints 1 with a USD output" in made.stderr
-    assert list(tmp_path.iterdir()) == []
+def test_colour_variants_are_prototypes_that_each_fish_wears_as_in_the_glb(tmp_path):
+    """--tints 2: a species' prototypes come in both colours, and each fish wears in USD the body
+    colour it wears in the glb of the same seed."""
+    from pxr import UsdShade
+
+    from fishgen.exchange.gltf_reader import read_gltf
+
+    usd = Usd.Stage.Open(str(_school(tmp_path, "school.usda", "--tints", "2", "--tint", "0.5")))
+    glb = read_gltf(_school(tmp_path, "school.glb", "--tints", "2", "--tint", "0.5"))
+    points = _instancer(usd)
+    prototypes = points.GetPrototypesRel().GetTargets()
+    assert len(prototypes) == 2 * 4
+    index = points.GetProtoIndicesAttr().Get()
+    colours = set()
+    for fish, root in enumerate(glb.roots):
+        body = next(c for c in glb.nodes[root].children if glb.nodes[c].name == "body")
+        material = glb.materials[glb.meshes[glb.nodes[body].mesh].primitives[0].material]
+        looks = usd.GetPrimAtPath(prototypes[index[fish]].AppendPath("Looks"))
+        texture = next(UsdShade.Shader(p) for p in Usd.PrimRange(looks)
+                       if p.GetName() == "BaseColor" and "body" in p.GetParent().GetName())
+        assert np.allclose(texture.GetInput("scale").Get(), material.base_color, atol=1e-6)
+        colours.add(tuple(round(c, 4) for c in material.base_color))
+    assert len(colours) == 2
 
 
 def test_clouds_cannot_be_written_as_usd(tmp_path):
