@@ -291,7 +291,7 @@ def test_blender_imports_the_school_with_its_instances_frame_range_and_bounds(tm
     counts = np.bincount(crowd.proto_indices, minlength=4)
     for frame in (0, 30, 44):
         seen = report["frames"][str(frame)]
-        assert seen["points"] == 12
+        assert seen["points"] == 12 and seen["direct"] == 0       # the prototypes are drawn only as copies
         assert {name: n for name, n in seen["roots"].items() if name.startswith("bonybream")} == \
             {f"bonybream_{k}": int(counts[k]) for k in range(4) if counts[k]}
         posed = []

@@ -1,8 +1,8 @@
 """Run by Blender's Python (bpy): import a USD file with Blender's own importer and print, as one
-JSON line, what Blender made of it: the frame range, and at each asked frame the points of its point clouds
-(a PointInstancer's copies), the mesh instances the evaluated scene draws, how many copies of
-each prototype's root it places, and the box around
-the drawn meshes' vertices in world space (a point instancer's prototypes themselves left out).
+JSON line, what Blender made of it: the frame range, and at each asked frame the points of its
+point clouds (a PointInstancer's copies), the mesh instances the evaluated scene draws and the meshes it draws
+as themselves, how many copies of each prototype's root it places, and the box around every drawn
+mesh's vertices in world space.
 
 Usage: python blender_usd.py FILE.usd FRAME [FRAME ...]
 """
@@ -27,21 +27,23 @@ def main() -> None:
         points_ = sum(len(o.data.points) for o in scene.objects if o.type == "POINTCLOUD")
         roots = Counter(i.object.name for i in graph.object_instances
                         if i.is_instance and i.object.type == "EMPTY")
-        instances, low, high = 0, np.full(3, np.inf), np.full(3, -np.inf)
+        instances, direct, low, high = 0, 0, np.full(3, np.inf), np.full(3, -np.inf)
         for inst in graph.object_instances:
             obj = inst.object
-            if obj.type != "MESH" or (points_ and not inst.is_instance):  # a prototype itself is not drawn
+            if obj.type != "MESH":
                 continue
             mesh = obj.data
             if not len(mesh.vertices):
                 continue
             instances += inst.is_instance
+            direct += not inst.is_instance
             points = np.empty(len(mesh.vertices) * 3)
             mesh.vertices.foreach_get("co", points)
             matrix = np.array(inst.matrix_world)
             world = points.reshape(-1, 3) @ matrix[:3, :3].T + matrix[:3, 3]
             low, high = np.minimum(low, world.min(axis=0)), np.maximum(high, world.max(axis=0))
-        report["frames"][str(frame)] = {"points": points_, "instances": instances, "roots": roots,
+        report["frames"][str(frame)] = {"points": points_, "instances": instances, "direct": direct,
+                                        "roots": roots,
                                         "low": low.tolist(), "high": high.tolist()}
     print(json.dumps(report))
 
