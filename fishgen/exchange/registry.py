@@ -29,8 +29,9 @@ MESHES, POINTS, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS = (
     "meshes", "points", "textures", "node animation", "skins", "morph targets")
 ALPHA_CUTOFF, DOUBLE_SIDED = "alpha cutoff", "double-sided faces"
 INSTANCES = "instances"  # copies of prototypes placed per frame (a school as USD's PointInstancer)
+LEVELS, CLIPS = "levels of detail", "more than one clip"
 CONTENT = (MESHES, POINTS, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS, ALPHA_CUTOFF, DOUBLE_SIDED,
-           INSTANCES)
+           LEVELS, CLIPS, INSTANCES)
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,8 @@ UsdGeom PointInstancer of such fish. Needs usd-core (``pip install 'fishgen[usd]
 
 A scene's nodes become one Skeleton under a SkelRoot: every node a joint (parents first), its
 meshes bound to it rigidly (a part of a fish) or through its skin (``--merge``), morph targets as
-BlendShapes, and the first clip as one SkelAnimation keyed every frame at the scene's frame rate.
+BlendShapes, and the swim clip (else the first) as one SkelAnimation keyed every frame at the
+scene's frame rate; other clips and coarser levels of detail are left out.
 A scene's :class:`~fishgen.scene.model.Instancer` becomes a PointInstancer whose prototypes are
 such SkelRoots, its copies keyed every frame: positions, half-precision orientations and extents.
 Metres, +Y up, glTF's axes; a time code is a frame. Textures are PNG files beside the file (inside
@@ -103,6 +104,11 @@ def _unique(names: list[str]) -> list[str]:
     return out
 
 
+def _clip(scene: Scene):
+    """The one clip USD keeps (a skeleton has one animation): ``swim``, else the first."""
+    return scene.clip("swim") or scene.clip()
+
+
 def _fps(scene: Scene) -> float:
     return float(scene.fps) if scene.fps else DEFAULT_FPS
 
@@ -117,7 +123,7 @@ def _stage(scene: Scene, pictures: _Pictures) -> Any:
     if scene.instancers:
         frames = len(scene.instancers[0].times)
     else:
-        clip = scene.clip()
+        clip = _clip(scene)
         frames = int(np.floor(clip.duration * fps + 1e-6)) + 1 if clip is not None and clip.channels else 1
     stage.SetTimeCodesPerSecond(fps)
     stage.SetFramesPerSecond(fps)
@@ -187,7 +193,7 @@ def _instance_extents(boxes: np.ndarray, positions: np.ndarray, turns: np.ndarra
 
 def _skel_root(stage, where, scene: Scene, times: np.ndarray, pictures: _Pictures) -> np.ndarray:
     """``scene``'s drawn nodes as a SkelRoot at ``where``: one Skeleton, its meshes and
-    materials, and its first clip sampled at ``times``. Returns the root's extent (2, 3), over
+    materials, and its clip (:func:`_clip`) sampled at ``times``. Returns the root's extent (2, 3), over
     every frame."""
     from pxr import Gf, UsdSkel, Vt
 
@@ -235,7 +241,7 @@ def _skel_root(stage, where, scene: Scene, times: np.ndarray, pictures: _Picture
                   shapes.get(node, ([], None))[0], mesh.target_names,
                   None if prim.material is None else material_paths[prim.material])
 
-    clip = scene.clip()
+    clip = _clip(scene)
     animated = clip is not None and bool(clip.channels)
     motion = _motion(scene, order, local, shapes, times if animated else times[:1])
     if animated:
@@ -252,7 +258,7 @@ def _shape_channels(scene: Scene, order: list[int], idents: list[str]) -> dict[i
     channel driving them (None: the mesh's default weights). Nodes driven by one sampler share
     channels (a fish's parts all follow one body wave): the first such group is named by its targets
     alone, the others by their node too."""
-    clip = scene.clip()
+    clip = _clip(scene)
     driver = {c.node: c for c in (clip.channels if clip else []) if c.path == "weights"}
     out: dict[int, tuple[list[str], Any]] = {}
     groups: dict[tuple[int, tuple[str, ...]], list[str]] = {}
@@ -413,8 +419,8 @@ class _Motion:
 
 def _motion(scene: Scene, order: list[int], local: list, shapes: dict[int, tuple[list[str], Any]],
             times: np.ndarray) -> _Motion:
-    """The first clip at ``times``: the joints' local transforms and the blend-shape weights."""
-    clip = scene.clip()
+    """The clip at ``times``: the joints' local transforms and the blend-shape weights."""
+    clip = _clip(scene)
     slot = {node: k for k, node in enumerate(order)}
     trs = [np.repeat(np.stack([part[j] for part in local])[None], len(times), axis=0) for j in range(3)]
     moved = [False, False, False]

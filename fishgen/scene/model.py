@@ -317,6 +317,10 @@ class Scene:
             kinds.add("skins")
         if any(c.channels for c in self.clips):
             kinds.add("node animation")
+        if sum(bool(c.channels) for c in self.clips) > 1:
+            kinds.add("more than one clip")
+        if any(n.lods is not None for n in self.nodes):
+            kinds.add("levels of detail")
         if self.instancers:
             kinds.add("instances")
         return kinds

@@ -105,6 +105,18 @@ def test_a_fish_keeps_its_materials_and_texture(tmp_path):
     assert texture.GetInput("file").Get().resolvedPath.endswith("fish_skin.png")
 
 
+def test_a_fish_keeps_its_swim_clip_and_says_what_usd_leaves_out(tmp_path):
+    """One animation a skeleton: the swim clip, wherever --clips lists it; the finest level only."""
+    out = tmp_path / "fish.usda"
+    made = run_cli("build", BONYBREAM, "-o", out, "--clips", "idle,swim", "--lods", "32x24,8x6")
+    assert made.returncode == 0, made.stderr
+    assert "swim loop 3.20 s" in made.stdout and "clips idle" not in made.stdout
+    assert "(USDA holds no levels of detail or more than one clip)" in made.stdout
+    stage = Usd.Stage.Open(str(out))
+    assert stage.GetEndTimeCode() == 96
+    assert len([p for p in stage.Traverse() if p.IsA(UsdGeom.Mesh)]) == 9      # 32x24's parts alone
+
+
 def test_usdz_packages_the_texture_and_needs_nothing_beside_it(tmp_path):
     path = _fish(tmp_path, "fish.usdz")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fish.usdz"]
