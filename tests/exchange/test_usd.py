@@ -280,7 +280,7 @@ def test_blender_imports_a_fish_that_swims_as_fishgen_poses_it(tmp_path):
     for frame in (0, 20, 50):
         seen = report["frames"][str(frame)]
         box = _from_blender(seen["low"], seen["high"])
-        assert np.abs(box - bounds(scene, frame / 30, "swim")).max() < 1e-4
+        assert np.abs(box - bounds(scene, frame / 30, "swim")).max() < 1e-6
 
 
 @pytest.mark.skipif(BPY is None, reason="no Python with bpy ($FISHGEN_BPY_PYTHON)")
@@ -315,4 +315,5 @@ def test_blender_imports_the_school_with_its_instances_frame_range_and_bounds(tm
             posed.append(points * crowd.scales[fish] @ turn.T + crowd.positions[frame, fish])
         every = np.concatenate(posed)
         expected = np.stack([every.min(axis=0), every.max(axis=0)])
-        assert np.abs(_from_blender(seen["low"], seen["high"]) - expected).max() < 5e-3
+        # fishgen turns by the float orientations, Blender by the file's halves
+        assert np.abs(_from_blender(seen["low"], seen["high"]) - expected).max() < 1e-3
