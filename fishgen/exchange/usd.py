@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from fishgen.scene.model import Image, Instancer, Material, Scene
-from fishgen.scene.pose import dequantized, pose, sample_many
+from fishgen.scene.pose import dequantized, pose, sample_many, trs_matrix
 
 PACKAGE_TIME = (2000, 1, 1, 0, 0, 0, 0, 0, -1)
 """The local time recorded for every file in a ``.usdz`` (whatever the time zone), so that packages
@@ -193,8 +193,8 @@ def _instance_extents(boxes: np.ndarray, positions: np.ndarray, turns: np.ndarra
 
 def _skel_root(stage, where, scene: Scene, times: np.ndarray, pictures: _Pictures) -> np.ndarray:
     """``scene``'s drawn nodes as a SkelRoot at ``where``: one Skeleton, its meshes and
-    materials, and its clip (:func:`_clip`) sampled at ``times``. Returns the root's extent (2, 3), over
-    every frame."""
+    materials, and its clip (:func:`_clip`) sampled at ``times``. Returns the root's extent (2, 3),
+    over every frame."""
     from pxr import Gf, UsdSkel, Vt
 
     skel_root = UsdSkel.Root.Define(stage, where)
@@ -215,7 +215,7 @@ def _skel_root(stage, where, scene: Scene, times: np.ndarray, pictures: _Picture
     skeleton = UsdSkel.Skeleton.Define(stage, where.AppendChild("Skeleton"))
     skeleton.CreateJointsAttr(tokens)
     skeleton.CreateBindTransformsAttr(Vt.Matrix4dArray([Gf.Matrix4d(m.T.tolist()) for m in binds]))
-    rest_matrices = [_matrix(*trs) for trs in local]
+    rest_matrices = [trs_matrix(*trs) for trs in local]
     skeleton.CreateRestTransformsAttr(Vt.Matrix4dArray([Gf.Matrix4d(m.T.tolist()) for m in rest_matrices]))
     UsdSkel.BindingAPI.Apply(skel_root.GetPrim()).CreateSkeletonRel().SetTargets([skeleton.GetPath()])
 
@@ -291,12 +291,6 @@ def _local_trs(scene: Scene, node: int) -> tuple[np.ndarray, np.ndarray, np.ndar
 
     t, r, s = UsdSkel.DecomposeTransform(Gf.Matrix4d(np.asarray(n.matrix, float).T.tolist()))
     return (np.array(t, float), np.array([*r.GetImaginary(), r.GetReal()], float), np.array(s, float))
-
-
-def _matrix(t: np.ndarray, r: np.ndarray, s: np.ndarray) -> np.ndarray:
-    from fishgen.scene.pose import trs_matrix
-
-    return trs_matrix(t, r, s)
 
 
 def _mesh(stage, where, scene: Scene, node: int, prim, slot: dict[int, int], skeleton, rest_world: np.ndarray,
