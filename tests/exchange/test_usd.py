@@ -208,6 +208,21 @@ def test_usd_validators_find_nothing(tmp_path, which):
     assert _validation_errors(path) == []
 
 
+def test_a_batch_manifest_writes_usd_and_sets_the_prototypes(tmp_path):
+    manifest = tmp_path / "m.toml"
+    manifest.write_text(f"""[[school]]
+input = "{BONYBREAM.as_posix()}"
+output = "s.usdc"
+count = 6
+frames = 10
+prototypes = 2
+""")
+    made = run_cli("batch", manifest, "-j", "1", "--out", tmp_path / "out")
+    assert made.returncode == 0, made.stderr
+    points = _instancer(Usd.Stage.Open(str(tmp_path / "out" / "s.usdc")))
+    assert len(points.GetPrototypesRel().GetTargets()) == 2
+
+
 # -- refusals -------------------------------------------------------------------------------------
 
 def test_without_usd_core_the_command_says_so_before_any_work(tmp_path, monkeypatch):
