@@ -219,8 +219,8 @@ prototypes = 2
 """)
     made = run_cli("batch", manifest, "-j", "1", "--out", tmp_path / "out")
     assert made.returncode == 0, made.stderr
-    points = _instancer(Usd.Stage.Open(str(tmp_path / "out" / "s.usdc")))
-    assert len(points.GetPrototypesRel().GetTargets()) == 2
+    stage = Usd.Stage.Open(str(tmp_path / "out" / "s.usdc"))
+    assert len(_instancer(stage).GetPrototypesRel().GetTargets()) == 2
 
 
 # -- refusals -------------------------------------------------------------------------------------
