@@ -11,8 +11,10 @@ import importlib.util
 from fishgen.errors import MissingDependency
 
 
-def needs(module: str, extra: str, feature: str) -> None:
-    """``feature`` needs ``module``: refuse now, in one line, if it is not installed."""
+def needs(module: str, extra: str, feature: str, package: str | None = None) -> None:
+    """``feature`` needs ``module`` (of the pip ``package``, when named otherwise): refuse now, in
+    one line, if it is not installed."""
     if importlib.util.find_spec(module) is None:
-        raise MissingDependency(f"{feature} needs {module}, which is not installed; install it with "
+        name = module if package is None else f"{package} ({module})"
+        raise MissingDependency(f"{feature} needs {name}, which is not installed; install it with "
                                 f"pip install 'fishgen[{extra}]'")

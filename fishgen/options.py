@@ -413,6 +413,12 @@ def merge_option() -> Any:
                   "instead of one per part; fins swing on joints.", False, flag=True)
 
 
+def prototypes_option() -> Any:
+    return option(click.IntRange(1, 64), "In a USD file (.usdc, .usda, .usdz), each species as this many "
+                  "prototypes of a PointInstancer, their swim clips phase-shifted by an equal share of a "
+                  "loop; each fish wears one, seeded (more: fewer fish swim in step, a larger file).", 4)
+
+
 def compact_option() -> Any:
     return option(click.BOOL, "Rotation keys and morph weights as normalized 16-bit integers "
                   "(core glTF 2.0), about half their size.", False, flag=True)

@@ -188,7 +188,7 @@ def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None
     parts = [_parts(body, fin_list, place, swings) for _, body, fin_list in built]
     fin_loop = _fin_loop_frames(species, list(swings.values()))
 
-    scene = Scene(name=species.name)
+    scene = Scene(name=species.name, fps=float(fps))
     skin_pictures = load_textures(species, mode)
     texture = scene.add_image(Image("skin", skin_pictures["skin"])) if "skin" in skin_pictures else None
     materials = tuple(scene.add_material(m) for m in make_materials(species, mode, texture))

@@ -98,7 +98,7 @@ def summary(fish, target: Path, written: list[Path]) -> str:
     if animated and facts.tail_beat_hz is not None:
         motion += f", body wave {facts.tail_beat_hz:.2f} Hz"
     others = [c for c in facts.clips if c.name != "swim"]
-    if animated and others:
+    if animated and others and "more than one clip" not in dropped:
         motion += ", clips " + ", ".join(f"{c.name} {c.seconds:.2f} s" for c in others)
     if len(facts.levels) > 1 and fmt is not None and fmt.name in ("glb", "gltf"):
         motion += ", levels " + ", ".join(f"{lv.bodies}x{lv.circles} ({lv.triangles})" for lv in facts.levels)

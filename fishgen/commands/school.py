@@ -18,6 +18,7 @@ from fishgen.options import (
     lods_option,
     merge_option,
     option,
+    prototypes_option,
     swim_option,
     textures_option,
 )
@@ -79,6 +80,7 @@ class SchoolOptions:
     compact: bool = compact_option()
     lods: tuple[tuple[int, int], ...] | None = lods_option()
     merge: bool = merge_option()
+    prototypes: int = prototypes_option()
 
 
 COMMAND = Command(
@@ -100,7 +102,8 @@ COMMAND = Command(
     options=SchoolOptions,
     run="fishgen.commands.school:school",
     inputs=Inputs("SPECIES|SCENE.toml..."),
-    output=Output("Animated asset to write (.glb or .gltf: the only formats that hold node animation).",
+    output=Output("Animated asset to write: .glb or .gltf (a node per fish), or .usdc, .usda or .usdz (a "
+                  "PointInstancer of skinned fish; needs usd-core).",
                   holds=(MESHES, NODE_ANIMATION)),
     batch=True,
     together=True,
@@ -127,10 +130,10 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     output = Path(output)
     from fishgen.commands.paths import check_inputs, check_targets, needs, suffix_of
     from fishgen.errors import UsageError
-    from fishgen.exchange.registry import FORMATS, MESHES, NODE_ANIMATION, output_format
+    from fishgen.exchange.registry import FORMATS, INSTANCES, MESHES, NODE_ANIMATION, output_format
     from fishgen.school.scene_file import SceneFile, SpeciesEntry, check_size, load_scene_file, with_options
 
-    output_format(output, [MESHES, NODE_ANIMATION])
+    instanced = INSTANCES in output_format(output, [MESHES, NODE_ANIMATION]).holds
     kinds = check_inputs(inputs, "school", [FORMATS["school scene"], FORMATS["species"]],
                          default=FORMATS["species"])
     scene_files = [p for p, kind in zip(inputs, kinds, strict=True) if kind is FORMATS["school scene"]]
@@ -166,7 +169,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     with events.progress("simulating", scene.frames) as bar:
         run = run_school(scene, fins=options.fins, swim=options.swim, tolerance=options.tolerance,
                          textures_dir=options.textures, progress=bar.update, lods=options.lods,
-                         merge=options.merge)
+                         merge=options.merge, prototypes=options.prototypes if instanced else None)
     if options.compact:
         from fishgen.assembly.compact import compact_clips
 

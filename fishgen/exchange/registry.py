@@ -28,7 +28,10 @@ from fishgen.errors import FishgenError
 MESHES, POINTS, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS = (
     "meshes", "points", "textures", "node animation", "skins", "morph targets")
 ALPHA_CUTOFF, DOUBLE_SIDED = "alpha cutoff", "double-sided faces"
-CONTENT = (MESHES, POINTS, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS, ALPHA_CUTOFF, DOUBLE_SIDED)
+INSTANCES = "instances"  # copies of prototypes placed per frame (a school as USD's PointInstancer)
+LEVELS, CLIPS = "levels of detail", "more than one clip"
+CONTENT = (MESHES, POINTS, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS, ALPHA_CUTOFF, DOUBLE_SIDED,
+           LEVELS, CLIPS, INSTANCES)
 
 
 @dataclass(frozen=True)
@@ -43,6 +46,7 @@ class Format:
     command: str | None = None      # for source formats: the command that turns them into assets
     reads_with: tuple[str, ...] = ()  # the options its reader takes, of READER_OPTIONS
     sniff: str | None = None        # "module:function(path) -> bool": is this file of this format?
+    extra: tuple[str, str, str] | None = None  # (module, pip package, extra) its writer needs
 
     def write(self, scene, path: Path) -> list[Path]:
         return _load(self.writer)(scene, path)
@@ -129,6 +133,11 @@ def output_format(path: str | os.PathLike, holding: Iterable[str] = (), what: st
                                f"{found!r} ({fmt.description}, an input of `fishgen {fmt.command}`)", path)
         raise FishgenError(f"expected an {what} ending in {', '.join(extensions(usable))}, found {found!r}",
                            path)
+    if fmt.extra is not None:
+        from fishgen.extras import needs
+
+        module, package, extra = fmt.extra
+        needs(module, extra, f"writing {Path(path).suffix.lower()}", package)
     missing = [k for k in need if k not in fmt.holds]
     if missing:
         raise FishgenError(f"expected a format that holds {' and '.join(missing)}, found "
@@ -167,7 +176,7 @@ def lost(fmt: Format, scene) -> list[str]:
     return [k for k in CONTENT if k in scene.has() and k not in fmt.holds]
 
 
-_ALL = frozenset(CONTENT)
+_ALL = frozenset(CONTENT) - {INSTANCES}
 register_format(Format("glb", (".glb",), "binary glTF 2.0", _ALL,
                        "fishgen.exchange.gltf:write_glb", "fishgen.exchange.gltf_reader:read_gltf",
                        viewer=True))
@@ -201,3 +210,10 @@ register_format(Format("texture cubes", (".awa",), "a RekAwan texture cloud file
                                                                                              TEXTURES}),
                        reader="fishgen.clouds.scene:cube_file_scene", command="clouds",
                        reads_with=("seed", "lighting", "textures_dir")))
+_USD = frozenset({MESHES, TEXTURES, NODE_ANIMATION, SKINS, MORPH_TARGETS, ALPHA_CUTOFF, DOUBLE_SIDED,
+                  INSTANCES})
+for _name, _what in (("usdc", "binary"), ("usda", "text"),
+                     ("usdz", "a package of binary USD and its textures")):
+    register_format(Format(_name, (f".{_name}",), f"OpenUSD, {_what}: a fish as a skinned UsdSkel mesh, a "
+                           "school as a PointInstancer (needs usd-core)", _USD,
+                           "fishgen.exchange.usd:write_usd", extra=("pxr", "usd-core", "usd")))

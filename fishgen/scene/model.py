@@ -185,6 +185,23 @@ class Clip:
 
 
 @dataclass
+class Instancer:
+    """Many copies of a few prototypes, each copy placed anew every frame (USD's PointInstancer).
+
+    ``prototypes`` are whole assets (a fish and its clip, which runs over ``times``); copy ``i`` is
+    prototype ``proto_indices[i]``, at frame ``f`` moved to ``positions[f, i]``, turned by
+    ``orientations[f, i]`` (x, y, z, w) and scaled by ``scales[i]``."""
+
+    name: str
+    prototypes: list[Scene]
+    proto_indices: np.ndarray   # (N,) int
+    times: np.ndarray           # (F,) seconds, one per frame
+    positions: np.ndarray       # (F, N, 3) metres
+    orientations: np.ndarray    # (F, N, 4) unit quaternions
+    scales: np.ndarray          # (N,) uniform scale
+
+
+@dataclass
 class Scene:
     """A whole asset. ``roots`` are the top-level nodes. ``source`` is the file a reader read it
     from, and ``note`` what a reader wants the user told (a subsampled cloud); writers ignore both.
@@ -193,7 +210,10 @@ class Scene:
     file keeps, as JSON values (a cloud's sunlight, a school's warm-up): glTF writes it as the scene's
     ``extras``. ``hidden_roots`` are written as a second glTF scene, which clients show only when
     asked: the coarser levels of detail a node's ``lods`` names (:meth:`add_levels`), kept out of
-    sight of clients that know nothing of levels, yet in a scene (a node in none is an orphan)."""
+    sight of clients that know nothing of levels, yet in a scene (a node in none is an orphan).
+    ``instancers`` are crowds of copies, which only formats that hold instances write (a school in
+    USD). ``fps``: the frame rate the asset was made at, at which formats that key every frame
+    (USD) sample its clips; None: 30."""
 
     name: str = ""
     nodes: list[Node] = field(default_factory=list)
@@ -207,6 +227,8 @@ class Scene:
     note: str | None = None
     extras: dict[str, Any] = field(default_factory=dict)
     hidden_roots: list[int] = field(default_factory=list)  # a second glTF scene's: coarser levels of detail
+    instancers: list[Instancer] = field(default_factory=list)
+    fps: float | None = None
 
     # -- building ------------------------------------------------------------------
     def add_node(self, node: Node, parent: int | None = None, *, root: bool = True) -> int:
@@ -295,4 +317,10 @@ class Scene:
             kinds.add("skins")
         if any(c.channels for c in self.clips):
             kinds.add("node animation")
+        if sum(bool(c.channels) for c in self.clips) > 1:
+            kinds.add("more than one clip")
+        if any(n.lods is not None for n in self.nodes):
+            kinds.add("levels of detail")
+        if self.instancers:
+            kinds.add("instances")
         return kinds

@@ -78,6 +78,57 @@ def sample(channel: Channel, t: float) -> np.ndarray:
     return _normalize(out) if rotation else np.array(out, float)
 
 
+def sample_many(channel: Channel, ts: np.ndarray) -> np.ndarray:
+    """The channel's values (T, width) at every time of ``ts``: :func:`sample`, for a whole
+    timeline at once."""
+    smp = channel.sampler
+    times = np.asarray(smp.times, float).ravel()
+    values = dequantized(smp.values)
+    cubic = smp.interpolation == "CUBICSPLINE"
+    keys = values.reshape(len(times), 3, -1) if cubic else values.reshape(len(times), -1)
+    at = keys[:, 1] if cubic else keys
+    ts = np.asarray(ts, float).ravel()
+    rotation = channel.path == "rotation"
+    if len(times) == 1:
+        out = np.repeat(at[:1], len(ts), axis=0)
+    else:
+        k = np.clip(np.searchsorted(times, ts, side="right") - 1, 0, len(times) - 2)
+        t0, t1 = times[k], times[k + 1]
+        s = np.clip(np.where(t1 > t0, (ts - t0) / np.where(t1 > t0, t1 - t0, 1.0), 0.0), 0.0, 1.0)[:, None]
+        a, b = at[k], at[k + 1]
+        if smp.interpolation == "STEP":
+            out = np.where(s >= 1.0, b, a)
+        elif cubic:
+            dt = (t1 - t0)[:, None]
+            m0, m1 = keys[k, 2] * dt, keys[k + 1, 0] * dt
+            s2, s3 = s * s, s * s * s
+            out = ((2 * s3 - 3 * s2 + 1) * a + (s3 - 2 * s2 + s) * m0
+                   + (-2 * s3 + 3 * s2) * b + (s3 - s2) * m1)
+        elif rotation:
+            out = _slerp_many(a, b, s)
+        else:
+            out = (1 - s) * a + s * b
+    if rotation:
+        norm = np.linalg.norm(out, axis=1, keepdims=True)
+        out = np.where(norm > 0, out / np.where(norm > 0, norm, 1.0), np.array([0.0, 0.0, 0.0, 1.0]))
+    return np.asarray(out, float)
+
+
+def _slerp_many(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """:func:`slerp` row by row: (T, 4) from (T, 4), (T, 4) and (T, 1)."""
+    a = a / np.maximum(np.linalg.norm(a, axis=1, keepdims=True), 1e-300)
+    b = b / np.maximum(np.linalg.norm(b, axis=1, keepdims=True), 1e-300)
+    d = np.einsum("ij,ij->i", a, b)[:, None]
+    b = np.where(d < 0, -b, b)
+    d = np.abs(d)
+    theta = np.arccos(np.minimum(d, 1.0))
+    sin = np.sin(theta)
+    near = d > 0.9995
+    safe = np.where(near, 1.0, sin)
+    far = (np.sin((1 - s) * theta) * a + np.sin(s * theta) * b) / safe
+    return np.where(near, a + s * (b - a), far)
+
+
 def quat_matrix(q: np.ndarray) -> np.ndarray:
     """3x3 rotation matrix of a unit quaternion (x, y, z, w)."""
     x, y, z, w = _normalize(np.asarray(q, float))
@@ -86,6 +137,22 @@ def quat_matrix(q: np.ndarray) -> np.ndarray:
         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
     ])
+
+
+def quat_matrices(q: np.ndarray, normalize: bool = True) -> np.ndarray:
+    """(..., 3, 3) rotation matrices of (..., 4) quaternions (x, y, z, w), normalized first unless
+    ``normalize`` is False (then the unit formula as it stands, which is what USD applies to an
+    instancer's half-precision orientations)."""
+    q = np.asarray(q, float)
+    if normalize:
+        norm = np.linalg.norm(q, axis=-1, keepdims=True)
+        q = np.where(norm > 0, q / np.where(norm > 0, norm, 1.0), [0.0, 0.0, 0.0, 1.0])
+    x, y, z, w = np.moveaxis(q, -1, 0)
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+    ], -2)
 
 
 def trs_matrix(t, r, s) -> np.ndarray:

@@ -22,7 +22,7 @@ import numpy as np
 from fishgen.assembly.body_wave import wave_nodes
 from fishgen.assembly.instance import add_species
 from fishgen.geometry.body_wave import BodyWave, integrate_phase, wave_weights
-from fishgen.scene.model import Channel, Clip, Node, Path_, Sampler, Scene
+from fishgen.scene.model import Channel, Clip, Instancer, Node, Path_, Sampler, Scene
 from fishgen.scene.pose import sample
 from fishgen.school.model import Tracks
 
@@ -30,6 +30,8 @@ STEPS = (2, 3, 4, 6, 8, 12, 16, 24, 30)
 """Key spacings tried, in frames; the longest is a one-second horizon at 30 fps."""
 TINT_STREAM = 0x7157
 """Mixed into the seed of the generators that tint: the fin and wave phases keep their own."""
+PROTOTYPE_STREAM = 0x1A57
+"""Mixed into the seed of the generator that gives each fish its prototype (:func:`bake_prototypes`)."""
 FIN_PHASES = 16
 """Distinct fin phases per species: fish sharing one share its fin keys in the file, and 16 phases
 already keep neighbours from beating in step."""
@@ -124,9 +126,7 @@ def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, 
     school = Scene(name="school")
     templates = [merge_species(school, fish) for fish in fish_scenes]
     variants = _tint_variants(school, templates, tints, tint, seed)
-    # which variant each fish wears: its own generator, so that the phases below stay as they were
-    wears = (np.random.default_rng((seed, TINT_STREAM)).integers(0, tints, len(tracks.group))
-             if tints > 1 else np.zeros(len(tracks.group), np.int64))
+    wears = _wears(len(tracks.group), tints, seed)
     swims = [fish.clip("swim") for fish in fish_scenes]
     plan = _school_keys(fish_scenes, tracks, tolerance, seed, body_lengths, wave)
     duration, rng, times32 = plan.duration, plan.rng, plan.times32
@@ -185,14 +185,13 @@ def _tint_variants(school: Scene, templates: list[list[Part]], tints: int, tint:
     whose primitives name those materials: the same vertex, index and morph arrays, which the
     writer stores once."""
     out = []
-    rng = np.random.default_rng((seed, TINT_STREAM, 1))
-    for parts in templates:
+    factors = _tint_factors(len(templates), tints, tint, seed)
+    for parts, species_factors in zip(templates, factors, strict=True):
         variants = [parts]
         meshes = sorted({t.mesh for t, _, _ in parts if t.mesh is not None})
         materials = sorted({p.material for m in meshes for p in school.meshes[m].primitives
                             if p.material is not None})
-        for v in range(1, max(1, int(tints))):
-            factor = 1.0 - float(tint) * rng.uniform(0.0, 1.0, 3)
+        for v, factor in enumerate(species_factors[1:], start=1):
             new_material = {}
             for m in materials:
                 base = school.materials[m]
@@ -210,6 +209,20 @@ def _tint_variants(school: Scene, templates: list[list[Part]], tints: int, tint:
                              for t, c, w in parts])
         out.append(variants)
     return out
+
+
+def _tint_factors(species: int, tints: int, tint: float, seed: int) -> list[list[np.ndarray]]:
+    """Per species, per colour variant, the (r, g, b) its materials' base colours are multiplied by
+    (variant 0: ones, the species' own colours), seeded."""
+    rng = np.random.default_rng((seed, TINT_STREAM, 1))
+    return [[np.ones(3)] + [1.0 - float(tint) * rng.uniform(0.0, 1.0, 3)
+                            for _ in range(1, max(1, int(tints)))] for _ in range(species)]
+
+
+def _wears(fish: int, tints: int, seed: int) -> np.ndarray:
+    """Which colour variant each fish wears: its own generator, so that the phases stay as they were."""
+    return (np.random.default_rng((seed, TINT_STREAM)).integers(0, tints, fish) if tints > 1
+            else np.zeros(fish, np.int64))
 
 
 def _wave_phases(fish_scenes: list[Scene], tracks: Tracks, lengths: np.ndarray,
@@ -306,3 +319,53 @@ def _school_keys(fish_scenes: list[Scene], tracks: Tracks, tolerance: float, see
     weights = (None if phases is None or duration <= 0
                else wave_weights(np.ascontiguousarray(phases.T)).astype(np.float32))
     return _Keys(times.astype(np.float32), duration, rng, position_keys, rotation_keys, weights)
+
+
+def bake_prototypes(fish_scenes: list[Scene], tracks: Tracks, *, prototypes: int = 4, seed: int = 0,
+                    fps: float = 30.0, tints: int = 1, tint: float = 0.15) -> Scene:
+    """The school as one :class:`Instancer`: ``prototypes`` copies of each species' fish (of each of
+    its ``tints`` colour variants, as :func:`bake` tints them and its fish wear them) whose swim
+    clips run phase-shifted (by 1/``prototypes`` of a loop each) over the whole run, and every fish
+    one of its species' prototypes, seeded, placed every frame by its tracks. Fish of one prototype
+    share one pose: the tail beats at the species' own speed, not the fish's (:func:`bake`'s)."""
+    times = np.asarray(tracks.times, np.float64)
+    duration = float(times[-1]) if len(times) else 0.0
+    factors = _tint_factors(len(fish_scenes), tints, tint, seed)
+    protos = [_phase_shifted(_tinted(fish, factor, v), f"{fish.name}{f'_tint{v}' if v else ''}_{p}",
+                             p / prototypes, duration)
+              for fish, species_factors in zip(fish_scenes, factors, strict=True)
+              for v, factor in enumerate(species_factors) for p in range(prototypes)]
+    phase = np.random.default_rng((seed, PROTOTYPE_STREAM)).integers(0, prototypes, len(tracks.group))
+    variant = _wears(len(tracks.group), tints, seed)
+    index = (np.asarray(tracks.group, np.int64) * max(1, tints) + variant) * prototypes + phase
+    crowd = Instancer("fish", protos, index, times, np.asarray(tracks.positions, np.float32),
+                      np.asarray(tracks.headings, np.float32), np.asarray(tracks.scale, np.float32))
+    return Scene(name="school", instancers=[crowd], fps=fps)
+
+
+def _tinted(fish: Scene, factor: np.ndarray, variant: int) -> Scene:
+    """``fish`` with every material's base colour multiplied by ``factor`` (variant 0: as it is)."""
+    if variant == 0:
+        return fish
+    materials = []
+    for m in fish.materials:
+        r, g, b, a = m.base_color
+        materials.append(replace(m, name=f"{m.name}_tint{variant}", base_color=(
+            r * float(factor[0]), g * float(factor[1]), b * float(factor[2]), a)))
+    return replace(fish, materials=materials)
+
+
+def _phase_shifted(fish: Scene, name: str, share: float, duration: float) -> Scene:
+    """``fish`` whose swim clip starts ``share`` of a loop in and runs for ``duration`` seconds;
+    channels that shared a sampler still share one."""
+    swim = fish.clip("swim")
+    if swim is None or duration <= 0:
+        return replace(fish, name=name, clips=[])
+    shifted: dict[int, Sampler] = {}
+    channels = []
+    for channel in swim.channels:
+        if id(channel.sampler) not in shifted:
+            t, v = _fin_keys(channel, swim.duration * share, duration)
+            shifted[id(channel.sampler)] = Sampler(t.astype(np.float32), v.astype(np.float32))
+        channels.append(Channel(channel.node, channel.path, shifted[id(channel.sampler)]))
+    return replace(fish, name=name, clips=[Clip("swim", channels)])

@@ -92,15 +92,18 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
                progress: Callable[[int], None] | None = None,
                couzin: CouzinParams | None = None, variety: Variety | None = None,
                warmup: float | None = None, length: float | None = None,
-               lods: tuple[tuple[int, int], ...] | None = None, merge: bool = False) -> SchoolRun:
+               lods: tuple[tuple[int, int], ...] | None = None, merge: bool = False,
+               prototypes: int | None = None) -> SchoolRun:
     """Build each species once, simulate the school, and bake it into one scene.
 
     `couzin`, `variety` and `warmup` (seconds) default to the scene file's (its `couzin`,
     `variety` and `warmup` members when it has them), else CouzinParams(), Variety() and the
     default warm-up. `length`: every species' nose-to-tail length in metres (default: each
     species file's own). `lods`, `merge`: each species built as `fishgen build --lods/--merge`
-    builds it, every fish a copy of its node tree over shared meshes (no colour variants then)."""
-    from fishgen.school.bake import bake, bake_instanced
+    builds it, every fish a copy of its node tree over shared meshes (no colour variants then).
+    `prototypes`: the school as an instancer of that many phase-shifted prototypes per species
+    (:func:`fishgen.school.bake.bake_prototypes`, what USD writes) instead of a node per fish."""
+    from fishgen.school.bake import bake, bake_instanced, bake_prototypes
     from fishgen.school.simulate import simulate
 
     variety = _given(variety, scene_file, "variety", Variety())
@@ -112,7 +115,10 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
     tracks = simulate(config, progress=progress)
     groups = config.groups
     lengths = np.array([groups[g].body_length for g in tracks.group]) * tracks.scale
-    if lods or merge:
+    if prototypes is not None:
+        scene = bake_prototypes(fishes, tracks, prototypes=prototypes, seed=scene_file.seed, fps=config.fps,
+                                tints=variety.tints, tint=variety.tint)
+    elif lods or merge:
         scene = bake_instanced(fishes, tracks, tolerance=tolerance, seed=scene_file.seed,
                                body_lengths=lengths)
     else:

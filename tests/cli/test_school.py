@@ -57,7 +57,8 @@ def test_csv_tracks_have_the_documented_columns(tmp_path):
 def test_formats_that_cannot_hold_a_school_say_what_to_use(tmp_path):
     result = run_cli("school", PARAMS / "bonybream.txt", "-o", tmp_path / "s.obj")
     assert result.returncode == 2 and result.stderr.count("\n") == 1
-    assert "holds node animation, found .obj" in result.stderr and "use .glb or .gltf instead" in result.stderr
+    assert "holds node animation, found .obj" in result.stderr
+    assert "use .glb or .gltf or .usdc or .usda or .usdz instead" in result.stderr
 
 
 def test_absurd_sizes_are_refused_before_anything_is_built(tmp_path):

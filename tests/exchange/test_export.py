@@ -131,7 +131,8 @@ def test_animation_pose_matches_fin_motion(assets):
 def test_unknown_extension(assets, tmp_path):
     with pytest.raises(FishgenError, match="expected an output ending in .glb, .gltf, .obj, .ply, .csv, .npy"):
         export(assets["bonybream"], tmp_path / "fish.fbx")
-    with pytest.raises(FishgenError, match="holds node animation, found .obj .* use .glb or .gltf instead"):
+    with pytest.raises(FishgenError, match="holds node animation, found .obj .* use .glb or .gltf or "
+                                             ".usdc or .usda or .usdz instead"):
         export(assets["bonybream"], tmp_path / "fish.obj", require=["node animation"])
     assert list(tmp_path.iterdir()) == []
 

@@ -24,7 +24,7 @@ def test_cli_choices_come_from_the_registry():
     from fishgen.clouds.export import FORMATS as CLOUD_FORMATS
     from fishgen.viewer.page import KINDS
 
-    assert [f.name for f in FISH_FORMATS] == ["glb", "gltf", "obj", "ply"]
+    assert [f.name for f in FISH_FORMATS] == ["glb", "gltf", "obj", "ply", "usdc", "usda", "usdz"]
     assert CLOUD_FORMATS == (".glb", ".gltf", ".ply", ".csv", ".npy")
     assert set(KINDS) == {".glb", ".gltf", ".obj", ".ply"}
 
@@ -34,7 +34,7 @@ def test_a_format_that_cannot_hold_what_is_asked_says_what_is_lost_and_what_to_u
         output_format("school.obj", [MESHES, NODE_ANIMATION])
     assert str(info.value) == ("school.obj: expected a format that holds node animation, found .obj "
                                "(Wavefront OBJ with .mtl and images (rest pose)), which would lose them; "
-                               "use .glb or .gltf instead")
+                               "use .glb or .gltf or .usdc or .usda or .usdz instead")
     with pytest.raises(FishgenError, match="an input of `fishgen clouds`"):
         output_format("sky.awn", [POINTS])
 

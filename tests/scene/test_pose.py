@@ -150,3 +150,30 @@ def test_normalized_integer_keys_play_as_floats():
     assert np.allclose(sample(spin, 1.0), _qy(90), atol=1e-4)
     w = Channel(0, "weights", Sampler(np.array([0.0, 1.0]), np.array([[0, 65535], [65535, 0]], np.uint16)))
     assert np.allclose(sample(w, 0.25), [0.25, 0.75])
+
+
+@pytest.mark.parametrize("interpolation", ["LINEAR", "STEP", "CUBICSPLINE"])
+@pytest.mark.parametrize("path", ["translation", "rotation", "weights"])
+def test_a_whole_timeline_samples_as_each_time_alone(path, interpolation):
+    """sample_many is sample at every time: between keys, on them, before the first and after the last."""
+    from fishgen.scene.pose import sample_many
+
+    rng = np.random.default_rng(4)
+    times = np.array([0.0, 0.4, 0.5, 1.5])
+    width = 4 if path in ("rotation", "weights") else 3
+    values = rng.normal(size=(len(times) * (3 if interpolation == "CUBICSPLINE" else 1), width))
+    ch = channel(0, path, times, values, interpolation)
+    at = np.concatenate([[-1.0], np.linspace(0, 1.5, 31), [0.4, 2.0]])
+    assert np.abs(sample_many(ch, at) - np.stack([sample(ch, t) for t in at])).max() < 1e-12
+
+
+def test_rotation_matrices_of_many_quaternions_are_each_ones():
+    from fishgen.scene.pose import quat_matrices, quat_matrix
+
+    q = np.random.default_rng(5).normal(size=(6, 2, 4)) * 3     # not unit: both normalize
+    many = quat_matrices(q)
+    assert many.shape == (6, 2, 3, 3)
+    assert np.allclose(many, [[quat_matrix(b) for b in a] for a in q])
+    unit = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    assert np.allclose(quat_matrices(unit, normalize=False), many)
+    assert not np.allclose(quat_matrices(q, normalize=False), many)  # the unit formula, as it stands

@@ -112,3 +112,33 @@ def test_colour_variants_share_geometry_and_differ_only_in_material(fish, tmp_pa
     # tinting draws from its own generator: every key of the plain file is in the tinted one
     assert [c.sampler.values.tobytes() for c in plain.clip("school").channels] == \
            [c.sampler.values.tobytes() for c in tinted.clip("school").channels]
+
+
+def test_prototypes_are_each_species_phase_shifted_and_every_fish_wears_one(fish):
+    """bake_prototypes: k prototypes a species, whose swim clips are the species' own started k
+    equal shares of a loop apart and run the whole school; each fish is one of its own species',
+    seeded; the copies follow the tracks exactly."""
+    from fishgen.scene.pose import sample
+    from fishgen.school.bake import bake_prototypes
+
+    tracks = circling()
+    scene = bake_prototypes(fish, tracks, prototypes=3, seed=5, fps=30.0)
+    (crowd,) = scene.instancers
+    assert not scene.roots and scene.fps == 30.0 and len(crowd.prototypes) == 6
+    assert np.array_equal(crowd.proto_indices // 3, tracks.group)
+    assert len(set(crowd.proto_indices.tolist())) > 3            # the phases are spread over the fish
+    again = bake_prototypes(fish, tracks, prototypes=3, seed=5).instancers[0].proto_indices
+    assert np.array_equal(again, crowd.proto_indices)
+    assert np.array_equal(crowd.positions, tracks.positions.astype(np.float32))
+    assert np.array_equal(crowd.orientations, tracks.headings.astype(np.float32))
+    swim = fish[0].clip("swim")
+    for k in range(3):
+        clip = crowd.prototypes[k].clip("swim")
+        assert clip.duration == pytest.approx(tracks.times[-1])
+        for own, shifted in zip(swim.channels, clip.channels, strict=True):
+            for t in (0.0, 0.7, 2.9):
+                expected = sample(own, (t + swim.duration * k / 3) % swim.duration)
+                assert np.abs(sample(shifted, t) - expected).max() < 1e-5
+    # parts that shared one weights sampler still share one: one blend-shape channel set in USD
+    weights = {id(c.sampler) for c in crowd.prototypes[1].clip("swim").channels if c.path == "weights"}
+    assert len(weights) == 1
