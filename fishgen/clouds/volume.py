@@ -24,8 +24,8 @@ __all__ = ["DEFAULT_VOXEL_SIZE", "MAX_VOXELS", "Volume", "particle_volume", "vox
 
 LEAF = 8
 """Voxels along a leaf's side (OpenVDB's and NanoVDB's 8^3 leaves)."""
-CHUNK = 1 << 22
-"""Footprint voxels evaluated at a time: keeps the splat's temporaries a few tens of MB."""
+CHUNK = 1 << 20
+"""Footprint voxels evaluated at a time: the splat's temporaries stay about 40 MB."""
 
 
 @dataclass(frozen=True)
@@ -101,8 +101,6 @@ def particle_volume(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
                     extinction: float, voxel_size: float, where=None) -> Volume:
     """Splat particles (world ``centers``, ``radii``, ``density``, baked ``light`` or None) into
     a ``density`` grid (extinction per world unit) and, when lit, a ``light`` grid."""
-    from scipy.special import erf  # type: ignore[import-untyped]
-
     from fishgen.clouds.light import peak_optical_depth
     from fishgen.clouds.sprite import SIGMA
 
@@ -123,7 +121,10 @@ def particle_volume(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     width = (stop - start + 1).max(1)
     total = np.zeros(shape, np.float32).reshape(-1)
     lit = np.zeros_like(total) if light is not None else None
-    order = np.argsort(width, kind="stable")  # equal widths together: one padded block each
+    strides = np.array([shape[1] * shape[2], shape[2], 1])
+    # equal widths together (one padded block each), in memory order within, so a chunk's
+    # footprints fall in a short stretch of the grid that one bincount sums
+    order = np.lexsort(((start - first) @ strides, width))
     bounds = np.flatnonzero(np.diff(width[order])) + 1
     for group in np.split(order, bounds):
         k = int(width[group[0]])
@@ -131,11 +132,15 @@ def particle_volume(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
         for at in range(0, len(group), step):
             members = group[at:at + step]
             index, weight = _footprints(c[members], sigma[members], far[members], start[members],
-                                        stop[members], k, first, shape, voxel_size, erf)
-            values = (weight * scale[members, None]).astype(np.float32)
-            np.add.at(total, index, values)
+                                        stop[members], k, first, shape, voxel_size)
+            values = weight * scale[members, None]
+            low = int(index.min())
+            index -= low
+            span = int(index.max()) + 1
+            total[low:low + span] += np.bincount(index.ravel(), values.ravel(), span).astype(np.float32)
             if lit is not None and light is not None:
-                np.add.at(lit, index, values * np.asarray(light, np.float32)[members, None])
+                shade = values * np.asarray(light, np.float64)[members, None]
+                lit[low:low + span] += np.bincount(index.ravel(), shade.ravel(), span).astype(np.float32)
     volume = _leaves(total.reshape(shape), None if lit is None else lit.reshape(shape), first, voxel_size)
     if not len(volume.origins):  # every particle's mass per voxel underflowed float32
         raise FishgenError(f"expected a voxel of density above 0, found none at voxel size {voxel_size:g}; "
@@ -143,7 +148,7 @@ def particle_volume(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     return volume
 
 
-def _footprints(c, sigma, far, start, stop, k, first, shape, voxel_size, erf):
+def _footprints(c, sigma, far, start, stop, k, first, shape, voxel_size):
     """Flat voxel indices (n, k^3) of each particle's footprint and its per-voxel mass shares
     (zero in the padding of particles narrower than ``k`` along an axis)."""
     n = len(c)
@@ -156,13 +161,26 @@ def _footprints(c, sigma, far, start, stop, k, first, shape, voxel_size, erf):
         lo = np.maximum((cell - 0.5) * voxel_size, (c[:, axis] - far)[:, None])
         hi = np.minimum((cell + 0.5) * voxel_size, (c[:, axis] + far)[:, None])
         root2s = math.sqrt(2) * sigma[:, None]
-        share = 0.5 * (erf((hi - c[:, axis, None]) / root2s) - erf((lo - c[:, axis, None]) / root2s))
+        share = 0.5 * (erfc((lo - c[:, axis, None]) / root2s) - erfc((hi - c[:, axis, None]) / root2s))
         share[cell > stop[:, axis, None]] = 0.0
         local = np.minimum(cell - first[axis], shape[axis] - 1) * strides[axis]
         view = (slice(None), *(slice(None) if a == axis else None for a in range(3)))
         weight *= share[view]
         index += local[view]
     return index.reshape(n, -1), weight.reshape(n, -1)
+
+
+def erfc(x: np.ndarray) -> np.ndarray:
+    """The complementary error function, to a relative 1.2e-7 everywhere (Numerical Recipes'
+    ``erfcc``, a Chebyshev fit): scipy.special takes a second to import."""
+    z = np.abs(x)
+    t = 1 / (1 + 0.5 * z)
+    poly = 0.17087277
+    for a in (-0.82215223, 1.48851587, -1.13520398, 0.27886807, -0.18628806, 0.09678418, 0.37409196,
+              1.00002368, -1.26551223):
+        poly = a + t * poly
+    tail = t * np.exp(-z * z + poly)
+    return np.where(x >= 0, tail, 2 - tail)
 
 
 def _leaves(total: np.ndarray, lit: np.ndarray | None, first: np.ndarray, voxel_size: float) -> Volume:

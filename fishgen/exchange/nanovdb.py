@@ -6,7 +6,8 @@ which is
 the in-memory layout NanoVDB reads in place (``nanovdb/NanoVDB.h``, version 32.9; byte offsets as
 ``PNanoVDB.h`` lists them): grid, tree, root with its tiles sorted by key, then the upper, lower
 and leaf nodes breadth first, every node 32-byte aligned, child pointers as byte offsets from
-the parent. No checksum (all bits set: "disabled"), no blind data.
+the parent. No checksum (all bits set: "disabled"), no blind data. The index space starts at the
+volume's first leaf; the map's translation puts it back in the world.
 """
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ import numpy as np
 
 from fishgen.atomic import write_files
 from fishgen.clouds.volume import DEFAULT_VOXEL_SIZE, Volume
-from fishgen.exchange.volumes import node_boxes, scene_volume, stats, tree
+from fishgen.exchange.volumes import node_boxes, scene_volume, shifted, stats, tree
 from fishgen.scene.model import Scene
 
 MAGIC = int.from_bytes(b"NanoVDB0", "little")
@@ -65,7 +66,9 @@ def write_nvdb(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZE)
 def nanovdb_bytes(volume: Volume) -> bytes:
     """The grids of ``volume`` as one uncompressed NanoVDB segment."""
     count = len(volume.grids)
-    grids = [_grid(volume, name, values, k, count) for k, (name, values) in enumerate(volume.grids)]
+    volume, translation = shifted(volume)
+    grids = [_grid(volume, translation, name, values, k, count)
+             for k, (name, values) in enumerate(volume.grids)]
     header = np.zeros(1, HEADER)
     header["magic"], header["version"], header["grids"] = MAGIC, VERSION, count
     return b"".join([header.tobytes(), *(meta for meta, _ in grids), *(buffer for _, buffer in grids)])
@@ -78,8 +81,10 @@ def root_key(origins: np.ndarray) -> np.ndarray:
     return (u[:, 0] << np.uint64(42)) | (u[:, 1] << np.uint64(21)) | u[:, 2]
 
 
-def _grid(volume: Volume, name: str, values: np.ndarray, index: int, count: int) -> tuple[bytes, bytes]:
-    """(its metadata and name, its buffer) of grid number ``index`` of ``count``."""
+def _grid(volume: Volume, translation: np.ndarray, name: str, values: np.ndarray, index: int,
+          count: int) -> tuple[bytes, bytes]:
+    """(its metadata and name, its buffer) of grid number ``index`` of ``count``; index (i, j, k) is
+    centred at ``translation + voxel_size x (i, j, k)``."""
     t = tree(volume.origins, root_key)
     n_up, n_low, n_leaf = len(t.uppers), len(t.lowers), len(t.leaves)
     root_at = GRID.itemsize + TREE.itemsize
@@ -136,12 +141,13 @@ def _grid(volume: Volume, name: str, values: np.ndarray, index: int, count: int)
     head["voxels"] = int(active.sum())
 
     vs = volume.voxel_size
-    world = np.concatenate([box[:3] * vs, (box[3:] + 1) * vs]).astype(np.float64)
+    world = np.concatenate([translation + box[:3] * vs, translation + (box[3:] + 1) * vs])
     grid = np.zeros(1, GRID)
     grid["magic"], grid["checksum"], grid["version"], grid["flags"] = MAGIC, NO_CHECKSUM, VERSION, GRID_FLAGS
     grid["index"], grid["count"], grid["size"], grid["name"] = index, count, size, name.encode("ascii")
     grid["matf"] = grid["matd"] = np.diag([vs] * 3).reshape(-1)
     grid["invmatf"] = grid["invmatd"] = np.diag([1 / vs] * 3).reshape(-1)
+    grid["vecf"] = grid["vecd"] = translation
     grid["taperf"] = grid["taperd"] = 1.0
     grid["world_box"], grid["voxel_size"] = world, [vs] * 3
     grid["class"], grid["type"] = FOG_VOLUME, FLOAT

@@ -4,11 +4,12 @@ File format 224 (OpenVDB 6 and later read it), uncompressed, as ``openvdb::io::F
 lays it out: the header (magic, format and library versions, "has grid offsets", a 36-character
 UUID), an empty file metadata map, the grid count, then per grid its descriptor (name, type,
 instance parent, and the stream offsets of the grid, its leaf data and its end), compression 0,
-its metadata (class "fog volume"), its transform (a ``UniformScaleMap``: voxel ``(i, j, k)`` is
-centred at ``voxel_size x (i, j, k)``), the topology (root background and children sorted by
-origin; each internal node's child and value masks and its values, all background, behind the
-"all values" byte 6; each leaf's value mask) and then every leaf's mask and 512 values in the
-same order. No pip package writes .vdb here (docs/decisions.md), so it is written from numpy.
+its metadata (class "fog volume"), its transform (a ``UniformScaleTranslateMap``: index space
+starts at the volume's first leaf, ``exchange.volumes.shifted``), the topology (root background
+and children sorted by origin; each internal node's child and value masks and its values, all
+background, behind the "all values" byte 6; each leaf's value mask) and then every leaf's mask
+and 512 values in the same order. No maintained pip package writes .vdb here (docs/volumes.md),
+so it is written from numpy.
 """
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ import numpy as np
 
 from fishgen.atomic import write_files
 from fishgen.clouds.volume import DEFAULT_VOXEL_SIZE, Volume
-from fishgen.exchange.volumes import tree
+from fishgen.exchange.volumes import shifted, tree
 from fishgen.scene.model import Scene
 
 MAGIC = 0x56444220
@@ -29,7 +30,7 @@ FILE_VERSION = 224
 LIBRARY = (11, 0)
 TREE_TYPE = "Tree_float_5_4_3"
 ALL_VALUES = 6  # NO_MASK_AND_ALL_VALS: the node's every value follows, uncompressed
-MAP = "UniformScaleMap"
+MAP = "UniformScaleTranslateMap"
 
 
 def write_vdb(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZE) -> list[Path]:
@@ -42,7 +43,8 @@ def write_vdb(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZE) 
 def openvdb_bytes(volume: Volume) -> bytes:
     """The grids of ``volume`` as one OpenVDB file; its UUID is a hash of the grids, so the same
     volume gives the same bytes."""
-    grids = [_grid(volume, name, values) for name, values in volume.grids]
+    volume, translation = shifted(volume)
+    grids = [_grid(volume, translation, name, values) for name, values in volume.grids]
     digest = hashlib.sha256(b"".join(body for _, body, _ in grids)).digest()[:16]
     header = (struct.pack("<qIIIB", MAGIC, FILE_VERSION, *LIBRARY, 1)
               + str(uuid.UUID(bytes=digest, version=4)).encode("ascii")
@@ -62,7 +64,8 @@ def _string(text: str) -> bytes:
     return struct.pack("<I", len(data)) + data
 
 
-def _grid(volume: Volume, name: str, values: np.ndarray) -> tuple[bytes, bytes, int]:
+def _grid(volume: Volume, translation: np.ndarray, name: str,
+          values: np.ndarray) -> tuple[bytes, bytes, int]:
     """(descriptor without its stream offsets, the grid from its compression flags to its end,
     where its leaf data starts in that)."""
     t = tree(volume.origins, lambda uppers: np.lexsort(uppers.T[::-1]).argsort())
@@ -75,8 +78,8 @@ def _grid(volume: Volume, name: str, values: np.ndarray) -> tuple[bytes, bytes, 
     head += struct.pack("<I", len(meta)) + b"".join(
         _string(key) + _string(kind) + struct.pack("<I", len(value)) + value for key, kind, value in meta)
     scale = np.array([vs] * 3)
-    head += _string(MAP) + np.concatenate([scale, scale, 1 / scale, 1 / scale ** 2, 0.5 / scale]).astype(
-        "<f8").tobytes()
+    vectors = [translation, scale, scale, 1 / scale, 1 / scale ** 2, 0.5 / scale]
+    head += _string(MAP) + np.concatenate(vectors).astype("<f8").tobytes()
     topology = [struct.pack("<i", 1), struct.pack("<f", 0.0), struct.pack("<II", 0, len(t.uppers))]
     lowers_of = np.split(np.arange(len(t.lowers)), np.flatnonzero(np.diff(t.lower_parent)) + 1)
     leaves_of = np.split(np.arange(len(t.leaves)), np.flatnonzero(np.diff(t.leaf_parent)) + 1)

@@ -33,6 +33,16 @@ def scene_volume(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZ
                            lighting.extinction, voxel_size, path)
 
 
+def shifted(volume: Volume) -> tuple[Volume, np.ndarray]:
+    """``volume`` with its index space moved so its first leaf starts at 0, and the world position
+    of index 0 (the translation the files' transforms carry). A cloud around the world's origin
+    straddles 8 upper and 8 lower nodes (each several kB to 270 kB); moved, one of each holds up to
+    128 voxels a side."""
+    shift = volume.origins.min(axis=0)
+    moved = Volume(volume.voxel_size, (volume.origins - shift).astype(np.int32), volume.active, volume.grids)
+    return moved, shift.astype(np.float64) * volume.voxel_size
+
+
 @dataclass(frozen=True)
 class Tree:
     """A volume's internal nodes and leaves in one stored order. ``uppers`` (U, 3) and ``lowers``

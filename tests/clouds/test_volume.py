@@ -113,3 +113,12 @@ def test_no_voxel_above_zero_is_refused():
     with pytest.raises(FishgenError, match="expected a voxel of density above 0, found none at voxel size "
                                            "1e\\+30; use a smaller --voxel-size"):
         particle_volume(*one(), EXTINCTION, 1e30)
+
+
+def test_erfc_is_scipys_to_a_relative_2e_7():
+    from scipy.special import erfc as reference  # type: ignore[import-untyped]
+
+    from fishgen.clouds.volume import erfc
+
+    x = np.concatenate([np.linspace(-6, 6, 100_001), [-30.0, 0.0, 9.0]])
+    assert np.allclose(erfc(x), reference(x), rtol=2e-7, atol=0)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import struct
 
 import numpy as np
+import pytest
 import tinyvdb._tinyvdb_nanovdb as nanovdb
 
 from fishgen.clouds import export_cloud
@@ -50,6 +51,8 @@ def test_tinyvdb_reads_both_grids_back_voxel_for_voxel(tmp_path):
     for k, name in enumerate(("density", "light")):
         assert (f.grid_type(k), f.grid_class(k)) == ("Float", "FogVolume")
         assert f.voxel_size(k) == DEFAULT_VOXEL_SIZE and f.active_voxel_count(k) == len(coords)
+        first = coords.min(0) + volume.origins.min(0)          # back in the world's index space
+        assert f.world_bbox(k)[0] == pytest.approx(volume.voxel_size * first)
         assert f.bbox(k) == (tuple(coords.min(0).astype(float)), tuple(coords.max(0).astype(float)))
         alone = tmp_path / f"{name}.nvdb"
         alone.write_bytes(one_grid_file(data, k))
@@ -61,6 +64,6 @@ def test_tinyvdb_reads_both_grids_back_voxel_for_voxel(tmp_path):
         # voxels no particle reaches read as the background, 0: around the box, and inside a leaf
         lo, hi = coords.min(0), coords.max(0)
         outside = [lo - 1, hi + 1, (lo + hi) // 2 + (hi - lo) * 10]
-        inside = np.argwhere(~volume.active[0])[:20] + volume.origins[0]
+        inside = np.argwhere(~volume.active[0])[:20] + volume.origins[0] - volume.origins.min(axis=0)
         assert all(grid.get(0, *map(int, c)) == 0.0 for c in [*outside, *inside])
 

@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 import tinyvdb
 
-from fishgen.clouds import Lighting, export_cloud
+from fishgen.clouds import Lighting, export_cloud, fill_cloud, light_cloud, load_cubes, merge_clouds
 from fishgen.clouds.light import CUT, peak_optical_depth
 from fishgen.clouds.sprite import SIGMA
-from fishgen.clouds.volume import reach
-from fishgen.exchange.volumes import tree
+from fishgen.clouds.volume import particle_volume, reach
+from fishgen.exchange.volumes import shifted, tree
 
-from .volume_clouds import active_voxels, table_cloud, table_volume
+from .volume_clouds import TABLE_4_4, active_voxels, table_cloud
 
 BPY = next((p for p in (os.environ.get("FISHGEN_BPY_PYTHON"), "/tmp/bpyvenv/bin/python")
             if p and Path(p).is_file()), None)
@@ -29,13 +29,20 @@ TINYVDB_CHILDREN = 64
 of one 16^3 node from a file it wrote itself); the voxel-exact test uses a cloud within that."""
 
 
-def test_tinyvdb_reads_both_grids_back_voxel_for_voxel(tmp_path):
-    size = 0.3
-    volume = table_volume(size)
-    t = tree(volume.origins, lambda uppers: np.lexsort(uppers.T[::-1]).argsort())
-    assert np.bincount(t.leaf_parent).max() <= TINYVDB_CHILDREN and len(t.lowers) > 1
+@pytest.mark.parametrize("apart,uppers,lowers", [(None, 1, 1), (100.0, 1, 2), (3000.0, 2, 2)])
+def test_tinyvdb_reads_both_grids_back_voxel_for_voxel(tmp_path, apart, uppers, lowers):
+    # Table 4.4 alone, or twice: 100 apart (two 16^3 internal nodes), 3000 apart (two 32^3 ones)
+    size = 0.6
+    cubes = load_cubes(TABLE_4_4)
+    cloud = table_cloud() if apart is None else light_cloud(merge_clouds(
+        [fill_cloud(cubes, seed=0), fill_cloud(cubes, seed=1, offset=(apart, 0.0, 30.0))]))
+    volume = particle_volume(cloud.centers, cloud.radii, cloud.density, cloud.light, Lighting().extinction,
+                             size)
+    t = tree(shifted(volume)[0].origins, lambda uppers: np.lexsort(uppers.T[::-1]).argsort())
+    assert np.bincount(t.leaf_parent).max() <= TINYVDB_CHILDREN
+    assert (len(t.uppers), len(t.lowers)) == (uppers, lowers)
     path = tmp_path / "cloud.vdb"
-    export_cloud(table_cloud(), path, voxel_size=size)
+    export_cloud(cloud, path, voxel_size=size)
     f = tinyvdb.open(str(path))
     assert f.header["file_version"] == 224 and f.header["compression_flags"] == 0
     f.read_grids()
@@ -45,8 +52,10 @@ def test_tinyvdb_reads_both_grids_back_voxel_for_voxel(tmp_path):
         grid = f.grid(k)
         assert (grid.name, grid.type_name, grid.float_background()) == (name, "Tree_float_5_4_3", 0.0)
         assert grid.metadata == {"class": "fog volume", "name": name}
-        assert grid.transform["type"] == "uniform_scale" and grid.transform["voxel_size"] == (size,) * 3
-        assert grid.transform["translation"] == (0.0, 0.0, 0.0)
+        assert grid.transform["type"] == "uniform_scale_translate"
+        assert grid.transform["voxel_size"] == (size,) * 3
+        # index space starts at the first leaf; the translation puts it back
+        assert grid.transform["translation"] == pytest.approx(tuple(volume.origins.min(0) * size))
         sparse = grid.to_sparse()
         got = np.frombuffer(sparse["coords"], np.int32).reshape(-1, 3).astype(np.int64)
         order = np.lexsort(got.T[::-1])

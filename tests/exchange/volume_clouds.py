@@ -27,8 +27,10 @@ def table_volume(voxel_size: float) -> Volume:
 
 
 def active_voxels(volume: Volume) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """(N, 3) int index coordinates of the active voxels, sorted x, y, z, and each grid's values there."""
+    """(N, 3) int coordinates of the active voxels in the files' index space (the volume's first
+    leaf at 0), sorted x, y, z, and each grid's values there."""
     leaf, x, y, z = np.nonzero(volume.active)
-    coords = volume.origins[leaf].astype(np.int64) + np.stack([x, y, z], axis=1)
+    first = volume.origins.min(axis=0).astype(np.int64)
+    coords = volume.origins[leaf].astype(np.int64) - first + np.stack([x, y, z], axis=1)
     order = np.lexsort(coords.T[::-1])
     return coords[order], {name: values[leaf, x, y, z][order] for name, values in volume.grids}
