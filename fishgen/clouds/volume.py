@@ -24,6 +24,11 @@ __all__ = ["DEFAULT_VOXEL_SIZE", "MAX_VOXELS", "Volume", "particle_volume", "vox
 
 LEAF = 8
 """Voxels along a leaf's side (OpenVDB's and NanoVDB's 8^3 leaves)."""
+TILE = 32
+"""Particles are splatted in runs of neighbours from tiles of this many voxels a side."""
+SPARSE = 2
+"""A chunk whose box holds more than this many voxels per footprint voxel is added in place
+(``np.add.at``) rather than summed over its box (``np.bincount``): about where they cost the same."""
 CHUNK = 1 << 20
 """Footprint voxels evaluated at a time: the splat's temporaries stay about 40 MB."""
 
@@ -119,29 +124,41 @@ def particle_volume(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     start = np.floor((c - far[:, None]) / voxel_size + 0.5).astype(np.int64)
     stop = np.floor((c + far[:, None]) / voxel_size + 0.5).astype(np.int64)
     width = (stop - start + 1).max(1)
-    total = np.zeros(shape, np.float32).reshape(-1)
+    total = np.zeros(shape, np.float32)
     lit = np.zeros_like(total) if light is not None else None
-    strides = np.array([shape[1] * shape[2], shape[2], 1])
-    # equal widths together (one padded block each), in memory order within, so a chunk's
-    # footprints fall in a short stretch of the grid that one bincount sums
-    order = np.lexsort(((start - first) @ strides, width))
+    grids = [(total, None)] if lit is None or light is None else [(total, None), (lit, light)]
+    # equal widths together (one padded block each), neighbours together within (by tiles of
+    # TILE voxels), so a chunk's footprints mostly fill a small box that one bincount sums
+    tile = (start - first) // TILE
+    order = np.lexsort((tile[:, 2], tile[:, 1], tile[:, 0], width))
     bounds = np.flatnonzero(np.diff(width[order])) + 1
     for group in np.split(order, bounds):
         k = int(width[group[0]])
         step = max(1, CHUNK // k ** 3)
         for at in range(0, len(group), step):
             members = group[at:at + step]
-            index, weight = _footprints(c[members], sigma[members], far[members], start[members],
+            cells, shares = _footprints(c[members], sigma[members], far[members], start[members],
                                         stop[members], k, first, shape, voxel_size)
-            values = weight * scale[members, None]
-            low = int(index.min())
-            index -= low
-            span = int(index.max()) + 1
-            total[low:low + span] += np.bincount(index.ravel(), values.ravel(), span).astype(np.float32)
-            if lit is not None and light is not None:
-                shade = values * np.asarray(light, np.float64)[members, None]
-                lit[low:low + span] += np.bincount(index.ravel(), shade.ravel(), span).astype(np.float32)
-    volume = _leaves(total.reshape(shape), None if lit is None else lit.reshape(shape), first, voxel_size)
+            low = [int(a[:, 0].min()) for a in cells]
+            box = [int(a[:, -1].max()) + 1 - lo for a, lo in zip(cells, low, strict=True)]
+            size = box[0] * box[1] * box[2]
+            sparse = size > SPARSE * len(members) * k ** 3  # footprints scattered in a big box
+            if sparse:                                      # index the whole grid, add in place
+                low, box = [0, 0, 0], list(shape)
+            x, y, z = (a - lo for a, lo in zip(cells, low, strict=True))
+            rows_y = (x * box[1])[:, :, None] + y[:, None, :]                       # (n, k, k)
+            index = (rows_y[..., None] * box[2] + z[:, None, None, :]).ravel()
+            plane = shares[1][:, :, None] * shares[2][:, None, :]                      # (n, k, k)
+            rows = shares[0] * scale[members, None]
+            for grid, carried in grids:
+                weight = rows if carried is None else rows * np.asarray(carried, np.float64)[members, None]
+                values = (weight[:, :, None, None] * plane[:, None]).ravel()
+                if sparse:
+                    np.add.at(grid.reshape(-1), index, values.astype(np.float32))
+                else:
+                    part = tuple(slice(lo, lo + b) for lo, b in zip(low, box, strict=True))
+                    grid[part] += np.bincount(index, values, size).reshape(box).astype(np.float32)
+    volume = _leaves(total, lit, first, voxel_size)
     if not len(volume.origins):  # every particle's mass per voxel underflowed float32
         raise FishgenError(f"expected a voxel of density above 0, found none at voxel size {voxel_size:g}; "
                            "use a smaller --voxel-size", where)
@@ -149,25 +166,21 @@ def particle_volume(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
 
 
 def _footprints(c, sigma, far, start, stop, k, first, shape, voxel_size):
-    """Flat voxel indices (n, k^3) of each particle's footprint and its per-voxel mass shares
-    (zero in the padding of particles narrower than ``k`` along an axis)."""
-    n = len(c)
+    """Per axis, each particle's ``k`` footprint cells (n, k), counted from the grid's ``first``
+    voxel, and the share of its Gaussian's mass in each (0 in the padding of particles narrower
+    than ``k``, whose cells stop at the grid's edge)."""
     steps = np.arange(k)
-    index = np.zeros((n, k, k, k), np.int64)
-    weight = np.ones((n, k, k, k), np.float64)
-    strides = (shape[1] * shape[2], shape[2], 1)
+    cells, shares = [], []
+    root2s = math.sqrt(2) * sigma[:, None]
     for axis in range(3):
         cell = start[:, axis, None] + steps[None, :]                     # (n, k) voxel indices
         lo = np.maximum((cell - 0.5) * voxel_size, (c[:, axis] - far)[:, None])
         hi = np.minimum((cell + 0.5) * voxel_size, (c[:, axis] + far)[:, None])
-        root2s = math.sqrt(2) * sigma[:, None]
         share = 0.5 * (erfc((lo - c[:, axis, None]) / root2s) - erfc((hi - c[:, axis, None]) / root2s))
         share[cell > stop[:, axis, None]] = 0.0
-        local = np.minimum(cell - first[axis], shape[axis] - 1) * strides[axis]
-        view = (slice(None), *(slice(None) if a == axis else None for a in range(3)))
-        weight *= share[view]
-        index += local[view]
-    return index.reshape(n, -1), weight.reshape(n, -1)
+        cells.append(np.minimum(cell - first[axis], shape[axis] - 1))
+        shares.append(share)
+    return cells, shares
 
 
 def erfc(x: np.ndarray) -> np.ndarray:
