@@ -17,7 +17,7 @@ import numpy as np
 
 from fishgen.atomic import write_files
 from fishgen.clouds.volume import DEFAULT_VOXEL_SIZE, Volume
-from fishgen.exchange.volumes import node_boxes, scene_volume, shifted, stats, tree
+from fishgen.exchange.volumes import leaf_stats, node_boxes, scene_volume, shifted, stats, tree
 from fishgen.scene.model import Scene
 
 MAGIC = int.from_bytes(b"NanoVDB0", "little")
@@ -106,13 +106,14 @@ def _grid(volume: Volume, translation: np.ndarray, name: str, values: np.ndarray
     leaves["span"] = leaf_hi - leaf_lo
     leaves["flags"] = NODE_HAS_BBOX | LEAF_HAS_STATS
     leaves["mask"] = np.packbits(active, axis=1, bitorder="little")
-    leaves["stats"] = stats(flat, active, np.arange(n_leaf), n_leaf)
+    per_leaf = leaf_stats(flat, active)
+    leaves["stats"] = stats(per_leaf, np.arange(n_leaf), n_leaf)
     leaves["values"] = flat
 
     lowers = np.zeros(n_low, LOWER_NODE)
     lowers["box"] = np.concatenate([low_lo, low_hi], axis=1)
     lowers["flags"] = NODE_HAS_BBOX
-    lowers["stats"] = stats(flat, active, t.leaf_parent, n_low)
+    lowers["stats"] = stats(per_leaf, t.leaf_parent, n_low)
     leaf_addresses = leaf_at + np.arange(n_leaf) * LEAF_NODE.itemsize
     parents = low_at + t.leaf_parent * LOWER_NODE.itemsize
     lowers["table"][t.leaf_parent, t.leaf_slot] = leaf_addresses - parents
@@ -121,7 +122,7 @@ def _grid(volume: Volume, translation: np.ndarray, name: str, values: np.ndarray
     uppers = np.zeros(n_up, UPPER_NODE)
     uppers["box"] = np.concatenate([up_lo, up_hi], axis=1)
     uppers["flags"] = NODE_HAS_BBOX
-    uppers["stats"] = stats(flat, active, upper_of_leaf, n_up)
+    uppers["stats"] = stats(per_leaf, upper_of_leaf, n_up)
     low_addresses = low_at + np.arange(n_low) * LOWER_NODE.itemsize
     parents = up_at + t.lower_parent * UPPER_NODE.itemsize
     uppers["table"][t.lower_parent, t.lower_slot] = low_addresses - parents
@@ -133,7 +134,7 @@ def _grid(volume: Volume, translation: np.ndarray, name: str, values: np.ndarray
     root = np.zeros(1, ROOT)
     root["box"] = box
     root["tiles"] = n_up
-    root["stats"] = stats(flat, active, everything, 1)
+    root["stats"] = stats(per_leaf, everything, 1)
 
     head = np.zeros(1, TREE)
     head["offsets"] = [x - GRID.itemsize for x in (leaf_at, low_at, up_at, root_at)]

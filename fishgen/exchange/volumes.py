@@ -114,18 +114,26 @@ def leaf_boxes(volume: Volume) -> tuple[np.ndarray, np.ndarray]:
     return lo + volume.origins, hi + volume.origins
 
 
-def stats(values: np.ndarray, active: np.ndarray, groups: np.ndarray, count: int) -> np.ndarray:
-    """(count, 4) float32 min, max, mean and standard deviation of the active ``values`` (L, 512)
-    of leaves in each of ``count`` groups (``groups``: each leaf's)."""
-    flat_groups = np.broadcast_to(groups[:, None], active.shape)[active]
-    v = values[active].astype(np.float64)
-    out = np.zeros((count, 4), np.float64)
+def leaf_stats(values: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """(L, 5) float64 per leaf of its active ``values`` (L, 512): count, mean, sum of squared
+    deviations, min and max (inf and -inf for none)."""
+    v = values.astype(np.float64)
+    n = active.sum(axis=1).astype(np.float64)
+    mean = np.where(active, v, 0).sum(axis=1) / np.maximum(n, 1)
+    squares = np.where(active, (v - mean[:, None]) ** 2, 0).sum(axis=1)
+    return np.stack([n, mean, squares, np.where(active, v, np.inf).min(axis=1),
+                     np.where(active, v, -np.inf).max(axis=1)], axis=1)
+
+
+def stats(leaves: np.ndarray, groups: np.ndarray, count: int) -> np.ndarray:
+    """(count, 4) float32 min, max, mean and standard deviation of the active values of the leaves
+    in each of ``count`` groups (``groups``: each leaf's), pooled from ``leaf_stats`` (Chan et al.)."""
+    n, mean, squares = leaves[:, 0], leaves[:, 1], leaves[:, 2]
     lo = np.full(count, np.inf)
     hi = np.full(count, -np.inf)
-    np.minimum.at(lo, flat_groups, v)
-    np.maximum.at(hi, flat_groups, v)
-    n = np.bincount(flat_groups, minlength=count).astype(np.float64)
-    mean = np.bincount(flat_groups, v, count) / np.maximum(n, 1)
-    var = np.bincount(flat_groups, (v - mean[flat_groups]) ** 2, count) / np.maximum(n, 1)
-    out[:, 0], out[:, 1], out[:, 2], out[:, 3] = lo, hi, mean, np.sqrt(var)
-    return out.astype(np.float32)
+    np.minimum.at(lo, groups, leaves[:, 3])
+    np.maximum.at(hi, groups, leaves[:, 4])
+    total = np.bincount(groups, n, count)
+    group_mean = np.bincount(groups, n * mean, count) / np.maximum(total, 1)
+    spread = np.bincount(groups, squares + n * (mean - group_mean[groups]) ** 2, count)
+    return np.stack([lo, hi, group_mean, np.sqrt(spread / np.maximum(total, 1))], axis=1).astype(np.float32)

@@ -67,3 +67,16 @@ def test_tinyvdb_reads_both_grids_back_voxel_for_voxel(tmp_path):
         inside = np.argwhere(~volume.active[0])[:20] + volume.origins[0] - volume.origins.min(axis=0)
         assert all(grid.get(0, *map(int, c)) == 0.0 for c in [*outside, *inside])
 
+
+
+def test_node_statistics_are_those_of_the_active_voxels_below():
+    from fishgen.exchange.volumes import leaf_stats, stats
+
+    rng = np.random.default_rng(0)
+    values = rng.random((50, 512)).astype(np.float32) * 10
+    active = rng.random((50, 512)) < 0.3
+    groups = rng.integers(0, 5, 50)
+    got = stats(leaf_stats(values, active), groups, 5)
+    for k in range(5):
+        mine = values[groups == k][active[groups == k]].astype(np.float64)
+        np.testing.assert_allclose(got[k], [mine.min(), mine.max(), mine.mean(), mine.std()], rtol=1e-6)
