@@ -450,3 +450,11 @@ def max_particles_option(default: int, whole: str = "scenes") -> Any:
 def seed_option(help_text: str, default: int | None = 0, shown_default: str | None = None) -> Any:
     return option(SEED, f"Random seed (0 to 2^63-1); the same seed gives byte-identical files. {help_text}",
                   default, shown_default=shown_default)
+
+
+def voxel_size_option(default: float) -> Any:
+    """--voxel-size of a command writing volumes (.vdb, .nvdb). ``default``: the cloud model's own
+    (options sit below the models)."""
+    return option(FiniteRange(0, FLOAT32_MAX, min_open=True),
+                  ".vdb and .nvdb only: the side of a voxel, in the cube files' units; a box of more "
+                  "than 2^25 voxels around the cloud is refused before filling.", default, metavar="SIZE")

@@ -4,6 +4,7 @@
     cloud = fill_cloud(cubes, seed=7, method="paper", offset=(0, 0, 0))
     cloud = light_cloud(cloud, Lighting(sun=(1, 0.3, 0)))     # Harris's first pass, baked
     export_cloud(cloud, "cloud.glb", billboards=True)
+    export_cloud(cloud, "cloud.vdb", voxel_size=0.1)               # density and light grids
 
 Several files make one scene with ``merge_clouds([fill_cloud(a, offset=...), ...])``, lit after
 merging so the clouds shadow each other.
@@ -26,5 +27,6 @@ _API = {
     "Lighting": "fishgen.clouds.lighting",
     "incident_light": "fishgen.clouds.light", "light_cloud": "fishgen.clouds.light",
     "lit_colors": "fishgen.clouds.light",
+    "Volume": "fishgen.clouds.volume", "particle_volume": "fishgen.clouds.volume",
 }
 __getattr__, __all__ = lazy_exports(__name__, _API)

@@ -4,11 +4,14 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from fishgen.clouds.model import Cloud
+from fishgen.clouds.model import DEFAULT_VOXEL_SIZE, Cloud
 from fishgen.errors import FishgenError
 from fishgen.exchange.registry import POINTS, extensions, formats, output_format
 
 FORMATS = extensions(formats(writable=True, holding=[POINTS]))
+VOLUME_FORMATS = tuple(ext for f in formats(writable=True, holding=[POINTS]) if "voxel_size" in f.writes_with
+                       for ext in f.extensions)
+"""Formats that hold the cloud as voxel grids (.nvdb, .vdb): they take a voxel size."""
 BILLBOARD_FORMATS = (".glb", ".gltf")
 """Billboards need unlit, alpha-blended, vertex-coloured quads: only glTF says all of that."""
 
@@ -40,12 +43,17 @@ def check_output(path: str | os.PathLike, billboards: bool = False, particles: i
     return suffix
 
 
-def export_cloud(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = False) -> list[Path]:
-    """Write ``cloud`` to ``path`` (.ply, .glb, .gltf, .csv or .npy), atomically."""
+def export_cloud(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = False,
+                 voxel_size: float = DEFAULT_VOXEL_SIZE) -> list[Path]:
+    """Write ``cloud`` to ``path`` (.ply, .glb, .gltf, .csv, .npy, or as volume grids of
+    ``voxel_size`` to .nvdb or .vdb), atomically."""
     from fishgen.clouds.scene import cloud_scene
     from fishgen.exchange import export
 
-    check_output(path, billboards)
+    suffix = check_output(path, billboards)
     if len(cloud) == 0:
         raise FishgenError("expected at least 1 particle to export, found 0", path)
-    return export(cloud_scene(cloud, billboards=billboards), path)
+    scene = cloud_scene(cloud, billboards=billboards)
+    if suffix in VOLUME_FORMATS:
+        return export(scene, path, voxel_size=voxel_size)
+    return export(scene, path)

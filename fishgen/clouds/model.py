@@ -11,6 +11,12 @@ if TYPE_CHECKING:  # numpy stays out of the import path of the parser and the CL
 
 DEFAULT_MAX_PARTICLES = 50_000_000
 """Refuse larger clouds before allocating (about 31 bytes per particle in memory)."""
+DEFAULT_VOXEL_SIZE = 0.2
+"""A volume's voxel side, in cube-file units: Table 4.4 (about 18 x 13 x 9 with its particles'
+reach) becomes about 90 x 65 x 45 voxels, 2 to 6 voxels across the sigma of most particles."""
+MAX_VOXELS = 1 << 25
+"""Most voxels in a volume's bounding box (about 320^3): the splat holds two float32 grids of that
+box, 256 MB at the cap; refused before filling."""
 METHODS = ("paper", "uniform")
 """How cubes are filled: the report's sine phase shifts with rejection, or plain uniform."""
 

@@ -9,10 +9,18 @@ from pathlib import Path
 import click
 
 from fishgen.clouds.lighting import Lighting
-from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, METHODS
+from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, DEFAULT_VOXEL_SIZE, METHODS
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
 from fishgen.exchange.registry import POINTS, extensions, formats
-from fishgen.options import Triple, cloud_textures_option, group, max_particles_option, option, seed_option
+from fishgen.options import (
+    Triple,
+    cloud_textures_option,
+    group,
+    max_particles_option,
+    option,
+    seed_option,
+    voxel_size_option,
+)
 
 BILLBOARD_TRIANGLES = 6  # fishgen.clouds.scene.TRIANGLES_PER_BILLBOARD, without numpy (a test checks)
 
@@ -31,6 +39,7 @@ class CloudsOptions:
                               "triangles, 12 vertices), an alpha-blended Gaussian sprite, instead of points; "
                               "a texture cloud (.awa) is always billboards, with its PNGs.", False, flag=True)
     max_particles: int = max_particles_option(DEFAULT_MAX_PARTICLES)
+    voxel_size: float = voxel_size_option(DEFAULT_VOXEL_SIZE)
     textures: Path | None = cloud_textures_option()
     lighting: Lighting = group(Lighting)
     light: bool = option(click.BOOL, "Bake the sunlight into each particle's colour (and its _LIGHT "
@@ -48,7 +57,10 @@ COMMAND = Command(
     one cloud; several files with --offset make one scene. The scene is lit by the
     sun as RekAwan's renderer lit it (Harris's multiple forward scattering, baked
     into each particle's colour and its _LIGHT attribute). A texture cloud (.awa:
-    each cube line also names its PNG) becomes textured billboards.
+    each cube line also names its PNG) becomes textured billboards. A .vdb or
+    .nvdb output is the cloud as a volume: a "density" grid (extinction per
+    unit, the particles' Gaussians as the lighting sees them) and a "light"
+    grid (the baked sunlight), in voxels of --voxel-size.
 
     \b
     Examples:
@@ -56,6 +68,7 @@ COMMAND = Command(
       fishgen clouds a.awn b.awn --offset 0,0,0 --offset 25,3,-10 -o out/sky.glb --billboards
       fishgen clouds params/clouds/table_4_4.awn -o out/cloud.glb --billboards --sun 1,0.3,0
       fishgen clouds params/clouds/sky.awa -o out/texture-sky.glb
+      fishgen clouds params/clouds/table_4_4.awn -o out/cloud.vdb --voxel-size 0.1
     """,
     options=CloudsOptions,
     run="fishgen.commands.clouds:clouds",
@@ -79,7 +92,7 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
            events: Events = QUIET) -> Made:
     """Fill every cube file, light them together (so clouds shadow each other) and write them as one
     scene; input i is filled with seed + i. A texture cloud (.awa) becomes textured billboards."""
-    from fishgen.clouds.export import check_output, export_cloud
+    from fishgen.clouds.export import VOLUME_FORMATS, check_output, export_cloud
     from fishgen.clouds.pipeline import cloud_textures, cube_clouds, read_cube_files
     from fishgen.commands.paths import check_inputs, check_targets
     from fishgen.errors import UsageError
@@ -109,6 +122,11 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
                     "written as particles")
     check_targets([output], textures)
     check_output(output, billboards, particles=sum(f.total for f in files))  # a glTF buffer holds 4 GiB
+    volume = output.suffix.lower() in VOLUME_FORMATS
+    if volume:
+        from fishgen.clouds.volume import check_cube_files
+
+        check_cube_files(files, options.offset, options.voxel_size, output)
     seed = options.seed or 0
     made = cube_clouds(files, seed=seed, method=options.method, offsets=options.offset,
                        lighting=options.lighting, light=options.light, max_particles=options.max_particles)
@@ -119,9 +137,10 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
         from fishgen.clouds.fill import merge_clouds
 
         cloud, sun = merge_clouds(made.clouds), "unlit"
-    written = export_cloud(cloud, output, billboards=billboards)
+    written = export_cloud(cloud, output, billboards=billboards, voxel_size=options.voxel_size)
     line = (f"{output}: {_plural(len(cloud), made.noun)} in {_plural(len(cloud.cube_bounds), 'cube')} "
-            f"from {_plural(len(files), 'file')} ({options.method} fill, seed {seed}, {sun})")
+            f"from {_plural(len(files), 'file')} ({options.method} fill, seed {seed}, {sun}"
+            f"{f', voxels of {options.voxel_size:g}' * volume})")
     facts = CloudFacts(len(cloud), len(cloud.cube_bounds), len(files), billboards, options.lighting)
     return Made(tuple(written), (*inputs, *textures), (line,), facts)
 

@@ -11,13 +11,14 @@ from pathlib import Path
 from fishgen.scene.model import Scene
 
 
-def export(scene: Scene, path: str | os.PathLike, *, require: Iterable[str] = ()) -> list[Path]:
+def export(scene: Scene, path: str | os.PathLike, *, require: Iterable[str] = (), **options) -> list[Path]:
     """Write ``scene`` to ``path`` in the format its extension names; returns the files written.
 
     ``require`` names what the format must hold (``"node animation"`` for a
-    school); a format that cannot is refused before anything is written.
+    school); a format that cannot is refused before anything is written. ``options`` (of
+    ``registry.WRITER_OPTIONS``: ``voxel_size``) go to the writers that take them.
     """
     from fishgen.exchange.registry import output_format
 
     path = Path(path)
-    return output_format(path, require).write(scene, path)
+    return output_format(path, require).write(scene, path, **options)

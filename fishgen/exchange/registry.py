@@ -45,11 +45,17 @@ class Format:
     viewer: bool = False            # the three.js viewer page can show it
     command: str | None = None      # for source formats: the command that turns them into assets
     reads_with: tuple[str, ...] = ()  # the options its reader takes, of READER_OPTIONS
+    writes_with: tuple[str, ...] = ()  # the options its writer takes, of WRITER_OPTIONS
     sniff: str | None = None        # "module:function(path) -> bool": is this file of this format?
     extra: tuple[str, str, str] | None = None  # (module, pip package, extra) its writer needs
 
-    def write(self, scene, path: Path) -> list[Path]:
-        return _load(self.writer)(scene, path)
+    def write(self, scene, path: Path, **offered) -> list[Path]:
+        """Write ``scene`` to ``path``; of the ``offered`` options (each one of WRITER_OPTIONS, or it
+        is a TypeError) the writer gets those it declares taking."""
+        unknown = set(offered) - set(WRITER_OPTIONS)
+        if unknown:
+            raise TypeError(f"no writer takes {', '.join(sorted(unknown))}")
+        return _load(self.writer)(scene, path, **{k: v for k, v in offered.items() if k in self.writes_with})
 
     def read(self, path: Path, **offered):
         """Read ``path``; of the ``offered`` options (each one of READER_OPTIONS, or it is a
@@ -67,6 +73,8 @@ FORMATS: dict[str, Format] = {}
 READER_OPTIONS = ("textures_dir", "seed", "lighting")
 """What a caller may offer readers: a species file's (or texture cloud's) texture folder, a cube
 file's fill seed, and the sunlight a cloud is lit with (:class:`fishgen.clouds.lighting.Lighting`)."""
+WRITER_OPTIONS = ("voxel_size",)
+"""What a caller may offer writers: a volume's voxel side (.vdb, .nvdb)."""
 
 
 def register_format(fmt: Format) -> Format:
@@ -78,6 +86,9 @@ def register_format(fmt: Format) -> Format:
     unknown = set(fmt.reads_with) - set(READER_OPTIONS)
     if unknown:
         raise ValueError(f"{fmt.name}: no such reader option {', '.join(sorted(unknown))}")
+    unknown = set(fmt.writes_with) - set(WRITER_OPTIONS)
+    if unknown:
+        raise ValueError(f"{fmt.name}: no such writer option {', '.join(sorted(unknown))}")
     FORMATS[fmt.name] = fmt
     return fmt
 
@@ -195,6 +206,12 @@ register_format(Format("csv", (".csv",), "CSV table of particles", frozenset({PO
                        "fishgen.exchange.table:write_csv"))
 register_format(Format("npy", (".npy",), "NumPy structured array of particles", frozenset({POINTS}),
                        "fishgen.exchange.table:write_npy"))
+register_format(Format("nvdb", (".nvdb",), "NanoVDB volume: a cloud's density and light grids",
+                       frozenset({POINTS}), "fishgen.exchange.nanovdb:write_nvdb",
+                       writes_with=("voxel_size",)))
+register_format(Format("vdb", (".vdb",), "OpenVDB volume: a cloud's density and light grids",
+                       frozenset({POINTS}), "fishgen.exchange.openvdb:write_vdb",
+                       writes_with=("voxel_size",)))
 register_format(Format("species", (".txt",), "a VRFish species file",
                        frozenset({MESHES, TEXTURES, NODE_ANIMATION}),
                        reader="fishgen.assembly.fish:species_scene", command="build",

@@ -113,6 +113,10 @@ def test_total_mismatch_is_a_warning_on_stderr(cli, write_awn, tmp_path):
                               "finite numbers within float32 range, found '0,0,inf'"),
     (["--offset", "nan,0,0"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z"),
     (["--billboards"], "out.ply: expected a .glb or .gltf output with --billboards"),
+    (["--voxel-size", "0"], "fishgen clouds: Invalid value for '--voxel-size': 0.0 is not in the range "
+                            "0<x<="),
+    (["--voxel-size", "nan"], "fishgen clouds: Invalid value for '--voxel-size': 'nan' is not a finite "
+                              "number."),
 ])
 def test_bad_options_are_one_line_errors(cli, tmp_path, args, message):
     result = cli("clouds", TABLES["4.3"], "-o", tmp_path / "out.ply", *args)
@@ -134,7 +138,8 @@ def test_help_documents_every_option_with_its_default(cli):
     for option, default in (("--output", "[required]"), ("--offset", "[default: 0,0,0"),
                             ("--seed", "[default: 0; in a batch, derived from the output's name]"),
                             ("--method", "[default: paper]"), ("--billboards", "[default: off"),
-                            ("--max-particles", "[default: 50000000] [x>=1]")):
+                            ("--max-particles", "[default: 50000000] [x>=1]"),
+                            ("--voxel-size", "[default: 0.2]")):
         assert option in text and default in text, option
 
 
@@ -246,3 +251,24 @@ def test_no_light_with_a_lighting_option_is_refused(cli, tmp_path):
 def test_help_says_light_is_baked_by_default(cli):
     text = " ".join(cli("clouds", "--help").stdout.split())
     assert "--light / --no-light Bake the sunlight" in text and "[default: on]" in text.split("--no-light")[1]
+
+
+def test_volumes_same_seed_same_bytes_through_the_cli(cli, tmp_path):
+    for ext in (".vdb", ".nvdb"):
+        for name, seed in (("a", "5"), ("b", "5"), ("c", "6")):
+            result = cli("clouds", TABLES["4.4"], "-o", tmp_path / f"{name}{ext}", "--seed", seed)
+            assert result.returncode == 0 and result.stderr == "", result.stderr
+            assert "615 particles" in result.stdout and "voxels of 0.2" in result.stdout
+        a, b, c = ((tmp_path / f"{n}{ext}").read_bytes() for n in "abc")
+        assert a == b != c
+
+
+@pytest.mark.parametrize("ext", [".vdb", ".nvdb"])
+def test_a_volume_of_too_many_voxels_is_refused_before_filling(cli, tmp_path, ext):
+    cubes = tmp_path / "wide.awn"
+    cubes.write_text("40000000\n1\n40000000, 3000 10 10, 0 0 0, 1\n")   # 1 GB of particles if filled
+    result = cli("clouds", cubes, "-o", tmp_path / f"wide{ext}")
+    assert_one_line_error(result, f"{tmp_path / f'wide{ext}'}: expected at most 33,554,432 voxels in the "
+                                  "volume's bounding box, found ")
+    assert result.returncode == 2 and "; use --voxel-size 0.246 or more" in result.stderr
+    assert list(tmp_path.iterdir()) == [cubes]

@@ -25,7 +25,7 @@ def test_cli_choices_come_from_the_registry():
     from fishgen.viewer.page import KINDS
 
     assert [f.name for f in FISH_FORMATS] == ["glb", "gltf", "obj", "ply", "usdc", "usda", "usdz"]
-    assert CLOUD_FORMATS == (".glb", ".gltf", ".ply", ".csv", ".npy")
+    assert CLOUD_FORMATS == (".glb", ".gltf", ".ply", ".csv", ".npy", ".nvdb", ".vdb")
     assert set(KINDS) == {".glb", ".gltf", ".obj", ".ply"}
 
 
