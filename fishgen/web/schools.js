@@ -4,11 +4,15 @@
 // one per fish and part. Shared by fishgen view and fly.
 //
 // Each frame the fish's root tracks are sampled for all fish of a species at once (one key search
-// per distinct key-times array, then a flat loop over typed arrays) into the instance matrices;
-// the body wave's morph weights go to three.js's per-instance morph texture; the fins' swings,
-// which fishgen keys in a few phases shared by many fish, are sampled once per phase into a small
-// float texture that the vertex shader reads by the fish's phase and the vertex's part. Anything
-// that does not fit this layout (skins, levels of detail, other interpolations) stays as it was.
+// per distinct key-times array, then a flat loop over typed arrays) into their matrices, and their
+// body-wave weights likewise; the fins' swings, which fishgen keys in a few phases shared by many
+// fish, are sampled once per phase. Just before a species is drawn, its fish in the camera's view
+// are laid out nearest first in float textures (matrix, fin phase and tint a fish; three.js's
+// per-instance morph texture for the weights) and the instanced meshes drawn with that many
+// instances: culled and ordered as three.js culls and orders a node per fish, and uploaded when
+// drawn. The vertex shader moves each vertex by its part's matrix for the fish's phase, then by
+// the fish's. Anything that does not fit this layout (skins, levels of detail, other
+// interpolations) stays as it was.
 import * as THREE from 'three';
 import { mergeGeometries } from 'three/addons/utils/BufferGeometryUtils.js';
 
@@ -78,35 +82,56 @@ function fishOf( node, tracks ) {
 
 // -- the shader ---------------------------------------------------------------------------------
 
-// Each vertex is moved by its part's matrix (rest translation and scale, the swing's rotation) for
-// the fish's fin phase, after the body wave's morph and before the instance's matrix; rows of the
-// 3x4 matrix are three RGBA texels of `fishgenParts`, one texture row per phase.
+// fishgenParts: a row per fin phase, six texels a part: its matrix's three rows (rest translation
+// and scale, the swing's rotation), then its normal matrix's. fishgenInstances: a row per drawn
+// fish: its matrix's three rows, (phase, -, -, -), then its tint for each of the species' materials.
 const PARS = `
 uniform highp sampler2D fishgenParts;
+uniform highp sampler2D fishgenInstances;
 attribute float fishgenPart;
-attribute float fishgenPose;
+varying vec3 fishgenTint;
 `;
-const FETCH = `
-	ivec2 fishgenAt = ivec2( int( fishgenPart ) * 3, int( fishgenPose ) );
-	vec4 fishgenRow0 = texelFetch( fishgenParts, fishgenAt, 0 );
-	vec4 fishgenRow1 = texelFetch( fishgenParts, fishgenAt + ivec2( 1, 0 ), 0 );
-	vec4 fishgenRow2 = texelFetch( fishgenParts, fishgenAt + ivec2( 2, 0 ), 0 );
-	mat3 fishgenLinear = mat3( fishgenRow0.xyz, fishgenRow1.xyz, fishgenRow2.xyz );   // transposed
+const FETCH = ( slot ) => `
+	vec4 fishgenFish0 = texelFetch( fishgenInstances, ivec2( 0, gl_InstanceID ), 0 );
+	vec4 fishgenFish1 = texelFetch( fishgenInstances, ivec2( 1, gl_InstanceID ), 0 );
+	vec4 fishgenFish2 = texelFetch( fishgenInstances, ivec2( 2, gl_InstanceID ), 0 );
+	float fishgenPhase = texelFetch( fishgenInstances, ivec2( 3, gl_InstanceID ), 0 ).x;
+	fishgenTint = texelFetch( fishgenInstances, ivec2( ${ 4 + slot }, gl_InstanceID ), 0 ).rgb;
+	ivec2 fishgenAt = ivec2( int( fishgenPart ) * 6, int( fishgenPhase ) );
+	vec4 fishgenPart0 = texelFetch( fishgenParts, fishgenAt, 0 );
+	vec4 fishgenPart1 = texelFetch( fishgenParts, fishgenAt + ivec2( 1, 0 ), 0 );
+	vec4 fishgenPart2 = texelFetch( fishgenParts, fishgenAt + ivec2( 2, 0 ), 0 );
+	vec3 fishgenNormal0 = texelFetch( fishgenParts, fishgenAt + ivec2( 3, 0 ), 0 ).xyz;
+	vec3 fishgenNormal1 = texelFetch( fishgenParts, fishgenAt + ivec2( 4, 0 ), 0 ).xyz;
+	vec3 fishgenNormal2 = texelFetch( fishgenParts, fishgenAt + ivec2( 5, 0 ), 0 ).xyz;
+`;
+// the fish's normal as three.js takes an instance's: divided by its columns' squared lengths, then
+// turned by its matrix (right for any scale but shear)
+const NORMAL = `
+	objectNormal = vec3( dot( fishgenNormal0, objectNormal ), dot( fishgenNormal1, objectNormal ), dot( fishgenNormal2, objectNormal ) );
+	objectNormal /= fishgenFish0.xyz * fishgenFish0.xyz + fishgenFish1.xyz * fishgenFish1.xyz + fishgenFish2.xyz * fishgenFish2.xyz;
+	objectNormal = vec3( dot( fishgenFish0.xyz, objectNormal ), dot( fishgenFish1.xyz, objectNormal ), dot( fishgenFish2.xyz, objectNormal ) );
+`;
+const POSITION = `
+	transformed = vec3( dot( fishgenPart0, vec4( transformed, 1.0 ) ), dot( fishgenPart1, vec4( transformed, 1.0 ) ), dot( fishgenPart2, vec4( transformed, 1.0 ) ) );
+	transformed = vec3( dot( fishgenFish0, vec4( transformed, 1.0 ) ), dot( fishgenFish1, vec4( transformed, 1.0 ) ), dot( fishgenFish2, vec4( transformed, 1.0 ) ) );
 `;
 
-function instancedMaterial( source, texture ) {
+function instancedMaterial( source, species, slot ) {
 	const material = source.clone();
 	material.onBeforeCompile = ( shader ) => {
-		shader.uniforms.fishgenParts = { value: texture };
+		shader.uniforms.fishgenParts = { value: species.partTexture };
+		shader.uniforms.fishgenInstances = { value: species.instanceTexture };
 		shader.vertexShader = shader.vertexShader
 			.replace( '#include <common>', '#include <common>\n' + PARS )
-			.replace( '#include <beginnormal_vertex>', FETCH + '#include <beginnormal_vertex>' )
-			// the normal matrix of A is inverse( transpose( A ) ): fishgenLinear is transpose( A )
-			.replace( '#include <morphnormal_vertex>', '#include <morphnormal_vertex>\n\tobjectNormal = inverse( fishgenLinear ) * objectNormal;' )
-			.replace( '#include <morphtarget_vertex>', '#include <morphtarget_vertex>\n\ttransformed = vec3( dot( fishgenRow0, vec4( transformed, 1.0 ) ), '
-				+ 'dot( fishgenRow1, vec4( transformed, 1.0 ) ), dot( fishgenRow2, vec4( transformed, 1.0 ) ) );' );
+			.replace( '#include <beginnormal_vertex>', FETCH( slot ) + '#include <beginnormal_vertex>' )
+			.replace( '#include <morphnormal_vertex>', '#include <morphnormal_vertex>\n' + NORMAL )
+			.replace( '#include <morphtarget_vertex>', '#include <morphtarget_vertex>\n' + POSITION );
+		shader.fragmentShader = shader.fragmentShader
+			.replace( '#include <common>', '#include <common>\nvarying vec3 fishgenTint;' )
+			.replace( '#include <color_fragment>', '#include <color_fragment>\n\tdiffuseColor.rgb *= fishgenTint;' );
 	};
-	material.customProgramCacheKey = () => 'fishgen-school';
+	material.customProgramCacheKey = () => `fishgen-school-${ slot }`;
 	return material;
 }
 
@@ -137,8 +162,10 @@ function byTimes( tracks ) {
 
 // -- one species' drawing ---------------------------------------------------------------------------
 
-const _m = new THREE.Matrix4(), _p = new THREE.Vector3(), _q = new THREE.Quaternion(), _s = new THREE.Vector3();
-const _at = [ 0, 0, 0 ], _swing = [ 0, 0, 0, 0 ];
+const _m = new THREE.Matrix4(), _n = new THREE.Matrix3(), _p = new THREE.Vector3(), _q = new THREE.Quaternion(), _s = new THREE.Vector3();
+const _at = [ 0, 0, 0 ], _swing = [ 0, 0, 0, 0 ], _frustum = new THREE.Frustum(), _sphere = new THREE.Sphere();
+const _view = new THREE.Matrix4(), _eye = new THREE.Vector3(), _look = new THREE.Vector3();
+const WAVE_MARGIN = 1.25;   // a fish's bounding sphere, grown for the body wave and the fins' swing
 
 class Species {
 
@@ -147,7 +174,10 @@ class Species {
 		this.name = first.node.name.replace( /_\d+$/, '' );
 		this.fish = fish;
 		this.clip = first.clip;
-		// the fish's own rest pose and tracks, as flat arrays
+		this.time = 0;
+		this.version = 0;
+		this.drawn = { key: null, count: 0 };
+		// the fish's own rest pose and tracks, as flat arrays; `matrices` holds all fish's, posed
 		this.restPosition = new Float32Array( n * 3 );
 		this.restQuaternion = new Float32Array( n * 4 );
 		this.scale = new Float32Array( n * 3 );
@@ -156,6 +186,7 @@ class Species {
 			f.node.quaternion.toArray( this.restQuaternion, 4 * i );
 			f.node.scale.toArray( this.scale, 3 * i );
 		} );
+		this.matrices = new Float32Array( n * 16 );
 		this.positions = byTimes( fish.map( ( f ) => f.position ) );
 		this.quaternions = byTimes( fish.map( ( f ) => f.quaternion ) );
 		this.positionValues = fish.map( ( f ) => f.position && f.position.values );
@@ -163,66 +194,75 @@ class Species {
 		// the fin phases: fish with the same swing tracks share a row of part matrices
 		const phases = new Map(), ids = new Map();
 		const id = ( track ) => { if ( ! track ) return 0; if ( ! ids.has( track.values ) ) ids.set( track.values, ids.size + 1 ); return ids.get( track.values ); };
-		const pose = new Float32Array( n );
+		this.phase = new Float32Array( n );
 		fish.forEach( ( f, i ) => {
 			const key = f.parts.map( ( p ) => id( p.swing ) ).join( ',' );
 			if ( ! phases.has( key ) ) phases.set( key, { row: phases.size, swings: f.parts.map( ( p ) => p.swing ) } );
-			pose[ i ] = phases.get( key ).row;
+			this.phase[ i ] = phases.get( key ).row;
 		} );
 		this.phases = [ ...phases.values() ].map( ( p ) => p.swings );
 		this.rest = first.parts.map( ( { mesh } ) => ( { position: mesh.position.clone(), quaternion: mesh.quaternion.clone(), scale: mesh.scale.clone() } ) );
-		this.partTexture = new THREE.DataTexture( new Float32Array( parts * 3 * this.phases.length * 4 ), parts * 3, this.phases.length,
+		this.partTexture = new THREE.DataTexture( new Float32Array( parts * 6 * this.phases.length * 4 ), parts * 6, this.phases.length,
 			THREE.RGBAFormat, THREE.FloatType );
-		// the body wave: one weights track a fish, three.js's per-instance morph texture
+		// the fish's bounds in its own frame, for culling
+		this.sphere = new THREE.Sphere();
+		first.parts.forEach( ( { mesh } ) => {
+			if ( ! mesh.geometry.boundingSphere ) mesh.geometry.computeBoundingSphere();
+			mesh.updateMatrix();
+			const s = mesh.geometry.boundingSphere.clone().applyMatrix4( mesh.matrix );
+			if ( this.sphere.isEmpty() ) this.sphere.copy( s ); else this.sphere.union( s );
+		} );
+		this.sphere.radius *= WAVE_MARGIN;
+		// the body wave: one weights track a fish
 		this.morphs = first.morphs;
 		this.weights = byTimes( fish.map( ( f ) => f.weights ) );
 		this.weightValues = fish.map( ( f ) => f.weights && f.weights.values );
 		this.relative = first.parts[ 0 ].mesh.geometry.morphTargetsRelative;
-		this.morphTexture = null;
-		if ( this.morphs ) {
-			const data = new Float32Array( ( this.morphs + 1 ) * n );
-			fish.forEach( ( f, i ) => {
-				const w = f.parts[ 0 ].mesh.morphTargetInfluences;
-				data.set( w, i * ( this.morphs + 1 ) + 1 );
-				data[ i * ( this.morphs + 1 ) ] = this.relative ? 1 : 1 - w.reduce( ( a, b ) => a + b, 0 );
-			} );
-			this.morphTexture = new THREE.DataTexture( data, this.morphs + 1, n, THREE.RedFormat, THREE.FloatType );
-		}
-		// one InstancedMesh a material of the first fish, its parts merged
-		const matrices = new THREE.InstancedBufferAttribute( new Float32Array( n * 16 ), 16 );
-		matrices.setUsage( THREE.DynamicDrawUsage );
-		const poses = new THREE.InstancedBufferAttribute( pose, 1 );
-		this.meshes = [];
-		for ( const slot of new Set( first.wears ) ) {
-			const members = first.parts.map( ( _, k ) => k ).filter( ( k ) => first.wears[ k ] === slot );
-			const geometry = merged( members.map( ( k ) => [ first.parts[ k ].mesh.geometry, k ] ) );
+		this.weightsNow = new Float32Array( ( this.morphs + 1 ) * n );
+		fish.forEach( ( f, i ) => {
+			const w = f.parts[ 0 ].mesh.morphTargetInfluences || [];
+			this.weightsNow.set( w, i * ( this.morphs + 1 ) + 1 );
+			this.weightsNow[ i * ( this.morphs + 1 ) ] = this.relative ? 1 : 1 - w.reduce( ( a, b ) => a + b, 0 );
+		} );
+		this.morphTexture = this.morphs ? new THREE.DataTexture( new Float32Array( ( this.morphs + 1 ) * n ), this.morphs + 1, n,
+			THREE.RedFormat, THREE.FloatType ) : null;
+		// one InstancedMesh a material of the first fish, its parts merged; each fish's tint per material
+		const slots = [ ...new Set( first.wears ) ];
+		this.width = 4 + slots.length;
+		this.tints = slots.map( ( slot ) => colours( fish, slot, first.parts[ slot ].mesh.material ) );
+		this.instanceTexture = new THREE.DataTexture( new Float32Array( this.width * n * 4 ), this.width, n, THREE.RGBAFormat, THREE.FloatType );
+		this.order = new Int32Array( n );
+		this.depth = new Float32Array( n );
+		this.meshes = slots.map( ( slot, k ) => {
+			const members = first.parts.map( ( _, j ) => j ).filter( ( j ) => first.wears[ j ] === slot );
+			const geometry = merged( members.map( ( j ) => [ first.parts[ j ].mesh.geometry, j ] ) );
 			if ( ! geometry ) throw new Error( 'parts of different layouts' );
-			geometry.setAttribute( 'fishgenPose', poses );
 			const source = first.parts[ slot ].mesh.material;
-			const mesh = new THREE.InstancedMesh( geometry, instancedMaterial( source, this.partTexture ), n );
+			// the instance matrices stay identity: each fish's is in fishgenInstances
+			const mesh = new THREE.InstancedMesh( geometry, instancedMaterial( source, this, k ), n );
 			mesh.name = `${ this.name } (${ n } instances, ${ source.name || 'material ' + slot })`;
-			mesh.instanceMatrix = matrices;
 			mesh.morphTexture = this.morphTexture;
-			mesh.frustumCulled = false;   // the fish move: the school is drawn whole
+			mesh.frustumCulled = false;   // culled fish by fish before it is drawn
 			mesh.boundingBox = bounds.clone();
 			mesh.boundingSphere = bounds.getBoundingSphere( new THREE.Sphere() );
-			const tint = colours( fish, slot, source );
-			if ( tint ) mesh.instanceColor = tint;
+			mesh.onBeforeRender = ( renderer, scene, camera ) => { mesh.count = this.layout( camera, mesh.matrixWorld ); };
 			parent.add( mesh );
-			this.meshes.push( mesh );
-		}
+			return mesh;
+		} );
 		this.update( 0 );
 	}
 
 	// Pose every fish at the clip's time t (seconds).
 	update( t ) {
+		this.time = t;
+		this.version ++;
 		this.updateMatrices( t );
 		this.updateParts( t );
-		if ( this.morphTexture ) this.updateWeights( t );
+		if ( this.morphs ) this.updateWeights( t );
 	}
 
 	updateMatrices( t ) {
-		const out = this.meshes[ 0 ].instanceMatrix.array, n = this.fish.length;
+		const out = this.matrices, n = this.fish.length;
 		const position = new Float32Array( this.restPosition ), quaternion = new Float32Array( this.restQuaternion );
 		for ( const { times, fish } of this.positions ) {
 			const [ a, b, w ] = bracket( times, t, _at );
@@ -242,11 +282,10 @@ class Species {
 			_p.fromArray( position, 3 * i ); _q.fromArray( quaternion, 4 * i ); _s.fromArray( this.scale, 3 * i );
 			_m.compose( _p, _q, _s ).toArray( out, 16 * i );
 		}
-		this.meshes[ 0 ].instanceMatrix.needsUpdate = true;
 	}
 
 	updateParts( t ) {
-		const data = this.partTexture.image.data, width = this.rest.length * 3;
+		const data = this.partTexture.image.data, width = this.rest.length * 6;
 		this.phases.forEach( ( swings, row ) => swings.forEach( ( swing, k ) => {
 			const rest = this.rest[ k ];
 			_q.copy( rest.quaternion );
@@ -255,14 +294,18 @@ class Species {
 				THREE.Quaternion.slerpFlat( _swing, 0, swing.values, 4 * a, swing.values, 4 * b, w );
 				_q.fromArray( _swing );
 			}
-			const e = _m.compose( rest.position, _q, rest.scale ).elements, at = ( row * width + 3 * k ) * 4;
-			for ( let r = 0; r < 3; r ++ ) for ( let c = 0; c < 4; c ++ ) data[ at + 4 * r + c ] = e[ 4 * c + r ];
+			const e = _m.compose( rest.position, _q, rest.scale ).elements, at = ( row * width + 6 * k ) * 4;
+			const ne = _n.getNormalMatrix( _m ).elements;
+			for ( let r = 0; r < 3; r ++ ) {
+				for ( let c = 0; c < 4; c ++ ) data[ at + 4 * r + c ] = e[ 4 * c + r ];
+				for ( let c = 0; c < 3; c ++ ) data[ at + 12 + 4 * r + c ] = ne[ 3 * c + r ];
+			}
 		} ) );
 		this.partTexture.needsUpdate = true;
 	}
 
 	updateWeights( t ) {
-		const data = this.morphTexture.image.data, m = this.morphs, stride = m + 1;
+		const data = this.weightsNow, m = this.morphs, stride = m + 1;
 		for ( const { times, fish } of this.weights ) {
 			const [ a, b, w ] = bracket( times, t, _at );
 			for ( const i of fish ) {
@@ -276,7 +319,42 @@ class Species {
 				data[ stride * i ] = this.relative ? 1 : 1 - sum;
 			}
 		}
-		this.morphTexture.needsUpdate = true;
+	}
+
+	// The fish in the camera's view laid out nearest first for drawing (their matrices, phases,
+	// tints and weights); how many. Done once for both materials' meshes and again only when the
+	// fish or the view moved.
+	layout( camera, world ) {
+		const key = `${ this.version } ${ camera.uuid } ${ camera.projectionMatrix.elements.join( ',' ) } ${ camera.matrixWorld.elements.join( ',' ) } ${ world.elements.join( ',' ) }`;
+		if ( this.drawn.key === key ) return this.drawn.count;
+		_view.multiplyMatrices( camera.projectionMatrix, camera.matrixWorldInverse );
+		_frustum.setFromProjectionMatrix( _view.multiply( world ) );   // in the school's frame
+		camera.getWorldPosition( _eye ).applyMatrix4( _m.copy( world ).invert() );
+		camera.getWorldDirection( _look ).transformDirection( _m.copy( world ).invert() );
+		const n = this.fish.length, e = this.matrices;
+		let count = 0;
+		for ( let i = 0; i < n; i ++ ) {
+			const o = 16 * i;
+			_sphere.center.copy( this.sphere.center ).applyMatrix4( _m.fromArray( e, o ) );
+			_sphere.radius = this.sphere.radius * _m.getMaxScaleOnAxis();
+			if ( ! _frustum.intersectsSphere( _sphere ) ) continue;
+			this.depth[ i ] = _sphere.center.sub( _eye ).dot( _look );
+			this.order[ count ++ ] = i;
+		}
+		const depth = this.depth, order = this.order.subarray( 0, count ).sort( ( a, b ) => depth[ a ] - depth[ b ] );
+		const data = this.instanceTexture.image.data, width = this.width;
+		const weights = this.weightsNow, stride = this.morphs + 1, morph = this.morphTexture && this.morphTexture.image.data;
+		for ( let k = 0; k < count; k ++ ) {
+			const i = order[ k ], o = 16 * i, at = 4 * width * k;
+			for ( let r = 0; r < 3; r ++ ) for ( let c = 0; c < 4; c ++ ) data[ at + 4 * r + c ] = e[ o + 4 * c + r ];
+			data[ at + 12 ] = this.phase[ i ];
+			this.tints.forEach( ( tint, s ) => { data.set( tint.subarray( 3 * i, 3 * i + 3 ), at + 16 + 4 * s ); } );
+			if ( morph ) morph.set( weights.subarray( stride * i, stride * i + stride ), stride * k );
+		}
+		this.instanceTexture.needsUpdate = true;
+		if ( this.morphTexture ) this.morphTexture.needsUpdate = true;
+		this.drawn = { key, count };
+		return count;
 	}
 
 }
@@ -295,20 +373,19 @@ function merged( geometries ) {
 	return mergeGeometries( parts );
 }
 
-// Each fish's colour over the first fish's (a tinted variant), or null when all wear the first's.
+// Each fish's colour over the first fish's, for one material (a tinted variant), rgb a fish.
 function colours( fish, slot, source ) {
-	const out = new Float32Array( fish.length * 3 ).fill( 1 );
-	let tinted = false;
+	const out = new Float32Array( fish.length * 3 ).fill( 1 ), base = source.color.toArray();
 	fish.forEach( ( f, i ) => {
-		const c = f.parts[ slot ].mesh.material.color;
-		[ c.r, c.g, c.b ].forEach( ( v, k ) => {
-			const base = source.color.toArray()[ k ];
-			out[ 3 * i + k ] = base === 0 ? 1 : v / base;
-			if ( out[ 3 * i + k ] !== 1 ) tinted = true;
-		} );
+		const c = f.parts[ slot ].mesh.material.color.toArray();
+		for ( let k = 0; k < 3; k ++ ) out[ 3 * i + k ] = base[ k ] === 0 ? 1 : c[ k ] / base[ k ];
 	} );
-	return tinted ? new THREE.InstancedBufferAttribute( out, 3 ) : null;
+	return out;
 }
+
+const MAX_INSTANCES = 8192;
+// A species' fish are rows of float textures (and of three.js's morph texture): WebGL2 promises
+// textures of 2,048 rows, every browser here gives 8,192 or more; more fish stay node by node.
 
 // -- the page's entry ---------------------------------------------------------------------------------
 
@@ -333,6 +410,7 @@ export function instanceSchools( root, clips, enabled = true ) {
 	root.updateMatrixWorld( true );
 	const toRoot = root.matrixWorld.clone().invert();
 	for ( const fish of groups.values() ) {
+		if ( fish.length > MAX_INSTANCES ) continue;
 		// the fish's bounds as drawn node by node, for pages that frame the view on them
 		const bounds = new THREE.Box3();
 		for ( const f of fish ) bounds.union( new THREE.Box3().setFromObject( f.node ).applyMatrix4( toRoot ) );
@@ -374,7 +452,7 @@ export function instanceSchools( root, clips, enabled = true ) {
 // For tests: each instanced species' fish names and their positions (x, y, z per fish) as drawn.
 export function instancePositions( drawing ) {
 	return drawing.species.map( ( s ) => {
-		const e = s.meshes[ 0 ].instanceMatrix.array;
+		const e = s.matrices;
 		return { species: s.name, fish: s.fish.map( ( f ) => f.node.name ),
 			positions: s.fish.map( ( _, i ) => [ e[ 16 * i + 12 ], e[ 16 * i + 13 ], e[ 16 * i + 14 ] ] ) };
 	} );
