@@ -82,9 +82,10 @@ function fishOf( node, tracks ) {
 
 // -- the shader ---------------------------------------------------------------------------------
 
-// fishgenParts: a row per fin phase, six texels a part: its matrix's three rows (rest translation
-// and scale, the swing's rotation), then its normal matrix's. fishgenInstances: a row per drawn
-// fish: its matrix's three rows, (phase, -, -, -), then its tint for each of the species' materials.
+// fishgenParts: a row per fin phase, three texels a part: its matrix's rows (rest translation and
+// scale, the swing's rotation). fishgenInstances: a row per drawn fish: its matrix's three rows,
+// then for each of the species' materials (its tint, its fin phase). Seven fetches a vertex: on a
+// software renderer each costs as much as the rest of the vertex's own work.
 const PARS = `
 uniform highp sampler2D fishgenParts;
 uniform highp sampler2D fishgenInstances;
@@ -95,20 +96,18 @@ const FETCH = ( slot ) => `
 	vec4 fishgenFish0 = texelFetch( fishgenInstances, ivec2( 0, gl_InstanceID ), 0 );
 	vec4 fishgenFish1 = texelFetch( fishgenInstances, ivec2( 1, gl_InstanceID ), 0 );
 	vec4 fishgenFish2 = texelFetch( fishgenInstances, ivec2( 2, gl_InstanceID ), 0 );
-	float fishgenPhase = texelFetch( fishgenInstances, ivec2( 3, gl_InstanceID ), 0 ).x;
-	fishgenTint = texelFetch( fishgenInstances, ivec2( ${ 4 + slot }, gl_InstanceID ), 0 ).rgb;
-	ivec2 fishgenAt = ivec2( int( fishgenPart ) * 6, int( fishgenPhase ) );
+	vec4 fishgenLook = texelFetch( fishgenInstances, ivec2( ${ 3 + slot }, gl_InstanceID ), 0 );
+	fishgenTint = fishgenLook.rgb;
+	ivec2 fishgenAt = ivec2( int( fishgenPart ) * 3, int( fishgenLook.w ) );
 	vec4 fishgenPart0 = texelFetch( fishgenParts, fishgenAt, 0 );
 	vec4 fishgenPart1 = texelFetch( fishgenParts, fishgenAt + ivec2( 1, 0 ), 0 );
 	vec4 fishgenPart2 = texelFetch( fishgenParts, fishgenAt + ivec2( 2, 0 ), 0 );
-	vec3 fishgenNormal0 = texelFetch( fishgenParts, fishgenAt + ivec2( 3, 0 ), 0 ).xyz;
-	vec3 fishgenNormal1 = texelFetch( fishgenParts, fishgenAt + ivec2( 4, 0 ), 0 ).xyz;
-	vec3 fishgenNormal2 = texelFetch( fishgenParts, fishgenAt + ivec2( 5, 0 ), 0 ).xyz;
 `;
-// the fish's normal as three.js takes an instance's: divided by its columns' squared lengths, then
-// turned by its matrix (right for any scale but shear)
+// normals as three.js turns an instance's: divided by the matrix's columns' squared lengths, then
+// turned by it (right for any scale but shear), the part's matrix then the fish's
 const NORMAL = `
-	objectNormal = vec3( dot( fishgenNormal0, objectNormal ), dot( fishgenNormal1, objectNormal ), dot( fishgenNormal2, objectNormal ) );
+	objectNormal /= fishgenPart0.xyz * fishgenPart0.xyz + fishgenPart1.xyz * fishgenPart1.xyz + fishgenPart2.xyz * fishgenPart2.xyz;
+	objectNormal = vec3( dot( fishgenPart0.xyz, objectNormal ), dot( fishgenPart1.xyz, objectNormal ), dot( fishgenPart2.xyz, objectNormal ) );
 	objectNormal /= fishgenFish0.xyz * fishgenFish0.xyz + fishgenFish1.xyz * fishgenFish1.xyz + fishgenFish2.xyz * fishgenFish2.xyz;
 	objectNormal = vec3( dot( fishgenFish0.xyz, objectNormal ), dot( fishgenFish1.xyz, objectNormal ), dot( fishgenFish2.xyz, objectNormal ) );
 `;
@@ -162,7 +161,7 @@ function byTimes( tracks ) {
 
 // -- one species' drawing ---------------------------------------------------------------------------
 
-const _m = new THREE.Matrix4(), _n = new THREE.Matrix3(), _p = new THREE.Vector3(), _q = new THREE.Quaternion(), _s = new THREE.Vector3();
+const _m = new THREE.Matrix4(), _p = new THREE.Vector3(), _q = new THREE.Quaternion(), _s = new THREE.Vector3();
 const _at = [ 0, 0, 0 ], _swing = [ 0, 0, 0, 0 ], _frustum = new THREE.Frustum(), _sphere = new THREE.Sphere();
 const _view = new THREE.Matrix4(), _eye = new THREE.Vector3(), _look = new THREE.Vector3();
 const WAVE_MARGIN = 1.25;   // a fish's bounding sphere, grown for the body wave and the fins' swing
@@ -202,7 +201,7 @@ class Species {
 		} );
 		this.phases = [ ...phases.values() ].map( ( p ) => p.swings );
 		this.rest = first.parts.map( ( { mesh } ) => ( { position: mesh.position.clone(), quaternion: mesh.quaternion.clone(), scale: mesh.scale.clone() } ) );
-		this.partTexture = new THREE.DataTexture( new Float32Array( parts * 6 * this.phases.length * 4 ), parts * 6, this.phases.length,
+		this.partTexture = new THREE.DataTexture( new Float32Array( parts * 3 * this.phases.length * 4 ), parts * 3, this.phases.length,
 			THREE.RGBAFormat, THREE.FloatType );
 		// the fish's bounds in its own frame, for culling
 		this.sphere = new THREE.Sphere();
@@ -228,7 +227,7 @@ class Species {
 			THREE.RedFormat, THREE.FloatType ) : null;
 		// one InstancedMesh a material of the first fish, its parts merged; each fish's tint per material
 		const slots = [ ...new Set( first.wears ) ];
-		this.width = 4 + slots.length;
+		this.width = 3 + slots.length;
 		this.tints = slots.map( ( slot ) => colours( fish, slot, first.parts[ slot ].mesh.material ) );
 		this.instanceTexture = new THREE.DataTexture( new Float32Array( this.width * n * 4 ), this.width, n, THREE.RGBAFormat, THREE.FloatType );
 		this.order = new Int32Array( n );
@@ -285,7 +284,7 @@ class Species {
 	}
 
 	updateParts( t ) {
-		const data = this.partTexture.image.data, width = this.rest.length * 6;
+		const data = this.partTexture.image.data, width = this.rest.length * 3;
 		this.phases.forEach( ( swings, row ) => swings.forEach( ( swing, k ) => {
 			const rest = this.rest[ k ];
 			_q.copy( rest.quaternion );
@@ -294,12 +293,8 @@ class Species {
 				THREE.Quaternion.slerpFlat( _swing, 0, swing.values, 4 * a, swing.values, 4 * b, w );
 				_q.fromArray( _swing );
 			}
-			const e = _m.compose( rest.position, _q, rest.scale ).elements, at = ( row * width + 6 * k ) * 4;
-			const ne = _n.getNormalMatrix( _m ).elements;
-			for ( let r = 0; r < 3; r ++ ) {
-				for ( let c = 0; c < 4; c ++ ) data[ at + 4 * r + c ] = e[ 4 * c + r ];
-				for ( let c = 0; c < 3; c ++ ) data[ at + 12 + 4 * r + c ] = ne[ 3 * c + r ];
-			}
+			const e = _m.compose( rest.position, _q, rest.scale ).elements, at = ( row * width + 3 * k ) * 4;
+			for ( let r = 0; r < 3; r ++ ) for ( let c = 0; c < 4; c ++ ) data[ at + 4 * r + c ] = e[ 4 * c + r ];
 		} ) );
 		this.partTexture.needsUpdate = true;
 	}
@@ -347,8 +342,10 @@ class Species {
 		for ( let k = 0; k < count; k ++ ) {
 			const i = order[ k ], o = 16 * i, at = 4 * width * k;
 			for ( let r = 0; r < 3; r ++ ) for ( let c = 0; c < 4; c ++ ) data[ at + 4 * r + c ] = e[ o + 4 * c + r ];
-			data[ at + 12 ] = this.phase[ i ];
-			this.tints.forEach( ( tint, s ) => { data.set( tint.subarray( 3 * i, 3 * i + 3 ), at + 16 + 4 * s ); } );
+			this.tints.forEach( ( tint, s ) => {
+				data.set( tint.subarray( 3 * i, 3 * i + 3 ), at + 12 + 4 * s );
+				data[ at + 15 + 4 * s ] = this.phase[ i ];
+			} );
 			if ( morph ) morph.set( weights.subarray( stride * i, stride * i + stride ), stride * k );
 		}
 		this.instanceTexture.needsUpdate = true;
