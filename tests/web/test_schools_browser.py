@@ -82,30 +82,29 @@ def pose(tab, t: float) -> np.ndarray:
     return np.asarray(Image.open(io.BytesIO(shot)).convert("RGB"), np.float32)
 
 
-def test_a_thousand_fish_of_one_species_are_two_draw_calls(schools):
-    tab, problems = open_view(schools["thousand"])
+def drawn(asset, query="", instancing=True) -> dict:
+    """What the viewer drew of ``asset`` at one second: its instanced species, fish and meshes, its
+    counts, and its draw calls; the page showed no error."""
+    tab, problems = open_view(asset, query, instancing)
     try:
-        state = tab.evaluate("({instanced: window.fishgenViewer.instanced, "
-                             "counts: window.fishgenViewer.counts})")
-        assert state["instanced"] == {"species": 1, "fish": 1000, "meshes": 2}
-        # counted as the file holds it: 1,000 fish of nine parts
-        assert state["counts"]["vertices"] == 1000 * 227
         pose(tab, 1.0)
-        assert tab.evaluate("window.fishgenViewer.calls") <= 2
+        state = tab.evaluate("({...window.fishgenViewer.instanced, counts: window.fishgenViewer.counts, "
+                             "calls: window.fishgenViewer.calls})")
         assert problems == []
+        return state
     finally:
         tab.close()
+
+
+def test_a_thousand_fish_of_one_species_are_two_draw_calls(schools):
+    state = drawn(schools["thousand"])
+    assert (state["species"], state["fish"], state["meshes"]) == (1, 1000, 2) and state["calls"] <= 2
+    assert state["counts"]["vertices"] == 1000 * 227   # counted as the file holds it: nine parts a fish
 
 
 def test_two_species_are_two_draw_calls_each(schools):
-    tab, problems = open_view(schools["reef"])
-    try:
-        pose(tab, 1.0)
-        assert tab.evaluate("window.fishgenViewer.instanced.species") == 2
-        assert tab.evaluate("window.fishgenViewer.calls") <= 4
-        assert problems == []
-    finally:
-        tab.close()
+    state = drawn(schools["reef"])
+    assert state["species"] == 2 and state["calls"] <= 4
 
 
 @pytest.mark.parametrize("kind", ["small", "translucent"])
@@ -148,25 +147,13 @@ def test_fish_stand_where_the_files_tracks_put_them(schools):
 
 def test_no_instancing_and_the_address_flag_draw_fish_by_fish(schools):
     for query, instancing in (("", False), ("?instancing=0", True)):
-        tab, problems = open_view(schools["small"], query, instancing)
-        try:
-            pose(tab, 1.0)
-            assert tab.evaluate("window.fishgenViewer.instanced.species") == 0
-            assert tab.evaluate("window.fishgenViewer.calls") == 12 * 9
-            assert problems == []
-        finally:
-            tab.close()
+        state = drawn(schools["small"], query, instancing)
+        assert state["species"] == 0 and state["calls"] == 12 * 9
 
 
 def test_a_school_of_skinned_fish_stays_node_by_node(schools):
-    tab, problems = open_view(schools["merged"])
-    try:
-        pose(tab, 1.0)
-        assert tab.evaluate("window.fishgenViewer.instanced.species") == 0
-        assert tab.evaluate("window.fishgenViewer.calls") == 6 * 2   # --merge: two draw calls a fish
-        assert problems == []
-    finally:
-        tab.close()
+    state = drawn(schools["merged"])
+    assert state["species"] == 0 and state["calls"] == 6 * 2   # --merge: two draw calls a fish
 
 
 @pytest.mark.parametrize("instancing", [True, False])
