@@ -424,6 +424,14 @@ def compact_option() -> Any:
                   "(core glTF 2.0), about half their size.", False, flag=True)
 
 
+def instancing_option() -> Any:
+    """--instancing of the pages that draw glb files (view, fly)."""
+    return option(click.BOOL, "Draw a `fishgen school` glb one instanced mesh per species and material (two "
+                  "draw calls for a school of one species, however many fish); --no-instancing draws it "
+                  "fish by fish as the file holds it, to compare (the page's ?instancing=0 does too).", True,
+                  flag=True, off="--no-instancing")
+
+
 def swim_option(help_text: str) -> Any:
     from fishgen.fish_modes import SWIM_MODES
 

@@ -17,6 +17,7 @@ from fishgen.options import (
     Size,
     cloud_textures_option,
     group,
+    instancing_option,
     max_particles_option,
     option,
     seed_option,
@@ -58,6 +59,7 @@ class FlyOptions:
     max_particles: int = max_particles_option(DEFAULT_MAX_PARTICLES)
     textures: Path | None = cloud_textures_option()
     lighting: Lighting = group(Lighting)
+    instancing: bool = instancing_option()
 
 
 COMMAND = Command(
@@ -123,7 +125,8 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
     run = {"inputs": [str(p) for p in inputs], "mode": options.mode, "timeout": timeout}
     config = FlyConfig(size=options.size, timeout=timeout, warmup=options.warmup,
                        path="fly" if options.headless else None, seed=options.seed,
-                       report=timeout is not None, cloud_scale=options.cloud_resolution)
+                       report=timeout is not None, cloud_scale=options.cloud_resolution,
+                       instancing=options.instancing)
     if options.headless:
         from fishgen.fly.headless import run_headless
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
-from fishgen.options import Colour, option
+from fishgen.options import Colour, instancing_option, option
 
 
 @dataclass(frozen=True)
@@ -22,6 +22,7 @@ class ViewOptions:
     background: tuple[int, int, int, int] = option(Colour(),
                                                    "Background colour of the 3D view (a CSS colour).",
                                                    (140, 173, 204, 255), shown_default="#8cadcc")
+    instancing: bool = instancing_option()
 
 
 COMMAND = Command(
@@ -53,7 +54,7 @@ def view(inputs: Sequence[Path], output: str | os.PathLike | None,
 
     (asset,) = inputs
     colour = "#{:02x}{:02x}{:02x}".format(*options.background[:3])
-    page = Path(write_page(asset, output, colour))
+    page = Path(write_page(asset, output, colour, instancing=options.instancing))
     if options.no_serve:
         return Made((page,), (asset,), (f"wrote {page}",))
     from fishgen.viewer.server import make_server, url_of

@@ -2,7 +2,7 @@
 // Keys as Pakawan's: W/S forward/back, A/D left/right, arrows look up/down and turn, 1/2/3 speed;
 // the mouse (drag) looks around. The upper left shows the window size, the time and the FPS.
 // State for tests and the headless driver: window.fishgenFly = {loaded, error, camera, frames, done, report}.
-const { THREE, GLTFLoader, cloudlight, drawing } = window.fishgenKit;   // fishgen/web/kit.js
+const { THREE, GLTFLoader, cloudlight, drawing, schools } = window.fishgenKit;   // fishgen/web/kit.js
 const { PREMULTIPLIED, billboardMaterial: cloudBillboardMaterial, particleMaterial: cloudParticleMaterial, readCloudLight } = cloudlight;
 
 const config = JSON.parse( document.getElementById( 'fishgen-fly' ).textContent );
@@ -233,13 +233,27 @@ async function addAsset( gltf, root ) {
 	// every other point set or billboard mesh is a unit of its own (a cube file without levels, any glb)
 	root.traverse( ( o ) => { if ( ( o.isPoints || isBillboards( o ) ) && ! done.has( o ) ) { done.add( o ); addUnit( [ drawable( o ) ], [] ); } } );
 	root.traverse( ( o ) => { if ( o.isMesh && ! done.has( o ) ) counts.meshes ++; } );
-	if ( gltf.animations.length ) {
+	// a fishgen school: one instanced mesh a species and material (fishgen/web/schools.js), counted above
+	// fish by fish as the file holds it
+	const school = schools.instanceSchools( root, gltf.animations, instancing );
+	for ( const key of Object.keys( instanced ) ) instanced[ key ] += school.info[ key ];
+	if ( school.clips.length ) {
 		const mixer = new THREE.AnimationMixer( root );
-		for ( const clip of gltf.animations ) mixer.clipAction( clip ).play();
-		mixers.push( mixer );
+		for ( const clip of school.clips ) mixer.clipAction( clip ).play();
+		mixers.push( { update( dt ) { mixer.update( dt ); school.follow( mixer ); } } );
 	}
 }
-const mixers = [];
+const mixers = [];   // each with update( dt ): the assets' animations
+// Unless the run said --no-instancing or the page's address ?instancing=0: then fish by fish, to compare.
+const instancing = config.instancing !== false && new URLSearchParams( location.search ).get( 'instancing' ) !== '0';
+const instanced = state.instanced = { species: 0, fish: 0, meshes: 0 };
+// For tests and benchmarks: the draw calls of one frame of the meshes (layer 0), as three.js counts them.
+state.meshCalls = () => {
+	camera.layers.set( 0 );
+	renderer.setRenderTarget( null );
+	renderer.render( scene, camera );
+	return renderer.info.render.calls;
+};
 
 // -- the frame: cull whole clouds, pick each one's level, sort the stalest, draw -----------------
 const frustum = new THREE.Frustum(), _m = new THREE.Matrix4();

@@ -28,7 +28,8 @@ class FlyConfig:
     round the scene, as chapter 5's test; "still": where the keys start; None: Pakawan's keys and the
     mouse), ``cloud_scale``: the
     clouds are drawn into a buffer of this share of the window's width and height (1: on the window
-    itself), and ``baseline``: plain unsorted three.js Points instead (benchmarks/fly.py)."""
+    itself), and ``baseline``: plain unsorted three.js Points instead (benchmarks/fly.py); ``instancing``:
+    a school drawn one instanced mesh per species and material (fishgen/web/schools.js), else fish by fish."""
 
     size: tuple[int, int] | None = (800, 600)
     timeout: float | None = None
@@ -39,6 +40,7 @@ class FlyConfig:
     baseline: bool = False
     background: str = "#8cadcc"
     cloud_scale: float = 0.5
+    instancing: bool = True
 
     def page_settings(self, assets: Sequence[Asset]) -> dict[str, Any]:
         from fishgen import __version__
@@ -47,6 +49,7 @@ class FlyConfig:
                 "size": list(self.size) if self.size else None, "timeout": self.timeout,
                 "warmup": self.warmup, "path": self.path, "seed": self.seed % 2**32, "report": self.report,
                 "baseline": self.baseline, "background": self.background, "cloudScale": self.cloud_scale,
+                "instancing": self.instancing,
                 "version": __version__}
 
 

@@ -1,11 +1,13 @@
 // fishgen viewer: shows one embedded asset with three.js; nothing is fetched from the network.
-// State for people and tests alike: window.fishgenViewer = {loaded, error, time, clip, clips, playing, counts}.
-const { THREE, OrbitControls, GLTFLoader, PLYLoader, OBJLoader, MTLLoader, cloudlight, drawing } = window.fishgenKit;   // fishgen/web/kit.js
+// State for people and tests alike: window.fishgenViewer = {loaded, error, time, clip, clips, playing, counts,
+// instanced, calls}.
+const { THREE, OrbitControls, GLTFLoader, PLYLoader, OBJLoader, MTLLoader, cloudlight, drawing, schools } = window.fishgenKit;   // fishgen/web/kit.js
 const { billboardMaterial, particleMaterial: makeParticleMaterial, readCloudLight } = cloudlight;
 
 const state = window.fishgenViewer = {
 	loaded: false, error: null, time: 0, clip: null, clips: [], playing: false,
 	counts: { vertices: 0, triangles: 0, particles: 0 }, cloudLight: null,
+	instanced: { species: 0, fish: 0, meshes: 0 }, calls: 0,
 };
 const $ = ( id ) => document.getElementById( id );
 const fail = ( err ) => {
@@ -17,6 +19,9 @@ const fail = ( err ) => {
 // The asset and its side files (buffers, textures, MTL) are embedded as base64 and
 // handed to the loaders as blob: URLs under a fake folder, via the URL modifier.
 const embedded = JSON.parse( $( 'fishgen-asset' ).textContent );
+// A school is drawn one instanced mesh a species and material (fishgen/web/schools.js) unless the
+// page was written with --no-instancing or opened with ?instancing=0: fish by fish, to compare.
+const instancing = embedded.instancing !== false && new URLSearchParams( location.search ).get( 'instancing' ) !== '0';
 const blobs = {};
 for ( const [ name, b64 ] of Object.entries( embedded.files ) ) {
 	const bytes = Uint8Array.from( atob( b64 ), ( c ) => c.charCodeAt( 0 ) );
@@ -168,6 +173,7 @@ function frameCamera( root ) {
 }
 
 let mixer = null;
+let school = schools.instanceSchools( new THREE.Group(), [] );   // the instanced schools, once loaded
 let clipObjects = [];
 let action = null;
 let duration = 0;
@@ -180,6 +186,7 @@ function choose( index ) {
 	const clip = clipObjects[ index ];
 	action = mixer.clipAction( clip );
 	action.play();
+	school.follow( mixer );
 	duration = clip.duration;
 	state.clip = clip.name;
 	slider.max = String( duration );
@@ -207,6 +214,7 @@ function tick( now ) {
 	resize();
 	if ( mixer && state.playing ) {
 		mixer.update( dt );
+		school.follow( mixer );
 		state.time = duration > 0 ? mixer.time % duration : 0;
 		slider.value = String( state.time );
 		dirty = true;
@@ -216,6 +224,7 @@ function tick( now ) {
 	if ( dirty ) {
 		dirty = false;
 		renderer.render( scene, camera );
+		state.calls = renderer.info.render.calls;
 	}
 	requestAnimationFrame( tick );
 }
@@ -237,6 +246,10 @@ load().then( ( { root, clips } ) => {
 	state.counts = count( root );
 	const c = state.counts;
 	$( 'counts' ).textContent = `${ c.vertices } vertices · ${ c.triangles } triangles · ${ c.particles } particles`;
+	school = schools.instanceSchools( root, clips, instancing );   // counted above as the file holds them
+	state.instanced = school.info;
+	state.instances = () => schools.instancePositions( school );
+	clips = school.clips;
 	const select = $( 'clip' );
 	clipObjects = clips;
 	state.clips = clips.map( ( clip ) => clip.name );
@@ -257,6 +270,7 @@ slider.addEventListener( 'input', () => {
 	if ( ! mixer ) return;
 	setPlaying( false );
 	mixer.setTime( Number( slider.value ) );
+	school.follow( mixer );
 	state.time = Number( slider.value );
 	redraw();
 } );

@@ -70,8 +70,9 @@ def sidecars(asset: Path) -> tuple[dict[str, Path], str | None]:
     return found, mtl_name
 
 
-def build_page(asset: str | Path, background: str = "#8cadcc") -> str:
-    """The viewer page for ``asset`` as HTML text."""
+def build_page(asset: str | Path, background: str = "#8cadcc", *, instancing: bool = True) -> str:
+    """The viewer page for ``asset`` as HTML text; ``instancing``: draw a school one instanced mesh per
+    species and material (fishgen/web/schools.js), else fish by fish."""
     asset = Path(asset)
     kind = KINDS.get(asset.suffix.lower())
     if kind is None:
@@ -92,15 +93,17 @@ def build_page(asset: str | Path, background: str = "#8cadcc") -> str:
         raise FishgenError(f"expected at most {MAX_EMBED_BYTES >> 20} MiB to embed in a page, "
                            f"found {total / 2**20:.0f} MiB", asset)
     payload = {"main": asset.name, "kind": kind, "mtl": mtl, "background": background,
+               "instancing": instancing,
                "files": {name: base64.b64encode(p.read_bytes()).decode("ascii") for name, p in files.items()}}
     return page_html("viewer", asset.name, ("fishgen-asset", payload))
 
 
-def write_page(asset: str | Path, page: str | Path | None = None, background: str = "#8cadcc") -> Path:
+def write_page(asset: str | Path, page: str | Path | None = None, background: str = "#8cadcc", *,
+               instancing: bool = True) -> Path:
     """Write the page (atomically) and return its path."""
     from fishgen.atomic import write_bytes
 
     asset = Path(asset)
     out = Path(page) if page is not None else page_path(asset)
-    write_bytes(out, build_page(asset, background).encode("utf-8"))
+    write_bytes(out, build_page(asset, background, instancing=instancing).encode("utf-8"))
     return out

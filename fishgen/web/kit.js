@@ -11,3 +11,4 @@ export { OBJLoader } from 'three/addons/loaders/OBJLoader.js';
 export { PLYLoader } from 'three/addons/loaders/PLYLoader.js';
 export * as cloudlight from './cloudlight.js';
 export * as drawing from './drawing.js';
+export * as schools from './schools.js';

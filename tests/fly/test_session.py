@@ -35,6 +35,7 @@ def test_the_page_holds_the_app_and_the_settings(session):
     assert status == 200 and b'id="fishgen-fly"' in page and b"window.fishgenFly" in page
     settings = json.loads(page.split(b'id="fishgen-fly">')[1].split(b"</script>")[0])
     assert settings["assets"] == [{"name": "a", "url": "asset/0"}] and settings["timeout"] == 3
+    assert settings["instancing"] is True   # a school drawn one instanced mesh per species and material
     assert session.url().startswith("http://127.0.0.1:") and f"token={session.server.token}" in session.url()
 
 
@@ -63,3 +64,16 @@ def test_mode_alone_needs_no_input_and_neither_is_one_line():
     from fishgen.commands import command
 
     assert command("fly").inputs.required is False
+
+
+def test_no_instancing_reaches_the_page():
+    from fishgen.commands.fly import FlyOptions, fly
+    from tests.conftest import PARAMS
+
+    made = fly([PARAMS / "clouds" / "table_4_3.awn"], None, FlyOptions(instancing=False))
+    try:
+        settings = json.loads(made.server.routes[("GET", "/")](None).body.split(b'id="fishgen-fly">')[1]
+                              .split(b"</script>")[0])
+        assert settings["instancing"] is False
+    finally:
+        made.server.server_close()

@@ -43,6 +43,14 @@ def test_page_inlines_the_viewer_bundle_and_embeds_the_asset(viewer_assets):
     assert html.count("</script>") == html.count("<script") == 3, "no bundle may end its element early"
 
 
+def test_instancing_is_on_unless_the_page_is_written_without_it(viewer_assets, tmp_path):
+    assert _payload(build_page(viewer_assets["fish"]))["instancing"] is True
+    page = tmp_path / "nodes.html"
+    made = run_cli("view", viewer_assets["fish"], "-o", page, "--no-serve", "--no-instancing")
+    assert made.returncode == 0, made.stderr
+    assert _payload(page.read_text(encoding="utf-8"))["instancing"] is False
+
+
 def test_bonybream_page_is_under_1_mb(viewer_assets):
     # The bound; the page was 3.4 MB with unminified three.js modules in base64.
     size = len(build_page(viewer_assets["fish"]).encode("utf-8"))
@@ -91,6 +99,7 @@ def test_server_listens_on_loopback_only(tmp_path):
 
 def test_help_documents_options():
     text = " ".join(run_cli("view", "--help").stdout.split())
-    for option in ("--port", "--no-serve", "--output", "--background"):
+    for option in ("--port", "--no-serve", "--output", "--background", "--instancing / --no-instancing"):
         assert option in text
     assert "default: 8765" in text
+    assert "to compare (the page's ?instancing=0 does too). [default: on]" in text
