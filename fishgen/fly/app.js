@@ -548,7 +548,8 @@ function frame() {
 	if ( measuring === null && ( end - started ) / 1000 >= config.warmup ) measuring = end;
 	else if ( measuring !== null && last !== null ) {
 		frames.push( [ end - measuring, end - last, drawn.particles, drawn.billboards, drawn.clouds,
-			updated - now, submitted - updated, end - submitted, drawn.redraws, redrawMs, drawn.impostors, drawn.redrawn ] );
+			updated - now, submitted - updated, end - submitted, drawn.redraws, redrawMs, drawn.impostors, drawn.redrawn,
+			impostors ? impostors.last.error : 0 ] );
 		state.frames = frames.length;
 	}
 	last = end;
@@ -608,10 +609,11 @@ function finish( end ) {
 		split: { update: median( frames.map( ( f ) => f[ 5 ] ) ), submit: median( frames.map( ( f ) => f[ 6 ] ) ),
 			wait: median( frames.map( ( f ) => f[ 7 ] ) ) },
 		renderer: rendererName(), path: config.path || 'keys', seed: config.seed, sorts: state.sorts,
-		// means a frame: clouds shown as impostors, redraws finished, particles drawn into impostors;
-		// and the redraws' share of the time flown (each frame's timed to its pixel read back)
+		// means a frame: clouds shown as impostors, redraws finished, particles drawn into impostors,
+		// how stale the pictures shown were (in units of the angle); and the redraws' share of the time
+		// flown (each frame's timed to its pixel read back)
 		impostors: { on: impostors !== null, angle: impostors ? config.impostors.angle : 0,
-			budget: impostors ? config.impostors.budget : 0, shown: mean( 10 ), redraws: mean( 8 ), particles: mean( 11 ),
+			budget: impostors ? config.impostors.budget : 0, shown: mean( 10 ), redraws: mean( 8 ), particles: mean( 11 ), error: mean( 12 ),
 			redraw_share: frames.length ? frames.reduce( ( a, f ) => a + f[ 9 ], 0 ) / Math.max( 1e-9, frames.reduce( ( a, f ) => a + f[ 1 ], 0 ) ) : 0,
 			textures: impostors ? impostors.stats.textures : 0 },
 		per_second: seconds.map( ( fs, s ) => ( { second: s, frames: fs.length,

@@ -89,6 +89,7 @@ export class Impostors {
 			const log = this.logSize( u.distance, u.world.radius, width, height );
 			const age = p ? this.staleness( u, p.shown, eye, log ) : Infinity;
 			u.mode = age === Infinity ? DIRECT : IMPOSTOR;
+			u.age = age;
 			// a redraw under way goes on unless it was started under another sun or for another level
 			if ( p && p.next && ( p.next.sun !== this.sun || p.next.level !== u.level ) ) { this.release( p.next.target ); p.next = null; }
 			if ( p && p.next ) due.push( [ Infinity, u, log ] );   // begun: finished first
@@ -102,15 +103,25 @@ export class Impostors {
 			if ( ! p.next ) this.begin( u, p, camera, log, height );
 			const drawn = this.step( p, left );
 			left -= drawn; particles += drawn;
-			if ( p.next.done === p.next.n ) { this.finish( p ); redraws ++; u.mode = IMPOSTOR; }
+			if ( p.next.done === p.next.n ) {
+				this.finish( p );
+				redraws ++;
+				u.mode = IMPOSTOR;
+				u.age = this.staleness( u, p.shown, eye, log );   // begun frames ago, it may be stale already
+			}
 		}
-		let impostors = 0, direct = 0;
+		let impostors = 0, direct = 0, error = 0;
 		for ( const u of units ) {
 			const p = u.impostor;
-			if ( u.mode === IMPOSTOR ) { impostors ++; this.place( u, p ); } else if ( u.mode === DIRECT ) direct ++;
+			if ( u.mode === IMPOSTOR ) {
+				impostors ++;
+				this.place( u, p );
+				error += Math.min( u.age, 1e3 );
+			} else if ( u.mode === DIRECT ) direct ++;
 			if ( p && p.quad ) p.quad.visible = u.mode === IMPOSTOR;
 		}
-		this.last = { redraws, particles, impostors, direct };
+		// error: how stale the pictures shown are, the mean over them in units of the tolerance
+		this.last = { redraws, particles, impostors, direct, error: impostors ? error / impostors : 0 };
 		const s = this.stats;
 		s.redraws += redraws; s.particles += particles; s.frames ++; s.impostors += impostors; s.direct += direct;
 		return particles;

@@ -25,7 +25,7 @@ MAX_TEXT = 300
 SCENE = ("particles", "billboards", "distant_particles", "distant_billboards", "clouds", "meshes")
 DRAWN = ("particles", "billboards", "clouds")
 SPLIT = ("update", "submit", "wait")
-IMPOSTORS = ("on", "angle", "budget", "shown", "redraws", "particles", "redraw_share", "textures")
+IMPOSTORS = ("on", "angle", "budget", "shown", "redraws", "particles", "error", "redraw_share", "textures")
 CSV_COLUMNS = ("second", "frames", "fps", "particles_drawn", "billboards_drawn", "width", "height",
                "particles_in_scene", "billboards_in_scene", "fps_median", "renderer", "fishgen")
 
@@ -93,6 +93,7 @@ def check_report(page: Any) -> dict[str, Any]:
                       "shown": round(_number(impostors["shown"], "impostors shown"), 2),
                       "redraws": round(_number(impostors["redraws"], "impostor redraws"), 3),
                       "particles": round(_number(impostors["particles"], "particles redrawn"), 1),
+                      "error": round(_number(impostors["error"], "impostor error"), 2),
                       "redraw_share": round(_number(impostors["redraw_share"], "impostor redraw share", 0, 1),
                                             4),
                       "textures": int(_number(impostors["textures"], "impostor textures"))},
@@ -158,4 +159,5 @@ def impostor_lines(imp: dict[str, Any]) -> list[str]:
         return []
     return [f"impostors: {imp['shown']:.1f} clouds shown as impostors (their particles not counted above), "
             f"{imp['redraws']:.2f} redraws finished and {imp['particles']:,.0f} particles redrawn a frame, "
-            f"{100 * imp['redraw_share']:.0f}% of the time"]
+            f"{100 * imp['redraw_share']:.0f}% of the time; the pictures shown {imp['error']:.1f} times the "
+            f"--impostor-angle off on average"]
