@@ -51,6 +51,23 @@ class FlyOptions:
                                      "particles: a quarter of the pixels at 0.5); 1 draws them on the "
                                      "window.", 0.5,
                                      metavar="SHARE")
+    impostors: bool = option(click.BOOL, "Draw each cloud (but those nearer than --impostor-near) "
+                             "into a texture and show it as one camera-facing quad until the view of it "
+                             "changes (SkyWorks' dynamic impostors, docs/fly.md); --no-impostors draws "
+                             "every particle every frame.",
+                             True, flag=True, off="--no-impostors")
+    impostor_angle: float = option(FiniteRange(0.001, 10), "Redraw a cloud's impostor once the angle between "
+                                   "the near and far points of its bounding sphere, seen from the camera, "
+                                   "reaches this many degrees (SkyWorks' error tolerance).", 0.125,
+                                   metavar="DEGREES")
+    impostor_budget: int = option(click.IntRange(1, 10**9), "Most particles drawn into impostors a frame, "
+                                  "the stalest first; a bigger redraw is spread over the next frames (the "
+                                  "old picture shown meanwhile), and a cloud with none yet is drawn "
+                                  "directly.", 5_000, metavar="PARTICLES")
+    impostor_near: float = option(FiniteRange(1, 100), "Clouds whose centre is nearer than this many of "
+                                  "their radii are drawn directly, particle by particle (1: those the camera "
+                                  "is in, as SkyWorks did).",
+                                  1.0, metavar="RADII")
     webgl: str = option(click.Choice(WEBGL), "--headless: software WebGL, Chromium's SwiftShader or Mesa's "
                         "llvmpipe (through ANGLE).", "swiftshader")
     seed: int = seed_option("It picks a --mode sky's clouds and the headless flight path.")
@@ -126,7 +143,9 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
     config = FlyConfig(size=options.size, timeout=timeout, warmup=options.warmup,
                        path="fly" if options.headless else None, seed=options.seed,
                        report=timeout is not None, cloud_scale=options.cloud_resolution,
-                       instancing=options.instancing)
+                       instancing=options.instancing,
+                       impostors=options.impostors, impostor_angle=options.impostor_angle,
+                       impostor_budget=options.impostor_budget, impostor_near=options.impostor_near)
     if options.headless:
         from fishgen.fly.headless import run_headless
 

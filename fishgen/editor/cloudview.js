@@ -8,9 +8,10 @@ const { billboardMaterial, cloudUniforms, particleMaterial: makeParticleMaterial
 
 export { cloudUniforms };
 
-// Particles and billboards as fishgen view draws them (fishgen/web/cloudlight.js), farthest first
+// Particles and billboards as fishgen fly draws them into its cloud buffer (fishgen/web/cloudlight.js:
+// premultiplied, for the editor's own half-size buffer, fishgen/editor/app.js), farthest first
 // (fishgen/web/drawing.js).
-const particleMaterial = makeParticleMaterial();
+const particleMaterial = makeParticleMaterial( { flying: true } );
 
 const TEXTURE_MATERIAL = 'cloud texture ';
 
@@ -27,8 +28,11 @@ export class CloudView {
 		this.loader = new GLTFLoader();
 	}
 
+	// The height in pixels of the buffer the cloud is drawn into. No sprite fades however near it is
+	// (fly's fade is for flying into a cloud; here the camera looks at it).
 	setViewport( height ) {
 		particleMaterial.uniforms.viewportHeight.value = height;
+		particleMaterial.uniforms.fadeHeight.value = 1e9;
 	}
 
 	// Show the GLB `glb` (an ArrayBuffer) in place of the last one.
@@ -44,7 +48,7 @@ export class CloudView {
 				this.points = o;
 				this.sorted.push( new drawing.DepthSorted( o, 1 ) );
 			} else if ( o.isMesh ) {
-				o.material = billboardMaterial( o.material, { textured: this.textured } );
+				o.material = billboardMaterial( o.material, { textured: this.textured, flying: true } );
 				o.frustumCulled = false;
 				this.billboards.push( o );
 				this.sorted.push( new drawing.DepthSorted( o, 3 ) );
@@ -57,7 +61,7 @@ export class CloudView {
 		this.textured = on;
 		for ( const mesh of this.billboards ) {
 			const old = mesh.material;
-			mesh.material = billboardMaterial( old.userData.source, { textured: on } );
+			mesh.material = billboardMaterial( old.userData.source, { textured: on, flying: true } );
 			old.dispose();
 		}
 	}

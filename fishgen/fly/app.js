@@ -3,14 +3,15 @@
 // the mouse (drag) looks around. The upper left shows the window size, the time and the FPS.
 // State for tests and the headless driver: window.fishgenFly = {loaded, error, camera, frames, done, report}.
 const { THREE, GLTFLoader, cloudlight, drawing, schools } = window.fishgenKit;   // fishgen/web/kit.js
-const { PREMULTIPLIED, billboardMaterial: cloudBillboardMaterial, particleMaterial: cloudParticleMaterial, readCloudLight } = cloudlight;
+import { Impostors } from './impostors.js';
+const { PREMULTIPLIED, billboardMaterial: cloudBillboardMaterial, cloudUniforms, particleMaterial: cloudParticleMaterial, readCloudLight } = cloudlight;
 
 const config = JSON.parse( document.getElementById( 'fishgen-fly' ).textContent );
 const token = new URLSearchParams( location.search ).get( 'token' ) || '';
 const $ = ( id ) => document.getElementById( id );
 const state = window.fishgenFly = {
 	loaded: false, error: null, done: false, report: null, frames: 0, fps: 0, time: 0, speed: 2,
-	camera: { position: [ 0, 0, 0 ], yaw: 0, pitch: 0 }, counts: null, sorts: 0,
+	camera: { position: [ 0, 0, 0 ], yaw: 0, pitch: 0 }, counts: null, sorts: 0, impostors: null,
 };
 const fail = ( err ) => {
 	state.error = String( err && err.message || err );
@@ -46,7 +47,13 @@ function resize() {
 	}
 	const bw = Math.max( 1, Math.round( w * config.cloudScale ) ), bh = Math.max( 1, Math.round( h * config.cloudScale ) );
 	if ( cloudBuffer && ( cloudBuffer.width !== bw || cloudBuffer.height !== bh ) ) cloudBuffer.setSize( bw, bh );
-	particleMaterial.uniforms.viewportHeight.value = cloudBuffer ? bh : h;
+	bufferSize = cloudBuffer ? [ bw, bh ] : [ w, h ];
+	pixelScale();
+}
+let bufferSize = [ 1, 1 ];
+function pixelScale( viewportHeight = bufferSize[ 1 ], fadeHeight = bufferSize[ 1 ] ) {
+	particleMaterial.uniforms.viewportHeight.value = viewportHeight;
+	particleMaterial.uniforms.fadeHeight.value = fadeHeight;
 }
 
 function draw() {
@@ -62,6 +69,11 @@ function draw() {
 		renderer.setRenderTarget( cloudBuffer );
 		renderer.setClearColor( 0x000000, 0 );
 		renderer.clear();
+		if ( depthTested ) {   // the meshes' depth, so that a mesh hides the particles behind it
+			camera.layers.set( 0 );
+			drawMeshDepth();
+			camera.layers.set( CLOUDS );
+		}
 		renderer.render( scene, camera );
 		renderer.setRenderTarget( null );
 		renderer.render( overlayScene, overlayCamera );
@@ -93,7 +105,20 @@ const plainMaterial = new THREE.PointsMaterial( { size: 1, vertexColors: true, s
 // pixels at 0.5), then laid over the view, bilinearly scaled up. Their pixels are what a software
 // renderer pays for; soft clouds lose little detail. At 1 they are drawn on the view itself.
 const CLOUDS = 1;   // the layer of everything drawn as a cloud; meshes stay on layer 0
-const cloudBuffer = config.cloudScale < 1 ? new THREE.WebGLRenderTarget( 1, 1, { depthBuffer: false } ) : null;
+const IMPOSTOR_DRAWS = 2;   // the layer a cloud is put on alone while it is drawn into its impostor
+// With meshes in the scene (a school, any glb), the clouds test the meshes' depth: on the window,
+// the depth they left; in the cloud buffer, their depth drawn into it first (colour untouched).
+let depthTested = false;
+// The meshes' depth is drawn with their own materials, colour writes off: an instanced school's fish
+// are placed by its own vertex shader (fishgen/web/schools.js), which an override material would lose.
+function drawMeshDepth() {
+	const materials = new Set( meshes.flatMap( ( m ) => [].concat( m.material ) ) );
+	const writes = new Map( [ ...materials ].map( ( m ) => [ m, m.colorWrite ] ) );
+	for ( const m of materials ) m.colorWrite = false;
+	renderer.render( scene, camera );
+	for ( const [ m, on ] of writes ) m.colorWrite = on;
+}
+const cloudBuffer = config.cloudScale < 1 ? new THREE.WebGLRenderTarget( 1, 1, { depthBuffer: true } ) : null;
 const overlay = new THREE.Mesh( new THREE.PlaneGeometry( 2, 2 ), new THREE.ShaderMaterial( {
 	uniforms: { map: { value: cloudBuffer ? cloudBuffer.texture : null } }, transparent: true, depthTest: false, depthWrite: false,
 	...PREMULTIPLIED,
@@ -124,8 +149,9 @@ function sorter( object, size ) {
 }
 
 const _dir = new THREE.Vector3(), _local = new THREE.Vector3(), _inv = new THREE.Matrix4();
-function sortNow( s ) {
-	camera.getWorldDirection( _dir );
+// `along`: the direction to sort along (an impostor's, from the eye to the cloud); the view's if none.
+function sortNow( s, along = null ) {
+	if ( along ) _dir.copy( along ); else camera.getWorldDirection( _dir );
 	_inv.copy( s.object.matrixWorld ).invert();
 	_local.copy( _dir ).transformDirection( _inv );   // the view direction in the cloud's frame
 	const dx = _local.x, dy = _local.y, dz = _local.z, c = s.centroids, n = s.n;
@@ -165,7 +191,8 @@ function addUnit( levels, coverage ) {
 	const level0 = levels[ 0 ];
 	level0.object.geometry.computeBoundingSphere();
 	const sphere = level0.object.geometry.boundingSphere.clone();
-	units.push( { levels, coverage, sphere, world: new THREE.Sphere(), level: 0, distance: 0, visible: true } );
+	units.push( { levels, coverage, sphere, world: new THREE.Sphere(), level: 0, distance: 0, visible: true,
+		mode: null, holds: false, renderOrder: 0, impostor: null } );
 	counts.clouds ++;
 }
 
@@ -237,6 +264,8 @@ async function addAsset( gltf, root ) {
 	// fish by fish as the file holds it
 	const school = schools.instanceSchools( root, gltf.animations, instancing );
 	for ( const key of Object.keys( instanced ) ) instanced[ key ] += school.info[ key ];
+	// what is drawn with depth, after instancing: the instanced meshes in place of their fish
+	root.traverse( ( o ) => { if ( o.isMesh && ! done.has( o ) ) meshes.push( o ); } );
 	if ( school.clips.length ) {
 		const mixer = new THREE.AnimationMixer( root );
 		for ( const clip of school.clips ) mixer.clipAction( clip ).play();
@@ -244,6 +273,7 @@ async function addAsset( gltf, root ) {
 	}
 }
 const mixers = [];   // each with update( dt ): the assets' animations
+const meshes = [];   // everything drawn with depth (a school, any glb's meshes)
 // Unless the run said --no-instancing or the page's address ?instancing=0: then fish by fish, to compare.
 const instancing = config.instancing !== false && new URLSearchParams( location.search ).get( 'instancing' ) !== '0';
 const instanced = state.instanced = { species: 0, fish: 0, meshes: 0 };
@@ -257,30 +287,92 @@ state.meshCalls = () => {
 
 // -- the frame: cull whole clouds, pick each one's level, sort the stalest, draw -----------------
 const frustum = new THREE.Frustum(), _m = new THREE.Matrix4();
-const drawn = { particles: 0, billboards: 0, clouds: 0, distant: 0 };
+const drawn = { particles: 0, billboards: 0, clouds: 0, distant: 0, impostors: 0, redraws: 0, redrawn: 0 };
+const impostors = config.impostors && config.impostors.on ? new Impostors( renderer, scene, {
+	angle: config.impostors.angle, budget: config.impostors.budget, near: config.impostors.near, layer: CLOUDS,
+	draws: IMPOSTOR_DRAWS, twin, sort: ( s, along ) => sortNow( s, along ), uniforms: pixelScale } ) : null;
+
+// A level's drawable as the impostors draw it: its attributes and material shared, its own index
+// (sorted along the line from the eye to the cloud, drawn a slice a frame), seen by their camera only.
+function twin( level ) {
+	const object = level.object, s = level.sorters[ 0 ], g = new object.geometry.constructor();   // a BufferGeometry
+	for ( const [ name, attribute ] of Object.entries( object.geometry.attributes ) ) g.setAttribute( name, attribute );
+	g.setIndex( new THREE.BufferAttribute( new Uint32Array( s.index ), 1 ) );
+	const copy = object.isPoints ? new THREE.Points( g, object.material ) : new THREE.Mesh( g, object.material );
+	copy.position.copy( object.position ); copy.quaternion.copy( object.quaternion ); copy.scale.copy( object.scale );
+	copy.frustumCulled = false;
+	copy.visible = false;   // shown only while drawn into its impostor
+	copy.layers.set( IMPOSTOR_DRAWS );
+	object.parent.add( copy );
+	copy.updateMatrixWorld( true );
+	const sorter = { ...s, object: copy, keys: new Uint16Array( s.n ), depth: new Float32Array( s.n ), start: new Uint32Array( BUCKETS + 1 ),
+		dir: new THREE.Vector3(), from: new THREE.Vector3( Infinity, 0, 0 ) };
+	return { object: copy, sorter, size: s.size, n: s.n };
+}
+
+// Which clouds hold a mesh (their particles must be cut by its depth, so they are drawn directly):
+// looked at again every HOLD_FRAMES frames, since a school swims.
+const HOLD_FRAMES = 30, _box = new THREE.Box3();
+let holdAge = Infinity;
+function findHolds() {
+	if ( ++ holdAge < HOLD_FRAMES ) return;
+	holdAge = 0;
+	for ( const u of units ) u.holds = false;
+	for ( const mesh of meshes ) {
+		_box.setFromObject( mesh );
+		if ( _box.isEmpty() ) continue;
+		for ( const u of units ) if ( ! u.holds && _box.intersectsSphere( u.world ) ) u.holds = true;
+	}
+}
+
+// The sun's uniforms as a key: the impostors are all redrawn when it changes.
+const sunKey = () => [ cloudUniforms.cloudLit.value, ...cloudUniforms.cloudSun.value.toArray(), ...cloudUniforms.sunColor.value.toArray(),
+	...cloudUniforms.skyColor.value.toArray(), cloudUniforms.albedo.value, cloudUniforms.g.value ].join( ',' );
+let redrawMs = 0;
 
 function update() {
 	camera.updateMatrixWorld();
 	_m.multiplyMatrices( camera.projectionMatrix, camera.matrixWorldInverse );
 	frustum.setFromProjectionMatrix( _m );
 	const tanHalf = Math.tan( THREE.MathUtils.degToRad( camera.fov / 2 ) );
-	drawn.particles = drawn.billboards = drawn.clouds = drawn.distant = 0;
+	drawn.particles = drawn.billboards = drawn.clouds = drawn.distant = drawn.impostors = drawn.redraws = drawn.redrawn = 0;
 	const due = [];
 	for ( const u of units ) {
 		const object0 = u.levels[ 0 ].object;
 		u.world.copy( u.sphere ).applyMatrix4( object0.matrixWorld );
 		u.visible = config.baseline || frustum.intersectsSphere( u.world );
 		u.distance = u.world.center.distanceTo( camera.position );
+		u.renderOrder = - u.distance;   // clouds and impostors together, farthest first
 		// MSFT_screencoverage: the share of the view's height the bounding sphere spans
 		const cover = u.distance > u.world.radius ? u.world.radius / ( u.distance * tanHalf ) : 1;
 		let level = 0;
 		while ( ! config.baseline && level < u.levels.length - 1 && level < u.coverage.length && cover < u.coverage[ level ] ) level ++;
 		u.level = level;
-		u.levels.forEach( ( l, k ) => { l.object.visible = u.visible && k === level; } );
+	}
+	redrawMs = 0;
+	if ( impostors ) {
+		findHolds();
+		const started = performance.now();
+		const particles = impostors.plan( units, camera, bufferSize[ 0 ], bufferSize[ 1 ], sunKey(), camera.near * 2 );
+		if ( particles ) {
+			renderer.setRenderTarget( null );
+			pixelScale();
+			gl.readPixels( 0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel );   // the redraws done: their share of the frame
+			redrawMs = performance.now() - started;
+		}
+		drawn.redraws = impostors.last.redraws;
+		drawn.redrawn = particles;
+		state.impostors = { ...impostors.last, textures: impostors.stats.textures };
+	}
+	for ( const u of units ) {
+		const direct = u.visible && u.mode !== 'impostor';
+		u.levels.forEach( ( l, k ) => { l.object.visible = direct && k === u.level; l.object.renderOrder = u.renderOrder; } );
 		if ( ! u.visible ) continue;
-		const l = u.levels[ level ];
-		drawn.particles += l.particles; drawn.billboards += l.billboards; drawn.clouds ++;
-		if ( level > 0 ) drawn.distant ++;
+		const l = u.levels[ u.level ];
+		drawn.clouds ++;
+		if ( u.level > 0 ) drawn.distant ++;
+		if ( ! direct ) { drawn.impostors ++; continue; }
+		drawn.particles += l.particles; drawn.billboards += l.billboards;
 		for ( const s of l.sorters ) { const age = stale( s, u.distance ); if ( age >= 1 ) due.push( [ age, s ] ); }
 	}
 	due.sort( ( a, b ) => b[ 0 ] - a[ 0 ] );
@@ -318,6 +410,29 @@ state.inspect = () => units.map( ( u ) => {
 		turn: THREE.MathUtils.radToDeg( Math.acos( Math.min( 1, _dir.dot( s.dir ) ) ) ),
 		moved: s.from.distanceTo( camera.position ) / Math.max( u.distance, 1e-6 ) };
 } );
+
+// For tests and benchmarks/fly.py's pictures: look from `position` at `target`. `how`: 'direct'
+// (every cloud drawn directly), 'impostors' (every picture redrawn for this view at once), 'flying'
+// (pictures dropped, the budget as configured) or 'keep' (pictures and budget as they are). The
+// seeded path must be "still" (nothing else moves the camera).
+state.look = ( position, target, how = 'keep' ) => {
+	camera.position.fromArray( position );
+	camera.lookAt( new THREE.Vector3().fromArray( target ) );
+	eye.yaw = camera.rotation.y; eye.pitch = camera.rotation.x;
+	camera.updateMatrixWorld();
+	if ( ! impostors || how === 'keep' ) return;
+	impostors.dropAll( units );
+	impostors.budget = { direct: 0, impostors: Infinity, flying: config.impostors.budget }[ how ];
+};
+// How each cloud is drawn now: 'impostor', 'direct', or null (out of view); and whether it holds a mesh.
+state.modes = () => units.map( ( u ) => ( { mode: u.visible ? ( u.mode || 'direct' ) : null, holds: u.holds,
+	distance: u.distance, radius: u.world.radius, centre: u.world.center.toArray(),
+	side: u.impostor && u.impostor.shown ? u.impostor.shown.side : 0, redraws: u.impostor ? u.impostor.redraws : 0 } ) );
+state.view = () => camera;
+// Change the sun the clouds are lit by (every impostor is redrawn under it).
+state.setSun = ( direction ) => { cloudUniforms.cloudSun.value.fromArray( direction ).normalize(); };
+// The picture drawn now, as a PNG data URL (drawn again and read in one task, so it is whole).
+state.capture = () => { resize(); update(); draw(); return canvas.toDataURL( 'image/png' ); };
 
 // -- moving: Pakawan's keys, the mouse, or a seeded path ----------------------------------------
 const keys = new Set();
@@ -386,6 +501,17 @@ function plan( box ) {
 		orbit = { still: true };
 		return;
 	}
+	if ( config.path === 'around' ) {   // one cloud: a seeded loop round it, 2.2 to 4 radii out, looking at it
+		const sphere = box.getBoundingSphere( new THREE.Sphere() ), rand = random( config.seed ), points = [];
+		for ( let k = 0; k < 6; k ++ ) {
+			const angle = ( k / 6 + 0.1 * ( rand() - 0.5 ) ) * Math.PI * 2, reach = sphere.radius * ( 2.2 + 1.8 * rand() );
+			points.push( new THREE.Vector3( sphere.center.x + Math.cos( angle ) * reach, sphere.center.y + sphere.radius * ( rand() - 0.4 ),
+				sphere.center.z + Math.sin( angle ) * reach ) );
+		}
+		path = new THREE.CatmullRomCurve3( points, true, 'centripetal' );
+		orbit = { around: sphere };
+		return;
+	}
 	if ( config.path !== 'fly' ) return;
 	// a closed loop through seeded waypoints in the middle of the sky, at the clouds' heights
 	const rand = random( config.seed );
@@ -401,6 +527,12 @@ function plan( box ) {
 const _at = new THREE.Vector3(), _ahead = new THREE.Vector3();
 function follow( seconds ) {
 	if ( orbit && orbit.still ) return;
+	if ( orbit && orbit.around ) {   // along the loop, the view wandering over the cloud
+		path.getPointAt( ( seconds / Math.max( 20, ( config.timeout || 0 ) + config.warmup ) ) % 1, camera.position );
+		const r = orbit.around.radius, w = seconds * Math.PI * 2 / 7;
+		camera.lookAt( _at.copy( orbit.around.center ).add( _ahead.set( Math.sin( w ) * 0.3 * r, Math.sin( 1.3 * w ) * 0.15 * r, 0 ) ) );
+		return;
+	}
 	if ( orbit ) {
 		const a = seconds * Math.PI * 2 / 30;   // once round in 30 s
 		camera.position.set( orbit.centre.x + Math.sin( a ) * orbit.distance, orbit.centre.y + orbit.distance * 0.15, orbit.centre.z + Math.cos( a ) * orbit.distance );
@@ -438,7 +570,8 @@ function frame() {
 	if ( measuring === null && ( end - started ) / 1000 >= config.warmup ) measuring = end;
 	else if ( measuring !== null && last !== null ) {
 		frames.push( [ end - measuring, end - last, drawn.particles, drawn.billboards, drawn.clouds,
-			updated - now, submitted - updated, end - submitted ] );
+			updated - now, submitted - updated, end - submitted, drawn.redraws, redrawMs, drawn.impostors, drawn.redrawn,
+			impostors ? impostors.last.error : 0 ] );
 		state.frames = frames.length;
 	}
 	last = end;
@@ -498,6 +631,13 @@ function finish( end ) {
 		split: { update: median( frames.map( ( f ) => f[ 5 ] ) ), submit: median( frames.map( ( f ) => f[ 6 ] ) ),
 			wait: median( frames.map( ( f ) => f[ 7 ] ) ) },
 		renderer: rendererName(), path: config.path || 'keys', seed: config.seed, sorts: state.sorts,
+		// means a frame: clouds shown as impostors, redraws finished, particles drawn into impostors,
+		// how stale the pictures shown were (in units of the angle); and the redraws' share of the time
+		// flown (each frame's timed to its pixel read back)
+		impostors: { on: impostors !== null, angle: impostors ? config.impostors.angle : 0,
+			budget: impostors ? config.impostors.budget : 0, shown: mean( 10 ), redraws: mean( 8 ), particles: mean( 11 ), error: mean( 12 ),
+			redraw_share: frames.length ? frames.reduce( ( a, f ) => a + f[ 9 ], 0 ) / Math.max( 1e-9, frames.reduce( ( a, f ) => a + f[ 1 ], 0 ) ) : 0,
+			textures: impostors ? impostors.stats.textures : 0 },
 		per_second: seconds.map( ( fs, s ) => ( { second: s, frames: fs.length,
 			fps: fs.length ? 1000 / median( fs.map( ( f ) => f[ 1 ] ) ) : 0,
 			particles: fs.length ? fs.reduce( ( a, f ) => a + f[ 2 ], 0 ) / fs.length : 0,
@@ -553,6 +693,12 @@ async function start() {
 	eye.yaw = homeYaw; eye.pitch = 0;
 	camera.rotation.set( 0, 0, 0 );
 	plan( box );
+	depthTested = counts.meshes > 0;
+	if ( depthTested ) {
+		for ( const u of units ) for ( const l of u.levels ) l.object.material.depthTest = true;
+		particleMaterial.depthTest = true;
+		if ( impostors ) impostors.setDepthTest( true );
+	}
 	state.counts = { ...counts };
 	state.loaded = true;
 	requestAnimationFrame( frame );

@@ -25,6 +25,7 @@ MAX_TEXT = 300
 SCENE = ("particles", "billboards", "distant_particles", "distant_billboards", "clouds", "meshes")
 DRAWN = ("particles", "billboards", "clouds")
 SPLIT = ("update", "submit", "wait")
+IMPOSTORS = ("on", "angle", "budget", "shown", "redraws", "particles", "error", "redraw_share", "textures")
 CSV_COLUMNS = ("second", "frames", "fps", "particles_drawn", "billboards_drawn", "width", "height",
                "particles_in_scene", "billboards_in_scene", "fps_median", "renderer", "fishgen")
 
@@ -52,12 +53,15 @@ def _members(value: Any, what: str, names: tuple[str, ...]) -> dict[str, Any]:
 def check_report(page: Any) -> dict[str, Any]:
     """The page's report, checked and in fishgen's order; a malformed one is a FishgenError."""
     r = _members(page, "a report", ("window", "seconds", "warmup", "frames", "fps", "scene", "drawn", "split",
-                                    "renderer", "path", "seed", "sorts", "per_second"))
+                                    "renderer", "path", "seed", "sorts", "impostors", "per_second"))
     window = _members(r["window"], "window", ("width", "height"))
     fps = _members(r["fps"], "fps", ("median", "p5", "min", "max"))
     scene = _members(r["scene"], "scene", SCENE)
     drawn = _members(r["drawn"], "drawn", DRAWN)
     split = _members(r["split"], "split", SPLIT)
+    impostors = _members(r["impostors"], "impostors", IMPOSTORS)
+    if not isinstance(impostors["on"], bool):
+        raise FishgenError(f"expected impostors on as true or false, found {impostors['on']!r}")
     rows = r["per_second"]
     if not isinstance(rows, list) or len(rows) > MAX_SECONDS + 1:
         raise FishgenError(f"expected per_second as a list of at most {MAX_SECONDS + 1} rows, found "
@@ -84,6 +88,15 @@ def check_report(page: Any) -> dict[str, Any]:
         "path": _text(r["path"], "path"),
         "seed": int(_number(r["seed"], "seed", 0, 2**63)),
         "sorts": int(_number(r["sorts"], "sorts")),
+        "impostors": {"on": impostors["on"], "angle": _number(impostors["angle"], "impostors angle", 0, 360),
+                      "budget": int(_number(impostors["budget"], "impostors budget", 0, 1e9)),
+                      "shown": round(_number(impostors["shown"], "impostors shown"), 2),
+                      "redraws": round(_number(impostors["redraws"], "impostor redraws"), 3),
+                      "particles": round(_number(impostors["particles"], "particles redrawn"), 1),
+                      "error": round(_number(impostors["error"], "impostor error"), 2),
+                      "redraw_share": round(_number(impostors["redraw_share"], "impostor redraw share", 0, 1),
+                                            4),
+                      "textures": int(_number(impostors["textures"], "impostor textures"))},
         "per_second": per_second,
     }
 
@@ -136,4 +149,15 @@ def summary(report: dict[str, Any]) -> list[str]:
             f"{things} in {scene['clouds']:,} clouds; drawn on average {drawn['particles']:,.0f} particles"
             + (f", {drawn['billboards']:,.0f} billboards" if scene["billboards"] else "")
             + f" in {drawn['clouds']:.1f} clouds",
+            *impostor_lines(report["impostors"]),
             f"renderer: {report['renderer']}"]
+
+
+def impostor_lines(imp: dict[str, Any]) -> list[str]:
+    """What the impostors did, a frame on average (nothing when they were off)."""
+    if not imp["on"]:
+        return []
+    return [f"impostors: {imp['shown']:.1f} clouds shown as impostors (their particles not counted above), "
+            f"{imp['redraws']:.2f} redraws finished and {imp['particles']:,.0f} particles redrawn a frame, "
+            f"{100 * imp['redraw_share']:.0f}% of the time; the pictures shown {imp['error']:.1f} times the "
+            f"--impostor-angle off on average"]

@@ -25,11 +25,14 @@ MAX_REPORT_BYTES = 4 << 20
 class FlyConfig:
     """How the page flies: the window size (None: the browser window's), seconds measured after
     ``warmup`` (None: fly until stopped), a seeded ``path`` ("fly": a loop through the sky; "orbit":
-    round the scene, as chapter 5's test; "still": where the keys start; None: Pakawan's keys and the
-    mouse), ``cloud_scale``: the
+    round the scene, as chapter 5's test; "around": a seeded loop round the scene, 2.2 to 4 of its
+    radii out, the view wandering over it; "still": where the keys start; None: Pakawan's keys and
+    the mouse), ``cloud_scale``: the
     clouds are drawn into a buffer of this share of the window's width and height (1: on the window
-    itself), and ``baseline``: plain unsorted three.js Points instead (benchmarks/fly.py); ``instancing``:
-    a school drawn one instanced mesh per species and material (fishgen/web/schools.js), else fish by fish."""
+    itself), ``baseline``: plain unsorted three.js Points instead (benchmarks/fly.py); ``instancing``:
+    a school drawn one instanced mesh per species and material (fishgen/web/schools.js), else fish by
+    fish; and the impostors (docs/fly.md): on or off, the redraw angle in degrees, the most particles
+    redrawn a frame, and the distance in cloud radii within which clouds are drawn directly."""
 
     size: tuple[int, int] | None = (800, 600)
     timeout: float | None = None
@@ -41,6 +44,10 @@ class FlyConfig:
     background: str = "#8cadcc"
     cloud_scale: float = 0.5
     instancing: bool = True
+    impostors: bool = True
+    impostor_angle: float = 0.125
+    impostor_budget: int = 5_000
+    impostor_near: float = 1.0
 
     def page_settings(self, assets: Sequence[Asset]) -> dict[str, Any]:
         from fishgen import __version__
@@ -50,6 +57,8 @@ class FlyConfig:
                 "warmup": self.warmup, "path": self.path, "seed": self.seed % 2**32, "report": self.report,
                 "baseline": self.baseline, "background": self.background, "cloudScale": self.cloud_scale,
                 "instancing": self.instancing,
+                "impostors": {"on": self.impostors and not self.baseline, "angle": self.impostor_angle,
+                              "budget": self.impostor_budget, "near": self.impostor_near},
                 "version": __version__}
 
 

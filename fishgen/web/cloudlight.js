@@ -45,7 +45,8 @@ export function readCloudLight( extras ) {
 // fishgen fly's materials (`flying`) draw the clouds into their own buffer, smaller than the window
 // and laid over the view (fishgen/fly/app.js), or on the view itself: they write colours
 // sRGB-encoded and premultiplied, so that both give the same picture ("over" is associative), and
-// test no depth (the buffer has none). The buffer is laid over with the same blending.
+// test no depth unless the page turns `depthTest` on (fly does, to cut clouds by the meshes' depth).
+// The buffer is laid over with the same blending.
 export const PREMULTIPLIED = { blending: THREE.CustomBlending, blendSrc: THREE.OneFactor, blendDst: THREE.OneMinusSrcAlphaFactor,
 	blendSrcAlpha: THREE.OneFactor, blendDstAlpha: THREE.OneMinusSrcAlphaFactor };
 const FLYING = { depthTest: false, ...PREMULTIPLIED };
@@ -76,18 +77,19 @@ const NEAR_FADE = 0.5, SPRITE_CUT = 0.8;
 // A cloud's particles: each a soft disc of its world radius (`_radius`: fishgen's _RADIUS, a PLY's
 // radius) with the billboard sprite's Gaussian profile, renormalised to reach 0 where it is cut, lit
 // by the second pass where the file is lit, in its own colour where not. One a page: set
-// `uniforms.viewportHeight` to the height of the buffer it is drawn into.
+// `uniforms.viewportHeight` to the height of the buffer it is drawn into and, flying, `fadeHeight`
+// to the pixels of that buffer the window's height stands for (they differ in an impostor's texture).
 export function particleMaterial( { flying = false } = {} ) {
 	const cut = flying ? SPRITE_CUT : 1, edge = Math.exp( - cut * cut / 0.32 );
 	return new THREE.ShaderMaterial( {
-		uniforms: { viewportHeight: { value: 1 }, ...cloudUniforms },
+		uniforms: { viewportHeight: { value: 1 }, fadeHeight: { value: 1 }, ...cloudUniforms },
 		defines: flying ? { FLYING: 1 } : {},
 		vertexColors: true, transparent: true, depthWrite: false, ...( flying ? FLYING : {} ),
 		vertexShader: /* glsl */`
 			attribute float _radius;
 			attribute float _density;
 			attribute float _light;
-			uniform float viewportHeight;
+			uniform float viewportHeight, fadeHeight;
 			varying vec3 vColor;
 			varying float vAlpha;
 			${ SECOND_PASS }
@@ -99,7 +101,7 @@ export function particleMaterial( { flying = false } = {} ) {
 				vColor = ( cloudLit && _light >= 0.0 ) ? scattered( _light, world.xyz ) : color;
 				vAlpha = 0.7 * clamp( _density, 0.0, 1.0 );
 			#ifdef FLYING
-				float limit = ${ NEAR_FADE.toFixed( 3 ) } * viewportHeight;
+				float limit = ${ NEAR_FADE.toFixed( 3 ) } * fadeHeight;
 				gl_PointSize = min( size, limit ) * ${ cut.toFixed( 3 ) };
 				vAlpha *= clamp( 2.0 - size / limit, 0.0, 1.0 );
 				if ( vAlpha <= 0.0 || - mv.z <= 0.0 ) gl_Position = vec4( 2.0, 2.0, 2.0, 1.0 );   // not rasterized at all

@@ -228,6 +228,26 @@ def test_an_edit_refreshes_the_preview_and_the_totals_and_fill_time_are_shown(sk
     assert ed.state("cubes[0].radius") == 2.1
 
 
+def test_the_preview_is_drawn_into_a_half_size_buffer_and_the_cubes_over_it(skies, open_editor):
+    # fill-bound soft particles: a quarter of the pixels, no multisampling (issue 33: 5,000 particles
+    # shown within 1 s of an edit on SwiftShader)
+    ed = open_editor(skies / "table_4_3.awn")
+    ed.button("Preview").click()
+    ed.settle()
+    w, h, canvas_w, canvas_h = ed.state("previewSize()")
+    assert abs(w - canvas_w / 2) <= 0.5 and abs(h - canvas_h / 2) <= 0.5
+    picture = ed.page.evaluate("document.getElementById('view').toDataURL('image/png')")
+    from tests.fly.pictures import png
+
+    view = png(picture).astype(int)
+    assert (view.min(axis=2) > 200).mean() > 0.01                       # the lit cloud
+    ed.page.get_by_label("Cube", exact=True).select_option("0")
+    ed.settle()
+    view = png(ed.page.evaluate("document.getElementById('view').toDataURL('image/png')")).astype(int)
+    red = (view[..., 0] > 180) & (view[..., 1] < 90) & (view[..., 2] < 110)
+    assert red.sum() > 300                                               # the chosen cube's edges, on top
+
+
 def test_undo_redo_duplicate_snapping_and_scale_all(skies, open_editor):
     ed = open_editor(skies / "table_4_3.awn")
     ed.page.get_by_label("Cube", exact=True).select_option("3")

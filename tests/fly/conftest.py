@@ -21,6 +21,8 @@ def page_report(**changes) -> dict:
         "split": {"update": 0.5, "submit": 1.0, "wait": 40.0},
         "renderer": "ANGLE (Google, Vulkan 1.3.0 (SwiftShader Device (Subzero)), SwiftShader driver)",
         "path": "fly", "seed": 0, "sorts": 12,
+        "impostors": {"on": True, "angle": 0.125, "budget": 8, "shown": 0.5, "redraws": 0.25,
+                      "particles": 150.0, "error": 1.5, "redraw_share": 0.1, "textures": 1},
         "per_second": [{"second": 0, "frames": 21, "fps": 21.0, "particles": 615.0, "billboards": 0.0},
                        {"second": 1, "frames": 19, "fps": 19.0, "particles": 600.0, "billboards": 0.0}],
     }

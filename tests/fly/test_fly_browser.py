@@ -81,9 +81,10 @@ def test_a_texture_cloud_flies_with_its_billboards_drawn(tmp_path):
 
 @pytest.fixture(scope="module")
 def served_sky(thin_sky):
-    """The thin sky served for interactive flights (no path: the keys steer)."""
+    """The thin sky served for interactive flights (no path: the keys steer), every cloud drawn
+    directly (impostors: tests/fly/test_impostors_browser.py)."""
     assets, _ = prepare_assets([thin_sky[0]])
-    session = FlySession(assets, FlyConfig(size=(640, 480), warmup=0.5))
+    session = FlySession(assets, FlyConfig(size=(640, 480), warmup=0.5, impostors=False))
     session.serve_in_background()
     yield session
     session.close()
