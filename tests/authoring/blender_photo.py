@@ -230,9 +230,10 @@ class Fitted:
 
 
 def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: bool = True,
-               skip: dict[str, str] | None = None) -> list[Fitted]:
+               skip: dict[str, str] | None = None, lens: bool = True) -> list[Fitted]:
     """``fishgen texture --fit-shape`` of every photo (name -> :func:`photograph`'s record) on every
-    base (name -> species) but the one it was shaped from (``skip``: photo -> base)."""
+    base (name -> species) but the one it was shaped from (``skip``: photo -> base), told the
+    photo's ``--focal-length`` when ``lens`` (as a camera's EXIF tells it)."""
     import time
 
     from PIL import Image
@@ -247,6 +248,7 @@ def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: boo
     for name, rec in records.items():
         truth = read_mask(Path(rec["mask"]))
         shot = Shot(**rec["shot"])
+        options = TextureOptions(fit_shape=True, focal_length=shot.lens if lens else None)
         for base_name, base in bases.items():
             if (skip or {}).get(name) == base_name:
                 continue
@@ -255,13 +257,12 @@ def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: boo
             notes: list[str] = []
             start = time.perf_counter()
             try:
-                result = make_texture(rec["photo"], base, out, TextureOptions(fit_shape=True), notes.append)
+                result = make_texture(rec["photo"], base, out, options, notes.append)
             except FishgenError as err:   # the photo's own silhouette failed: the documented escape
                 notes = [f"needs --mask ({err.message})"]
                 mask = folder / name / "mask.png"
                 Image.fromarray(truth).save(mask)
-                result = make_texture(rec["photo"], base, out, TextureOptions(fit_shape=True, mask=mask),
-                                      notes.append)
+                result = make_texture(rec["photo"], base, out, replace(options, mask=mask), notes.append)
             seconds = time.perf_counter() - start
             rebuilt = load_species(out)
             level = result.frame.level(truth)
