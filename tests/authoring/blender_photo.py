@@ -54,16 +54,9 @@ class Shot:
 
 def rest_triangles(scene: Scene) -> np.ndarray:
     """(n, 3, 3) every drawn triangle at rest, glTF axes, metres."""
-    from fishgen.scene.pose import deformed, pose
+    from fishgen.exchange.rest import rest_meshes
 
-    posed = pose(scene)
-    out = []
-    for node, prim in scene.drawn():
-        if prim.mode != "TRIANGLES" or prim.indices is None:
-            continue
-        positions, _ = deformed(scene, node, prim, posed)
-        out.append(positions[np.asarray(prim.indices)])
-    return np.concatenate(out)
+    return np.concatenate([m.positions[m.faces] for m in rest_meshes(scene)])
 
 
 def camera_for(points: np.ndarray, shot: Shot, size=SIZE) -> dict:

@@ -164,6 +164,18 @@ def _attached(fit: ShapeFit) -> tuple[ShapeFit, list[str]]:
     return replace(fit, species=sp), notes
 
 
+#: What the fin tips' searches move: every fin's lengths and angles but the pectoral's (never grown).
+TIPS = [(r, n, kind) for r, n, kind in PARAMETERS if kind in ("length", "angle") and r != "pectoral"]
+
+
+def _moved(sp: Species, record: str, name: str, kind: str, step: float) -> Species:
+    """``sp`` with fin ``record``'s ``name`` (a length: x(1 + step); an angle: + step x TIP_DEGREES)."""
+    fin = getattr(sp, record)
+    value = getattr(fin, name)
+    return with_fin(sp, record, replace(fin, **{
+        name: value * (1.0 + step) if kind == "length" else value + step * TIP_DEGREES}))
+
+
 def settled_tips(fit: ShapeFit, px_per_unit: float) -> ShapeFit:
     """``fit`` with its fin lengths searched again (a pattern search in steps of 4 % down to 0.5 %),
     the species drawn at ``px_per_unit`` pixels a thesis unit (the scale its render is measured
@@ -185,18 +197,14 @@ def settled_tips(fit: ShapeFit, px_per_unit: float) -> ShapeFit:
     drawer = Drawer(first, place, shape)
     best = score(drawer.whole())
     sp, step = first, TIP_STEPS[0]
-    tuned = [(r, n, kind) for r, n, kind in PARAMETERS if kind in ("length", "angle") and r != "pectoral"]
     while step >= TIP_STEPS[1]:
         improved = False
-        for record, name, kind in tuned:
+        for record, name, kind in TIPS:
             fin = getattr(sp, record)
             if record in ("dorsal", "anal", "adipose") and not fin.present:
                 continue
             for k in (-step, step):
-                fin = getattr(sp, record)
-                value = getattr(fin, name)
-                trial = with_fin(sp, record, replace(fin, **{
-                    name: value * (1.0 + k) if kind == "length" else value + k * TIP_DEGREES}))
+                trial = _moved(sp, record, name, kind, k)
                 kept, best = better(drawer, score, sp, best, trial, record)
                 improved |= kept is not sp
                 sp = kept
@@ -245,19 +253,15 @@ def settled_in_perspective(fit: ShapeFit, distance: float, size: tuple[int, int]
 
         sp = fit.species
         best = score(sp)
-        tuned = [(r, n, kind) for r, n, kind in PARAMETERS if kind in ("length", "angle") and r != "pectoral"]
         for step in PERSPECTIVE_STEPS:
             improved = True
             while improved:
                 improved = False
-                for record, name, kind in tuned:
+                for record, name, kind in TIPS:
                     if record in ("dorsal", "anal", "adipose") and not getattr(sp, record).present:
                         continue
                     for k in (-step, step):
-                        fin = getattr(sp, record)
-                        value = getattr(fin, name)
-                        trial = with_fin(sp, record, replace(fin, **{
-                            name: value * (1.0 + k) if kind == "length" else value + k * TIP_DEGREES}))
+                        trial = _moved(sp, record, name, kind, k)
                         if valid(trial) and (value_ := score(trial)) > best + 1e-4:
                             sp, best, improved = trial, value_, True
     finally:
