@@ -6,11 +6,12 @@
         # issue 25: fish fishgen does not ship, lit photos on textured backdrops, turned and in
         # perspective; each on its own geometry, then --fit-shape on every shipped base, the
         # rebuilt fish photographed by three.js
-    python benchmarks/texture.py --blender [--seeds 301,302,303,304] [--bases a,b]
+    python benchmarks/texture.py --blender [--seeds 301,302,303,304] [--bases a,b] [--no-lens]
         # issue 32: fish from `fishgen species --random` on seeds held out from all tuning,
         # photographed by Blender (Cycles, a 50-135 mm lens, small yaw and roll, a sun, translucent
         # fins over alpha or a mottled backdrop); --fit-shape on every shipped base, the rebuilt
-        # fish photographed again by Blender side-on with the photo's lens: IoU per fit, min, median
+        # fish photographed again by Blender side-on with the photo's lens: IoU per fit, min, median;
+        # the command is told each photo's --focal-length unless --no-lens
 
 Each photo is an orthographic side render (tests/authoring/photos.py), varied as
 the robustness tests vary it. Columns: the rebuilt fish's silhouette IoU against
@@ -225,7 +226,7 @@ def blender() -> None:
     records = photograph(subjects, shots, work / "shots")
     shot_s = time.perf_counter() - start
     bases = {n: load_species(ROOT / "params" / f"{n}.txt") for n in (_option("--bases") or SHIPPED)}
-    rows = fit_photos(records, bases, work / "fits")
+    rows = fit_photos(records, bases, work / "fits", lens="--no-lens" not in sys.argv)
     print(f"{'photo':12s} {'lens':>5s} {'yaw':>5s} {'roll':>5s} {'backdrop':8s} {'base':16s} {'Blender':>8s} "
           f"{'Pillow':>7s} {'own':>6s} {'s':>5s} note")
     for r in rows:

@@ -241,7 +241,7 @@ def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: boo
     for name, rec in records.items():
         truth = read_mask(Path(rec["mask"]))
         shot = Shot(**rec["shot"])
-        options = TextureOptions(fit_shape=True, focal_length=shot.lens if lens else None)
+        options = TextureOptions(fit_shape=True, **({"focal_length": shot.lens} if lens else {}))
         for base_name, base in bases.items():
             if (skip or {}).get(name) == base_name:
                 continue
