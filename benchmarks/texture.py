@@ -6,6 +6,12 @@
         # issue 25: fish fishgen does not ship, lit photos on textured backdrops, turned and in
         # perspective; each on its own geometry, then --fit-shape on every shipped base, the
         # rebuilt fish photographed by three.js
+    python benchmarks/texture.py --blender [--seeds 301,302,303,304] [--bases a,b] [--no-lens]
+        # issue 32: fish from `fishgen species --random` on seeds held out from all tuning,
+        # photographed by Blender (Cycles, a 50-135 mm lens, small yaw and roll, a sun, translucent
+        # fins over alpha or a mottled backdrop); --fit-shape on every shipped base, the rebuilt
+        # fish photographed again by Blender side-on with the photo's lens: IoU per fit, min, median;
+        # the command is told each photo's --focal-length unless --no-lens
 
 Each photo is an orthographic side render (tests/authoring/photos.py), varied as
 the robustness tests vary it. Columns: the rebuilt fish's silhouette IoU against
@@ -197,10 +203,49 @@ def photographs() -> None:
 
 
 SHIPPED = ("bonybream", "centroberyx", "pineapplefish", "threadfingoldie")
+#: `fishgen species --random` seeds never looked at while the fit was tuned for Blender's photos
+#: (tuned on 201-203 and the shaped fish of tests/authoring/subjects.py).
+HELD_OUT = (301, 302, 303, 304)
+
+
+def blender() -> None:
+    """Issue 32, item 1: Blender's photos of held-out sampled fish, fitted on every shipped base."""
+    import statistics
+
+    from tests.authoring.blender_photo import bpy_python, fit_photos, photograph, shots_for
+    from tests.authoring.subjects import write_subjects
+
+    if bpy_python() is None:
+        print("--blender needs a Python with bpy ($FISHGEN_BPY_PYTHON or /tmp/bpyvenv/bin/python)")
+        return
+    start = time.perf_counter()
+    seeds = tuple(int(s) for s in (_option("--seeds") or HELD_OUT))
+    work = Path(tempfile.mkdtemp(prefix="fishgen-blender-"))
+    subjects = write_subjects(work / "subjects", seeds, {})
+    shots = shots_for(list(subjects))
+    records = photograph(subjects, shots, work / "shots")
+    shot_s = time.perf_counter() - start
+    bases = {n: load_species(ROOT / "params" / f"{n}.txt") for n in (_option("--bases") or SHIPPED)}
+    rows = fit_photos(records, bases, work / "fits", lens="--no-lens" not in sys.argv)
+    print(f"{'photo':12s} {'lens':>5s} {'yaw':>5s} {'roll':>5s} {'backdrop':8s} {'base':16s} {'Blender':>8s} "
+          f"{'Pillow':>7s} {'own':>6s} {'s':>5s} note")
+    for r in rows:
+        shot = shots[r.photo]
+        note = next((n for n in r.notes if n.startswith("silhouette IoU") or "not kept" in n), "")
+        print(f"{r.photo:12s} {shot.lens:5.0f} {shot.yaw:5.0f} {shot.roll:5.0f} {shot.backdrop:8s} "
+              f"{r.base:16s} "
+              f"{r.blender or 0:8.3f} {r.raster:7.3f} {r.own or 0:6.3f} {r.seconds:5.1f} {note}")
+    ious = [r.blender or 0.0 for r in rows]
+    print(f"\n{len(rows)} fits of {len(records)} Blender photos (seeds {','.join(map(str, seeds))}): "
+          f"IoU in Blender min {min(ious):.3f}, median {statistics.median(ious):.3f}, "
+          f"{sum(i >= 0.85 for i in ious)}/{len(ious)} >= 0.85; photos {shot_s:.0f} s, "
+          f"fits {sum(r.seconds for r in rows):.0f} s, whole run {time.perf_counter() - start:.0f} s")
 
 
 if __name__ == "__main__":
-    if "--photographs" in sys.argv:
+    if "--blender" in sys.argv:
+        blender()
+    elif "--photographs" in sys.argv:
         photographs()
     else:
         main()

@@ -37,6 +37,10 @@ class TextureCommandOptions:
                                  "them.", shown_default="none", metavar="POINTS.FXL")
     fxl_out: Path | None = option(FILE, "Also write the points as a Fixel .FXL file.", shown_default="none",
                                   metavar="POINTS.FXL")
+    focal_length: float | None = option(
+        click.FloatRange(4.0, 2000.0), "The photo's focal length in mm on a 36 mm wide sensor (EXIF's "
+        "FocalLengthIn35mmFilm): the rebuilt fish is measured in that perspective and, with --fit-shape, "
+        "its fins are refined in it.", shown_default="none: seen from afar, no perspective", metavar="MM")
 
 
 COMMAND = Command(
@@ -84,7 +88,8 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     settings = TextureOptions(mask=options.mask, fit_shape=options.fit_shape,
                               body_sections=options.body_sections,
                               circle_sections=options.circle_sections, spacing=options.spacing,
-                              compare=options.compare, fxl_in=options.fxl_in, fxl_out=options.fxl_out)
+                              compare=options.compare, fxl_in=options.fxl_in, fxl_out=options.fxl_out,
+                              focal_length=options.focal_length)
     result = make_texture(photo, species, output, settings, on_note=events.note)
     turned = (["head on the right"] if result.mirrored else []) + (
         [f"turned {result.angle:+.1f} degrees"] if result.angle else [])

@@ -57,8 +57,30 @@ def variants() -> dict[str, tuple[Species, Palette]]:
     }
 
 
-def write_subjects(folder: Path) -> dict[str, Species]:
-    """Every unseen subject written into ``folder`` and loaded back: name -> species."""
+def shaped() -> dict[str, tuple[Species, Palette]]:
+    """Issue 32's hand-shaped fish, for photos from Blender: a tall body, a long low one and a deep
+    tail, none of them tuned on before."""
+    return {
+        "tall": (_variant("bonybream", shape_class="FishShapeSin", shape_params=(), scale=(0.2, 0.13, 0.05),
+                          anal={"start_length": 0.5}),
+                 Palette((110, 100, 40), (245, 240, 210), (180, 160, 70), "spot", (40, 30, 10))),
+        "long": (_variant("centroberyx", scale=(0.4, 0.07, 0.04), body_sections=24,
+                          dorsal={"start_section": 5, "end_section": 17},
+                          anal={"start_section": 14, "end_section": 20},
+                          pelvic={"start_section": 6, "end_section": 8},
+                          pectoral={"start_section": 5}),
+                 Palette((70, 80, 100), (215, 220, 230), (120, 130, 160), "stripe", (200, 60, 40))),
+        "deep-tail": (_variant("pineapplefish", caudal={"top_line": 1.1, "bottom_line": 1.1,
+                                                        "middle_line": 0.35, "top_angle": 62.0,
+                                                        "bottom_angle": 62.0}),
+                      Palette((160, 90, 20), (250, 225, 170), (230, 140, 40), "scales", (30, 20, 10))),
+    }
+
+
+def write_subjects(folder: Path, seeds: tuple[int, ...] = SAMPLED,
+                   made: dict[str, tuple[Species, Palette]] | None = None) -> dict[str, Species]:
+    """Every unseen subject (the samples of ``seeds`` and the ``made`` ones, by default
+    :func:`variants`) written into ``folder`` and loaded back: name -> species."""
     from fishgen.authoring.painter import texture_files
     from fishgen.authoring.species_files import sample_files
     from fishgen.authoring.texture_points import project_texture_points
@@ -67,12 +89,12 @@ def write_subjects(folder: Path) -> dict[str, Species]:
 
     folder.mkdir(parents=True, exist_ok=True)
     out = {}
-    for seed in SAMPLED:
+    for seed in seeds:
         stem = f"sampled_{seed}"
         for name, data in sample_files(seed, stem).items():
             (folder / name).write_bytes(data)
         out[stem] = load_species(folder / f"{stem}.txt")
-    for stem, (sp, palette) in variants().items():
+    for stem, (sp, palette) in (variants() if made is None else made).items():
         name = stem.replace("-", "_")
         sp = project_texture_points(replace(sp, name=name, textured=True), aspect=2.0)
         (folder / f"{name}.txt").write_text(format_species(sp, f"{name}.png", f"{name}_mask.png"))

@@ -139,8 +139,8 @@ def test_a_poor_fit_is_tried_at_other_levels(tmp_path, gl_available, photos, mon
     # as the renders would measure a turned fish: poor at its measured level, good 4 degrees on
     scores = {0.0: 0.80, 4.0: 0.90}
 
-    def rendered(photo_, candidate, out):
-        render, iou = real_rendered(photo_, candidate, out)
+    def rendered(photo_, candidate, out, distance=None):
+        render, iou = real_rendered(photo_, candidate, out, distance)
         fitted = bool(shapes) and (candidate.species.shape_params, candidate.species.scale) == shapes[-1]
         return render, (scores[turns[-1]] if fitted else 0.5)
 

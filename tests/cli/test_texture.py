@@ -213,3 +213,22 @@ def test_more_body_sections_than_the_photo_has_pixels_are_refused_at_once(tmp_pa
     most, length = int(said[1]), int(said[2])
     assert 60 <= length <= 70 and most == length // 2          # the fixture's fish, fin tips and all
     assert not (tmp_path / "new.txt").exists()
+
+
+def test_focal_length_measures_the_rebuilt_fish_in_that_perspective(tmp_path, cli, bream_photo):
+    """--focal-length: the rebuilt fish is rendered as that lens saw it. The photo here is an
+    orthographic render, so a wide angle's view of the rebuilt fish is less like it than a side-on
+    one; 0 mm is a one-line usage error."""
+    path, _ = bream_photo
+
+    def figure(*extra):
+        out = tmp_path / f"x{len(extra)}.txt"
+        r = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", out, *extra)
+        assert r.returncode == 0, r.stderr
+        return float(re.search(r"silhouette IoU of the rebuilt fish: ([0-9.]+)", r.stderr).group(1))
+
+    assert figure("--focal-length", "18") < figure() - 0.01
+    bad = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "y.txt",
+              "--focal-length", "0")
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1, bad.stderr
+    assert "--focal-length" in bad.stderr

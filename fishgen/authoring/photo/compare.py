@@ -1,25 +1,60 @@
 """Render a species side-on as the photo shows a fish, and measure how alike two silhouettes are."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from fishgen.species.model import Species
 
 
-def render_side(species: Species, width: int, height: int) -> np.ndarray:
-    """(H, W, 4) uint8 orthographic left-side render on a transparent background, head left."""
+def render_side(species: Species, width: int, height: int, distance: float | None = None,
+                renderer: Any = None) -> np.ndarray:
+    """(H, W, 4) uint8 left-side render on a transparent background, head left: orthographic, or
+    in the perspective of a camera ``distance`` fish lengths away. ``renderer``: one to reuse (a
+    new one costs about 0.4 s)."""
     from fishgen.assembly.fish import build_fish
     from fishgen.preview.camera import frame
     from fishgen.preview.pipeline import subject_points
     from fishgen.preview.render import Renderer
 
     scene = build_fish(species)
-    camera = frame(subject_points(scene, [None], None), "side", width / height, ortho=True)
-    renderer = Renderer(width, height)
+    points = subject_points(scene, [None], None)
+    camera = frame(points, "side", width / height, ortho=distance is None)
+    if distance is not None:
+        camera = _from_afar(camera, points, distance)
+    own = renderer is None
+    renderer = Renderer(width, height) if own else renderer
     try:
         return renderer.render(scene, camera, None, (0.0, 0.0, 0.0, 0.0))
     finally:
-        renderer.release()
+        if own:
+            renderer.release()
+
+
+def camera_distance(focal_length: float, photo_width: int, mask: np.ndarray) -> float:
+    """How many fish lengths from the camera a fish ``mask`` shows was, photographed with a lens of
+    ``focal_length`` mm on a 36 mm wide sensor: the focal length in pixels over the fish's length in
+    pixels (its longer extent: a side photo shows a fish about level)."""
+    ys, xs = np.nonzero(mask)
+    length = max(float(np.ptp(xs)), float(np.ptp(ys))) + 1.0
+    return focal_length / 36.0 * photo_width / length
+
+
+def _from_afar(camera: Any, points: np.ndarray, distance: float) -> Any:
+    """``camera``'s side view of ``points`` taken from ``distance`` times their length, its field of
+    view narrowed to frame them as before."""
+    from dataclasses import replace
+
+    back = (camera.eye - camera.target) / np.linalg.norm(camera.eye - camera.target)
+    right = np.cross(-back, camera.up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, -back)
+    length, height = float(np.ptp(points @ right)), float(np.ptp(points @ up))
+    far = distance * length
+    half = max(0.5 * length / camera.aspect, 0.5 * height) / 0.8 / (far - 0.5 * float(np.ptp(points @ back)))
+    return replace(camera, eye=camera.target + back * far, fov_y=2 * float(np.arctan(half)),
+                   near=0.01 * far, far=10.0 * far + length, ortho=False)
 
 
 def render_scale(species: Species, width: int, height: int) -> float:

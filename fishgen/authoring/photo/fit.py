@@ -50,7 +50,7 @@ from fishgen.authoring.photo.draw import (
     with_fin,
 )
 from fishgen.authoring.photo.measure import Body, holds, measure_body, measured, working_mask
-from fishgen.authoring.photo.optimise import PARAMETERS, better, drop_hidden, refine
+from fishgen.authoring.photo.optimise import PARAMETERS, better, drop_hidden, refine, valid
 from fishgen.authoring.photo.sideview import with_counts
 from fishgen.species.model import Species
 
@@ -164,6 +164,18 @@ def _attached(fit: ShapeFit) -> tuple[ShapeFit, list[str]]:
     return replace(fit, species=sp), notes
 
 
+#: What the fin tips' searches move: every fin's lengths and angles but the pectoral's (never grown).
+TIPS = [(r, n, kind) for r, n, kind in PARAMETERS if kind in ("length", "angle") and r != "pectoral"]
+
+
+def _moved(sp: Species, record: str, name: str, kind: str, step: float) -> Species:
+    """``sp`` with fin ``record``'s ``name`` (a length: x(1 + step); an angle: + step x TIP_DEGREES)."""
+    fin = getattr(sp, record)
+    value = getattr(fin, name)
+    return with_fin(sp, record, replace(fin, **{
+        name: value * (1.0 + step) if kind == "length" else value + step * TIP_DEGREES}))
+
+
 def settled_tips(fit: ShapeFit, px_per_unit: float) -> ShapeFit:
     """``fit`` with its fin lengths searched again (a pattern search in steps of 4 % down to 0.5 %),
     the species drawn at ``px_per_unit`` pixels a thesis unit (the scale its render is measured
@@ -185,23 +197,26 @@ def settled_tips(fit: ShapeFit, px_per_unit: float) -> ShapeFit:
     drawer = Drawer(first, place, shape)
     best = score(drawer.whole())
     sp, step = first, TIP_STEPS[0]
-    tuned = [(r, n, kind) for r, n, kind in PARAMETERS if kind in ("length", "angle") and r != "pectoral"]
     while step >= TIP_STEPS[1]:
         improved = False
-        for record, name, kind in tuned:
+        for record, name, kind in TIPS:
             fin = getattr(sp, record)
             if record in ("dorsal", "anal", "adipose") and not fin.present:
                 continue
             for k in (-step, step):
-                fin = getattr(sp, record)
-                value = getattr(fin, name)
-                trial = with_fin(sp, record, replace(fin, **{
-                    name: value * (1.0 + k) if kind == "length" else value + k * TIP_DEGREES}))
+                trial = _moved(sp, record, name, kind, k)
                 kept, best = better(drawer, score, sp, best, trial, record)
                 improved |= kept is not sp
                 sp = kept
         if not improved:
             step /= 2
+    return _settled(fit, sp)
+
+
+def _settled(fit: ShapeFit, sp: Species) -> ShapeFit:
+    """``fit`` with its fins searched again into ``sp``, except a fin that then stands taller than
+    the photographed fish (it keeps its size from before), and placed on the frame again."""
+    first = fit.species
     if sp is first:
         return fit
     before = height_problems(first, fit.work, fit.placement)
@@ -210,8 +225,48 @@ def settled_tips(fit: ShapeFit, px_per_unit: float) -> ShapeFit:
         if problem not in before and tall is not None:
             sp = with_fin(sp, tall, getattr(first, tall))
     settled = replace(fit, species=sp, iou=shape_score(fit.work)(draw(sp, fit.placement, fit.work.shape)))
-    _, to_frame, offset = working_mask(target)
+    _, to_frame, offset = working_mask(fit.frame.mask)
     return replace(settled, frame_map=_frame_map(settled, to_frame, offset))
+
+
+#: The perspective search's steps: fin lengths x(1 +- step), angles +- step x TIP_DEGREES.
+PERSPECTIVE_STEPS = (0.08, 0.04, 0.02)
+
+
+def settled_in_perspective(fit: ShapeFit, distance: float, size: tuple[int, int]) -> ShapeFit:
+    """``fit`` with its fin lengths and angles searched again (not the pectoral's, which never
+    grows) with the species rendered from ``distance`` fish lengths, as the photo was taken, against
+    the levelled silhouette by the overlap the command reports. Seen from near, a paired fin that
+    stands out towards the camera looks longer and lower than side-on: a fit drawn side-on takes
+    that into the fin, and the fish then looks wrong from the photo's own camera (a 50 mm photo:
+    0.84 against 0.94 side-on, in Blender)."""
+    from fishgen.authoring.photo.compare import render_side, silhouette_iou
+    from fishgen.preview.render import Renderer
+
+    if fit.frame is None or fit.frame_map is None:
+        return fit
+    target = fit.frame.mask
+    renderer = Renderer(*size)
+    try:
+        def score(species: Species) -> float:
+            return silhouette_iou(target, render_side(species, *size, distance, renderer)[:, :, 3] >= 64)
+
+        sp = fit.species
+        best = score(sp)
+        for step in PERSPECTIVE_STEPS:
+            improved = True
+            while improved:
+                improved = False
+                for record, name, kind in TIPS:
+                    if record in ("dorsal", "anal", "adipose") and not getattr(sp, record).present:
+                        continue
+                    for k in (-step, step):
+                        trial = _moved(sp, record, name, kind, k)
+                        if valid(trial) and (value_ := score(trial)) > best + 1e-4:
+                            sp, best, improved = trial, value_, True
+    finally:
+        renderer.release()
+    return _settled(fit, sp)
 
 
 def _trimmed(fit: ShapeFit) -> ShapeFit:

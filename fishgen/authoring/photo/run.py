@@ -44,6 +44,7 @@ class TextureOptions:
     compare: Path | None = None
     fxl_in: Path | None = None
     fxl_out: Path | None = None
+    focal_length: float | None = None   # mm on a 36 mm wide sensor; None: no perspective
 
 
 @dataclass
@@ -213,13 +214,18 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     base = with_counts(base, options.body_sections, options.circle_sections)
     imported = fxl.read_fxl(options.fxl_in) if options.fxl_in is not None else {}
     textures = texture_bytes(original, photo, sil.mask)
+    distance = None   # from the camera, in fish lengths: the perspective the rebuilt fish is seen in
+    if options.focal_length is not None:
+        from fishgen.authoring.photo.compare import camera_distance
+
+        distance = camera_distance(options.focal_length, photo.size[0], sil.mask)
     chosen = _candidate(photo, sil.mask, base, out, options, imported, textures)
     shown: tuple[np.ndarray, float] | None = None   # the chosen fish rendered, and its IoU
     fitted, problems, fit = False, [], None
     if options.fit_shape:
         from fishgen.authoring.photo.checks import fit_problems
         from fishgen.authoring.photo.compare import render_scale
-        from fishgen.authoring.photo.fit import fit_species, settled_tips
+        from fishgen.authoring.photo.fit import fit_species, settled_in_perspective, settled_tips
 
         tried: tuple[np.ndarray, float] | None = None
         chosen_fit: tuple[_Candidate, Any] | None = None
@@ -228,6 +234,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
                 break
             attempt = fit_species(base, sil.mask, sections_fixed=options.body_sections is not None, turn=turn)
             attempt = settled_tips(attempt, render_scale(attempt.species, *_render_size(photo)))
+            if distance is not None:
+                attempt = settled_in_perspective(attempt, distance, _render_size(photo))
             found = fit_problems(attempt.species, attempt.work, attempt.placement)
             if turn == 0.0:
                 fit, problems = attempt, found
@@ -235,7 +243,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
                 continue
             candidate = _candidate(photo, sil.mask, attempt.species, out, options, imported, textures,
                                    attempt)
-            rendered = _rendered(photo, candidate, out)
+            rendered = _rendered(photo, candidate, out, distance)
             # another level is kept only for a clear gain: the renders differ by a little anyway
             if tried is None or rendered[1] >= tried[1] + TURN_GAIN:
                 tried, chosen_fit, fit, problems = rendered, (candidate, attempt), attempt, []
@@ -246,7 +254,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
             candidate, kept = chosen_fit
             assert tried is not None
             # Keep the fit only if the rebuilt fish matches the photo better than the base's geometry.
-            shown = _rendered(photo, chosen, out)
+            shown = _rendered(photo, chosen, out, distance)
             iou_base, iou_fit = shown[1], tried[1]
             if iou_fit >= iou_base:
                 note(f"fitted shape: silhouette IoU {iou_base:.3f} with the base's geometry -> {iou_fit:.3f}")
@@ -263,7 +271,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         note(f"note: no {name} fin found in the photo; its texture is body skin near its attachment")
     if shown is None:
         try:
-            shown = _rendered(photo, chosen, out)
+            shown = _rendered(photo, chosen, out, distance)
         except FishgenError:   # no OpenGL here: nothing to measure the rebuilt fish with
             shown = None
     if shown is not None and shown[1] < ADVICE_IOU:
@@ -280,7 +288,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         files[Path(options.fxl_out)] = fxl.format_fxl(tp, chosen.species.circle_sections).encode()
     if options.compare is not None:
         if shown is None:
-            shown = _rendered(photo, chosen, out)
+            shown = _rendered(photo, chosen, out, distance)
         files[Path(options.compare)], _ = _compare_png(photo, *shown)
     write_files(files)
     return TextureResult(chosen.species, list(files), chosen.measured.angle, chosen.measured.mirrored,
@@ -326,9 +334,11 @@ def _candidate(photo: Photo, mask: np.ndarray, base: Species, out: Path, options
     return _Candidate(species, files, measured)
 
 
-def _rendered(photo: Photo, candidate: _Candidate, out: Path) -> tuple[np.ndarray, float]:
-    """The candidate rebuilt from its files and rendered side-on at about the photo's size, and its
-    silhouette IoU with the photo's fish (head left, level)."""
+def _rendered(photo: Photo, candidate: _Candidate, out: Path,
+              distance: float | None = None) -> tuple[np.ndarray, float]:
+    """The candidate rebuilt from its files and rendered side-on at about the photo's size (from
+    ``distance`` fish lengths, in perspective, when the lens is known), and its silhouette IoU with
+    the photo's fish (head left, level)."""
     from fishgen.authoring.photo.compare import render_side, silhouette_iou
     from fishgen.species.parser import load_species
 
@@ -339,7 +349,7 @@ def _rendered(photo: Photo, candidate: _Candidate, out: Path) -> tuple[np.ndarra
             except OSError as err:  # a full scratch disk: say which output it was for, and where
                 raise cannot(f"check {path} in the scratch folder", tmp, err) from None
         rebuilt = load_species(Path(tmp) / out.name)
-        render = render_side(rebuilt, *_render_size(photo))
+        render = render_side(rebuilt, *_render_size(photo), distance)
     return render, silhouette_iou(candidate.measured.frame_mask, render[:, :, 3] >= 64)
 
 

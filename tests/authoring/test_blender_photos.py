@@ -1,0 +1,116 @@
+"""Photos from Blender (Cycles, a perspective camera, a sun and a world light, translucent fins over
+alpha or a mottled backdrop) of fish fishgen does not ship, fitted with --fit-shape on other bases
+(issue 32, item 1). CI has no Blender: it fits the committed photos (tests/fixtures/blender_photos)
+and fills the fitted fish's triangles with Pillow from the photo's camera; with Blender, the fit is
+photographed again by Blender itself."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from tests.authoring import blender_photo as bp
+from tests.conftest import PARAMS
+
+#: The fits CI holds to the target: each committed photo on bases it was not shaped from.
+TARGET = 0.85
+FITS = [("sampled_303", "centroberyx"), ("long", "bonybream"), ("long", "threadfingoldie"),
+        ("deep-tail", "centroberyx"),
+        # strict: when it holds, the marker must go
+        pytest.param("sampled_303", "pineapplefish", marks=pytest.mark.xfail(strict=True, reason=(
+            "0.849: the silhouette over water loses the translucent caudal lobes' thin tips, which set "
+            "the box the IoU crops to (the command's own figure, on that silhouette: 0.898)")))]
+needs_blender = pytest.mark.skipif(bp.bpy_python() is None, reason="no Python with bpy ($FISHGEN_BPY_PYTHON)")
+
+
+def _bases(names):
+    from fishgen.species.parser import load_species
+
+    return {n: load_species(PARAMS / f"{n}.txt") for n in names}
+
+
+def test_fixtures_are_whole():
+    """Each committed photo has its true silhouette and the shot it was taken with."""
+    records = bp.fixture_records()
+    assert {"sampled_303", "long", "deep-tail"} <= set(records)
+    for name, rec in records.items():
+        truth = bp.read_mask(rec["mask"])
+        assert truth.shape == (rec["camera"]["height"], rec["camera"]["width"]), name
+        assert 0.03 < truth.mean() < 0.6, f"{name}: the mask is not a fish"
+        bp.Shot(**rec["shot"])
+
+
+def test_rasteriser_agrees_with_the_committed_blender_masks(tmp_path):
+    """The Pillow rasteriser CI measures fits with, from the committed camera, covers what Blender
+    covered (a subject rebuilt from its seed): it is a stand-in for Blender, not for fishgen."""
+    from fishgen.assembly.fish import build_fish
+    from tests.authoring.subjects import write_subjects
+
+    rec = bp.fixture_records()["sampled_303"]
+    species = write_subjects(tmp_path, (303,), {})["sampled_303"]
+    scene = build_fish(species, fins="blend")
+    camera = bp.camera_for(bp.rest_triangles(scene).reshape(-1, 3), bp.Shot(**rec["shot"]))
+    for key in ("eye", "target", "up", "lens", "width", "height"):
+        assert np.allclose(camera[key], rec["camera"][key]), key
+    mine, truth = bp.raster_mask(scene, rec["camera"]), bp.read_mask(rec["mask"])
+    assert (mine & truth).sum() / (mine | truth).sum() >= 0.97
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("photo, base", FITS)
+def test_fit_of_a_blender_photo_holds_on_another_base(tmp_path, gl_available, photo, base):
+    """--fit-shape on a base the fish was not shaped from: the rebuilt fish, projected side-on with
+    the photo's lens and framing, overlaps the photo's true silhouette (levelled by the command)
+    with IoU >= 0.85, and the command's own figure is not kinder than that by more than 0.06."""
+    rows = bp.fit_photos({photo: bp.fixture_records()[photo]}, _bases([base]), tmp_path, blender=False)
+    (row,) = rows
+    assert row.kept, row.notes
+    assert row.raster >= TARGET, f"{photo} on {base}: IoU {row.raster:.3f} (the command says {row.own:.3f})"
+    assert row.own is not None and row.own - row.raster <= 0.06
+
+
+@needs_blender
+def test_blender_covers_what_the_rasteriser_fills(tmp_path):
+    """Blender's mask pass and Pillow's fill of the same fish from the same camera agree."""
+    from fishgen.assembly.fish import build_fish
+    from tests.authoring.subjects import write_subjects
+
+    species = write_subjects(tmp_path / "s", (303,), {})
+    shot = bp.Shot(85.0, 0.7, 0.0, 5.0, -3.0, "alpha", 1)
+    rec = bp.photograph(species, {"sampled_303": shot}, tmp_path / "shots")["sampled_303"]
+    truth = bp.read_mask(rec["mask"])
+    mine = bp.raster_mask(build_fish(species["sampled_303"], fins="blend"), rec["camera"])
+    assert (mine & truth).sum() / (mine | truth).sum() >= 0.97
+    assert json.loads((tmp_path / "shots" / "sampled_303.json").read_text())["camera"] == rec["camera"]
+
+
+@pytest.mark.slow
+@needs_blender
+def test_fit_photographed_again_by_blender(tmp_path, gl_available):
+    """The whole measure in Blender: a committed photo fitted on another base, the fitted species
+    built as a glb and photographed by Blender with the photo's lens, IoU >= 0.85."""
+    (row,) = bp.fit_photos({"long": bp.fixture_records()["long"]}, _bases(["bonybream"]), tmp_path)
+    assert row.blender is not None and row.blender >= TARGET, row
+    assert abs(row.blender - row.raster) <= 0.03
+
+
+def test_fixtures_folder_is_small():
+    """Committed photos stay a few hundred KB."""
+    assert sum(p.stat().st_size for p in bp.FIXTURES.iterdir()) < 800_000
+    assert np.all([p.suffix in (".png", ".json") for p in bp.FIXTURES.iterdir()])
+
+
+@pytest.mark.slow
+def test_focal_length_fits_for_the_photo_s_perspective_and_repeats_byte_for_byte(tmp_path, gl_available):
+    """A 50 mm photo fitted told its focal length: the fish from the photo's camera is no less like
+    the photo than a fit that assumed no perspective, and the same inputs write the same bytes."""
+    rec = bp.fixture_records()["long"]
+    assert rec["shot"]["lens"] == 50.0
+    told = bp.fit_photos({"long": rec}, _bases(["threadfingoldie"]), tmp_path / "a", blender=False)[0]
+    bp.fit_photos({"long": rec}, _bases(["threadfingoldie"]), tmp_path / "b", blender=False)
+    blind = bp.fit_photos({"long": rec}, _bases(["threadfingoldie"]), tmp_path / "c", blender=False,
+                          lens=False)[0]
+    assert told.raster >= blind.raster - 0.005 and told.raster >= TARGET, (told, blind)
+    for name in ("threadfingoldie.txt", "threadfingoldie.png", "threadfingoldie_mask.png"):
+        assert (tmp_path / "a" / "long" / name).read_bytes() == (tmp_path / "b" / "long" / name).read_bytes()
