@@ -82,16 +82,15 @@ def check_cube_files(files, offsets, voxel_size: float, where=None) -> None:
     """Refuse, before filling, a volume of these cube files (``CubeFile``s, placed at ``offsets``
     or all at the origin) whose bounding box would hold more than ``MAX_VOXELS``: every particle
     lies in its cube, and reaches at most its cube's maximum radius further."""
-    lo, hi = [], []
-    for k, f in enumerate(files):
-        shift = np.asarray(offsets[k] if offsets else (0.0, 0.0, 0.0), np.float64)
-        for cube in f.cubes:
-            if cube.particles:
-                half = np.asarray(cube.size, np.float64) / 2 + reach(cube.max_radius)
-                lo.append(np.asarray(cube.centre) + shift - half)
-                hi.append(np.asarray(cube.centre) + shift + half)
-    if lo:
-        voxel_box(np.min(lo, axis=0), np.max(hi, axis=0), voxel_size, where)
+    # a file may hold 100,000 cubes: their boxes as arrays, not one numpy call per cube
+    cubes = [(c, k) for k, f in enumerate(files) for c in f.cubes if c.particles]
+    if not cubes:
+        return
+    shifts = np.array([offsets[k] if offsets else (0.0, 0.0, 0.0) for _, k in cubes], np.float64)
+    centres = np.array([c.centre for c, _ in cubes], np.float64) + shifts
+    half = (np.array([c.size for c, _ in cubes], np.float64) / 2
+            + reach(np.array([c.max_radius for c, _ in cubes], np.float64))[:, None])
+    voxel_box((centres - half).min(axis=0), (centres + half).max(axis=0), voxel_size, where)
 
 
 def reach(radii) -> np.ndarray:
