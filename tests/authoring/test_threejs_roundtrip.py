@@ -68,3 +68,23 @@ def test_unseen_fish_lit_and_turned_fits_any_base(tmp_path, gl_available, camera
     assert iou >= 0.85, f"{subject} on {base_name}: IoU {iou:.3f} by three.js"
     fit = result.shape_fit
     assert fit_problems(rebuilt, fit.work, fit.placement) == []
+
+
+def test_mottled_water_beside_an_opaque_fin_stays_backdrop(tmp_path, camera):
+    """The translucent-fin search (issue 32) keeps only patches whose tint lifts them as a whole:
+    three.js's mottled water beside BonyBream's thin tail fin, brighter than the water around it
+    at its crest, stays backdrop (it cost that photo's fits 0.08-0.12 IoU when it was taken)."""
+    from scipy import ndimage  # type: ignore[import-untyped]
+
+    from fishgen.authoring.photo.image import load_photo
+    from fishgen.authoring.photo.silhouette import silhouette
+    from fishgen.species.parser import load_species
+    from tests.authoring.threejs import lit_photo
+    from tests.conftest import PARAMS
+
+    photo, truth = lit_photo(camera, load_species(PARAMS / "bonybream.txt"), "lit+water")
+    photo.save(tmp_path / "photo.png")
+    found = silhouette(load_photo(tmp_path / "photo.png"))
+    assert found.source == "background model"
+    outside = found.mask & ~ndimage.binary_dilation(truth, iterations=2)
+    assert outside.sum() <= 0.002 * truth.sum(), f"{outside.sum()} px of water taken as fish"

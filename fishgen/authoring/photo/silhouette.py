@@ -24,6 +24,7 @@ MIN_CONTRAST = 20.0        # ... and never less than this (0-255 units), for fla
 THREAD_REACH = 6           # px: how near the fish a fin's thread is judged against its contrast
 LOCAL_SIGMA = 12.0         # px: the scale of the local backdrop a translucent fin is judged against
 LOCAL_SIGMAS = 4.0         # colour distance from the local backdrop, in its own deviations, that is fin
+PATCH_SIGMAS = 6.0         # ... that a patch of fin holds at its median, where mottled water peaks
 LOCAL_CONTRAST = 6.0       # ... and never less than this (0-255 units)
 LOCAL_BOX = 5              # px: a box filter that averages JPEG's ringing out, not a fin
 LOCAL_WIDTH = 4            # px: the narrowest patch of fin judged so
@@ -88,8 +89,9 @@ def translucent_mask(rgb: np.ndarray, fish: np.ndarray) -> np.ndarray:
     the tint stands out: that backdrop is the photo's confidently-backdrop pixels (under 3 border
     deviations, away from the fish) spread over the gaps by a normalised Gaussian, and a pixel is fin
     when it differs from it by LOCAL_SIGMAS of its own spread and LOCAL_CONTRAST, in a patch at least
-    3 px wide that touches the fish. Its rim is kept as :func:`background_model_mask` keeps the
-    fish's: where it carries half the contrast of the fin just inside it."""
+    LOCAL_WIDTH px wide that touches the fish and differs by PATCH_SIGMAS at its median. Its rim is
+    kept as :func:`background_model_mask` keeps the fish's: where it carries half the contrast of
+    the fin just inside it."""
     img = ndimage.uniform_filter(rgb.astype(np.float32), size=(LOCAL_BOX, LOCAL_BOX, 1))
     _, distance = _off_backdrop(img)
     known = ~ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=3) & (distance < 3.0)
@@ -115,6 +117,12 @@ def translucent_mask(rgb: np.ndarray, fish: np.ndarray) -> np.ndarray:
     touching = np.unique(labels[ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool)) & raw])
     patches = np.bincount(labels[patch], minlength=count + 1)
     touching = touching[(touching > 0) & (patches[touching] >= LOCAL_PATCH * fish.sum())]
+    # A fin's tint lifts its whole patch; a brighter swirl of mottled water beside a thin fin
+    # passes LOCAL_SIGMAS only at its crest (three.js's water: medians of 4.3-5.1 deviations, where
+    # Blender's translucent fins hold 6.8 and more).
+    if touching.size:
+        medians = np.asarray(ndimage.median(contrast, labels, touching))
+        touching = touching[medians >= PATCH_SIGMAS * spread]
     fin = np.isin(labels, touching)
     core = ndimage.binary_erosion(fin, structure=np.ones((3, 3), bool))
     inside = ndimage.maximum_filter(np.where(core, contrast, 0.0), size=5)
