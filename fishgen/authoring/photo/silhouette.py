@@ -30,6 +30,9 @@ LOCAL_BOX = 5              # px: a box filter that averages JPEG's ringing out, 
 LOCAL_WIDTH = 4            # px: the narrowest patch of fin judged so
 LOCAL_PATCH = 0.001        # of the fish's area: the smallest patch of fin judged so
 NEAR_BAND = 12             # px round the fish whose backdrop sets that spread
+FAINT_ALPHA = 16           # alpha that may be a translucent fin's edge, not surely fish
+FAINT_SIGMAS = 4.0         # unfiltered colour distance from the local backdrop that may be fin
+FAINT_HALF_WIDTH = 2.5     # px: the widest run of such pixels that is a fin's thread, not a swirl
 
 
 @dataclass(frozen=True)
@@ -93,18 +96,10 @@ def translucent_mask(rgb: np.ndarray, fish: np.ndarray) -> np.ndarray:
     kept as :func:`background_model_mask` keeps the fish's: where it carries half the contrast of
     the fin just inside it."""
     img = ndimage.uniform_filter(rgb.astype(np.float32), size=(LOCAL_BOX, LOCAL_BOX, 1))
-    _, distance = _off_backdrop(img)
-    known = ~ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=3) & (distance < 3.0)
-    weight = ndimage.gaussian_filter(known.astype(np.float32), LOCAL_SIGMA)
-    local = np.stack([ndimage.gaussian_filter(img[..., i] * known, LOCAL_SIGMA) for i in range(3)], axis=-1)
-    diff = img - local / np.maximum(weight, 1e-6)[..., None]
-    contrast = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
-    if not known.any():
+    local = _local_contrast(img, fish)
+    if local is None:
         return np.zeros_like(fish)
-    # the spread is the backdrop's near the fish: JPEG rings round an outline, a flat frame does not
-    band = known & ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=NEAR_BAND)
-    near = band if band.sum() >= 50 else known
-    spread = float(np.median(contrast[near])) * 1.4826 + 0.5
+    contrast, weight, spread = local
     # weight: far from any known backdrop (a frame filled by fish) there is nothing to compare with
     raw = (contrast > max(LOCAL_SIGMAS * spread, LOCAL_CONTRAST)) & (weight > 0.02) & ~fish
     raw = ndimage.binary_opening(raw, structure=np.ones((3, 3), bool))   # the fish's own halo is 1 px
@@ -128,6 +123,51 @@ def translucent_mask(rgb: np.ndarray, fish: np.ndarray) -> np.ndarray:
     inside = ndimage.maximum_filter(np.where(core, contrast, 0.0), size=5)
     fin = core | (fin & ~core & (contrast >= 0.5 * inside))
     return ndimage.binary_fill_holes(fin | fish) & ~fish
+
+
+def faint_edges(photo: Photo, fish: np.ndarray) -> np.ndarray:
+    """Pixels joined to ``fish`` that may be fish too, though the silhouette left them out: an
+    alpha photo's pixels of alpha FAINT_ALPHA and more; over a backdrop, thin runs (at most
+    2 x FAINT_HALF_WIDTH px wide) of the unfiltered photo that differ from the backdrop around them
+    by FAINT_SIGMAS of its spread: a translucent fin's last tips and the outline's own rim. Too
+    unsure to measure the fish by, they tell how far its measure can be trusted."""
+    if photo.alpha is not None:
+        maybe = photo.alpha >= FAINT_ALPHA
+    else:
+        local = _local_contrast(photo.rgb.astype(np.float32), fish)
+        if local is None:
+            return np.zeros_like(fish)
+        contrast, weight, spread = local
+        maybe = (contrast > max(FAINT_SIGMAS * spread, LOCAL_CONTRAST)) & (weight > 0.02)
+    grown = ndimage.binary_propagation(fish, mask=maybe | fish, structure=np.ones((3, 3), bool)) & ~fish
+    if photo.alpha is not None:
+        return grown
+    labels, count = ndimage.label(grown, structure=np.ones((3, 3), bool))
+    if count == 0:
+        return grown
+    # a swirl of the backdrop beside the fish is a blob; a fin's tip or rim is a thread
+    index = np.arange(1, count + 1)
+    widest = np.asarray(ndimage.maximum(ndimage.distance_transform_edt(grown), labels, index))
+    return np.isin(labels, index[widest <= FAINT_HALF_WIDTH])
+
+
+def _local_contrast(img: np.ndarray, fish: np.ndarray) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """How far each pixel of ``img`` is from the backdrop around it: (contrast in 0-255 units, the
+    weight of known backdrop near it, the spread of that contrast over the backdrop near the fish);
+    None when no pixel is surely backdrop. The backdrop is the photo's confidently-backdrop pixels
+    (under 3 border deviations, away from the fish) spread over the gaps by a normalised Gaussian."""
+    _, distance = _off_backdrop(img)
+    known = ~ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=3) & (distance < 3.0)
+    if not known.any():
+        return None
+    weight = ndimage.gaussian_filter(known.astype(np.float32), LOCAL_SIGMA)
+    local = np.stack([ndimage.gaussian_filter(img[..., i] * known, LOCAL_SIGMA) for i in range(3)], axis=-1)
+    diff = img - local / np.maximum(weight, 1e-6)[..., None]
+    contrast = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+    # the spread is the backdrop's near the fish: JPEG rings round an outline, a flat frame does not
+    band = known & ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=NEAR_BAND)
+    near = band if band.sum() >= 50 else known
+    return contrast, weight, float(np.median(contrast[near])) * 1.4826 + 0.5
 
 
 def _off_backdrop(img: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
