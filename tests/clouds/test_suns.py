@@ -22,18 +22,7 @@ HIGHEST = 10_000
 """Most particles of a file here (the suite's time); the benchmark goes to 10^5."""
 
 
-SHORT = {
-    102: "209 particles: a random sun 0.786; a finer one-by-one grid (1024 cells, 6 per sigma) gives "
-         "0.86, but that grid would change every shipped file's light",
-    112: "171 particles: an axis sun 0.79, the same with a grid four times finer: Harris's recurrence "
-         "gives a neighbour a hair nearer the sun its whole shadow and one a hair farther none, where "
-         "the reference's Gaussians shade each other as far as they overlap along the ray",
-}
-"""Held-out files the light does not reach GOAL on, and why (strict: a fix shows as XPASS)."""
-
-
-@pytest.mark.parametrize("seed", [pytest.param(seed, marks=pytest.mark.xfail(strict=True, reason=SHORT[seed]))
-                                  if seed in SHORT else seed for seed in [*TUNED, *HELD_OUT]])
+@pytest.mark.parametrize("seed", [*TUNED, *HELD_OUT])
 def test_light_falls_with_the_optical_depth_towards_any_sun(seed, tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")     # nothing but a file's declared total can warn here
