@@ -53,11 +53,11 @@ PAIRS = 1 << 19
 CDF_STEPS = 1 << 14
 """Steps of the normal CDF's table over -REACH..REACH (linear interpolation: within 3e-8)."""
 GRID = 256
-"""Most cells along a side of a big cloud's light grid. Only a cloud
-wider than GRID / CELLS_PER_SIGMA typical particle widths across the sun's rays reaches it (cube
-files strung out along one direction, seen from the side): with 96, those cells grew wider than
-the particles, their shadows fell on neighbours they did not cover, and the light's rank
-correlation with the optical depth towards the sun fell to 0.67-0.8 (issue 32)."""
+"""Most cells along a side of a big cloud's light grid. Only a cloud wider than GRID /
+CELLS_PER_SIGMA typical particle widths across the sun's rays reaches it (cube files strung out
+along one direction, seen from the side): with 96, those cells grew wider than the particles,
+their shadows fell on neighbours they did not cover, and the light's rank correlation with the
+optical depth towards the sun fell to 0.67-0.8 (issue 32)."""
 CELLS_PER_SIGMA = 2.5
 """Grid cells across the Gaussian width of the median particle, where the grid allows."""
 CLASSES = 4
