@@ -146,8 +146,8 @@ def _pairs(centers, radii, density, frame, middle, extinction: float, forward: f
     nearer 84 %. Harris's recurrence, one particle after another, gives a neighbour a hair nearer
     the sun its whole shadow and one a hair farther none; on clouds of a few hundred particles
     that ranked the light below 0.8 against the optical depth towards the sun (issue 32), and
-    left the sunlit side of a dense cloud far brighter than exp(-tau) (50x in the mean on Table
-    4.2, scattering off). With scattering on, j's depth d on the ray passes on ``e^-d + F (1 -
+    left the sunlit side of a dense cloud far brighter than exp(-tau) (20-50x in the mean on
+    Table 4.2, scattering off). With scattering on, j's depth d on the ray passes on ``e^-d + F (1 -
     e^-d)`` of the light, F the forward fraction, as it does in the recurrence: an effective
     depth e(d), of which the same share Phi counts (as the slabs take half their own slab's).
     So with scattering off the light is exactly ``exp(-tau)``.
