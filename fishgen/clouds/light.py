@@ -99,11 +99,23 @@ def lit_colors(light: np.ndarray, lighting: Lighting) -> np.ndarray:
 
     level = np.linspace(0.0, 1.0, COLOR_LEVELS + 1)[:, None]
     linear = lighting.albedo * (np.array(lighting.sky_color) + np.array(lighting.sun_color) * level)
-    table = np.round(linear_to_srgb(np.clip(linear, 0, 1)) * 255).astype(np.uint8)
-    index = np.asarray(light, _F32) * _F32(COLOR_LEVELS)
-    index += _F32(0.5)
-    np.clip(index, 0, COLOR_LEVELS, out=index)
-    return table[index.astype(np.intp)]
+    table = np.zeros((COLOR_LEVELS + 1, 4), np.uint8)
+    table[:, :3] = np.round(linear_to_srgb(np.clip(linear, 0, 1)) * 255)
+    words = table.view(np.uint32).ravel()          # a colour a word: one gather a particle, not three
+    light = np.asarray(light, _F32)
+    out = np.empty((len(light), 3), np.uint8)
+    into = out.view(_RGB_BYTES).ravel()
+    for start in range(0, len(light), CHUNK):       # a chunk's temporaries stay in cache
+        index = light[start:start + CHUNK] * _F32(COLOR_LEVELS)
+        index += _F32(0.5)
+        np.clip(index, 0, COLOR_LEVELS, out=index)
+        into[start:start + CHUNK] = np.take(words, index.astype(np.int32)).view(_RGB_WORD)["rgb"]
+    return out
+
+
+_RGB_BYTES = np.dtype("V3")
+_RGB_WORD = np.dtype({"names": ["rgb"], "formats": ["V3"], "offsets": [0], "itemsize": 4})
+"""A packed sRGB colour, and the same three bytes as the first of a 32-bit word's four."""
 
 
 def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
