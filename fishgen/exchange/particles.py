@@ -44,11 +44,53 @@ def particle_chunks(prim: Primitive, columns: list[tuple[str, np.ndarray, str]])
     dtype = np.dtype([(name, kind) for name, _, kind in columns])
     n = prim.vertex_count
     buffer = np.empty(min(ROWS, n), dtype)
+    blocks = _blocks(columns, dtype, n)
+    view = buffer.view(np.dtype({"names": [f"b{k}" for k in range(len(blocks))],
+                                 "formats": [kind for _, _, kind in blocks],
+                                 "offsets": [offset for _, offset, _ in blocks],
+                                 "itemsize": dtype.itemsize}))
     for start in range(0, n, ROWS):
         stop = min(start + ROWS, n)
-        rec = buffer[: stop - start]
-        for name, values, _ in columns:
-            rec[name] = values[start:stop]
-        yield rec
+        rec = view[: stop - start]
+        for k, (values, _, kind) in enumerate(blocks):
+            part = values[start:stop]
+            rec[f"b{k}"] = part.view(kind).reshape(-1) if kind.kind == "V" else part
+        yield buffer[: stop - start]
 
 
+def _blocks(columns: list[tuple[str, np.ndarray, str]], dtype: np.dtype,
+            n: int) -> list[tuple[np.ndarray, int, np.dtype]]:
+    """How to pack ``columns``: (source, offset in the record, type). Columns side by side in one
+    C-contiguous (n, w) array of their type (x y z of POSITION, an RGB's three bytes) make one
+    block copied as raw bytes, as does a contiguous column of its type: a few byte copies a chunk
+    instead of a typed copy a column into the unaligned record."""
+    blocks: list[tuple[np.ndarray, int, np.dtype]] = []
+    offsets = {name: int(dtype.fields[name][1]) for name in dtype.names or ()} if dtype.fields else {}
+    k = 0
+    while k < len(columns):
+        name, values, kind = columns[k]
+        offset, size = offsets[name], np.dtype(kind).itemsize
+        base = values.base
+        if isinstance(base, np.ndarray) and base.ndim == 2 and base.shape[0] == n and base.dtype == kind \
+                and base.flags.c_contiguous and k + base.shape[1] <= len(columns) \
+                and all(columns[k + j][2] == kind and _side_by_side(columns[k + j][1], base, j)
+                        for j in range(base.shape[1])):
+            blocks.append((base, offset, np.dtype((np.void, base.shape[1] * size))))
+            k += base.shape[1]
+            continue
+        if values.dtype == kind and values.flags.c_contiguous:
+            blocks.append((values, offset, np.dtype((np.void, size))))
+        else:
+            blocks.append((values, offset, np.dtype(kind)))
+        k += 1
+    return blocks
+
+
+def _side_by_side(column: np.ndarray, base: np.ndarray, j: int) -> bool:
+    """``column`` is ``base[:, j]``."""
+    return column.base is base and column.strides == base.strides[:1] \
+        and _address(column) == _address(base) + j * base.itemsize
+
+
+def _address(array: np.ndarray) -> int:
+    return int(array.__array_interface__["data"][0])
