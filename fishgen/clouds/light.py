@@ -147,8 +147,8 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
         np.clip(light, 0, 1, out=light)
     else:
         count = min(n, SLABS, max(FEW_SLABS, n // 2048)) if slabs is None else max(1, min(n, int(slabs)))
-        _slabs(centers, radii, density, frame, middle, count, lighting.extinction, forward, light,
-               grid_cells)
+        light = _slabs(centers, radii, density, frame, middle, count, lighting.extinction, forward, light,
+                       grid_cells)
     return light
 
 
@@ -188,7 +188,7 @@ def _one_by_one(grid: _Grid, order, across, radii, density, extinction, forward,
 
 
 def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forward, light,
-           grid_cells: int | None) -> None:
+           grid_cells: int | None) -> np.ndarray:
     """A big cloud, in ``slabs`` slabs along the sun axis, all read from and splatted into one
     light map.
 
@@ -205,7 +205,9 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     its own thread: one numbers the slabs; one splats every particle into its slab's maps
     (summed in chunk order, so threads do not change a bit); then the maps go down the slabs
     in order, keeping the light each slab received and the depth it holds; and the last
-    pass reads each particle's light from its slab's maps, clipped to [0, 1].
+    pass reads each particle's light from its slab's maps, clipped to [0, 1], into ``light``,
+    or, when one group holds every slab, over the across-ray coordinate it has just read (and
+    returns that array): fresh pages cost more than the arithmetic on them.
     """
     n = len(centers)
     spans = _spans(n, CHUNK)
@@ -213,14 +215,15 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
         depth, a, b = np.empty(n, _F32), np.empty(n, _F32), np.empty(n, _F32)
         ends = _project(centers, frame, middle, out=(depth, a, b), pool=pool)
         slab = _slab_numbers(depth, slabs, pool, ends[0])
-        del depth
         grid = _Grid(ends[1:, 0].astype(np.float64), ends[1:, 1].astype(np.float64), radii, False,
                      most=grid_cells)
         cells = grid.shape[0] * grid.shape[1]
         table = _peak_table(float(extinction), float(forward))
         # the slabs in groups whose maps fit in MAP_VALUES (one group but for a very fine grid)
         group = max(1, min(slabs, MAP_VALUES // (CLASSES * cells)))
-        own = np.empty(n, _F32)           # each particle's own depth at its centre, once splatted
+        own = depth             # each particle's own depth at its centre, once splatted
+        if group >= slabs:
+            light = a
         for first in range(0, slabs, group):
             last = min(slabs, first + group)
             place = functools.partial(_place, grid, slab, a, b, first, last, slabs)
@@ -242,6 +245,7 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
                 direct *= np.exp(-depths[k])
             read = functools.partial(_read_chunk, grid, place, own, before, depths, light)
             list(pool.map(read, spans))
+    return light
 
 
 def _spans(n: int, size: int) -> list[tuple[int, int]]:
