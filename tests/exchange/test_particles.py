@@ -5,14 +5,16 @@ import numpy as np
 import pytest
 
 from fishgen.exchange import particles
+from fishgen.numeric import linear16_to_srgb8
 from fishgen.scene.model import Primitive
 
 
 def _field_by_field(prim: Primitive) -> bytes:
     columns = particles.particle_columns(prim)
     rec = np.empty(prim.vertex_count, np.dtype([(name, kind) for name, _, kind in columns]))
-    for name, values, _ in columns:
-        rec[name] = values
+    for name, values, kind in columns:
+        # 16-bit linear colour is written as its sRGB bytes
+        rec[name] = linear16_to_srgb8()[values] if kind == "|u1" and values.dtype == np.uint16 else values
     return rec.tobytes()
 
 
@@ -29,10 +31,12 @@ def _points(n: int, layout: str) -> Primitive:
     }
     if layout == "float colours":
         attributes["COLOR_0"] = rng.random((n, 4)).astype(np.float32)
+    if layout == "rgba16":     # three channels of four: converted a column at a time
+        attributes["COLOR_0"] = rng.integers(0, 65536, (n, 4)).astype(np.uint16)
     return Primitive(attributes, mode="POINTS")
 
 
-@pytest.mark.parametrize("layout", ["contiguous", "strided", "float colours"])
+@pytest.mark.parametrize("layout", ["contiguous", "strided", "float colours", "rgba16"])
 def test_chunks_hold_the_columns_bytes_whatever_the_layout(layout, monkeypatch):
     monkeypatch.setattr(particles, "ROWS", 1000)    # several chunks, the last one short
     prim = _points(2500, layout)
