@@ -156,7 +156,8 @@ def whole_command(n: int, workdir: Path, repeats: int, kinds=("fishgen",), basel
     """Per kind of COMMANDS: median wall time and peak RSS (bytes) of the whole run on a
     Table 4.4 cloud of n particles to PLY, the kinds interleaved run by run. A kind ``base:K`` is
     K run from ``baseline`` (another checkout: its fishgen, its benchmarks/clouds.py). ``cpu``, if
-    given, gets each kind's median CPU seconds (user + system, all threads)."""
+    given, gets each kind's median CPU seconds in user mode and in the kernel (all threads), as
+    ``kind`` and ``kind:system``."""
     awn, ply = workdir / f"cloud_{n}.awn", workdir / f"cloud_{n}.ply"
     write_awn(scaled_cubes(n), awn)
     # Each measurement runs in its own wrapper so RUSAGE_CHILDREN sees only that command.
@@ -164,9 +165,9 @@ def whole_command(n: int, workdir: Path, repeats: int, kinds=("fishgen",), basel
              "t = time.perf_counter()\n"
              "subprocess.run(sys.argv[1:], check=True, stdout=subprocess.DEVNULL)\n"
              "u = resource.getrusage(resource.RUSAGE_CHILDREN)\n"
-             "print(time.perf_counter() - t, u.ru_maxrss, u.ru_utime + u.ru_stime)")
+             "print(time.perf_counter() - t, u.ru_maxrss, u.ru_utime, u.ru_stime)")
     times: dict[str, list[float]] = {k: [] for k in kinds}
-    cpus: dict[str, list[float]] = {k: [] for k in kinds}
+    cpus: dict[str, list[float]] = {k: [] for k in kinds} | {f"{k}:system": [] for k in kinds}
     peaks: dict[str, list[int]] = {k: [] for k in kinds}
     for _ in range(repeats):
         for kind in kinds:
@@ -183,10 +184,11 @@ def whole_command(n: int, workdir: Path, repeats: int, kinds=("fishgen",), basel
             times[kind].append(float(out[0]))
             peaks[kind].append(int(out[1]) * 1024)  # ru_maxrss is in KiB on Linux
             cpus[kind].append(float(out[2]))
+            cpus[f"{kind}:system"].append(float(out[3]))
             assert ply.stat().st_size > (0 if kind.endswith("plain") else 23 * n)
             ply.unlink()
     if cpu is not None:
-        cpu.update({k: statistics.median(cpus[k]) for k in kinds})
+        cpu.update({k: statistics.median(v) for k, v in cpus.items()})
     return {k: (statistics.median(times[k]), max(peaks[k])) for k in kinds}
 
 
@@ -232,8 +234,9 @@ def cost_report(small: int, large: int, plain_size: int, repeats: int, workdir: 
     particle at ``plain_size`` (each a fresh process, so the loop's heap is its own): the fill
     alone (the issue's baseline) and the fill plus packing and writing the same PLY. Target: the
     lit command's marginal cost at least 50x below the plain fill's. With ``baseline`` (another
-    checkout, e.g. main's), its two commands run interleaved with these, and the CPU time
-    (all threads) is given beside the wall time: on a shared machine it is the steadier figure."""
+    checkout, e.g. main's), its two commands run interleaved with these. The CPU time (all
+    threads) is given beside the wall time, in user mode (the steadier figure on a shared machine)
+    and in the kernel (page faults of fresh arrays, the page cache, fsync: it varies 5x there)."""
     kinds = ("fishgen", "no-light") + (("base:fishgen", "base:no-light") if baseline else ())
     cpu_low: dict[str, float] = {}
     cpu_high: dict[str, float] = {}
@@ -244,15 +247,16 @@ def cost_report(small: int, large: int, plain_size: int, repeats: int, workdir: 
     print(f"\nwhole command, Table 4.4 cloud to PLY, medians of {repeats}, kinds interleaved run by run"
           f"{f'; base: {baseline}' if baseline else ''}:")
     print("| command | " + f"{small:,} | {large:,} | marginal per particle | plain fill / marginal "
-          f"| plain fill+PLY / marginal | CPU marginal | peak at {large:,} |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+          f"| plain fill+PLY / marginal | user CPU marginal | kernel CPU marginal | peak at {large:,} |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     labels = {"fishgen": "`fishgen clouds` (lit)", "no-light": "`fishgen clouds --no-light`"}
     for kind in kinds:
         label = labels[kind.removeprefix("base:")] + (" (base)" if kind.startswith("base:") else "")
         marginal = (high[kind][0] - low[kind][0]) / (large - small)
-        cpu = (cpu_high[kind] - cpu_low[kind]) / (large - small)
+        user, kernel = ((cpu_high[k] - cpu_low[k]) / (large - small) for k in (kind, f"{kind}:system"))
         print(f"| {label} | {low[kind][0]:.2f} s | {high[kind][0]:.2f} s | {marginal * 1e9:.0f} ns "
-              f"| {per['plain'] / marginal:.1f}x | {per['plain-ply'] / marginal:.1f}x | {cpu * 1e9:.0f} ns "
+              f"| {per['plain'] / marginal:.1f}x | {per['plain-ply'] / marginal:.1f}x | {user * 1e9:.0f} ns "
+              f"| {kernel * 1e9:.0f} ns "
               f"| {high[kind][1] / large:.1f} B/particle |")
     print(f"plain loops at {plain_size:,} particles, whole process: "
           f"fill {per['plain'] * 1e9:,.0f} ns a particle, fill + PLY {per['plain-ply'] * 1e9:,.0f} ns")
