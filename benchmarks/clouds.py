@@ -6,6 +6,7 @@
     python benchmarks/clouds.py --light-only    # lighting vs fill, and lit vs unlit whole runs
     python benchmarks/clouds.py --cost          # issue 32: the whole command's marginal cost per
                                                 # particle, lit and --no-light, against plain loops
+    python benchmarks/clouds.py --cost --baseline /work/main   # the same, beside another checkout's
     chrt -f 10 python benchmarks/clouds.py --light-only   # the same, ahead of everything else
                                                           # running (root; a busy shared machine)
 
@@ -150,26 +151,44 @@ def run(kind: str, awn: str, ply: str) -> None:
     export_cloud(cloud, ply)
 
 
-def whole_command(n: int, workdir: Path, repeats: int, kinds=("fishgen",)) -> dict[str, tuple[float, int]]:
+def whole_command(n: int, workdir: Path, repeats: int, kinds=("fishgen",), baseline: Path | None = None,
+                  cpu: dict[str, float] | None = None) -> dict[str, tuple[float, int]]:
     """Per kind of COMMANDS: median wall time and peak RSS (bytes) of the whole run on a
-    Table 4.4 cloud of n particles to PLY, the kinds interleaved run by run."""
+    Table 4.4 cloud of n particles to PLY, the kinds interleaved run by run. A kind ``base:K`` is
+    K run from ``baseline`` (another checkout: its fishgen, its benchmarks/clouds.py). ``cpu``, if
+    given, gets each kind's median CPU seconds in user mode and in the kernel (all threads), as
+    ``kind`` and ``kind:system``."""
     awn, ply = workdir / f"cloud_{n}.awn", workdir / f"cloud_{n}.ply"
     write_awn(scaled_cubes(n), awn)
     # Each measurement runs in its own wrapper so RUSAGE_CHILDREN sees only that command.
     probe = ("import resource, subprocess, sys, time\n"
              "t = time.perf_counter()\n"
              "subprocess.run(sys.argv[1:], check=True, stdout=subprocess.DEVNULL)\n"
-             "print(time.perf_counter() - t, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)")
+             "u = resource.getrusage(resource.RUSAGE_CHILDREN)\n"
+             "print(time.perf_counter() - t, u.ru_maxrss, u.ru_utime, u.ru_stime)")
     times: dict[str, list[float]] = {k: [] for k in kinds}
+    cpus: dict[str, list[float]] = {k: [] for k in kinds} | {f"{k}:system": [] for k in kinds}
     peaks: dict[str, list[int]] = {k: [] for k in kinds}
     for _ in range(repeats):
         for kind in kinds:
-            out = subprocess.run([sys.executable, "-c", probe, *COMMANDS[kind](awn, ply)],
-                                 cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
+            base = kind.startswith("base:")
+            if base and baseline is None:
+                raise ValueError(f"{kind} needs a baseline checkout")
+            where = baseline if base else ROOT
+            argv = COMMANDS[kind.removeprefix("base:")](awn, ply)
+            if base and argv[1] == __file__:
+                argv[1] = str(where / "benchmarks" / "clouds.py")
+            env = {**os.environ, "PYTHONPATH": str(where)}
+            out = subprocess.run([sys.executable, "-c", probe, *argv], cwd=where, env=env,
+                                 capture_output=True, text=True, check=True).stdout.split()
             times[kind].append(float(out[0]))
             peaks[kind].append(int(out[1]) * 1024)  # ru_maxrss is in KiB on Linux
-            assert ply.stat().st_size > (0 if kind == "plain" else 23 * n)
+            cpus[kind].append(float(out[2]))
+            cpus[f"{kind}:system"].append(float(out[3]))
+            assert ply.stat().st_size > (0 if kind.endswith("plain") else 23 * n)
             ply.unlink()
+    if cpu is not None:
+        cpu.update({k: statistics.median(v) for k, v in cpus.items()})
     return {k: (statistics.median(times[k]), max(peaks[k])) for k in kinds}
 
 
@@ -208,25 +227,37 @@ def light_report(sizes: list[int], command_size: int, repeats: int, workdir: Pat
     print(f"  `fishgen clouds` / `--no-light`: {runs['fishgen'][0] / runs['no-light'][0]:.2f}x")
 
 
-def cost_report(small: int, large: int, plain_size: int, repeats: int, workdir: Path) -> None:
+def cost_report(small: int, large: int, plain_size: int, repeats: int, workdir: Path,
+                baseline: Path | None = None) -> None:
     """Issue 32, item 3: the whole command's marginal cost per particle between ``small`` and
     ``large`` particles, lit (as shipped) and --no-light, against the plain loops' cost per
     particle at ``plain_size`` (each a fresh process, so the loop's heap is its own): the fill
     alone (the issue's baseline) and the fill plus packing and writing the same PLY. Target: the
-    lit command's marginal cost at least 50x below the plain fill's."""
-    kinds = ("fishgen", "no-light")
-    low = whole_command(small, workdir, repeats, kinds)
-    high = whole_command(large, workdir, repeats, kinds)
+    lit command's marginal cost at least 50x below the plain fill's. With ``baseline`` (another
+    checkout, e.g. main's), its two commands run interleaved with these. The CPU time (all
+    threads) is given beside the wall time, in user mode (the steadier figure on a shared machine)
+    and in the kernel (page faults of fresh arrays, the page cache, fsync: it varies 5x there)."""
+    kinds = ("fishgen", "no-light") + (("base:fishgen", "base:no-light") if baseline else ())
+    cpu_low: dict[str, float] = {}
+    cpu_high: dict[str, float] = {}
+    low = whole_command(small, workdir, repeats, kinds, baseline, cpu_low)
+    high = whole_command(large, workdir, repeats, kinds, baseline, cpu_high)
     plain = whole_command(plain_size, workdir, repeats, ("plain", "plain-ply"))
     per = {k: plain[k][0] / plain_size for k in plain}   # start-up (~30 ms) left in: < 2 %
-    print(f"\nwhole command, Table 4.4 cloud to PLY, medians of {repeats}, kinds interleaved run by run:")
+    print(f"\nwhole command, Table 4.4 cloud to PLY, medians of {repeats}, kinds interleaved run by run"
+          f"{f'; base: {baseline}' if baseline else ''}:")
     print("| command | " + f"{small:,} | {large:,} | marginal per particle | plain fill / marginal "
-          "| plain fill+PLY / marginal |")
-    print("|---|---:|---:|---:|---:|---:|")
-    for kind, label in (("fishgen", "`fishgen clouds` (lit)"), ("no-light", "`fishgen clouds --no-light`")):
+          f"| plain fill+PLY / marginal | user CPU marginal | kernel CPU marginal | peak at {large:,} |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    labels = {"fishgen": "`fishgen clouds` (lit)", "no-light": "`fishgen clouds --no-light`"}
+    for kind in kinds:
+        label = labels[kind.removeprefix("base:")] + (" (base)" if kind.startswith("base:") else "")
         marginal = (high[kind][0] - low[kind][0]) / (large - small)
+        user, kernel = ((cpu_high[k] - cpu_low[k]) / (large - small) for k in (kind, f"{kind}:system"))
         print(f"| {label} | {low[kind][0]:.2f} s | {high[kind][0]:.2f} s | {marginal * 1e9:.0f} ns "
-              f"| {per['plain'] / marginal:.1f}x | {per['plain-ply'] / marginal:.1f}x |")
+              f"| {per['plain'] / marginal:.1f}x | {per['plain-ply'] / marginal:.1f}x | {user * 1e9:.0f} ns "
+              f"| {kernel * 1e9:.0f} ns "
+              f"| {high[kind][1] / large:.1f} B/particle |")
     print(f"plain loops at {plain_size:,} particles, whole process: "
           f"fill {per['plain'] * 1e9:,.0f} ns a particle, fill + PLY {per['plain-ply'] * 1e9:,.0f} ns")
     print("target (issue 32): lit marginal cost >= 50x below the plain fill's")
@@ -264,6 +295,9 @@ def main() -> None:
     parser.add_argument("--light-sizes", default="1e5,1e6", help="particle counts to light [default: %(default)s]")
     parser.add_argument("--cost", action="store_true",
                         help="only the whole command's marginal cost per particle against the plain loops")
+    parser.add_argument("--baseline", type=Path, metavar="DIR",
+                        help="with --cost: also run the commands of the checkout in DIR (e.g. main's), "
+                             "interleaved with these [default: none]")
     parser.add_argument("--run", nargs=3, metavar=("KIND", "AWN", "PLY"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.run:
@@ -272,7 +306,7 @@ def main() -> None:
     if args.cost:
         with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:
             cost_report(10**6, int(args.command_size), 10**6, args.repeats if args.repeats != 5 else 3,
-                        Path(tmp))
+                        Path(tmp), args.baseline.resolve() if args.baseline else None)
         return
     if args.light_only:
         with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:

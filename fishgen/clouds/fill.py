@@ -156,32 +156,34 @@ def _fill_chunk(out: Cloud, t: _Tables, start: int, stop: int, seed: int, method
     idx = out.cube_index[start:stop]
     s = _paper_offsets(rng, m) if method == "paper" else _uniform_offsets(rng, m)
 
-    # Particles are sorted by cube, so a chunk is a few runs of equal cube index: expand
-    # each per-cube table by run length (a scalar row when one cube covers the chunk).
+    # Particles are sorted by cube, so a chunk is a few runs of equal cube index: each run is
+    # placed with its cube's numbers as scalars, an axis at a time into the (m, 3) centres (no
+    # per-particle copies of the tables, no transposed copy of the whole chunk).
     first, last = int(idx[0]), int(idx[-1])
-    runs = None if first == last else np.bincount(idx - first, minlength=last - first + 1)
-
-    def per_cube(table: np.ndarray) -> np.ndarray:
-        if runs is None:
-            return table[first][:, None] if table.ndim == 2 else table[first]
-        part = table[first:last + 1]
-        return np.repeat(part.T, runs, axis=1) if table.ndim == 2 else np.repeat(part, runs)
-
-    world = per_cube(t.centre) + s * per_cube(t.half)
-    np.clip(world, per_cube(t.lo), per_cube(t.hi), out=world)
-    out.centers[start:stop] = world.T
-
+    ends = [0, m] if first == last else [0, *np.cumsum(np.bincount(idx - first, minlength=last - first + 1))]
     u = _F32(1) - rng.random(m, dtype=_F32)  # (0, 1]: a radius is never 0
     if method == "paper":
         # eq. 4.9-4.12 in units of the cube's maximum radius, renormalised into (0, 1].
         u = (u + _HALF_PI * np.sin(u)) / _RADIUS_NORM
-    radius = u * per_cube(t.rmax)
-    np.clip(radius, _TINY, per_cube(t.rmax), out=radius)
-    out.radii[start:stop] = radius
+    centers, radii = out.centers[start:stop], out.radii[start:stop]
+    for cube, (a, b) in enumerate(zip(ends[:-1], ends[1:], strict=True), start=first):
+        if a == b:
+            continue
+        for axis in range(3):
+            column = centers[a:b, axis]
+            np.multiply(s[axis, a:b], t.half[cube, axis], out=column)
+            column += t.centre[cube, axis]
+            np.clip(column, t.lo[cube, axis], t.hi[cube, axis], out=column)
+        np.multiply(u[a:b], t.rmax[cube], out=radii[a:b])
+        np.clip(radii[a:b], _TINY, t.rmax[cube], out=radii[a:b])
 
     # Gaussian fall-off from the cube centre: 1 at the core, e^-1 at a face centre.
     np.square(s, out=s)
-    out.density[start:stop] = np.exp(-s.sum(axis=0))
+    density = out.density[start:stop]
+    np.add(s[0], s[1], out=density)
+    density += s[2]
+    np.negative(density, out=density)
+    np.exp(density, out=density)
 
 
 def _uniform_offsets(rng: np.random.Generator, m: int) -> np.ndarray:

@@ -99,11 +99,23 @@ def lit_colors(light: np.ndarray, lighting: Lighting) -> np.ndarray:
 
     level = np.linspace(0.0, 1.0, COLOR_LEVELS + 1)[:, None]
     linear = lighting.albedo * (np.array(lighting.sky_color) + np.array(lighting.sun_color) * level)
-    table = np.round(linear_to_srgb(np.clip(linear, 0, 1)) * 255).astype(np.uint8)
-    index = np.asarray(light, _F32) * _F32(COLOR_LEVELS)
-    index += _F32(0.5)
-    np.clip(index, 0, COLOR_LEVELS, out=index)
-    return table[index.astype(np.intp)]
+    table = np.zeros((COLOR_LEVELS + 1, 4), np.uint8)
+    table[:, :3] = np.round(linear_to_srgb(np.clip(linear, 0, 1)) * 255)
+    words = table.view(np.uint32).ravel()          # a colour a word: one gather a particle, not three
+    light = np.asarray(light, _F32)
+    out = np.empty((len(light), 3), np.uint8)
+    into = out.view(_RGB_BYTES).ravel()
+    for start in range(0, len(light), CHUNK):       # a chunk's temporaries stay in cache
+        index = light[start:start + CHUNK] * _F32(COLOR_LEVELS)
+        index += _F32(0.5)
+        np.clip(index, 0, COLOR_LEVELS, out=index)
+        into[start:start + CHUNK] = np.take(words, index.astype(np.int32)).view(_RGB_WORD)["rgb"]
+    return out
+
+
+_RGB_BYTES = np.dtype("V3")
+_RGB_WORD = np.dtype({"names": ["rgb"], "formats": ["V3"], "offsets": [0], "itemsize": 4})
+"""A packed sRGB colour, and the same three bytes as the first of a 32-bit word's four."""
 
 
 def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
@@ -130,9 +142,8 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
         _pairs(centers, radii, density, frame, middle, lighting.extinction, lighting.forward_fraction, light)
     else:
         count = min(n, SLABS, max(FEW_SLABS, n // 2048)) if slabs is None else max(1, min(n, int(slabs)))
-        _slabs(centers, radii, density, frame, middle, count, lighting.extinction, forward, light,
-               grid_cells)
-    np.clip(light, 0, 1, out=light)
+        light = _slabs(centers, radii, density, frame, middle, count, lighting.extinction, forward, light,
+                       grid_cells)
     return light
 
 
@@ -217,7 +228,7 @@ def _cdf_table() -> np.ndarray:
 
 
 def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forward, light,
-           grid_cells: int | None) -> None:
+           grid_cells: int | None) -> np.ndarray:
     """A big cloud, in ``slabs`` slabs along the sun axis, all read from and splatted into one
     light map.
 
@@ -234,32 +245,33 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     its own thread: one numbers the slabs; one splats every particle into its slab's maps
     (summed in chunk order, so threads do not change a bit); then the maps go down the slabs
     in order, keeping the light each slab received and the depth it holds; and the last
-    pass reads each particle's light from its slab's maps.
+    pass reads each particle's light from its slab's maps, clipped to [0, 1], into ``light``,
+    or, when one group holds every slab, over the across-ray coordinate it has just read (and
+    returns that array): fresh pages cost more than the arithmetic on them.
     """
     n = len(centers)
+    spans = _spans(n, CHUNK)
     with ThreadPoolExecutor(WORKERS) as pool:
-        depth, across = np.empty(n, _F32), np.empty(n, np.complex64)        # across: a + ib
-        _project(centers, frame, middle, out=(depth, across.real, across.imag), pool=pool)
-        slab = _slab_numbers(depth, slabs, pool)
-        del depth
-        grid = _Grid(np.array([across.real.min(), across.imag.min()], np.float64),
-                     np.array([across.real.max(), across.imag.max()], np.float64), radii,
+        depth, a, b = np.empty(n, _F32), np.empty(n, _F32), np.empty(n, _F32)
+        ends = _project(centers, frame, middle, out=(depth, a, b), pool=pool)
+        slab = _slab_numbers(depth, slabs, pool, ends[0])
+        grid = _Grid(ends[1:, 0].astype(np.float64), ends[1:, 1].astype(np.float64), radii,
                      most=grid_cells)
         cells = grid.shape[0] * grid.shape[1]
         table = _peak_table(float(extinction), float(forward))
         # the slabs in groups whose maps fit in MAP_VALUES (one group but for a very fine grid)
         group = max(1, min(slabs, MAP_VALUES // (CLASSES * cells)))
-        own = np.empty(n, _F32)           # each particle's own depth at its centre, once splatted
+        own = depth             # each particle's own depth at its centre, once splatted
+        if group >= slabs:
+            light = a
         for first in range(0, slabs, group):
             last = min(slabs, first + group)
-            place = functools.partial(_place, grid, slab, across, first, last)
+            place = functools.partial(_place, grid, slab, a, b, first, last, slabs)
             size = (last - first) * CLASSES * cells
             # two fixed shares of the chunks, each summed in chunk order, then added: the same
             # sums whatever runs them, and only two maps (and a chunk's) held at once
-            spans = _spans(n, CHUNK)
-            shares = [spans[:(len(spans) + 1) // 2], spans[(len(spans) + 1) // 2:]]
             splat = functools.partial(_splat_share, grid, place, radii, density, table, size, own)
-            layers, other = pool.map(splat, shares)
+            layers, other = pool.map(splat, _halves(spans))
             layers += other
             del other
             maps = layers.reshape(last - first, CLASSES, -1)
@@ -273,30 +285,50 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
                 direct *= np.exp(-depths[k])
             read = functools.partial(_read_chunk, grid, place, own, before, depths, light)
             list(pool.map(read, spans))
+    return light
 
 
 def _spans(n: int, size: int) -> list[tuple[int, int]]:
     return [(start, min(n, start + size)) for start in range(0, n, size)]
 
 
-def _place(grid: _Grid, slab, across, first: int, last: int, span: tuple[int, int]):
+def _halves(spans: list[tuple[int, int]]) -> list[list[tuple[int, int]]]:
+    """The spans in two fixed shares, the first the longer: one a thread, each summed in order."""
+    return [spans[:(len(spans) + 1) // 2], spans[(len(spans) + 1) // 2:]]
+
+
+def _place(grid: _Grid, slab, a, b, first: int, last: int, slabs: int, span: tuple[int, int],
+           bilinear: bool = True):
     """A chunk's particles of slabs first..last-1: which of the chunk (None: all), their slab
-    (counted from ``first``), cell and fractions to read the map at, and the nearest cell."""
+    (counted from ``first``, int32), their nearest cell and, with ``bilinear``, the cell and
+    fractions to read the map at (else None)."""
     start, stop = span
     number = slab[start:stop]
     pick = None
-    if first > 0 or last < int(number.max(initial=0)) + 1:
+    if (first > 0 or last < slabs) and (first > 0 or last < int(number.max(initial=0)) + 1):
         pick = np.flatnonzero((number >= first) & (number < last))
         number = number[pick]
-    ab = across[start:stop] if pick is None else across[start:stop][pick]
-    gx, gy = grid.coordinates(ab.real, ab.imag)
+    gx, gy = grid.coordinates(a[start:stop] if pick is None else a[start:stop][pick],
+                              b[start:stop] if pick is None else b[start:stop][pick])
+    number = number.astype(np.int32)
+    if first:
+        number -= np.int32(first)
+    # Cell centres sit at whole numbers and every particle at least 2.5 cells in from the edge,
+    # so truncating g + 1/2 rounds to the nearest cell exactly as floor(g) + (frac(g) >= 1/2)
+    # did (g + 1/2 rounds in float32 only where it crosses a power of two >= 2, never down).
+    w = np.int32(grid.shape[1])
+    near = np.add(gx, _F32(0.5)).astype(np.int32)
+    near *= w
+    near += np.add(gy, _F32(0.5)).astype(np.int32)
+    if not bilinear:
+        return pick, number, None, near
     ix, iy = np.floor(gx), np.floor(gy)
-    fx, fy = gx - ix, gy - iy
-    flat = ix.astype(np.intp)
-    flat *= grid.shape[1]
-    flat += iy.astype(np.intp)
-    near = flat + grid.shape[1] * (fx >= _F32(0.5)) + (fy >= _F32(0.5))
-    return pick, number.astype(np.intp) - first, (flat, fx, fy), near
+    gx -= ix
+    gy -= iy
+    flat = ix.astype(np.int32)
+    flat *= w
+    flat += iy.astype(np.int32)
+    return pick, number, (flat, gx, gy), near
 
 
 def _splat_share(grid: _Grid, place, radii, density, table, size: int, own: np.ndarray,
@@ -309,28 +341,28 @@ def _splat_share(grid: _Grid, place, radii, density, table, size: int, own: np.n
     ``np.add.at`` rather than ``bincount``: a bincount a chunk allocates the whole maps
     (25 MB for 128 slabs) each time, and was slower."""
     total = np.zeros(size)
-    cells = grid.shape[0] * grid.shape[1]
+    cells = np.int32(grid.shape[0] * grid.shape[1])
     for span in spans:
-        pick, number, _, near = place(span)
+        pick, number, _, near = place(span, bilinear=False)
         start, stop = span
         r = radii[start:stop] if pick is None else radii[start:stop][pick]
         d = density[start:stop] if pick is None else density[start:stop][pick]
         sigma = r * _F32(SIGMA / grid.cell)
-        klass = np.zeros(len(sigma), np.intp)
+        klass = np.zeros(len(sigma), np.int32)
         for bound in grid.bounds:     # 3 compares: 15x faster than searchsorted on 3 values
             klass += sigma < bound
         level = d * _F32(PEAK_LEVELS)
         level += _F32(0.5)
         np.clip(level, 0, PEAK_LEVELS, out=level)
-        mass = table[level.astype(np.intp)]
+        mass = table[level.astype(np.int32)]
         mass *= sigma
         mass *= sigma
-        mine = mass / grid.spread[klass]
+        mine = np.divide(mass, grid.spread[klass], out=sigma)
         if pick is None:
             own[start:stop] = mine
         else:
             own[start:stop][pick] = mine
-        index = number * CLASSES
+        index = number * np.int32(CLASSES)
         index += klass
         index *= cells
         index += near
@@ -342,19 +374,19 @@ def _splat_share(grid: _Grid, place, radii, density, table, size: int, own: np.n
 def _read_chunk(grid: _Grid, place, own: np.ndarray, before: np.ndarray, depths: np.ndarray,
                 light: np.ndarray, span: tuple[int, int]) -> None:
     """Each particle's light: what reached its slab, at its centre, less about half of what the
-    rest of its own slab holds there."""
+    rest of its own slab holds there, clipped to [0, 1]."""
     pick, number, (flat, fx, fy), near = place(span)
     start, stop = span
-    cells = grid.shape[0] * grid.shape[1]
-    base = number * cells
-    flat += base
-    near += base
+    number *= np.int32(grid.shape[0] * grid.shape[1])
+    flat += number
+    near += number
     got = _bilinear(before.ravel(), flat, fx, fy, grid.shape[1])
-    half = depths.ravel()[near]
+    half = np.take(depths.ravel(), near)
     half -= own[start:stop] if pick is None else own[start:stop][pick]          # less its own
     np.maximum(half, 0, out=half)
     half *= _F32(-0.5)
     got *= np.exp(half, out=half)
+    np.clip(got, 0, 1, out=got)
     if pick is None:
         light[start:stop] = got
     else:
@@ -435,65 +467,79 @@ def _middle(centers: np.ndarray) -> np.ndarray:
 
 
 def _project(centers: np.ndarray, rows: np.ndarray, middle: np.ndarray,
-             out: tuple[np.ndarray, ...] | None = None, pool: ThreadPoolExecutor | None = None) -> np.ndarray:
+             out: tuple[np.ndarray, ...] | None = None, pool: ThreadPoolExecutor | None = None):
     """The centres' coordinates along each of ``rows`` (unit vectors), relative to ``middle``,
-    as float32 (len(rows), N), or written into ``out`` (one float32 (N,) view per row); the
-    chunks on ``pool``'s threads if given."""
+    as float32 (len(rows), N); or written into ``out`` (one float32 (N,) array per row), then
+    returning each row's (least, greatest) value, (len(rows), 2) float32. The chunks on
+    ``pool``'s threads if given."""
     n = len(centers)
     store = np.empty((len(rows), n), _F32) if out is None else np.empty((0, n), _F32)
     into = list(store) if out is None else list(out)
     top = float(np.finfo(_F32).max)
 
-    def chunk(span: tuple[int, int]) -> None:
+    def chunk(span: tuple[int, int]) -> np.ndarray:
         start, stop = span
-        x, y, z = (centers[start:stop] - middle).T                  # float64, chunk-sized
+        # one contiguous float64 row per axis: the products below then run on unit strides
+        x, y, z = np.subtract(centers[start:stop].T, middle[:, None], order="C")
+        ends = np.empty((len(rows), 2), _F32)
         for k, row in enumerate(rows):
             # written out: a (65536, 3) x (3, 3) matmul took 40 ms a chunk here (BLAS threads)
             value = x * row[0]
             value += y * row[1]
             value += z * row[2]
             np.clip(value, -top, top, out=value)                      # a cloud spanning all of float32
-            into[k][start:stop] = value
+            part = into[k][start:stop]
+            part[...] = value
+            ends[k] = part.min(), part.max()
+        return ends
 
-    _each(pool, chunk, _spans(n, CHUNK))
-    return store
+    extents = _each(pool, chunk, _spans(n, CHUNK))
+    if out is None:
+        return store
+    return np.stack([np.min(extents, axis=0)[:, 0], np.max(extents, axis=0)[:, 1]], axis=1)
 
 
-def _each(pool: ThreadPoolExecutor | None, work, spans: list[tuple[int, int]]) -> list:
+def _each(pool: ThreadPoolExecutor | None, work, spans: list) -> list:
     """``work`` of each span, in order; on the pool's threads if there is one."""
     return list(pool.map(work, spans)) if pool is not None else [work(span) for span in spans]
 
 
-def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None = None) -> np.ndarray:
+def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None = None,
+                  ends: np.ndarray | None = None) -> np.ndarray:
     """Each particle's slab, 0 nearest the sun (uint8, or uint16 for more than 256 slabs).
 
     The depth is cut into KEY_LEVELS + 1 levels and the levels into ``slabs`` runs of about
-    equal count; a level is never split, so a slab may hold more or fewer, or none.
+    equal count; a level is never split, so a slab may hold more or fewer, or none. ``ends``:
+    the depth's (least, greatest), when known.
     """
     n = len(depth)
     spans = _spans(n, CHUNK)
-    ends = np.array(_each(pool, lambda span: (depth[span[0]:span[1]].min(), depth[span[0]:span[1]].max()),
-                          spans))
-    top, bottom = float(ends[:, 1].max()), float(ends[:, 0].min())
+    if ends is None:
+        ends = np.array(_each(pool, lambda span: (depth[span[0]:span[1]].min(), depth[span[0]:span[1]].max()),
+                              spans)).T
+    top, bottom = float(np.max(ends[1])), float(np.min(ends[0]))
     span = top - bottom
     scale = _F32(KEY_LEVELS / span) if span > 0 else _F32(0)
     key = np.empty(n, np.uint16)
 
-    def level(span: tuple[int, int]) -> np.ndarray:
-        part = (_F32(top) - depth[span[0]:span[1]]) * scale
-        np.clip(part, 0, KEY_LEVELS, out=part)
-        part += _F32(0.5)
-        key[span[0]:span[1]] = part
-        return np.bincount(key[span[0]:span[1]], minlength=KEY_LEVELS + 1)
+    def levels(share: list[tuple[int, int]]) -> np.ndarray:
+        count = np.zeros(KEY_LEVELS + 1, np.int64)
+        for start, stop in share:
+            part = (_F32(top) - depth[start:stop]) * scale
+            np.clip(part, 0, KEY_LEVELS, out=part)
+            part += _F32(0.5)
+            key[start:stop] = part
+            count += np.bincount(key[start:stop], minlength=KEY_LEVELS + 1)
+        return count
 
-    per_level = np.sum(_each(pool, level, spans), axis=0)    # whole numbers: any order is exact
+    per_level = sum(_each(pool, levels, _halves(spans)))   # whole numbers: any order is exact
     before = np.cumsum(per_level) - per_level                # particles on nearer levels
     slab_of_level = (before * slabs) // n                     # the slab each level begins in
     table = slab_of_level.astype(np.uint8 if slabs <= 256 else np.uint16)
     slab = np.empty(n, table.dtype)
 
     def number(span: tuple[int, int]) -> None:
-        slab[span[0]:span[1]] = table[key[span[0]:span[1]]]
+        np.take(table, key[span[0]:span[1]], out=slab[span[0]:span[1]])
 
     _each(pool, number, spans)
     return slab
@@ -603,9 +649,17 @@ def _spectrum(kernel: np.ndarray | None, shape: tuple[int, int]) -> np.ndarray:
 
 
 def _bilinear(values: np.ndarray, flat: np.ndarray, fx: np.ndarray, fy: np.ndarray, w: int) -> np.ndarray:
-    """Interpolate as lerps, so a constant map reads back exactly (full sun is exactly 1)."""
-    a, b = values[flat], values[flat + 1]
-    c, d = values[flat + w], values[flat + w + 1]
-    low = a + (b - a) * fy
-    high = c + (d - c) * fy
-    return low + (high - low) * fx
+    """Interpolate as lerps, so a constant map reads back exactly (full sun is exactly 1). The
+    neighbours are read through shifted views of ``values``: no index arrays to add up."""
+    low, b = np.take(values, flat), np.take(values[1:], flat)
+    high, d = np.take(values[w:], flat), np.take(values[w + 1:], flat)
+    b -= low
+    b *= fy
+    low += b
+    d -= high
+    d *= fy
+    high += d
+    high -= low
+    high *= fx
+    low += high
+    return low
