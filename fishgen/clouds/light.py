@@ -48,6 +48,11 @@ REACH = 8.0
 """In a small cloud a particle shades the others within REACH x its sigma of its centre across the
 sun's rays, and those less than that farther from the sun: beyond, its Gaussian is under e^-32 of
 its peak, below anything float32 light can show (the grid of a big cloud cuts at CUT)."""
+FRONT = 1.0
+"""A small cloud's particle takes its light FRONT x its own sigma nearer the sun than its centre:
+at the face its billboard turns to the sun. At its centre, half shaded by every neighbour at its
+own depth, Table 4.2's dense clouds turned an even grey with no sunlit side; Harris's recurrence,
+which reads the light as it arrives at the particle, left them 20-50x brighter than exp(-tau)."""
 PAIRS = 1 << 19
 """Most pairs of a small cloud weighed at once (a few float64 arrays of this many)."""
 CDF_STEPS = 1 << 14
@@ -152,10 +157,11 @@ def _pairs(centers, radii, density, frame, middle, extinction: float, forward: f
 
     Particle j's optical depth on the ray from particle i's centre towards the sun is its
     Gaussian across the rays, ``peak_j exp(-b^2 / 2 sigma_j^2)`` at i's distance b from j's
-    centre, times the share of it that lies nearer the sun than i's centre, ``Phi(t / sigma_j)``
-    (t how much nearer j's centre is): a neighbour at i's own depth shades it half, one a sigma
-    nearer 84 %. Harris's recurrence, one particle after another, gives a neighbour a hair nearer
-    the sun its whole shadow and one a hair farther none; on clouds of a few hundred particles
+    centre, times the share of it that lies nearer the sun than i's sunward face (FRONT sigma_i
+    nearer the sun than its centre), ``Phi((t - FRONT sigma_i) / sigma_j)``, t how much nearer j's
+    centre is: a neighbour of i's size at i's own depth shades it 16 %, one a sigma nearer half.
+    Harris's recurrence, one particle after another, gives a neighbour a hair nearer the sun its
+    whole shadow and one a hair farther none; on clouds of a few hundred particles
     that ranked the light below 0.8 against the optical depth towards the sun (issue 32), and
     left the sunlit side of a dense cloud far brighter than exp(-tau) (20-50x in the mean on
     Table 4.2, scattering off). With scattering on, j's depth d on the ray passes on ``e^-d + F (1 -
@@ -191,6 +197,7 @@ def _pairs(centers, radii, density, frame, middle, extinction: float, forward: f
             across += np.square(b[None, first:last] - b[start:stop, None])
             across *= np.square(inverse[first:last])
             along = depth[None, first:last] - depth[start:stop, None]
+            along -= FRONT * sigma[start:stop, None]
             along *= inverse[first:last]
             near = (across < REACH * REACH) & (along > -REACH)
         i, j = np.nonzero(near)

@@ -3,7 +3,8 @@
 The particle model the light is computed for: particle j's optical depth across the sun's
 rays is a Gaussian of width sigma_j = 0.4 radius_j with peak Li2(1 - exp(-extinction x
 density_j)) (the shadow of SkyWorks' splat), and it shades particle i as far as it lies nearer
-the sun than i's centre: Phi(t / sigma_j) of it, t how much nearer j's centre is. With
+the sun than i's sunward face, FRONT sigma_i before its centre: Phi((t - FRONT sigma_i) / sigma_j)
+of it, t how much nearer j's centre is. With
 scattering off a particle's light is exp(-tau), tau summed over those shares; with scattering
 on, depth d passes on e^-d + F (1 - e^-d) of the light (Harris's recurrence, report eq. 3.12,
 along the ray), to the same share. A small cloud is lit so pair by pair; a big one through slabs of a grid,
@@ -16,6 +17,7 @@ import warnings
 
 import numpy as np
 import pytest
+from cloud_tables import TABLES
 from scipy import special, stats
 
 import fishgen.clouds.light as light_module
@@ -23,8 +25,6 @@ from fishgen.clouds import Cloud, Lighting, export_cloud, fill_cloud, light_clou
 from fishgen.clouds.light import incident_light, lit_colors, peak_optical_depth
 from fishgen.clouds.lighting import EXTRAS_KEY, from_extras
 from fishgen.errors import FishgenError
-
-from cloud_tables import TABLES
 
 SUNS = {"above": (0.35, 1.0, 0.55), "side": (1.0, 0.2, 0.0), "below": (0.2, -1.0, 0.3)}
 
@@ -38,7 +38,8 @@ def random_cloud(n=300, seed=3, radii=(1.0, 2.0), box=(8.0, 4.0, 6.0)):
 
 def brute_force(centers, radii, density, lighting):
     """(light, tau) per particle over every pair, in float64: each other particle's Gaussian
-    across the sun's rays at this one's centre (uncut), times the share of it nearer the sun."""
+    across the sun's rays at this one's centre (uncut), times the share of it nearer the sun than
+    this one's sunward face."""
     sun = np.array(lighting.sun_unit)
     p = centers.astype(np.float64)
     sigma = 0.4 * radii.astype(np.float64)
@@ -51,7 +52,7 @@ def brute_force(centers, radii, density, lighting):
         t = q @ sun                                                   # > 0: nearer the sun than i
         r2 = np.maximum((q * q).sum(axis=1) - t * t, 0.0)
         depth = peak * np.exp(-r2 / (2 * sigma**2))
-        share = special.ndtr(t / sigma)
+        share = special.ndtr((t - light_module.FRONT * sigma[i]) / sigma)
         share[i] = 0.0
         tau[i] = (share * depth).sum()
         light[i] = np.prod((np.exp(-depth) + f * -np.expm1(-depth)) ** share)
@@ -84,15 +85,16 @@ def test_scattering_off_gives_exp_minus_tau_exactly(sun, extinction):
 
 
 def test_a_neighbour_shades_as_far_as_it_lies_nearer_the_sun():
-    """Two particles on one ray: at the same depth each takes half the other's shadow, a sigma
-    apart the one behind 84 % and the one in front 16 % (Harris's recurrence gave all or none)."""
+    """Two particles on one ray, each lit at its sunward face a sigma before its centre: at the same
+    depth each takes 16 % of the other's shadow, a sigma apart the one behind half and the one in
+    front 2 % (Harris's recurrence gave all or none)."""
     lighting = Lighting(sun=(1.0, 0.0, 0.0), scattering=False)
     peak = peak_optical_depth([1.0], lighting.extinction)[0]
     for ahead in (0.0, 0.4, 1.2):           # how much nearer the sun the second one is, sigma = 0.4
         centers = np.array([[0, 0, 0], [ahead, 0, 0]], np.float32)
         light = incident_light(centers, np.ones(2, np.float32), np.ones(2, np.float32), lighting)
-        behind = special.ndtr(ahead / 0.4)
-        np.testing.assert_allclose(light, np.exp(-peak * np.array([behind, 1 - behind])), rtol=1e-6)
+        behind, front = special.ndtr((ahead - 0.4) / 0.4), special.ndtr((-ahead - 0.4) / 0.4)
+        np.testing.assert_allclose(light, np.exp(-peak * np.array([behind, front])), rtol=1e-6)
 
 
 @pytest.mark.parametrize("sun", sorted(SUNS))
