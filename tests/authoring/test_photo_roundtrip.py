@@ -89,3 +89,32 @@ def test_large_photo_is_measured_on_a_smaller_copy(tmp_path, gl_available):
     assert body.max() <= BODY_TOLERANCE and max(fins.values()) <= FIN_TOLERANCE
     assert Image.open(tmp_path / "new.png").size == (2600, 1300)
     assert Image.open(tmp_path / "new_mask.png").size == (2600, 1300)
+
+
+def test_a_fish_that_matches_only_without_its_faint_edges_is_said_so(tmp_path, gl_available, photos,
+                                                                     monkeypatch):
+    """Where the photo's faint edges (thin fin tips the silhouette left out) would take the rebuilt
+    fish under 0.85, the command says so in one line with both figures; with none, it is silent."""
+    from fishgen.authoring.photo import silhouette as sil
+
+    species, photo = photos["pineapplefish"]
+    path = tmp_path / "photo.png"
+    ph.KINDS["plain"](photo).save(path, "PNG")
+    quiet: list[str] = []
+    make_texture(path, species, tmp_path / "a.txt", on_note=quiet.append)
+    assert not [n for n in quiet if "faint" in n], quiet
+
+    def a_long_faint_tip(photo, fish):
+        """A thread as long as the fish, from its tail on: a tip the silhouette lost."""
+        ys, xs = np.nonzero(fish)
+        tip = np.zeros_like(fish)
+        row = int(np.median(ys[xs == xs.max()]))
+        tip[row, xs.max() + 1:min(fish.shape[1] - 1, 2 * xs.max() - xs.min())] = True
+        return tip
+
+    monkeypatch.setattr(sil, "faint_edges", a_long_faint_tip)
+    notes: list[str] = []
+    result = make_texture(path, species, tmp_path / "b.txt", on_note=notes.append)
+    said = [n for n in notes if "faint" in n]
+    assert len(said) == 1 and "\n" not in said[0], notes
+    assert said[0].startswith(f"silhouette IoU {result.iou:.3f}, but 0.") and "give --mask" in said[0]

@@ -76,3 +76,38 @@ def test_translucent_fins_over_mottled_water_are_fish():
         assert sil.source == "background model"
         iou = (sil.mask & truth).sum() / (sil.mask | truth).sum()
         assert iou >= 0.92, f"{name}: silhouette IoU {iou:.3f} with the true coverage"
+
+
+def test_faint_edges_give_back_the_fin_tips_that_set_the_box():
+    """Over water a translucent fin's last tips are too faint for the silhouette, yet they set the
+    box a cropped IoU is measured in: the silhouette's faint edges (thin runs joined to it that
+    differ from the backdrop around them) bring that box back to the true coverage's."""
+    from fishgen.authoring.photo.compare import silhouette_iou
+    from fishgen.authoring.photo.image import load_photo
+    from fishgen.authoring.photo.silhouette import faint_edges
+    from tests.authoring.blender_photo import fixture_records, read_mask
+
+    for name, rec in fixture_records().items():
+        if rec["shot"]["backdrop"] != "water":
+            continue
+        photo, truth = load_photo(rec["photo"]), read_mask(rec["mask"])
+        fish = silhouette(photo).mask
+        faint = faint_edges(photo, fish)
+        assert not (faint & fish).any()
+        # the rest is mostly the rim: pixels less than half covered, which the truth leaves out
+        assert (faint & truth).sum() >= 2 / 3 * faint.sum(), f"{name}: faint edges off the fish"
+        before, after = silhouette_iou(truth, fish), silhouette_iou(truth, fish | faint)
+        assert after >= before + 0.03, f"{name}: cropped IoU {before:.3f} -> {after:.3f}"
+
+
+def test_faint_edges_of_an_alpha_photo_are_its_faint_alpha():
+    alpha = np.zeros((40, 60), np.uint8)
+    alpha[10:30, 10:40] = 255          # the fish
+    alpha[19:21, 40:50] = 30           # a translucent fin's tip, under the silhouette's cutoff
+    alpha[2:4, 2:6] = 30               # faint, but not joined to the fish
+    photo = Photo(np.zeros((40, 60, 3), np.float32), alpha, Path("p.png"))
+    from fishgen.authoring.photo.silhouette import faint_edges
+
+    fish = silhouette(photo).mask
+    assert not fish[19:21, 40:50].any()
+    assert faint_edges(photo, fish).sum() == 20 and faint_edges(photo, fish)[19:21, 40:50].all()
