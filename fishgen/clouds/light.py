@@ -64,6 +64,8 @@ along one direction, seen from the side): with 96, those cells grew wider than t
 their shadows fell on neighbours they did not cover, and the light's rank correlation with the
 optical depth towards the sun fell to 0.67-0.8 (issue 32)."""
 CELLS_PER_SIGMA = 2.5
+LONGEST = 4
+"""How many times GRID cells a big cloud's light grid may have along its longer side."""
 """Grid cells across the Gaussian width of the median particle, where the grid allows."""
 CLASSES = 4
 """Width classes of a big slab's splat: sigma_max / 2^c, c = 0..3; narrower particles share the last."""
@@ -560,9 +562,13 @@ class _Grid:
         typical = float(np.median(radii[::step])) * SIGMA
         sigma_max = float(radii.max()) * SIGMA
         margin = CUT * sigma_max
-        extent = float(np.max(hi - lo)) + 2 * margin
-        most = max(16, most) if most is not None else GRID
-        cell = max(extent / (most - 6), typical / CELLS_PER_SIGMA)
+        sides = np.asarray(hi - lo, np.float64) + 2 * margin
+        # GRID x GRID cells, shaped as the cloud is: a cloud strung out across the rays gets up to
+        # LONGEST times GRID cells along it for the same number of cells (the same FFTs). A sky
+        # sets its own side (``most``), and keeps it.
+        longest, most = (LONGEST, GRID) if most is None else (1, max(16, most))
+        cell = max(math.sqrt(float(sides[0] * sides[1])) / (most - 6),
+                   float(sides.max()) / (longest * most - 6), typical / CELLS_PER_SIGMA)
         if not (math.isfinite(cell) and cell > 0):
             cell = max(sigma_max, float(np.max(np.abs(hi - lo))), 1.0)
         self.cell = cell
