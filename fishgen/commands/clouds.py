@@ -109,7 +109,10 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     if not options.light and options.lighting != Lighting():
         from dataclasses import fields
 
-        given = [f"--{f.name.replace('_', '-')}" for f in fields(Lighting)
+        def flag(name: str, value: object) -> str:   # a switch given off reads --no-NAME
+            return f"--{'no-' if value is False else ''}{name.replace('_', '-')}"
+
+        given = [flag(f.name, getattr(options.lighting, f.name)) for f in fields(Lighting)
                  if getattr(options.lighting, f.name) != getattr(Lighting(), f.name)]
         raise UsageError(f"expected no lighting options with --no-light, found {', '.join(given)}")
     if options.offset and len(options.offset) != len(inputs):

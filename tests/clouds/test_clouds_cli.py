@@ -272,3 +272,10 @@ def test_a_volume_of_too_many_voxels_is_refused_before_filling(cli, tmp_path, ex
                                   "volume's bounding box, found ")
     assert result.returncode == 2 and "; use --voxel-size 0.246 or more" in result.stderr
     assert list(tmp_path.iterdir()) == [cubes]
+
+
+def test_a_switch_given_off_with_no_light_is_named_as_given(cli, tmp_path):
+    result = cli("clouds", TABLES["4.4"], "-o", tmp_path / "c.ply", "--no-light", "--no-scattering")
+    assert_one_line_error(result,
+                          "fishgen: expected no lighting options with --no-light, found --no-scattering")
+    assert list(tmp_path.iterdir()) == []
