@@ -47,7 +47,10 @@ def _values(path: Path) -> list[tuple]:
 
 
 def _drag_handle(ed: EditorPage, axis: str, dx: float, dy: float) -> None:
-    """Drag the selected cube's handle along ``axis`` by (dx, dy) pixels, as a mouse does."""
+    """Drag the selected cube's handle along ``axis`` by (dx, dy) pixels, as a mouse does, once two
+    frames have been drawn: on a loaded machine the handles of a cube just selected may not be
+    placed yet, and the press then misses them (seen once in CI)."""
+    ed.page.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
     point = ed.page.evaluate(f"fishgenEditor.handlePoint('{axis}')")
     mouse = ed.page.mouse
     mouse.move(point["x"], point["y"])
