@@ -219,6 +219,13 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         from fishgen.authoring.photo.compare import camera_distance
 
         distance = camera_distance(options.focal_length, photo.size[0], sil.mask)
+    # Pixels that may be fish though the silhouette left them out (a mask file is the truth):
+    # found once, for the fit's target and for the second measure of the rebuilt fish.
+    faint = None
+    if options.mask is None:
+        from fishgen.authoring.photo.silhouette import faint_edges
+
+        faint = faint_edges(photo, sil.mask)
     chosen = _candidate(photo, sil.mask, base, out, options, imported, textures)
     shown: tuple[np.ndarray, float] | None = None   # the chosen fish rendered, and its IoU
     fitted, problems, fit = False, [], None
@@ -232,11 +239,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         # Over a backdrop the silhouette loses a translucent fin's last tips, and the fish fitted
         # without them was 0.85 in Blender where the command's own measure said 0.93: the fit
         # takes the faint edges too (an alpha channel keeps the tips; a mask file is the truth).
-        target = sil.mask
-        if sil.source == "background model":
-            from fishgen.authoring.photo.silhouette import faint_edges
-
-            target = sil.mask | faint_edges(photo, sil.mask)
+        target = sil.mask | faint if sil.source == "background model" and faint is not None else sil.mask
         for turn in (0.0, *TURNS):
             if tried is not None and tried[1] >= TURN_GOOD:
                 break
@@ -282,8 +285,10 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
             shown = _rendered(photo, chosen, out, distance)
         except FishgenError:   # no OpenGL here: nothing to measure the rebuilt fish with
             shown = None
-    unsure = None if shown is None or shown[1] < ADVICE_IOU or options.mask is not None else \
-        _with_faint_edges(photo, sil.mask, chosen, shown[0])
+    unsure = None   # the rebuilt fish against the photo's outline with its faint edges
+    if shown is not None and shown[1] >= ADVICE_IOU and faint is not None and faint.any() \
+            and chosen.measured.frame is not None:
+        unsure = _iou_with(chosen, sil.mask | faint, shown[0])
     if shown is not None and unsure is not None and unsure < ADVICE_IOU:
         note(f"silhouette IoU {shown[1]:.3f}, but {unsure:.3f} if the faint pixels round the photo's "
              "outline are fish (thin translucent fin tips over the backdrop): the rebuilt fish may be "
@@ -367,19 +372,14 @@ def _rendered(photo: Photo, candidate: _Candidate, out: Path,
     return render, silhouette_iou(candidate.measured.frame_mask, render[:, :, 3] >= 64)
 
 
-def _with_faint_edges(photo: Photo, fish: np.ndarray, candidate: _Candidate,
-                      render: np.ndarray) -> float | None:
-    """The rendered fish's silhouette IoU with the photo's fish and its faint edges
-    (:func:`.silhouette.faint_edges`), or None when the silhouette left none out. A lost fin tip
-    sets the box the IoU crops to, so a fish fitted without it can match the silhouette well and
-    the photographed fish not (Blender's photos: 0.93 against 0.85)."""
+def _iou_with(candidate: _Candidate, mask: np.ndarray, render: np.ndarray) -> float:
+    """The rendered fish's silhouette IoU with ``mask``, another mask of the photo (its outline with
+    the faint edges, say: a lost fin tip sets the box the IoU crops to, so a fish fitted without it
+    can match the silhouette well and the photographed fish not), levelled as the fish is."""
     from fishgen.authoring.photo.compare import silhouette_iou
-    from fishgen.authoring.photo.silhouette import faint_edges
 
-    faint = faint_edges(photo, fish)
-    if not faint.any() or candidate.measured.frame is None:
-        return None
-    return silhouette_iou(candidate.measured.frame.level(fish | faint), render[:, :, 3] >= 64)
+    assert candidate.measured.frame is not None
+    return silhouette_iou(candidate.measured.frame.level(mask), render[:, :, 3] >= 64)
 
 
 def _render_size(photo: Photo) -> tuple[int, int]:
