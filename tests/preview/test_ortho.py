@@ -26,3 +26,22 @@ def test_ortho_option_renders_a_transparent_side_photo(tmp_path, cli, gl_availab
     assert r.returncode == 0, r.stderr
     alpha = np.asarray(Image.open(out))[:, :, 3]
     assert alpha[0, 0] == 0 and (alpha > 0).mean() > 0.1
+
+
+def test_a_coverage_render_is_the_full_render_s_alpha(gl_available):
+    """The fit scores silhouettes on ``coverage``: the very alpha ``render`` would give, in
+    perspective and orthographic, with translucent fins (partial alpha) included."""
+    from fishgen.authoring.photo.compare import render_side
+    from fishgen.preview.render import Renderer
+    from fishgen.species.parser import load_species
+
+    species = load_species(PARAMS / "threadfingoldie.txt")
+    renderer = Renderer(240, 120)
+    try:
+        for distance in (None, 6.0):
+            full = render_side(species, 240, 120, distance, renderer)
+            alpha = render_side(species, 240, 120, distance, renderer, coverage=True)
+            assert alpha.shape == (120, 240) and np.array_equal(alpha, full[:, :, 3])
+            assert ((alpha > 0) & (alpha < 255)).any() and (alpha == 255).any()
+    finally:
+        renderer.release()

@@ -9,10 +9,10 @@ from fishgen.species.model import Species
 
 
 def render_side(species: Species, width: int, height: int, distance: float | None = None,
-                renderer: Any = None) -> np.ndarray:
+                renderer: Any = None, coverage: bool = False) -> np.ndarray:
     """(H, W, 4) uint8 left-side render on a transparent background, head left: orthographic, or
     in the perspective of a camera ``distance`` fish lengths away. ``renderer``: one to reuse (a
-    new one costs about 0.4 s)."""
+    new one costs about 0.4 s). ``coverage``: only the (H, W) alpha, the silhouette's measure."""
     from fishgen.assembly.fish import build_fish
     from fishgen.preview.camera import frame
     from fishgen.preview.pipeline import subject_points
@@ -26,6 +26,8 @@ def render_side(species: Species, width: int, height: int, distance: float | Non
     own = renderer is None
     renderer = Renderer(width, height) if own else renderer
     try:
+        if coverage:
+            return renderer.coverage(scene, camera)
         return renderer.render(scene, camera, None, (0.0, 0.0, 0.0, 0.0))
     finally:
         if own:

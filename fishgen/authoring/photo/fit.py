@@ -249,7 +249,8 @@ def settled_in_perspective(fit: ShapeFit, distance: float, size: tuple[int, int]
     renderer = Renderer(*size)
     try:
         def score(species: Species) -> float:
-            return silhouette_iou(target, render_side(species, *size, distance, renderer)[:, :, 3] >= 64)
+            drawn = render_side(species, *size, distance, renderer, coverage=True)
+            return silhouette_iou(target, drawn >= 64)
 
         sp = fit.species
         best = score(sp)
