@@ -15,9 +15,9 @@ from tests.conftest import PARAMS
 
 #: The fits CI holds to the target: each committed photo on bases it was not shaped from.
 TARGET = 0.85
-FITS = [("sampled_303", "centroberyx"), ("long", "bonybream"), ("long", "threadfingoldie"),
-        ("deep-tail", "centroberyx")]
-"""sampled_303 on PineappleFish (0.857; 0.849 until the fit took the silhouette's faint edges, the
+FITS = [("sampled_303", "centroberyx"), ("long", "bonybream"), ("deep-tail", "centroberyx")]
+"""long on ThreadfinGoldie is held by the focal-length test, which fits it twice anyway.
+sampled_303 on PineappleFish (0.857; 0.849 until the fit took the silhouette's faint edges, the
 translucent caudal lobes' thin tips) tries every level of the fish and takes a minute: it is left
 to `python benchmarks/texture.py --blender`, and the photo is held here on Centroberyx."""
 
@@ -111,6 +111,8 @@ def test_focal_length_fits_for_the_photo_s_perspective_and_repeats_byte_for_byte
     bp.fit_photos({"long": rec}, _bases(["threadfingoldie"]), tmp_path / "b", blender=False)
     blind = bp.fit_photos({"long": rec}, _bases(["threadfingoldie"]), tmp_path / "c", blender=False,
                           lens=False)[0]
-    assert told.raster >= blind.raster - 0.005 and told.raster >= TARGET, (told, blind)
+    assert told.kept and told.raster >= TARGET, told
+    assert told.own is not None and told.own - told.raster <= 0.06, told
+    assert told.raster >= blind.raster - 0.005, (told, blind)
     for name in ("threadfingoldie.txt", "threadfingoldie.png", "threadfingoldie_mask.png"):
         assert (tmp_path / "a" / "long" / name).read_bytes() == (tmp_path / "b" / "long" / name).read_bytes()
