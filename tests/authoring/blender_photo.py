@@ -130,6 +130,7 @@ class Job:
     mask: Path
     photo: Path | None = None
     seed: int = 0
+    alpha: bool = False   # the mask of what the file shows (materials' alpha kept), not of every triangle
 
 
 def run_blender(jobs: list[Job], timeout: float = 1800.0) -> list[dict]:
@@ -143,7 +144,8 @@ def run_blender(jobs: list[Job], timeout: float = 1800.0) -> list[dict]:
             {"glb": str(j.glb),
              "camera": {k: v for k, v in j.camera.items() if k not in ("backdrop", "floor", "sun")},
              "sun": j.camera["sun"], "backdrop": j.camera.get("backdrop"), "floor": j.camera.get("floor"),
-             "photo": None if j.photo is None else str(j.photo), "mask": str(j.mask), "seed": j.seed}
+             "photo": None if j.photo is None else str(j.photo), "mask": str(j.mask), "seed": j.seed,
+             "alpha": j.alpha}
             for j in jobs]))
         run = subprocess.run([python, str(HERE / "blender_photo_bpy.py"), str(spec)], capture_output=True,
                              text=True, timeout=timeout)
@@ -192,9 +194,10 @@ def photograph(species: dict, shots: dict, folder: Path) -> dict[str, dict]:
     return out
 
 
-def fitted_masks(fits: dict[str, tuple], folder: Path) -> dict[str, np.ndarray]:
+def fitted_masks(fits: dict[str, tuple], folder: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Each fitted species (name -> (species, Shot)) photographed side-on in Blender with its photo's
-    lens and framing: name -> its coverage mask."""
+    lens and framing: name -> its coverage masks, of what the file shows (the materials' alpha kept:
+    a fitted fin's texture mask trims it) and of every triangle."""
     from fishgen.assembly.fish import build_fish
 
     folder.mkdir(parents=True, exist_ok=True)
@@ -202,16 +205,20 @@ def fitted_masks(fits: dict[str, tuple], folder: Path) -> dict[str, np.ndarray]:
     for name, (sp, shot) in fits.items():
         scene = build_fish(sp)
         camera = camera_for(rest_triangles(scene).reshape(-1, 3), shot.side_on())
-        jobs.append(Job(fish_glb(scene, folder / f"{name}.glb"), camera, folder / f"{name}_mask.png"))
+        glb = fish_glb(scene, folder / f"{name}.glb")
+        jobs += [Job(glb, camera, folder / f"{name}_shown.png", alpha=True),
+                 Job(glb, camera, folder / f"{name}_mask.png")]
     run_blender(jobs)
-    return {name: read_mask(folder / f"{name}_mask.png") for name in fits}
+    return {name: (read_mask(folder / f"{name}_shown.png"), read_mask(folder / f"{name}_mask.png"))
+            for name in fits}
 
 
 @dataclass(frozen=True)
 class Fitted:
     """One photo fitted on one base: the command's own figure, and the rebuilt fish's overlap with
-    the photo's true silhouette (levelled by the command's frame) photographed by Blender and, with
-    no renderer, filled by :func:`raster_mask`."""
+    the photo's true silhouette (levelled by the command's frame) photographed by Blender as the
+    file shows it (``blender``) and every triangle of it (``triangles``: the fins' texture masks
+    ignored), and, with no renderer, every triangle filled by :func:`raster_mask`."""
     photo: str
     base: str
     kept: bool
@@ -220,6 +227,7 @@ class Fitted:
     blender: float | None
     notes: tuple[str, ...]
     seconds: float
+    triangles: float | None = None
 
 
 def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: bool = True,
@@ -267,7 +275,8 @@ def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: boo
             rows.append((key, Fitted(name, base_name, result.fitted, result.iou, raster, None, tuple(notes),
                                      seconds), level))
     masks = fitted_masks(fits, folder / "blender") if blender else {}
-    return [replace(row, blender=silhouette_iou(level, masks[key])) if key in masks else row
+    return [replace(row, blender=silhouette_iou(level, masks[key][0]),
+                    triangles=silhouette_iou(level, masks[key][1])) if key in masks else row
             for key, row, level in rows]
 
 

@@ -6,7 +6,8 @@ JOBS.json is a list of jobs made by tests/authoring/blender_photo.py: ``glb`` (t
 (eye, target, up in glTF axes, metres; ``lens`` and ``sensor`` in mm, ``width`` x ``height`` px),
 ``sun`` (towards the sun, glTF axes), ``backdrop`` (none, or a plane's centre, normal and size),
 ``floor`` (none, or its height), ``photo`` (a PNG to write, or none) and ``mask`` (the PNG of the
-fish's exact coverage from the same camera). Prints one JSON line per job when it is written.
+fish's exact coverage from the same camera: of every triangle, or with ``alpha`` of what the file
+shows, its materials' alpha kept). Prints one JSON line per job when it is written.
 """
 from __future__ import annotations
 
@@ -72,6 +73,25 @@ def _plane(name: str, centre, normal, size: float, mat):
     return ob
 
 
+def _flat_keeping_alpha(mat) -> None:
+    """``mat`` made one opaque emission wherever its surface is drawn: the alpha the glTF importer
+    wired into its Principled BSDF (a masked fin's clipped texture alpha, a blended one's) still
+    decides where, so the coverage is what the file shows, not every triangle it holds."""
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    bsdf = next(n for n in nodes if n.type == "BSDF_PRINCIPLED")
+    output = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
+    emit, clear, mix = (nodes.new(kind) for kind in ("ShaderNodeEmission", "ShaderNodeBsdfTransparent",
+                                                      "ShaderNodeMixShader"))
+    alpha = bsdf.inputs["Alpha"]
+    if alpha.links:
+        links.new(alpha.links[0].from_socket, mix.inputs["Fac"])
+    else:
+        mix.inputs["Fac"].default_value = alpha.default_value
+    links.new(clear.outputs["BSDF"], mix.inputs[1])
+    links.new(emit.outputs["Emission"], mix.inputs[2])
+    links.new(mix.outputs["Shader"], output.inputs["Surface"])
+
+
 def shoot(job: dict) -> dict:
     import bpy
     from blender_engine import _rest
@@ -125,11 +145,15 @@ def shoot(job: dict) -> dict:
     # The mask: the fish alone, every surface one opaque emission, coverage as alpha.
     for ob in others:
         ob.hide_render = True
-    flat = bpy.data.materials.new("flat")
-    emit = flat.node_tree.nodes.new("ShaderNodeEmission")
-    output = flat.node_tree.nodes["Material Output"]
-    flat.node_tree.links.new(emit.outputs["Emission"], output.inputs["Surface"])
-    scene.view_layers[0].material_override = flat
+    if job.get("alpha"):
+        for mat in {slot.material for ob in fish for slot in ob.material_slots if slot.material}:
+            _flat_keeping_alpha(mat)
+    else:
+        flat = bpy.data.materials.new("flat")
+        emit = flat.node_tree.nodes.new("ShaderNodeEmission")
+        output = flat.node_tree.nodes["Material Output"]
+        flat.node_tree.links.new(emit.outputs["Emission"], output.inputs["Surface"])
+        scene.view_layers[0].material_override = flat
     scene.cycles.samples = 16
     scene.cycles.use_denoising = False
     scene.cycles.pixel_filter_type, scene.cycles.filter_width = "BOX", 1.0
