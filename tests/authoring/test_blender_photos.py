@@ -68,25 +68,6 @@ def test_fit_of_a_blender_photo_holds_on_another_base(tmp_path, gl_available, ph
     assert row.kept, row.notes
     assert row.raster >= TARGET, f"{photo} on {base}: IoU {row.raster:.3f} (the command says {row.own:.3f})"
     assert row.own is not None and row.own - row.raster <= 0.06
-    if bp.Shot(**bp.fixture_records()[photo]["shot"]).backdrop != "alpha":
-        _mask_keeps_the_faint_edges(photo, tmp_path / photo / f"{base}_mask.png")
-
-
-def _mask_keeps_the_faint_edges(photo: str, written) -> None:
-    """A fit over a backdrop grew its fins to the silhouette's faint edges (translucent tips): the
-    fish's mask texture keeps them too, so a viewer, which cuts the fins by that mask, shows them."""
-    from PIL import Image
-
-    from fishgen.authoring.photo.image import load_photo
-    from fishgen.authoring.photo.silhouette import faint_edges, silhouette
-
-    shot = load_photo(bp.fixture_records()[photo]["photo"])
-    sil = silhouette(shot)
-    faint = faint_edges(shot, sil.mask)
-    mask = np.asarray(Image.open(written).convert("L").resize(shot.size))[::-1] >= 128
-    assert faint.sum() >= 20, "the photo shows no faint edges to keep"
-    assert (mask & faint).sum() >= 0.8 * faint.sum(), f"{(mask & faint).sum()} of {faint.sum()} faint pixels kept"
-    assert (mask & sil.mask).sum() >= 0.98 * sil.mask.sum()
 
 
 @needs_blender
@@ -108,13 +89,10 @@ def test_blender_covers_what_the_rasteriser_fills(tmp_path):
 @needs_blender
 def test_fit_photographed_again_by_blender(tmp_path, gl_available):
     """The whole measure in Blender: a committed photo fitted on another base, the fitted species
-    built as a glb and photographed by Blender with the photo's lens, IoU >= 0.85 as Blender shows
-    the file; Blender's fill of every triangle agrees with Pillow's, and the command's own figure
-    (its render honours the fins' texture masks too) with Blender's."""
+    built as a glb and photographed by Blender with the photo's lens, IoU >= 0.85."""
     (row,) = bp.fit_photos({"long": bp.fixture_records()["long"]}, _bases(["bonybream"]), tmp_path)
     assert row.blender is not None and row.blender >= TARGET, row
-    assert row.triangles is not None and abs(row.triangles - row.raster) <= 0.03, row
-    assert row.own is not None and abs(row.own - row.blender) <= 0.03, row
+    assert abs(row.blender - row.raster) <= 0.03
 
 
 def test_fixtures_folder_is_small():

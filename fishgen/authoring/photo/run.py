@@ -240,9 +240,6 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         # without them was 0.85 in Blender where the command's own measure said 0.93: the fit
         # takes the faint edges too (an alpha channel keeps the tips; a mask file is the truth).
         target = sil.mask | faint if sil.source == "background model" and faint is not None else sil.mask
-        # ...and the fitted fish's mask texture keeps them: cut to the bare silhouette, it trimmed
-        # the very tips the fit grew (seed 303 over water: 0.914 drawn whole, 0.858 as a viewer shows it)
-        fit_textures = textures if target is sil.mask else texture_bytes(original, photo, target)
         for turn in (0.0, *TURNS):
             if tried is not None and tried[1] >= TURN_GOOD:
                 break
@@ -255,7 +252,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
                 fit, problems = attempt, found
             if found:
                 continue
-            candidate = _candidate(photo, sil.mask, attempt.species, out, options, imported, fit_textures,
+            candidate = _candidate(photo, sil.mask, attempt.species, out, options, imported, textures,
                                    attempt)
             rendered = _rendered(photo, candidate, out, distance)
             # another level is kept only for a clear gain: the renders differ by a little anyway
