@@ -128,3 +128,36 @@ def test_a_fish_that_matches_only_without_its_faint_edges_is_said_so(tmp_path, g
     said = [n for n in notes if "faint" in n]
     assert len(said) == 1 and "\n" not in said[0], notes
     assert said[0].startswith(f"silhouette IoU {result.iou:.3f}, but 0.") and "give --mask" in said[0]
+
+
+def test_a_fish_that_matches_only_by_its_faded_pixels_is_said_so(tmp_path, gl_available, photos,
+                                                                  monkeypatch):
+    """Where the rebuilt fish matches the photo at a quarter of a pixel covered but not at a half
+    (its thin or translucent fin parts: another renderer's coverage counts half), the command says
+    so in one line with both figures; a fish drawn solid is silent."""
+    from fishgen.authoring.photo import run as run_module
+
+    species, photo = photos["centroberyx"]
+    path = tmp_path / "photo.png"
+    photo.save(path, "PNG")
+    quiet: list[str] = []
+    make_texture(path, species, tmp_path / "a.txt", on_note=quiet.append)
+    assert not [n for n in quiet if "at least half" in n], quiet
+
+    real = run_module._rendered
+
+    def faded_at_the_back(photo, candidate, out, distance=None):
+        """The rebuilt fish with its back half drawn at 40 % alpha, its figure as the command gives it."""
+        render, iou = real(photo, candidate, out, distance)
+        render = render.copy()
+        cols = np.flatnonzero((render[:, :, 3] > 0).any(axis=0))
+        back = render[:, (cols[0] + cols[-1]) // 2:, 3]
+        back[back > 0] = 100
+        return render, iou
+
+    monkeypatch.setattr(run_module, "_rendered", faded_at_the_back)
+    notes: list[str] = []
+    result = make_texture(path, species, tmp_path / "b.txt", on_note=notes.append)
+    said = [n for n in notes if "at least half" in n]
+    assert len(said) == 1 and "\n" not in said[0], notes
+    assert said[0].startswith(f"silhouette IoU {result.iou:.3f}, but 0.") and "another renderer" in said[0]

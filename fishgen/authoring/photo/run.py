@@ -25,6 +25,11 @@ from fishgen.species.model import Species, TexturePoints
 MAX_TEXTURE_SIDE = 4096
 #: Below this silhouette IoU the rebuilt fish does not look like the photographed one: say so.
 ADVICE_IOU = 0.85
+#: A rendered pixel is the fish's from this alpha (a quarter covered: a thin fin's edge counts).
+DRAWN_ALPHA = 64
+#: ...and surely so from this one (half covered, as Blender's coverage counts a pixel): a fish that
+#: matches only by its quarter-covered pixels, a translucent fin's fading parts, is said to.
+HALF_ALPHA = 128
 #: --fit-shape: a fish photographed turned off side-on has no one true level (its nose-to-tail line
 #: is foreshortened, its far fins show): when the fit at the measured level matches under TURN_GOOD,
 #: it is tried again with the photo turned these degrees further, in order, until one matches that
@@ -289,10 +294,19 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     if shown is not None and shown[1] >= ADVICE_IOU and faint is not None and faint.any() \
             and chosen.measured.frame is not None:
         unsure = _iou_with(chosen, sil.mask | faint, shown[0])
+    faded = None    # the rebuilt fish counting only the pixels it covers at least half
+    if shown is not None and shown[1] >= ADVICE_IOU and (unsure is None or unsure >= ADVICE_IOU):
+        from fishgen.authoring.photo.compare import silhouette_iou
+
+        faded = silhouette_iou(chosen.measured.frame_mask, shown[0][:, :, 3] >= HALF_ALPHA)
     if shown is not None and unsure is not None and unsure < ADVICE_IOU:
         note(f"silhouette IoU {shown[1]:.3f}, but {unsure:.3f} if the faint pixels round the photo's "
              "outline are fish (thin translucent fin tips over the backdrop): the rebuilt fish may be "
              "unlike the photographed one; give --mask to be sure")
+    elif shown is not None and faded is not None and faded < ADVICE_IOU:
+        note(f"silhouette IoU {shown[1]:.3f}, but {faded:.3f} counting only the pixels the rebuilt fish "
+             "covers at least half (thin or translucent fin parts fade out there): it may look unlike "
+             "the photographed fish in another renderer; see --compare")
     elif shown is not None and shown[1] < ADVICE_IOU:
         if options.fit_shape:
             note(f"silhouette IoU {shown[1]:.3f}: the rebuilt fish is still unlike the photo's; if the "
@@ -369,7 +383,7 @@ def _rendered(photo: Photo, candidate: _Candidate, out: Path,
                 raise cannot(f"check {path} in the scratch folder", tmp, err) from None
         rebuilt = load_species(Path(tmp) / out.name)
         render = render_side(rebuilt, *_render_size(photo), distance)
-    return render, silhouette_iou(candidate.measured.frame_mask, render[:, :, 3] >= 64)
+    return render, silhouette_iou(candidate.measured.frame_mask, render[:, :, 3] >= DRAWN_ALPHA)
 
 
 def _iou_with(candidate: _Candidate, mask: np.ndarray, render: np.ndarray) -> float:
@@ -379,7 +393,7 @@ def _iou_with(candidate: _Candidate, mask: np.ndarray, render: np.ndarray) -> fl
     from fishgen.authoring.photo.compare import silhouette_iou
 
     assert candidate.measured.frame is not None
-    return silhouette_iou(candidate.measured.frame.level(mask), render[:, :, 3] >= 64)
+    return silhouette_iou(candidate.measured.frame.level(mask), render[:, :, 3] >= DRAWN_ALPHA)
 
 
 def _render_size(photo: Photo) -> tuple[int, int]:
