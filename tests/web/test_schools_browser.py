@@ -161,7 +161,9 @@ def test_fly_draws_a_school_instanced_unless_told_not_to(schools, instancing):
     from fishgen.fly.assets import Asset
     from fishgen.fly.session import FlyConfig, FlySession
 
-    asset = Asset("school", schools["thousand"].read_bytes(), "glb")
+    # the thousand fish instanced; node by node, a small school shows the same path (a thousand fish
+    # drawn part by part took 9-12 s of a software renderer)
+    asset = Asset("school", schools["thousand" if instancing else "small"].read_bytes(), "glb")
     session = FlySession([asset], FlyConfig(size=(640, 480), path="still", instancing=instancing))
     session.serve_in_background()
     tab = shared_browser().new_page(viewport={"width": 640, "height": 480})
@@ -172,11 +174,11 @@ def test_fly_draws_a_school_instanced_unless_told_not_to(schools, instancing):
         state = tab.evaluate("({error: window.fishgenFly.error, instanced: window.fishgenFly.instanced, "
                              "meshes: window.fishgenFly.counts.meshes, "
                              "calls: window.fishgenFly.meshCalls()})")
-        assert state["error"] is None and state["meshes"] == 9000
+        assert state["error"] is None and state["meshes"] == (9000 if instancing else 12 * 9)
         if instancing:
             assert state["instanced"] == {"species": 1, "fish": 1000, "meshes": 2} and 0 < state["calls"] <= 2
         else:
-            assert state["instanced"]["species"] == 0 and state["calls"] > 100   # the fish in view, each part
+            assert state["instanced"]["species"] == 0 and state["calls"] > 12   # the fish in view, each part
     finally:
         tab.close()
         session.close()
