@@ -7,6 +7,12 @@ import numpy as np
 
 from fishgen.species.model import Species
 
+DRAWN_ALPHA = 64
+"""A rendered pixel is the fish's from this alpha: a quarter covered, so a thin fin's edge counts."""
+HALF_ALPHA = 128
+"""...and surely so from this one: half covered, as Blender's coverage counts a pixel. A fish that
+matches the photo only by its quarter-covered pixels (a translucent fin's fading parts) is said to."""
+
 
 def render_side(species: Species, width: int, height: int, distance: float | None = None,
                 renderer: Any = None, coverage: bool = False) -> np.ndarray:

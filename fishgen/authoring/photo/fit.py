@@ -240,7 +240,7 @@ def settled_in_perspective(fit: ShapeFit, distance: float, size: tuple[int, int]
     stands out towards the camera looks longer and lower than side-on: a fit drawn side-on takes
     that into the fin, and the fish then looks wrong from the photo's own camera (a 50 mm photo:
     0.84 against 0.94 side-on, in Blender)."""
-    from fishgen.authoring.photo.compare import render_side, silhouette_iou
+    from fishgen.authoring.photo.compare import DRAWN_ALPHA, render_side, silhouette_iou
     from fishgen.preview.render import Renderer
 
     if fit.frame is None or fit.frame_map is None:
@@ -250,7 +250,7 @@ def settled_in_perspective(fit: ShapeFit, distance: float, size: tuple[int, int]
     try:
         def score(species: Species) -> float:
             drawn = render_side(species, *size, distance, renderer, coverage=True)
-            return silhouette_iou(target, drawn >= 64)
+            return silhouette_iou(target, drawn >= DRAWN_ALPHA)
 
         sp = fit.species
         best = score(sp)

@@ -25,11 +25,6 @@ from fishgen.species.model import Species, TexturePoints
 MAX_TEXTURE_SIDE = 4096
 #: Below this silhouette IoU the rebuilt fish does not look like the photographed one: say so.
 ADVICE_IOU = 0.85
-#: A rendered pixel is the fish's from this alpha (a quarter covered: a thin fin's edge counts).
-DRAWN_ALPHA = 64
-#: ...and surely so from this one (half covered, as Blender's coverage counts a pixel): a fish that
-#: matches only by its quarter-covered pixels, a translucent fin's fading parts, is said to.
-HALF_ALPHA = 128
 #: --fit-shape: a fish photographed turned off side-on has no one true level (its nose-to-tail line
 #: is foreshortened, its far fins show): when the fit at the measured level matches under TURN_GOOD,
 #: it is tried again with the photo turned these degrees further, in order, until one matches that
@@ -296,7 +291,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         unsure = _iou_with(chosen, sil.mask | faint, shown[0])
     faded = None    # the rebuilt fish counting only the pixels it covers at least half
     if shown is not None and shown[1] >= ADVICE_IOU and (unsure is None or unsure >= ADVICE_IOU):
-        from fishgen.authoring.photo.compare import silhouette_iou
+        from fishgen.authoring.photo.compare import HALF_ALPHA, silhouette_iou
 
         faded = silhouette_iou(chosen.measured.frame_mask, shown[0][:, :, 3] >= HALF_ALPHA)
     if shown is not None and unsure is not None and unsure < ADVICE_IOU:
@@ -372,7 +367,7 @@ def _rendered(photo: Photo, candidate: _Candidate, out: Path,
     """The candidate rebuilt from its files and rendered side-on at about the photo's size (from
     ``distance`` fish lengths, in perspective, when the lens is known), and its silhouette IoU with
     the photo's fish (head left, level)."""
-    from fishgen.authoring.photo.compare import render_side, silhouette_iou
+    from fishgen.authoring.photo.compare import DRAWN_ALPHA, render_side, silhouette_iou
     from fishgen.species.parser import load_species
 
     with tempfile.TemporaryDirectory(prefix="fishgen-texture-") as tmp:
@@ -390,7 +385,7 @@ def _iou_with(candidate: _Candidate, mask: np.ndarray, render: np.ndarray) -> fl
     """The rendered fish's silhouette IoU with ``mask``, another mask of the photo (its outline with
     the faint edges, say: a lost fin tip sets the box the IoU crops to, so a fish fitted without it
     can match the silhouette well and the photographed fish not), levelled as the fish is."""
-    from fishgen.authoring.photo.compare import silhouette_iou
+    from fishgen.authoring.photo.compare import DRAWN_ALPHA, silhouette_iou
 
     assert candidate.measured.frame is not None
     return silhouette_iou(candidate.measured.frame.level(mask), render[:, :, 3] >= DRAWN_ALPHA)
