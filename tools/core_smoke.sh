@@ -6,8 +6,9 @@ cd "$(dirname "$0")/.."
 root=$(pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-python -m venv "$work/venv"
-"$work/venv/bin/python" -m pip install -q --disable-pip-version-check "$root"
+# no pip of its own (ensurepip took 5 s of the suite's time): this pip installs into it
+python -m venv --without-pip "$work/venv"
+python -m pip --python "$work/venv/bin/python" install -q --disable-pip-version-check "$root"
 fishgen="$work/venv/bin/fishgen"
 cd "$work"
 run() {  # run a command; fail on a non-zero exit or any traceback on stderr
