@@ -303,11 +303,11 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
              "outline are fish (thin translucent fin tips over the backdrop): the rebuilt fish may be "
              "unlike the photographed one; give --mask to be sure")
     elif shown is not None and faded is not None and faded < ADVICE_IOU + RENDERERS_DIFFER:
-        near = (f", within {RENDERERS_DIFFER} of {ADVICE_IOU} (renderers differ by as much)"
-                if faded >= ADVICE_IOU else "")
-        note(f"silhouette IoU {shown[1]:.3f}, but {faded:.3f} counting only the pixels the rebuilt fish "
-             f"covers at least half (thin or translucent fin parts fade out there){near}: it may look "
-             "unlike the photographed fish in another renderer; see --compare")
+        near = faded >= ADVICE_IOU   # then four places: 0.8557 is near the line and reads so
+        margin = f", within {RENDERERS_DIFFER} of {ADVICE_IOU} (renderers differ by as much)" if near else ""
+        note(f"silhouette IoU {shown[1]:.3f}, but {faded:.{4 if near else 3}f} counting only the pixels the "
+             f"rebuilt fish covers at least half (thin or translucent fin parts fade out there){margin}: it "
+             "may look unlike the photographed fish in another renderer; see --compare")
     elif shown is not None and shown[1] < ADVICE_IOU:
         if options.fit_shape:
             note(f"silhouette IoU {shown[1]:.3f}: the rebuilt fish is still unlike the photo's; if the "
