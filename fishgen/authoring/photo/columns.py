@@ -17,11 +17,13 @@ def extent(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def run_through(mask: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(top row, bottom edge) of each column's run of fish pixels containing row ``rows[c]``.
 
-    NaN where that pixel is background. A run is found with one running max and one
-    running min over the whole mask rather than by walking columns.
+    NaN where that pixel is background or ``rows[c]`` is NaN. A run is found with one running
+    max and one running min over the whole mask rather than by walking columns.
     """
     h, w = mask.shape
-    r = np.clip(np.round(rows - 0.5).astype(int), 0, h - 1)
+    known = np.isfinite(rows)
+    # a NaN row (a place no fin could be put) has no run; casting it to int is undefined
+    r = np.clip(np.round(np.where(known, rows, 0.5) - 0.5).astype(int), 0, h - 1)
     k = np.arange(h)[:, None]
     above = np.zeros_like(mask)
     above[1:] = mask[:-1]
@@ -32,7 +34,7 @@ def run_through(mask: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndar
     last_start = np.maximum.accumulate(starts, axis=0)
     next_end = np.minimum.accumulate(ends[::-1], axis=0)[::-1]
     cols = np.arange(w)
-    inside = mask[r, cols]
+    inside = mask[r, cols] & known
     top = np.where(inside, last_start[r, cols], np.nan).astype(float)
     bottom = np.where(inside, next_end[r, cols] + 1, np.nan).astype(float)
     return top, bottom
