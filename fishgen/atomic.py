@@ -8,13 +8,16 @@ fails part-way, the targets already replaced get their old contents back.
 A command with several outputs (a school's glb, tracks, metrics and plot) writes them inside
 :func:`together`: every writer then stages, and the whole set is renamed at the end, or none of it.
 Inside :func:`protecting`, no file may be written over one of the command's inputs.
+
+A signal's exception (SIGTERM in a batch worker, Ctrl-C) may come between any two instructions.
+So a temporary file's name is noted before the file is created, and every cleanup knows it; and
+the renames that land a set of files run to their end first (:mod:`fishgen.interrupts`).
 """
 from __future__ import annotations
 
 import logging
 import os
 import stat
-import tempfile
 import time
 from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager
@@ -23,6 +26,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import BinaryIO, Literal, TypeVar
 
+from fishgen import interrupts
 from fishgen.errors import FishgenError, SystemFailure, UsageError, cannot
 
 #: A path type: any one of them per call (a Mapping's key type cannot widen).
@@ -39,16 +43,20 @@ def together() -> Iterator[list[tuple[str, Path]]]:
     (the CLI prints a school's summary before anything lands, so a failed print leaves no file).
     Yields the (temporary file, target) pairs staged so far, to be read inside the block."""
     staged: list[tuple[str, Path]] = []
-    token = _staging.set(staged)
-    try:
-        yield staged
+    outer = _staging.get()
+    try:  # set inside, and reset in both clauses: an interrupt just before one of them would
+        # leave every later write staged here
+        _staging.set(staged)
+        try:
+            yield staged
+        finally:
+            _staging.set(outer)
+        _land(staged)
     except BaseException:
+        _staging.set(outer)
         for tmp, _ in reversed(staged):  # the last first: a folder made for the first is then empty
             _discard(tmp)
         raise
-    finally:
-        _staging.reset(token)
-    _land(staged)
 
 
 @contextmanager
@@ -61,11 +69,12 @@ def protecting(paths: Iterable[str | os.PathLike]) -> Iterator[None]:
         except OSError:
             continue
         ids[(info.st_dev, info.st_ino)] = os.fspath(path)
-    token = _inputs.set(ids)
+    outer = _inputs.get()
     try:
+        _inputs.set(ids)
         yield
     finally:
-        _inputs.reset(token)
+        _inputs.set(outer)
 
 
 def _land(staged: list[tuple[str, Path]]) -> None:
@@ -118,26 +127,41 @@ _held: dict[str, int] = {}  # temporary file -> the descriptor holding its lock 
 _folders: dict[str, list[Path]] = {}  # temporary file -> the folders made for it, deepest first
 
 
-def _temporary(path: Path) -> tuple[int, str]:
+_CREATE = (os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+           | getattr(os, "O_BINARY", 0))
+
+
+def _beside(path: Path, suffix: str) -> str:
+    """A fresh name for a temporary file beside ``path``: ``.NAME.XXXXXXXXXXXX.tmp``."""
+    return os.path.join(path.parent, f".{path.name}.{os.urandom(6).hex()}{suffix}")
+
+
+def _temporary(path: Path, into: list[tuple[str, Path]]) -> tuple[int, str]:
     """A new temporary file beside ``path``, locked for as long as this run may rename it; stale
-    ones of the same target are swept first."""
+    ones of the same target are swept first. Its name goes on ``into`` before the file (or a
+    folder made for it) exists, so that whoever cleans up after an interrupt knows it."""
     made: list[Path] = []
     folder = path.parent
     while not folder.exists() and folder != folder.parent:
         made.append(folder)
         folder = folder.parent
-    try:
+    for _ in range(100):
+        tmp = _beside(path, ".tmp")
+        if made:  # a run that fails leaves no folder it made either
+            _folders[tmp] = made
+        into.append((tmp, path))
         path.parent.mkdir(parents=True, exist_ok=True)
         sweep(path)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    except BaseException:
-        _remove_empty(made)
-        raise
-    _lock(fd)
-    _held[tmp] = fd
-    if made:  # a run that fails leaves no folder it made either
-        _folders[tmp] = made
-    return fd, tmp
+        try:
+            fd = os.open(tmp, _CREATE, 0o600)
+        except FileExistsError:  # 48 random bits: another writer's name, once in a lifetime
+            into.pop()
+            _folders.pop(tmp, None)
+            continue
+        _held[tmp] = fd
+        _lock(fd)
+        return fd, tmp
+    raise FileExistsError(f"no free temporary name beside {path}")
 
 
 def _remove_empty(folders: list[Path]) -> None:
@@ -198,10 +222,12 @@ def _release(tmp: str) -> None:
         os.close(fd)
 
 
-def _stage(path: Path, data: bytes) -> str:
+def _stage(path: Path, data: bytes, into: list[tuple[str, Path]]) -> None:
+    """Write ``data`` to a new temporary file for ``path``, named on ``into`` (the caller discards
+    what is there if this raises)."""
     check_target(path)
     try:
-        fd, tmp = _temporary(path)
+        fd, tmp = _temporary(path, into)
     except OSError as err:
         raise _fail(path, err) from None
     try:
@@ -215,13 +241,12 @@ def _stage(path: Path, data: bytes) -> str:
         if isinstance(err, OSError):
             raise _fail(path, err) from None
         raise
-    return tmp
 
 
 def _discard(tmp: str) -> None:
     try:
         os.unlink(tmp)
-    except FileNotFoundError:
+    except OSError:  # never made (its folder could not be), or already renamed into place
         pass
     made = _folders.get(tmp, [])
     _release(tmp)
@@ -236,42 +261,43 @@ def write_files(files: Mapping[_PathT, bytes]) -> None:
     staged: list[tuple[str, Path]] = []
     try:
         for target, data in zip(targets, files.values(), strict=True):
-            staged.append((_stage(target, data), target))
-    except BaseException:
+            _stage(target, data, staged)
+        _land(staged)
+    except BaseException:  # files already renamed into place have no temporary file left to remove
         for tmp, _ in reversed(staged):
             _discard(tmp)
         raise
-    _land(staged)
 
 
 def _commit(staged: list[tuple[str, Path]]) -> None:
-    """Rename every staged file over its target, undoing earlier renames if one fails."""
-    backups: list[tuple[str | None, Path]] = []
-    try:
-        for tmp, target in staged:
-            backup = None
-            if len(staged) > 1 and target.is_file():
-                fd, backup = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent)
-                os.close(fd)
-                os.replace(target, backup)
-            backups.append((backup, target))
-            try:
-                os.replace(tmp, target)
-            except OSError as err:
-                raise _fail(target, err) from None
-            _release(tmp)
-    except BaseException:
-        for backup, target in reversed(backups):
+    """Rename every staged file over its target, undoing earlier renames if one fails. An interrupt
+    waits for the end, so that a set of outputs is never left half old and half new."""
+    with interrupts.held():
+        undo: list[tuple[str, str | None, Path]] = []  # (temporary file, old target's backup, target)
+        try:
+            for tmp, target in staged:
+                backup = _beside(target, ".old") if len(staged) > 1 and target.is_file() else None
+                undo.append((tmp, backup, target))
+                if backup is not None:
+                    os.replace(target, backup)
+                try:
+                    os.replace(tmp, target)
+                except OSError as err:
+                    raise _fail(target, err) from None
+                _release(tmp)
+        except BaseException:
+            for tmp, backup, target in reversed(undo):
+                if backup is not None:
+                    if os.path.lexists(backup):
+                        os.replace(backup, target)
+                elif len(staged) > 1 and not os.path.lexists(tmp) and target.is_file():
+                    os.unlink(target)  # new in this set, and the set does not land
+            for tmp, _ in reversed(staged):
+                _discard(tmp)
+            raise
+        for _, backup, _ in undo:
             if backup is not None:
-                os.replace(backup, target)
-            elif target.is_file():
-                os.unlink(target)
-        for tmp, _ in reversed(staged):
-            _discard(tmp)
-        raise
-    for backup, _ in backups:
-        if backup is not None:
-            _discard(backup)
+                _discard(backup)
     for _, target in staged:
         _log.info("wrote %s", target)
 
@@ -295,13 +321,13 @@ class atomic_open:
 
     def __enter__(self) -> BinaryIO:
         check_target(self.path)
-        self._tmp = None
+        named: list[tuple[str, Path]] = []
         try:
-            fd, self._tmp = _temporary(self.path)
+            fd, self._tmp = _temporary(self.path, named)
             self._handle = os.fdopen(os.dup(fd), "wb")  # the lock stays with fd until the rename
         except BaseException as err:  # also SIGTERM or Ctrl-C before the `with` body: no temp file left
-            if self._tmp is not None:
-                _discard(self._tmp)
+            for tmp, _ in named:
+                _discard(tmp)
             if isinstance(err, OSError):
                 raise _fail(self.path, err) from None
             raise
@@ -324,13 +350,13 @@ class atomic_open:
                 else:
                     _land([(self._tmp, self.path)])
                 return False
+            _discard(self._tmp)
         except OSError as err:
             _discard(self._tmp)
             raise _fail(self.path, err) from None
         except BaseException:
             _discard(self._tmp)
             raise
-        _discard(self._tmp)
         if isinstance(exc, OSError) and exc.filename is None:
             # A write to the handle failed (a full disk, a file size limit): its error names no
             # file, so say which output it was.

@@ -5,6 +5,7 @@ import os
 
 import pytest
 
+from fishgen import interrupts
 from fishgen.atomic import atomic_open, together, write_bytes, write_files
 from fishgen.errors import FishgenError
 
@@ -125,3 +126,82 @@ def test_a_failed_set_of_outputs_leaves_no_folder_it_made(tmp_path):
         write_bytes(tmp_path / "kept" / "new" / "x.glb", b"glb")
         raise RuntimeError("a later output failed")
     assert list(tmp_path.iterdir()) == [tmp_path / "kept"] and list((tmp_path / "kept").iterdir()) == []
+
+
+class Interrupt(BaseException):
+    """What a signal handler raises (SIGTERM in a batch worker, Ctrl-C in the CLI)."""
+
+
+def interrupted_at(step: int, write) -> bool:
+    """Run ``write()`` with an interrupt raised at its ``step``-th chance, as a signal handler's
+    exception would be: CPython runs handlers when a call returns, on entering a function or a
+    generator, and on a backward jump, so those are the chances. Counted in the atomic writer's own
+    frames (every frame would be thousands of steps of pathlib, and an exception inside the
+    standard library's own locks would hang it). False: it ended first."""
+    import dis
+    import sys
+
+    import fishgen.atomic
+
+    count = 0
+    after: dict = {}  # frame -> the instruction it ran last
+    watched = fishgen.atomic.__file__
+
+    def trace(frame, event, arg):
+        nonlocal count
+        if frame.f_code.co_filename != watched:
+            return None
+        frame.f_trace_opcodes = True
+        if event == "opcode":
+            name = dis.opname[frame.f_code.co_code[frame.f_lasti]]
+            if name in ("RESUME", "JUMP_BACKWARD") or after.get(frame, "").startswith("CALL"):
+                count += 1
+                if count == step:
+                    interrupts.deliver(Interrupt())  # as fishgen's signal handlers raise
+            after[frame] = name
+        return trace
+
+    sys.settrace(trace)
+    try:
+        write()
+    except Interrupt:
+        return True
+    finally:
+        sys.settrace(None)
+    return False
+
+
+@pytest.mark.parametrize("how", ["write_files", "write_files over older files", "together", "atomic_open"])
+def test_an_interrupt_at_any_step_leaves_no_temporary_file_and_no_half_set(tmp_path, how):
+    """A signal's exception may come at any of the writer's steps, also between creating a
+    temporary file and noting its name, or between two renames: every step is tried, and none may
+    leave a file behind or a set of outputs half old and half new."""
+    target, other = tmp_path / "out" / "a.glb", tmp_path / "out" / "a.png"
+    old = how.endswith("older files")
+    if old:
+        target.parent.mkdir()
+        target.write_bytes(b"old glb")
+        other.write_bytes(b"old png")
+
+    def write():
+        if how.startswith("write_files"):
+            write_files({target: b"new", other: b"png"})
+        elif how == "together":
+            with together():
+                write_bytes(target, b"new")
+                write_bytes(other, b"png")
+        else:
+            with atomic_open(target) as handle:
+                handle.write(b"new")
+
+    step = 1
+    while interrupted_at(step, write):
+        names = sorted(p.name for p in tmp_path.rglob("*"))
+        assert [n for n in names if n.endswith((".tmp", ".old"))] == [], f"interrupted at step {step}"
+        if old:  # all old or all new
+            pair = (target.read_bytes(), other.read_bytes())
+            assert pair in {(b"old glb", b"old png"), (b"new", b"png")}, f"interrupted at step {step}"
+        elif target.exists():  # the rename came first: the output is whole
+            assert target.read_bytes() == b"new"
+        step += 1
+    assert step > 10 and target.read_bytes() == b"new"

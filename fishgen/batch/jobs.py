@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fishgen import interrupts
 from fishgen.batch.manifest import Job
 from fishgen.batch.record import file_sha256
 from fishgen.errors import FishgenError, SystemFailure, cannot
@@ -96,7 +97,8 @@ class Stopped(BaseException):
 
 def _stop(signum: int, _frame: object) -> None:
     if _busy:
-        raise Stopped(128 + signum)
+        interrupts.deliver(Stopped(128 + signum))  # after the renames under way, if any
+        return
     os._exit(128 + signum)  # idle: nothing to clean up, and no traceback from the pool's loop
 
 

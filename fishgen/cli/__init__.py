@@ -14,6 +14,7 @@ import threading
 
 import click
 
+from fishgen import interrupts
 from fishgen.cli.common import add_common_options, error_line, json_errors, reset
 from fishgen.commands import MODULES, command
 
@@ -58,7 +59,7 @@ class Interrupted(BaseException):
 
 
 def _interrupt(signum: int, _frame: object) -> None:
-    raise Interrupted(128 + signum)
+    interrupts.deliver(Interrupted(128 + signum))  # after the renames under way, if any
 
 
 def main(argv: list[str] | None = None) -> None:
