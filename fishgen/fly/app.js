@@ -2,6 +2,8 @@
 // Keys as Pakawan's: W/S forward/back, A/D left/right, arrows look up/down and turn, 1/2/3 speed;
 // the mouse (drag) looks around. The upper left shows the window size, the time and the FPS.
 // State for tests and the headless driver: window.fishgenFly = {loaded, error, camera, frames, done, report}.
+// `loaded` turns true once the assets are in and the first frame is drawn: from then on modes(),
+// inspect(), drawn and camera describe a frame (before it no cloud has a place, a level or a mode).
 const { THREE, GLTFLoader, cloudlight, drawing, schools } = window.fishgenKit;   // fishgen/web/kit.js
 import { Impostors } from './impostors.js';
 const { PREMULTIPLIED, billboardMaterial: cloudBillboardMaterial, cloudUniforms, particleMaterial: cloudParticleMaterial, readCloudLight } = cloudlight;
@@ -191,7 +193,7 @@ function addUnit( levels, coverage ) {
 	const level0 = levels[ 0 ];
 	level0.object.geometry.computeBoundingSphere();
 	const sphere = level0.object.geometry.boundingSphere.clone();
-	units.push( { levels, coverage, sphere, world: new THREE.Sphere(), level: 0, distance: 0, visible: true,
+	units.push( { levels, coverage, sphere, world: new THREE.Sphere(), level: 0, distance: 0, visible: false,
 		mode: null, holds: false, renderOrder: 0, impostor: null } );
 	counts.clouds ++;
 }
@@ -700,8 +702,10 @@ async function start() {
 		if ( impostors ) impostors.setDepthTest( true );
 	}
 	state.counts = { ...counts };
+	// The first frame now (it asks for the next), not at the next animation frame: a test or driver that
+	// reads modes() as soon as `loaded` is true would find every cloud unplaced (centre 0, radius -1).
+	frame();
 	state.loaded = true;
-	requestAnimationFrame( frame );
 }
 
 start().catch( fail );

@@ -79,6 +79,44 @@ def test_a_texture_cloud_flies_with_its_billboards_drawn(tmp_path):
     cloud = np.abs(sky - np.median(sky.reshape(-1, 3), axis=0)).max(-1) > 20
     assert 0.005 < cloud.mean() < 0.5, "the billboards should show as clouds on the sky"
 
+
+# Run before the page's own script: keeps what modes() and drawn say at the moment `loaded` turns true.
+AT_LOAD = """(() => {
+    let state;
+    Object.defineProperty(window, 'fishgenFly', { configurable: true, get: () => state, set(s) {
+        state = s;
+        let loaded = s.loaded;
+        Object.defineProperty(s, 'loaded', { enumerable: true, get: () => loaded, set(on) {
+            if (on && ! loaded) window.atLoad = { modes: s.modes(), drawn: s.drawn || null };
+            loaded = on;
+        } });
+    } });
+})()"""
+
+
+def test_once_the_page_says_loaded_a_frame_is_drawn_and_modes_describe_it():
+    # `loaded` once came a frame early: modes() then gave the cloud no place (centre 0, radius -1) and
+    # called it drawn directly, and a test that read it at once built its views (and boxes) from that
+    session = FlySession(prepare_assets([PARAMS / "clouds" / "table_4_4.awn"])[0],
+                         FlyConfig(size=(320, 240), warmup=0.1, path="still"))
+    session.serve_in_background()
+    tab = shared_browser().new_page(viewport={"width": 320, "height": 240})
+    try:
+        tab.add_init_script(AT_LOAD)
+        tab.goto(session.url())
+        tab.wait_for_function("window.fishgenFly.loaded || window.fishgenFly.error", timeout=120_000)
+        assert tab.evaluate("window.fishgenFly.error") is None
+        seen = tab.evaluate("window.atLoad")
+        assert seen["drawn"] is not None and seen["drawn"]["clouds"] == 1
+        [cloud] = seen["modes"]
+        assert cloud["radius"] > 0 and cloud["distance"] > 0 and cloud["mode"] in ("direct", "impostor")
+        later = tab.evaluate("window.fishgenFly.modes()")[0]
+        assert (cloud["centre"], cloud["radius"]) == (later["centre"], later["radius"])
+    finally:
+        tab.close()
+        session.close()
+
+
 @pytest.fixture(scope="module")
 def served_sky(thin_sky):
     """The thin sky served for interactive flights (no path: the keys steer), every cloud drawn
