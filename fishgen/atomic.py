@@ -125,6 +125,15 @@ STALE_SECONDS = 10.0
 left by a killed run (SIGKILL runs no cleanup): the next write beside it removes it."""
 _held: dict[str, int] = {}  # temporary file -> the descriptor holding its lock until renamed or discarded
 _folders: dict[str, list[Path]] = {}  # temporary file -> the folders made for it, deepest first
+_live: dict[str, None] = {}  # every temporary file named and not yet renamed or discarded, in order
+
+
+@interrupts.at_stop
+def discard_all() -> None:
+    """Discard every temporary file not yet renamed into place, the newest first: the process stops
+    on a signal, which may have come as a writer's cleanup began, before it could run."""
+    for tmp in reversed(list(_live)):
+        _discard(tmp)
 
 
 _CREATE = (os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
@@ -147,6 +156,7 @@ def _temporary(path: Path, into: list[tuple[str, Path]]) -> tuple[int, str]:
         folder = folder.parent
     for _ in range(100):
         tmp = _beside(path, ".tmp")
+        _live[tmp] = None
         if made:  # a run that fails leaves no folder it made either
             _folders[tmp] = made
         into.append((tmp, path))
@@ -157,6 +167,7 @@ def _temporary(path: Path, into: list[tuple[str, Path]]) -> tuple[int, str]:
         except FileExistsError:  # 48 random bits: another writer's name, once in a lifetime
             into.pop()
             _folders.pop(tmp, None)
+            _live.pop(tmp, None)
             continue
         _held[tmp] = fd
         _lock(fd)
@@ -168,6 +179,8 @@ def _remove_empty(folders: list[Path]) -> None:
     for folder in folders:
         try:
             folder.rmdir()
+        except FileNotFoundError:  # never made: an interrupt came inside mkdir
+            continue
         except OSError:  # not empty: another output, or a file someone else put there
             return
 
@@ -216,6 +229,7 @@ def sweep(path: Path) -> list[Path]:
 
 
 def _release(tmp: str) -> None:
+    _live.pop(tmp, None)
     _folders.pop(tmp, None)
     fd = _held.pop(tmp, None)
     if fd is not None:

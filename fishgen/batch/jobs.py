@@ -169,6 +169,7 @@ def run_in_worker(jobs: tuple[Job, ...], work: Work, fail_fast: bool = False) ->
                 break
         return results
     except Stopped as stop:
+        interrupts.stopped()  # os._exit runs no other cleanup
         os._exit(stop.args[0])
     finally:
         _busy = False

@@ -84,6 +84,7 @@ def main(argv: list[str] | None = None) -> None:
         plain = err.file is None or isinstance(err, SystemFailure)  # a system's refusal names its path
         _fail(f"fishgen: {err}" if plain else str(err), err.status, err.file, err.line, err.kind)
     except click.exceptions.Abort:
+        interrupts.stopped()
         _fail("fishgen: interrupted", 130, kind="interrupted")  # the shell's ^C ends the line before ours
     except click.UsageError as err:  # one line, like every other error (`--help` shows the usage)
         command = err.ctx.command_path if err.ctx is not None else "fishgen"
@@ -94,6 +95,7 @@ def main(argv: list[str] | None = None) -> None:
             sys.exit(err.exit_code)
         _fail(err.format_message(), err.exit_code, kind="usage")
     except (KeyboardInterrupt, Interrupted) as err:
+        interrupts.stopped()
         _fail("fishgen: interrupted", err.status if isinstance(err, Interrupted) else 130, kind="interrupted")
     except OSError as err:  # one no layer below turned into a SystemFailure with its path
         where = f"{err.filename}: " if err.filename else ""
