@@ -309,7 +309,8 @@ def still_pictures(webgl: str, image: Path | None) -> None:
 
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=find_chromium(), args=[*COMMON, *WEBGL[webgl]])
-            page = browser.new_page(viewport={"width": 800, "height": 600})
+            page = browser.new_page(viewport={"width": 800, "height": 600},
+                                    bypass_csp=True)  # wait_for_function polls with eval
             page.goto(session.url())
             page.wait_for_function("window.fishgenFly.loaded", timeout=300_000)
             if what == "table 4.4":

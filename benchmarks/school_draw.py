@@ -62,7 +62,8 @@ def draw_calls(asset: Asset, instancing: bool, webgl: str, size: tuple[int, int]
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=find_chromium(), args=[*COMMON, *WEBGL[webgl]])
             try:
-                page = browser.new_page(viewport={"width": size[0], "height": size[1]})
+                page = browser.new_page(viewport={"width": size[0], "height": size[1]},
+                                        bypass_csp=True)  # wait_for_function polls with eval
                 page.goto(session.url())
                 page.wait_for_function("window.fishgenFly.loaded || window.fishgenFly.error",
                                        timeout=180_000)

@@ -33,14 +33,33 @@ def unavailable() -> str | None:
     return None
 
 
-def browser():
+class _Browser:
+    """The shared ``Browser``, whose new pages and contexts bypass the pages' Content-Security-Policy
+    unless told ``bypass_csp=False``: Playwright's ``wait_for_function`` polls a string predicate
+    with ``eval``, which the policy forbids. tests/web/test_policy_browser.py runs every page under
+    its policy, and `fishgen fly --headless` flies under it."""
+
+    def __init__(self, real: Any):
+        self._real = real
+
+    def new_page(self, **options: Any) -> Any:
+        return self._real.new_page(**{"bypass_csp": True, **options})
+
+    def new_context(self, **options: Any) -> Any:
+        return self._real.new_context(**{"bypass_csp": True, **options})
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._real, name)
+
+
+def browser() -> Any:
     """The shared Playwright ``Browser`` (started now if it is not running)."""
     if "browser" not in _open:
         from playwright.sync_api import sync_playwright
 
         playwright = sync_playwright().start()
         try:
-            _open["browser"] = playwright.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+            _open["browser"] = _Browser(playwright.chromium.launch(executable_path=CHROMIUM, args=ARGS))
         except Exception:
             playwright.stop()
             raise

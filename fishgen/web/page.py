@@ -9,6 +9,8 @@ checked routes, and `fishgen view --no-serve` writes a page that works opened fr
 """
 from __future__ import annotations
 
+import base64
+import hashlib
 import html
 import json
 import re
@@ -23,7 +25,7 @@ STATIC = HERE / "static"
 KIT = STATIC / "kit.min.js"
 PAGES = {"viewer": "fishgen viewer", "editor": "fishgen edit", "fly": "fishgen fly"}
 """Each page (its folder in fishgen/ and its bundle's name) and the end of its title."""
-_PLACEHOLDER = re.compile(r"\{\{(TITLE|STYLE|BODY|DATA|KIT|APP)\}\}")
+_PLACEHOLDER = re.compile(r"\{\{(POLICY|TITLE|STYLE|BODY|DATA|KIT|APP)\}\}")
 _ENDS_SCRIPT = re.compile(r"</script|<!--|<script", re.I)
 _OWN = re.compile(r"\A\s*(<style>.*?</style>)\s*(<body[^>]*>.*?)</body>\s*\Z", re.S)
 
@@ -41,6 +43,17 @@ def script(path: Path) -> str:
     return text
 
 
+def policy(*scripts: str) -> str:
+    """The page's Content-Security-Policy: only its own inline scripts run (each by its hash, as
+    the template wraps it in newlines), nothing is loaded from another origin, and no form or
+    <base> can send it elsewhere. Pictures and glTF buffers also come as blob: and data: URLs
+    (an embedded viewer's asset, a glb's textures)."""
+    digests = (hashlib.sha256(("\n" + text + "\n").encode("ascii")).digest() for text in scripts)
+    hashes = " ".join(f"'sha256-{base64.b64encode(digest).decode('ascii')}'" for digest in digests)
+    return (f"default-src 'none'; script-src {hashes}; style-src 'unsafe-inline'; "
+            "img-src 'self' data: blob:; connect-src 'self' data: blob:; base-uri 'none'; form-action 'none'")
+
+
 def page_html(page: str, title: str, data: tuple[str, Any] | None = None) -> str:
     """Page ``page`` (a key of PAGES) as HTML text, titled ``title`` (any text: it is escaped), with
     ``data`` = (element id, JSON value) for its app to read, if it takes any."""
@@ -53,8 +66,9 @@ def page_html(page: str, title: str, data: tuple[str, Any] | None = None) -> str
         # "<" escaped so no text in the data (a file name, say) can close the element early.
         value = json.dumps(data[1]).replace("<", "\\u003c")
         element = f'<script type="application/json" id="{data[0]}">{value}</script>\n'
-    fields = {"TITLE": f"{html.escape(title)} · {PAGES[page]}", "STYLE": own[1], "BODY": own[2].rstrip(),
-              "DATA": element, "KIT": script(KIT), "APP": script(bundle(page))}
+    kit, app = script(KIT), script(bundle(page))
+    fields = {"POLICY": policy(kit, app), "TITLE": f"{html.escape(title)} · {PAGES[page]}", "STYLE": own[1],
+              "BODY": own[2].rstrip(), "DATA": element, "KIT": kit, "APP": app}
     template = (HERE / "template.html").read_text(encoding="utf-8")
     # One pass, so text put in for one placeholder (a title, a bundle) is never searched for another.
     return _PLACEHOLDER.sub(lambda m: fields[m[1]], template)

@@ -2,6 +2,8 @@
 assembly of the pages (fishgen/web/page.py)."""
 from __future__ import annotations
 
+import base64
+import hashlib
 import json
 import re
 import shutil
@@ -70,6 +72,12 @@ def test_every_page_is_the_shared_head_with_the_kit_then_its_app(name):
     assert not re.search(r"<script[^>]+src=|importmap|<link[^>]+href=\"(?!data:)", html), \
         "nothing may be loaded from outside the page"
     assert html.count("</script>") == html.count("<script") == 2
+    policy = re.search(r'<meta http-equiv="Content-Security-Policy" content="([^"]*)">', html)[1]
+    hashes = {f"'sha256-{base64.b64encode(hashlib.sha256(m[1].encode()).digest()).decode()}'"
+              for m in re.finditer(r"<script[^>]*>(.*?)</script>", html, re.S)}
+    directives = dict(d.strip().split(" ", 1) for d in policy.split(";"))
+    assert set(directives["script-src"].split()) == hashes, "only the page's own two scripts may run"
+    assert directives["default-src"] == "'none'" and "unsafe" not in directives["script-src"]
     own = (ROOT / "fishgen" / name / "template.html").read_text(encoding="utf-8")
     assert "<head" not in own and "<title" not in own and "<script" not in own, "the head is shared"
     assert own.split("</style>")[1].strip().removesuffix("</body>").rstrip() in html
