@@ -99,6 +99,9 @@ def _fail(target: Path, err: OSError) -> SystemFailure:
     error names no file, so the target is always named here)."""
     if target.is_dir():
         return SystemFailure(f"cannot write {target}: a folder is in the way", target)
+    blocker = next((folder for folder in target.parents if folder.is_file()), None)
+    if blocker is not None:  # mkdir's error says only "File exists"
+        return SystemFailure(f"cannot write {target}: expected a folder at {blocker}, found a file", target)
     return cannot("write", target, err)
 
 

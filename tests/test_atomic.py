@@ -30,6 +30,14 @@ def test_folder_in_the_way_is_refused_before_writing(tmp_path):
     assert leftovers(tmp_path) == []
 
 
+def test_a_file_where_a_folder_of_the_target_should_be_is_named(tmp_path):
+    (tmp_path / "models").write_bytes(b"not a folder")
+    with pytest.raises(FishgenError, match=r"cannot write .*models/fish/a\.glb: expected a folder at "
+                                           r".*models, found a file"):
+        write_bytes(tmp_path / "models" / "fish" / "a.glb", b"data")
+    assert (tmp_path / "models").read_bytes() == b"not a folder" and leftovers(tmp_path) == []
+
+
 def test_multi_file_output_is_all_or_nothing(tmp_path):
     good = tmp_path / "x.gltf"
     good.write_bytes(b"yesterday")
