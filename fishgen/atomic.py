@@ -291,6 +291,7 @@ def _commit(staged: list[tuple[str, Path]]) -> None:
     waits for the end, so that a set of outputs is never left half old and half new."""
     with interrupts.held():
         undo: list[tuple[str, str | None, Path]] = []  # (temporary file, old target's backup, target)
+        made = [_folders.get(tmp, []) for tmp, _ in staged]  # a rename forgets them; a rollback needs them
         try:
             for tmp, target in staged:
                 backup = _beside(target, ".old") if len(staged) > 1 and target.is_file() else None
@@ -302,15 +303,26 @@ def _commit(staged: list[tuple[str, Path]]) -> None:
                 except OSError as err:
                     raise _fail(target, err) from None
                 _release(tmp)
-        except BaseException:
+        except BaseException as err:
+            stranded: list[tuple[str, Path]] = []
             for tmp, backup, target in reversed(undo):
-                if backup is not None:
-                    if os.path.lexists(backup):
-                        os.replace(backup, target)
-                elif len(staged) > 1 and not os.path.lexists(tmp) and target.is_file():
-                    os.unlink(target)  # new in this set, and the set does not land
+                try:  # every step tried: one that fails must not leave the others undone
+                    if backup is not None:
+                        if os.path.lexists(backup):
+                            os.replace(backup, target)
+                    elif len(staged) > 1 and not os.path.lexists(tmp) and target.is_file():
+                        os.unlink(target)  # new in this set, and the set does not land
+                except OSError:
+                    if backup is not None:
+                        stranded.append((backup, target))
             for tmp, _ in reversed(staged):
                 _discard(tmp)
+            for folders in reversed(made):
+                _remove_empty(folders)
+            if stranded:  # never discarded: the only copy of what the user had
+                backup, target = stranded[0]
+                raise SystemFailure(f"cannot write {target}, nor put its earlier content back: it is in "
+                                    f"{backup}", target) from err
             raise
         for _, backup, _ in undo:
             if backup is not None:

@@ -66,6 +66,42 @@ def test_failed_rename_restores_earlier_targets(tmp_path, monkeypatch):
     assert a.read_bytes() == b"old a" and b.read_bytes() == b"old b" and leftovers(tmp_path) == []
 
 
+def test_a_failed_set_leaves_no_folder_it_made_even_after_some_renames(tmp_path, monkeypatch):
+    a, b = tmp_path / "new" / "a.gltf", tmp_path / "new" / "b.bin"
+    real = os.replace
+
+    def flaky(src, dst):
+        if str(dst) == str(b):
+            raise OSError(28, "No space left on device")
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", flaky)
+    with pytest.raises(FishgenError, match="cannot write .*b.bin: No space left on device"):
+        write_files({a: b"new a", b: b"new b"})
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_earlier_output_that_cannot_be_put_back_is_kept_and_named(tmp_path, monkeypatch):
+    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
+    a.write_bytes(b"old a")
+    b.write_bytes(b"old b")
+    real = os.replace
+
+    def flaky(src, dst):
+        if str(dst) == str(b) and str(src).endswith(".tmp"):
+            raise OSError(28, "No space left on device")
+        if str(dst) == str(a) and str(src).endswith(".old"):  # the restore fails too
+            raise OSError(5, "Input/output error")
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", flaky)
+    with pytest.raises(FishgenError, match=r"cannot write .*a\.txt, nor put its earlier content back: it is "
+                                           r"in .*\.a\.txt\.\w+\.old") as raised:
+        write_files({a: b"new a", b: b"new b"})
+    kept = raised.value.args[0].rsplit(" ", 1)[1]
+    assert open(kept, "rb").read() == b"old a" and b.read_bytes() == b"old b"
+
+
 def test_streaming_writer_discards_on_error(tmp_path):
     target = tmp_path / "big.ply"
     target.write_bytes(b"good")
