@@ -595,6 +595,10 @@ class HarnessPage(LocalBrowser):
         self.page.on("pageerror", lambda e: self.console.append(f"pageerror: {e}"))
         self.page.on("response", lambda r: self.requests.append((r.url, r.status)))
         self.page.on("requestfailed", lambda r: self.requests.append((r.url, f"failed {r.failure}")))
+        self.inflight: set = set()
+        self.page.on("request", lambda r: self.inflight.add(r))
+        self.page.on("requestfinished", lambda r: self.inflight.discard(r))
+        self.page.on("requestfailed", lambda r: self.inflight.discard(r))
         self.page.route("**/*", self._route)
         self.page.goto(f"{self.base}/harness/{page}")
         self.page.wait_for_function("window.harnessReady === true", timeout=60_000)
@@ -621,6 +625,11 @@ class HarnessPage(LocalBrowser):
         return out
 
     def _clear(self) -> None:
+        """Forget what was recorded, once every request the page made has ended: a response that came
+        after the last check (a broken asset's 404, under load) would otherwise count against the next."""
+        deadline = time.monotonic() + 10
+        while self.inflight and time.monotonic() < deadline:
+            self.page.wait_for_timeout(20)
         self.console.clear()
         self.requests.clear()
         self.outside.clear()
@@ -653,7 +662,7 @@ class ThreeClient(HarnessPage):
 
     def tail_track(self, relative: str, times: list[float]) -> dict:
         """The tail tip as three.js plays the file at /assets/RELATIVE (harness.js tailTrack)."""
-        self.console.clear()
+        self._clear()
         result = self.page.evaluate("([u, t]) => window.tailTrack(u, t)", [f"{self.base}/assets/{relative}", times])
         expect("error" not in result, f"three.js: {result.get('error')}")
         expect(not self._problems(), "; ".join(self._problems()[:3]))
