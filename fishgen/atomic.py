@@ -143,9 +143,29 @@ _CREATE = (os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | g
            | getattr(os, "O_BINARY", 0))
 
 
+NAME_MAX = 255
+"""Longest file name, in bytes, of the file systems fishgen writes to (ext4, APFS, NTFS)."""
+_TAIL = 16  # XXXXXXXXXXXX.tmp
+
+
+def _prefix(path: Path) -> str:
+    """How the temporary files of ``path`` begin: ``.NAME.``, or for a name too long to take the
+    tail, ``.NAM~HASH.``: the name cut to fit and 8 hex digits of the whole name's SHA-1, so that
+    any name a file system takes can be written."""
+    prefix = f".{path.name}."
+    raw = os.fsencode(prefix)
+    if len(raw) + _TAIL <= NAME_MAX:
+        return prefix
+    import hashlib
+
+    digest = hashlib.sha1(os.fsencode(path.name)).hexdigest()[:8]
+    cut = raw[1:NAME_MAX - _TAIL - len(digest) - 3].decode("utf-8", "ignore")  # no half a character
+    return f".{cut}~{digest}."
+
+
 def _beside(path: Path, suffix: str) -> str:
     """A fresh name for a temporary file beside ``path``: ``.NAME.XXXXXXXXXXXX.tmp``."""
-    return os.path.join(path.parent, f".{path.name}.{os.urandom(6).hex()}{suffix}")
+    return os.path.join(path.parent, f"{_prefix(path)}{os.urandom(6).hex()}{suffix}")
 
 
 def _temporary(path: Path, into: list[tuple[str, Path]]) -> tuple[int, str]:
@@ -172,8 +192,8 @@ def _temporary(path: Path, into: list[tuple[str, Path]]) -> tuple[int, str]:
             _folders.pop(tmp, None)
             _live.pop(tmp, None)
             continue
-        _held[tmp] = fd
-        _lock(fd)
+        if _lock(fd):
+            _held[tmp] = fd
         return fd, tmp
     raise FileExistsError(f"no free temporary name beside {path}")
 
@@ -205,7 +225,7 @@ def sweep(path: Path) -> list[Path]:
     """Remove ``path``'s stale temporary files: ours by their name (``.NAME.XXXX.tmp``), older than
     STALE_SECONDS, and not locked, so no running writer holds them. Returns what was removed."""
     removed: list[Path] = []
-    prefix = f".{path.name}."
+    prefix = _prefix(path)
     try:
         entries = list(os.scandir(path.parent))
     except OSError:
@@ -231,6 +251,13 @@ def sweep(path: Path) -> list[Path]:
     return removed
 
 
+def _writer(tmp: str, fd: int) -> BinaryIO:
+    """A handle that writes ``tmp``. Where ``fd`` holds its lock, the lock stays with ``fd`` until
+    the rename; where there are no locks (Windows) the handle takes ``fd``, since a file still open
+    there cannot be renamed."""
+    return os.fdopen(os.dup(fd) if tmp in _held else fd, "wb")
+
+
 def _release(tmp: str) -> None:
     _live.pop(tmp, None)
     _folders.pop(tmp, None)
@@ -248,7 +275,7 @@ def _stage(path: Path, data: bytes, into: list[tuple[str, Path]]) -> None:
     except OSError as err:
         raise _fail(path, err) from None
     try:
-        with os.fdopen(os.dup(fd), "wb") as handle:  # the lock stays with fd until the rename
+        with _writer(tmp, fd) as handle:
             handle.write(data)
             handle.flush()
             os.fsync(handle.fileno())
@@ -353,7 +380,7 @@ class atomic_open:
         named: list[tuple[str, Path]] = []
         try:
             fd, self._tmp = _temporary(self.path, named)
-            self._handle = os.fdopen(os.dup(fd), "wb")  # the lock stays with fd until the rename
+            self._handle = _writer(self._tmp, fd)
         except BaseException as err:  # also SIGTERM or Ctrl-C before the `with` body: no temp file left
             for tmp, _ in named:
                 _discard(tmp)

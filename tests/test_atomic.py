@@ -160,6 +160,52 @@ def test_a_fresh_temporary_file_is_never_swept(tmp_path):
     assert atomic.sweep(tmp_path / "a.txt") == [] and fresh.exists()
 
 
+@pytest.mark.parametrize("name", ["f" * 251 + ".glb", "é" * 125 + ".glb"], ids=["ascii", "two-byte"])
+def test_a_name_as_long_as_the_file_system_takes_is_written_and_swept(tmp_path, name):
+    """255 bytes: the temporary file's own name is then shortened, not refused (ENAMETOOLONG)."""
+    import fishgen.atomic as atomic
+
+    target = tmp_path / name
+    assert len(os.fsencode(target.name)) in (255, 254)
+    write_files({target: b"one", tmp_path / "b.bin": b"b"})
+    write_files({target: b"two", tmp_path / "b.bin": b"c"})  # over older files: backups, long too
+    with atomic_open(target) as handle:
+        handle.write(b"three")
+    assert target.read_bytes() == b"three" and leftovers(tmp_path) == []
+    stale = atomic._beside(target, ".tmp")
+    open(stale, "wb").close()
+    os.utime(stale, (0, 0))
+    assert atomic.sweep(target) == [atomic.Path(stale)]
+
+
+def test_where_files_cannot_be_locked_none_is_open_as_it_is_renamed(tmp_path, monkeypatch):
+    """Windows has no advisory locks, and there a file still open cannot be renamed."""
+    if not os.path.isdir("/proc/self/fd"):
+        pytest.skip("needs /proc to list open files")
+    import fishgen.atomic as atomic
+
+    monkeypatch.setattr(atomic, "_lock", lambda fd: False)
+    replace = os.replace
+    open_at_rename: list[str] = []
+
+    def checked(src, dst):
+        for fd in os.listdir("/proc/self/fd"):
+            try:
+                if os.readlink(f"/proc/self/fd/{fd}") == os.fspath(src):
+                    open_at_rename.append(os.fspath(src))
+            except OSError:
+                pass
+        replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", checked)
+    write_files({tmp_path / "a.glb": b"a", tmp_path / "a.bin": b"b"})
+    write_files({tmp_path / "a.glb": b"a2", tmp_path / "a.bin": b"b2"})
+    with atomic_open(tmp_path / "c.ply") as handle:
+        handle.write(b"c")
+    assert open_at_rename == [] and (tmp_path / "c.ply").read_bytes() == b"c"
+    assert (tmp_path / "a.glb").read_bytes() == b"a2" and leftovers(tmp_path) == []
+
+
 def test_a_failed_set_of_outputs_leaves_no_folder_it_made(tmp_path):
     with pytest.raises(RuntimeError), together():
         write_bytes(tmp_path / "a" / "b" / "x.glb", b"glb")
