@@ -28,6 +28,7 @@ from typing import BinaryIO, Literal, TypeVar
 
 from fishgen import interrupts
 from fishgen.errors import FishgenError, SystemFailure, UsageError, cannot
+from fishgen.file_names import NAME_MAX
 
 #: A path type: any one of them per call (a Mapping's key type cannot widen).
 _PathT = TypeVar("_PathT", bound="str | os.PathLike[str]")
@@ -143,8 +144,6 @@ _CREATE = (os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | g
            | getattr(os, "O_BINARY", 0))
 
 
-NAME_MAX = 255
-"""Longest file name, in bytes, of the file systems fishgen writes to (ext4, APFS, NTFS)."""
 _TAIL = 16  # XXXXXXXXXXXX.tmp
 
 

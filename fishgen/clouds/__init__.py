@@ -16,8 +16,8 @@ from __future__ import annotations
 from fishgen.lazy import lazy_exports
 
 _API = {
-    "FORMATS": "fishgen.clouds.export", "check_output": "fishgen.clouds.export",
-    "export_cloud": "fishgen.clouds.export",
+    "FORMATS": "fishgen.exchange.clouds", "check_output": "fishgen.exchange.clouds",
+    "export_cloud": "fishgen.exchange.clouds",
     "METHODS": "fishgen.clouds.model", "fill_cloud": "fishgen.clouds.fill",
     "merge_clouds": "fishgen.clouds.fill",
     "DEFAULT_MAX_PARTICLES": "fishgen.clouds.model", "Cloud": "fishgen.clouds.model",

@@ -86,7 +86,7 @@ def texture_roots(path: Path, textures_dir: str | os.PathLike | None = None) -> 
 
 
 def _texture(token: str, roots: list[Path], name: str, number: int) -> str:
-    from fishgen.species.parser import resolve_texture
+    from fishgen.file_names import resolve_texture
 
     if not token.lower().endswith(".png"):
         raise expected("a texture file name ending in .png", describe(token), name, number)

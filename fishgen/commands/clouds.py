@@ -92,10 +92,10 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
            events: Events = QUIET) -> Made:
     """Fill every cube file, light them together (so clouds shadow each other) and write them as one
     scene; input i is filled with seed + i. A texture cloud (.awa) becomes textured billboards."""
-    from fishgen.clouds.export import VOLUME_FORMATS, check_output, export_cloud
     from fishgen.clouds.pipeline import cloud_textures, cube_clouds, read_cube_files
     from fishgen.commands.paths import check_inputs, check_targets
     from fishgen.errors import UsageError
+    from fishgen.exchange.clouds import VOLUME_FORMATS, check_output, export_cloud
     from fishgen.exchange.registry import FORMATS
 
     inputs = tuple(Path(p) for p in inputs)

@@ -101,10 +101,10 @@ class SkyFacts:
 def sky(inputs: Sequence[Path], output: str | os.PathLike, options: SkyOptions = SkyOptions(),
         events: Events = QUIET) -> Made:
     """Build the sky and write it atomically; the summary says its clouds, particles and size."""
-    from fishgen.clouds.export import check_output
     from fishgen.commands.paths import check_inputs, check_targets
     from fishgen.errors import UsageError
     from fishgen.exchange import export
+    from fishgen.exchange.clouds import check_output
     from fishgen.exchange.registry import FORMATS
 
     output = Path(output)

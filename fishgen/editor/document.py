@@ -138,7 +138,7 @@ Resolver = Callable[[str, int], str]
 def texture_resolver(roots: Sequence[Path], name: str) -> Resolver:
     """How a .awa file's texture names resolve, as :func:`fishgen.clouds.parser.load_cubes` does:
     a .png inside one of ``roots``, which must exist and be a readable picture."""
-    from fishgen.species.parser import resolve_texture
+    from fishgen.file_names import resolve_texture
 
     def resolve(token: str, line: int) -> str:
         if not token.lower().endswith(".png"):

@@ -5,7 +5,7 @@ textures in the allowed texture folders. Nothing else, whatever the page asks.
   ``..``, no absolute path, no drive; a name that is a symbolic link leading out of the folder is
   refused (one inside it is followed).
 - A texture is named as a ``.awa`` file names it, relative to a texture folder, and is resolved by
-  the rule of :func:`fishgen.species.parser.resolve_texture` (never outside the folders).
+  the rule of :func:`fishgen.file_names.resolve_texture` (never outside the folders).
 - The folders are listed shallowly and with caps, so a huge folder cannot stall the page.
 
 Leaf module: no numpy.
@@ -97,7 +97,7 @@ class Workspace:
 
     def texture(self, name: object, file: Path | None = None) -> bytes:
         """The bytes of the texture a .awa file here names ``name``; only a PNG in the folders."""
-        from fishgen.species.parser import resolve_texture
+        from fishgen.file_names import resolve_texture
 
         if (not isinstance(name, str) or not _TEXTURE_NAME.fullmatch(name)
                 or not name.lower().endswith(".png")):

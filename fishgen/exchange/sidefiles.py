@@ -13,19 +13,10 @@ from pathlib import Path
 from urllib.parse import unquote
 
 from fishgen.errors import describe, expected
+from fishgen.file_names import NAME_MAX, too_long
 
 _SCHEME = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:")
 """``http:``, ``file:``, ``C:`` ... - anything but a plain relative path."""
-
-
-NAME_MAX = 255
-"""Bytes a file name's every part may have (Linux's NAME_MAX); a longer one is an OSError to ask about."""
-
-
-def too_long(name: str) -> bool:
-    """Whether a relative file name has a part longer than the file system allows."""
-    parts = name.replace("\\", "/").split("/")
-    return any(len(part.encode("utf-8", "surrogateescape")) > NAME_MAX for part in parts)
 
 
 def side_file(asset: str | Path, ref: str, *, uri: bool = False, must_exist: bool = False) -> Path:

@@ -15,7 +15,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
-from fishgen.errors import FishgenError, describe
+from fishgen.errors import FishgenError
+from fishgen.file_names import resolve_texture
 from fishgen.reading import read_capped
 from fishgen.shape_names import SHAPE_NAMES, check_shape_params
 from fishgen.species.model import (
@@ -437,50 +438,6 @@ def texture_roots(species_path: Path, textures_dir: str | os.PathLike | None) ->
     if textures.resolve().is_relative_to(here.parent):
         return [here, textures.resolve()]
     return [here]
-
-
-def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> Path:
-    """Resolve a texture name inside one of ``roots``; never outside them."""
-    from fishgen.exchange.sidefiles import NAME_MAX, too_long
-
-    shown = " or ".join(str(r) for r in roots)
-    if too_long(name):
-        raise FishgenError(f"expected a texture file name of at most {NAME_MAX} bytes a part, found "
-                           f"{describe(name)}", file, line)
-    escaped = False
-    for root in roots:
-        candidate = (root / name).resolve()
-        if not candidate.is_relative_to(root):
-            escaped = True
-            continue
-        if candidate.is_file():
-            _check_image(candidate, name, file, line)
-            return candidate
-    if escaped or os.path.isabs(name):
-        raise FishgenError(f"expected a texture path inside {shown}, found {name!r} "
-                           "(texture paths may not leave the texture folder; use --textures DIR)",
-                           file, line)
-    raise FishgenError(f"expected an existing texture file, found {name!r} missing from {shown}",
-                       file, line)
-
-
-#: Largest texture side accepted (pixels); larger files are refused before decoding.
-MAX_TEXTURE_SIDE = 8192
-
-
-def _check_image(path: Path, name: str, file: str, line: int) -> None:
-    """Read only the image header: a readable picture of a sane size, or a clear error."""
-    from PIL import Image, UnidentifiedImageError
-
-    try:
-        with Image.open(path) as img:
-            width, height = img.size
-    except (UnidentifiedImageError, OSError):
-        raise FishgenError(f"expected a texture image (PNG, GIF, JPEG, ...), found {name!r} unreadable",
-                           file, line) from None
-    if max(width, height) > MAX_TEXTURE_SIDE:
-        raise FishgenError(f"expected a texture of at most {MAX_TEXTURE_SIDE} pixels a side, found {name!r} "
-                           f"{width}x{height}", file, line)
 
 
 def load_species(path: str | os.PathLike, textures_dir: str | os.PathLike | None = None) -> Species:

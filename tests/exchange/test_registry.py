@@ -21,7 +21,7 @@ def test_every_writer_and_reader_entry_point_resolves():
 
 def test_cli_choices_come_from_the_registry():
     from fishgen.commands.build import FISH_FORMATS
-    from fishgen.clouds.export import FORMATS as CLOUD_FORMATS
+    from fishgen.exchange.clouds import FORMATS as CLOUD_FORMATS
     from fishgen.viewer.page import KINDS
 
     assert [f.name for f in FISH_FORMATS] == ["glb", "gltf", "obj", "ply", "usdc", "usda", "usdz"]

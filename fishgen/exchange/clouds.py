@@ -1,4 +1,6 @@
-"""Export a particle cloud: build its scene (fishgen.clouds.scene) and write it by extension."""
+"""Export a particle cloud: build its scene (fishgen.clouds.scene) and write it by extension.
+
+The writers' side of a cloud, above the cloud package: fishgen.clouds re-exports its names."""
 from __future__ import annotations
 
 import os

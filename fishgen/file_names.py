@@ -1,0 +1,60 @@
+"""File names fishgen reads and writes: how long a name may be, and where a texture an input names
+may come from. Below every parser and writer, so that each of them can use it."""
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+from fishgen.errors import FishgenError, describe
+
+NAME_MAX = 255
+"""Bytes a file name's every part may have (Linux's NAME_MAX; ext4, APFS, NTFS alike)."""
+
+
+def too_long(name: str) -> bool:
+    """Whether a relative file name has a part longer than the file system allows."""
+    parts = name.replace("\\", "/").split("/")
+    return any(len(part.encode("utf-8", "surrogateescape")) > NAME_MAX for part in parts)
+
+
+def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> Path:
+    """Resolve a texture name inside one of ``roots``; never outside them."""
+    shown = " or ".join(str(r) for r in roots)
+    if too_long(name):
+        raise FishgenError(f"expected a texture file name of at most {NAME_MAX} bytes a part, found "
+                           f"{describe(name)}", file, line)
+    escaped = False
+    for root in roots:
+        candidate = (root / name).resolve()
+        if not candidate.is_relative_to(root):
+            escaped = True
+            continue
+        if candidate.is_file():
+            _check_image(candidate, name, file, line)
+            return candidate
+    if escaped or os.path.isabs(name):
+        raise FishgenError(f"expected a texture path inside {shown}, found {name!r} "
+                           "(texture paths may not leave the texture folder; use --textures DIR)",
+                           file, line)
+    raise FishgenError(f"expected an existing texture file, found {name!r} missing from {shown}",
+                       file, line)
+
+
+#: Largest texture side accepted (pixels); larger files are refused before decoding.
+MAX_TEXTURE_SIDE = 8192
+
+
+def _check_image(path: Path, name: str, file: str, line: int) -> None:
+    """Read only the image header: a readable picture of a sane size, or a clear error."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as img:
+            width, height = img.size
+    except (UnidentifiedImageError, OSError):
+        raise FishgenError(f"expected a texture image (PNG, GIF, JPEG, ...), found {name!r} unreadable",
+                           file, line) from None
+    if max(width, height) > MAX_TEXTURE_SIDE:
+        raise FishgenError(f"expected a texture of at most {MAX_TEXTURE_SIDE} pixels a side, found {name!r} "
+                           f"{width}x{height}", file, line)
