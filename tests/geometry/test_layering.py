@@ -1,4 +1,5 @@
-"""Package layering: geometry knows nothing of species files, species nothing of geometry.
+"""Package layering: geometry knows nothing of species files, species nothing of geometry, cube
+files nothing of species files, and a lit cloud nothing of the writers.
 
 Each check imports the modules in a fresh interpreter, so what other tests have
 already imported cannot hide a dependency.
@@ -33,7 +34,13 @@ def modules_loaded_by(modules: tuple[str, ...], then: str) -> list[str]:
      " 8, 6, (1, 1, 1))", "fishgen.species"),
     (("fishgen.species.parser", "fishgen.species.model"),
      "fishgen.species.parser.load_species('params/bonybream.txt')", "fishgen.geometry"),
-], ids=["geometry-without-species", "species-without-geometry"])
+    (("fishgen.clouds.parser",), "fishgen.clouds.parser.load_cubes('params/clouds/sky.awa')",
+     "fishgen.species"),
+    (("fishgen.clouds", "fishgen.clouds.pipeline"),
+     "fishgen.clouds.pipeline.cube_clouds(fishgen.clouds.pipeline.read_cube_files("
+     "['params/clouds/sky.awa', 'params/clouds/table_4_3.awn']))", "fishgen.exchange"),
+], ids=["geometry-without-species", "species-without-geometry", "cube-files-without-species",
+        "lit-clouds-without-writers"])
 def test_package_does_not_import_the_other(imports, then, forbidden):
     loaded = modules_loaded_by(imports, then)
     assert set(imports) <= set(loaded)          # the check ran the imports it names
