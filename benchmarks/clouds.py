@@ -60,7 +60,7 @@ def scaled_cubes(n: int) -> CubeFile:
     counts = [c.particles * n // total for c in cubes]
     counts[0] += n - sum(counts)
     return CubeFile(f"table 4.4 x {n}", n, tuple(
-        Cube(k, c.size, c.centre, c.max_radius, c.line) for k, c in zip(counts, cubes)))
+        Cube(k, c.size, c.centre, c.max_radius, c.line) for k, c in zip(counts, cubes, strict=True)))
 
 
 def write_awn(cube_file: CubeFile, path: Path) -> None:
@@ -222,7 +222,8 @@ def light_report(sizes: list[int], command_size: int, repeats: int, workdir: Pat
                         ("no-light", "`fishgen clouds --no-light`"), ("unlit", "library steps, unlit"),
                         ("lit", "library steps, lit")):
         wall, peak = runs[kind]
-        print(f"  {label:34s} {wall:6.2f} s, peak {peak / 2**20:,.0f} MiB = {peak / command_size:.1f} bytes/particle")
+        print(f"  {label:34s} {wall:6.2f} s, peak {peak / 2**20:,.0f} MiB = "
+              f"{peak / command_size:.1f} bytes/particle")
     print(f"  lit / unlit library steps: {runs['lit'][0] / runs['unlit'][0]:.2f}x (target < 2x)")
     print(f"  `fishgen clouds` / `--no-light`: {runs['fishgen'][0] / runs['no-light'][0]:.2f}x")
 
@@ -291,8 +292,10 @@ def main() -> None:
     parser.add_argument("--writers-only", action="store_true",
                         help="only time the CSV and PLY writers at 10^6 particles")
     parser.add_argument("--light-only", action="store_true",
-                        help="only the lighting figures: vs the fill at --light-sizes, whole runs at --command-size")
-    parser.add_argument("--light-sizes", default="1e5,1e6", help="particle counts to light [default: %(default)s]")
+                        help="only the lighting figures: vs the fill at --light-sizes, "
+                             "whole runs at --command-size")
+    parser.add_argument("--light-sizes", default="1e5,1e6",
+                        help="particle counts to light [default: %(default)s]")
     parser.add_argument("--cost", action="store_true",
                         help="only the whole command's marginal cost per particle against the plain loops")
     parser.add_argument("--baseline", type=Path, metavar="DIR",
@@ -332,10 +335,10 @@ def main() -> None:
     plain_rate = None
     for n in sizes:
         cubes = scaled_cubes(n)
-        fast = median_time(lambda: fill_cloud(cubes, seed=1), args.repeats if n < 10**7 else 3)
+        fast = median_time(functools.partial(fill_cloud, cubes, seed=1), args.repeats if n < 10**7 else 3)
         if n <= args.baseline_max:
             reps = max(1, min(args.repeats, int(2e5 // n)))
-            slow = median_time(lambda: plain_fill(cubes, 1), reps)
+            slow = median_time(functools.partial(plain_fill, cubes, 1), reps)
             plain_rate, mark = n / slow, ""
         else:
             if plain_rate is None:  # every size is above --baseline-max: measure the loop there once

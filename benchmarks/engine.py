@@ -87,14 +87,15 @@ def levels(folder: Path, species) -> None:
         over = min(ec.iou(ec.silhouette(fish.scene, t=float(t), clip="swim", box=box),
                           ec.silhouette(scene, t=float(t), clip="swim", box=box))
                    for t in np.linspace(0, swim, 9))
-        parts = make_fish(species, lods=LODS, clips=CLIPS)            # fin gaps: per part (the layouts pose alike)
-        gap = max(ec.fin_gap(ec.level_scene(parts.scene, k), c, np.linspace(0, parts.scene.clip(c).duration, 9))
+        parts = make_fish(species, lods=LODS, clips=CLIPS)  # fin gaps: per part (the layouts pose alike)
+        gap = max(ec.fin_gap(ec.level_scene(parts.scene, k), c,
+                             np.linspace(0, parts.scene.clip(c).duration, 9))
                   for c in CLIPS)
         alone = make_fish(species, lods=[(lv.bodies, lv.circles)], merge=True, clips=CLIPS)
         path = folder / f"level{k}.glb"
         path.write_bytes(glb_bytes(alone.scene))
-        print(f"{'LOD' + str(k):>6} {f'{lv.bodies}x{lv.circles}':>9} {lv.triangles:10,} {rest:9.3f} {over:9.3f} "
-              f"{gap:8.2%} {lv.coverage:9.4f} {path.stat().st_size:13,}")
+        print(f"{'LOD' + str(k):>6} {f'{lv.bodies}x{lv.circles}':>9} {lv.triangles:10,} "
+              f"{rest:9.3f} {over:9.3f} {gap:8.2%} {lv.coverage:9.4f} {path.stat().st_size:13,}")
     print(f"all three levels in one glb: {whole.stat().st_size:,} bytes; validator: {validator(whole)[0]}")
     print()
 
@@ -102,7 +103,8 @@ def levels(folder: Path, species) -> None:
 # ---------------------------------------------------------------- 2. one fish, two layouts
 def layouts(folder: Path, species, repeat: int, bpy: str | None) -> None:
     print("2. one BonyBream (swim clip): a node per part against one merged skinned mesh")
-    print(f"{'layout':8} {'draws':>5} {'bytes':>9} {'write s':>8}  {'tail p-p (fishgen / three.js / Blender)':40} "
+    print(f"{'layout':8} {'draws':>5} {'bytes':>9} {'write s':>8}  "
+          f"{'tail p-p (fishgen / three.js / Blender)':40} "
           f"{'fin swing deg (fishgen / three.js / Blender)'}")
     three = None
     reason = None
@@ -130,11 +132,12 @@ def layouts(folder: Path, species, repeat: int, bpy: str | None) -> None:
             tracks.append(ec.blender_play(path, {"swim": times}, probes.all())["clips"]["swim"])
         for track in tracks:
             p = probes.split(track)
-            cells.append((ec.peak_to_peak(p["tail"], probes.length), np.ptp(ec.fin_swing(p["fin_tip"], p["fin_base"]))))
+            cells.append((ec.peak_to_peak(p["tail"], probes.length),
+                          np.ptp(ec.fin_swing(p["fin_tip"], p["fin_base"]))))
         tails = " / ".join(f"{a:.3f}" for a, _ in cells)
         fins = " / ".join(f"{b:.2f}" for _, b in cells)
-        print(f"{'merged' if merge else 'parts':8} {fish.facts.draw_calls:5} {path.stat().st_size:9,} {seconds:8.4f}  "
-              f"{tails:40} {fins}   {validator(path)[0]}")
+        print(f"{'merged' if merge else 'parts':8} {fish.facts.draw_calls:5} {path.stat().st_size:9,} "
+              f"{seconds:8.4f}  {tails:40} {fins}   {validator(path)[0]}")
     if three is not None:
         three.close()
     elif reason:
@@ -175,7 +178,8 @@ def schools(folder: Path, species, count: int, frames: int, repeat: int, fps_fra
     except Exception:  # noqa: BLE001
         three = None
     files = [(scene, folder / ("school-" + label.split(" ")[0].replace("(", "")
-                               + ("-compact" if "compact" in label else "") + ".glb")) for label, scene, _ in rows]
+                               + ("-compact" if "compact" in label else "") + ".glb"))
+             for label, scene, _ in rows]
     took = write_times(files, repeat)
     written = [(label, path, seconds, error)
                for (label, _, error), (_, path), seconds in zip(rows, files, took, strict=True)]
@@ -200,9 +204,10 @@ def schools(folder: Path, species, count: int, frames: int, repeat: int, fps_fra
         print(f"{label:28} {path.stat().st_size:12,} {seconds:8.3f} {err:>11} {draws.get(label, 0):6} "
               f"{ms:9.1f} {best:6.1f} {mixer:6.1f} {1000.0 / ms:6.2f}  {validator(path)[0]}")
     if rates:
-        print(f"(ms/frame: the median over {fps_frames} frames of playing (three.js AnimationMixer) and drawing "
-              f"the school, then the median and the best of {ROUNDS} runs taken in turn, each in a fresh page; "
-              f"mixer: the playing alone. three.js r0.187, headless Chromium, SwiftShader WebGL at 960x540)")
+        print(f"(ms/frame: the median over {fps_frames} frames of playing (three.js AnimationMixer) "
+              f"and drawing the school, then the median and the best of {ROUNDS} runs taken in turn, "
+              f"each in a fresh page; mixer: the playing alone. three.js r0.187, headless Chromium, "
+              f"SwiftShader WebGL at 960x540)")
     print()
 
 
@@ -229,7 +234,8 @@ def clips(folder: Path, species) -> None:
         p = probes.split(played.probes)
         curvature = ec.bend_curvature(p["midline"], probes.length)
         if c.name.startswith("turn"):
-            bend = ec.bend_curvature(p["midline"].mean(axis=0)[None], probes.length)[0]   # the wave averages out
+            # the wave averages out
+            bend = ec.bend_curvature(p["midline"].mean(axis=0)[None], probes.length)[0]
         elif c.name == "burst":
             bend = curvature.max()
         else:
@@ -245,9 +251,9 @@ def clips(folder: Path, species) -> None:
             worst = [max(ec.normal_error(pos[i], faces, nrm[i]).max() for i in range(len(sample)))
                      for faces, pos, nrm in run.meshes.values()]
             errors.append(" / ".join(f"{w:.2f}" for w in worst))
-        print(f"{c.name:10} {c.seconds:7.3f} {'yes' if c.loop else 'once':>5} {ec.frequency(p['tail'], times):8.2f} "
-              f"{ec.peak_to_peak(p['tail'], probes.length):9.3f} {np.degrees(bend):12.1f} {errors[0]:>27} "
-              f"{errors[1]:>19}")
+        print(f"{c.name:10} {c.seconds:7.3f} {'yes' if c.loop else 'once':>5} "
+              f"{ec.frequency(p['tail'], times):8.2f} {ec.peak_to_peak(p['tail'], probes.length):9.3f} "
+              f"{np.degrees(bend):12.1f} {errors[0]:>27} {errors[1]:>19}")
     print(f"(design: turns {TURN_DEGREES:g} deg per body length, burst peak C {C_START_DEGREES:g} deg)")
     if three is not None:
         three.close()

@@ -30,11 +30,12 @@ def whole_command(inp: str, out: Path, size: str) -> float:
 
 
 def breakdown(inp: str, size: str) -> dict[str, float]:
+    from PIL import Image
+
     from fishgen.preview.camera import frame
     from fishgen.preview.inputs import load_input
     from fishgen.preview.pipeline import PreviewOptions, encode, parse_size, subject_points
     from fishgen.preview.render import Renderer
-    from PIL import Image
 
     w, h = parse_size(size)
     opts = PreviewOptions(width=w, height=h)
@@ -49,7 +50,8 @@ def breakdown(inp: str, size: str) -> dict[str, float]:
     encode([img], Path("x.png"), 0)
     t.append(time.perf_counter())
     renderer.release()
-    return dict(zip(("load+build", "gl context", "render", "png encode"), (b - a for a, b in zip(t, t[1:]))))
+    intervals = (b - a for a, b in zip(t, t[1:], strict=False))  # consecutive stamps: t[1:] is one shorter
+    return dict(zip(("load+build", "gl context", "render", "png encode"), intervals, strict=True))
 
 
 def main() -> int:

@@ -14,9 +14,9 @@ command does.
 Targets (issue 9, section 5): fishgen's boids at least 100x Mesa's fish-steps per second at 1,000
 fish; 10,000 fish x 1,000 frames simulated in under 20 s on a 2-core machine; 1,000 fish x 300
 frames with fins baked and written as glb in under 1 s, in under 10 MB. Issue 10: the same bake
-with the body wave (every fish's four morph weights keyed every frame) under 1.5 s and 15 MB. Prints medians over
---repeat runs, one row each. A fish-step is one fish moved by one frame: a run of F frames is F - 1
-steps (frame 0 is the start layout). Mesa is a benchmark-only dependency:
+with the body wave (every fish's four morph weights keyed every frame) under 1.5 s and 15 MB.
+Prints medians over --repeat runs, one row each. A fish-step is one fish moved by one frame: a run
+of F frames is F - 1 steps (frame 0 is the start layout). Mesa is a benchmark-only dependency:
 pip install "mesa[network]>=3,<4". `--quick` is a smoke run with small sizes.
 
 Mesa runs in two spaces. The target is judged in the issue's: the example's own 100 x 100 space
@@ -48,8 +48,8 @@ MESA_BUDGET = 60.0   # seconds: a Mesa size whose steps would take longer than t
 
 def school_config(count: int, frames: int, model: str = "boids"):
     """One BonyBream-sized group in the region `fishgen school` gives it by default."""
-    from fishgen.school.run import DEFAULT_BOUNDS_BODY_LENGTHS
     from fishgen.school.model import Group, SchoolConfig
+    from fishgen.school.run import DEFAULT_BOUNDS_BODY_LENGTHS
 
     half = DEFAULT_BOUNDS_BODY_LENGTHS * BODY_LENGTH * max(1.0, count ** (1 / 3))
     return SchoolConfig(groups=(Group("bonybream", count, BODY_LENGTH, 1.0),), model=model,  # type: ignore[arg-type]
@@ -284,7 +284,8 @@ def big_school_measures(count: int, frames: int) -> str:
             "s = summary(measures(tracks, [config.groups[0].body_length], start=warm,\n"
             "            only=('polarization', 'groups', 'overlaps', 'nearest_neighbour')), warm)\n"
             "p, least = s['polarization'][0], s['polarization_least'][0]\n"
-            "print(f'polarization mean {p:.2f} least {least:.2f}, groups at most {s[\"groups_peak\"][0]:.0f}, '\n"
+            "print(f'polarization mean {p:.2f} least {least:.2f}, '\n"
+            "      f'groups at most {s[\"groups_peak\"][0]:.0f}, '\n"
             "      f'overlapping pairs at most {s[\"overlaps_peak\"]:.0f}, '\n"
             "      f'nearest neighbour {s[\"nearest_neighbour\"]:.2f} body lengths')\n")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, cwd=ROOT)
@@ -379,7 +380,8 @@ def main() -> None:
           f"process {wall_s:.2f} s, peak RSS {peak:,.0f} MiB")
     print(f"{big[0]:,} BonyBream, default school of 300 frames, after the warm-up: {big_numbers}")
     for label, times, nbytes in (("with fins, rigid bodies", (bake_s, glb_s, write_s), size),
-                                 ("with body wave and fins", (wave_bake_s, wave_glb_s, wave_write_s), wave_size)):
+                                 ("with body wave and fins", (wave_bake_s, wave_glb_s, wave_write_s),
+                                  wave_size)):
         print(f"bake {baked[0]:,} fish x {baked[1]:,} frames {label} (median of {repeat}): "
               f"bake {times[0]:.3f} s, glb_bytes {times[1]:.3f} s, write {times[2]:.3f} s, "
               f"together {sum(times):.3f} s, {nbytes / 1e6:.2f} MB")

@@ -50,7 +50,8 @@ def _strip_morphs(scene: Scene) -> None:
         clip.channels = [c for c in clip.channels if c.path != "weights"]
 
 
-def _skin_weights(local_z: np.ndarray, nose: float, length: float, joints: int) -> tuple[np.ndarray, np.ndarray]:
+def _skin_weights(local_z: np.ndarray, nose: float, length: float,
+                  joints: int) -> tuple[np.ndarray, np.ndarray]:
     """JOINTS_0 and WEIGHTS_0 blending each vertex between the two joints around it."""
     x = np.clip((nose - local_z) / length, 0.0, 1.0) * joints - 0.5
     lower = np.clip(np.floor(x), 0, joints - 1).astype(np.int64)
@@ -180,7 +181,8 @@ def fin_gap(scene: Scene, samples: int = 49) -> float:
     lo, hi = bounds(scene)
     length = float(hi[2] - lo[2])
     rest = pose(scene)
-    rest_body = trimesh.Trimesh(deformed(scene, body, drawn[body], rest)[0], drawn[body].indices, process=False)
+    rest_body = trimesh.Trimesh(deformed(scene, body, drawn[body], rest)[0], drawn[body].indices,
+                                process=False)
     touching = {}
     for f in fins:
         _, d, _ = trimesh.proximity.closest_point(rest_body, deformed(scene, f, drawn[f], rest)[0])
@@ -193,7 +195,8 @@ def fin_gap(scene: Scene, samples: int = 49) -> float:
                                   process=False)
         for f, idx in touching.items():
             if len(idx):
-                _, d, _ = trimesh.proximity.closest_point(surface, deformed(scene, f, drawn[f], posed)[0][idx])
+                _, d, _ = trimesh.proximity.closest_point(surface,
+                                                          deformed(scene, f, drawn[f], posed)[0][idx])
                 worst = max(worst, float(d.max()))
     return worst / length
 
@@ -231,8 +234,8 @@ def validator(path: Path) -> str:
 
 
 def blender_tail(bpy_python: str, path: Path) -> str:
-    proc = subprocess.run([bpy_python, str(ROOT / "tools" / "blender_tail.py"), str(path)], capture_output=True,
-                          text=True, timeout=600)
+    proc = subprocess.run([bpy_python, str(ROOT / "tools" / "blender_tail.py"), str(path)],
+                          capture_output=True, text=True, timeout=600)
     if proc.returncode != 0:
         return f"blender failed: {proc.stderr.strip().splitlines()[-1:]}"
     return proc.stdout.strip().splitlines()[-1]
@@ -253,7 +256,8 @@ def main() -> None:
         print(f"body wave export, morph targets vs a skin of {args.joints} joints (median of {args.repeat})")
         print(f"expected tail peak-to-peak: {WAVE.tail_peak_to_peak:.3f} body lengths")
         print()
-        print(f"{'variant':8} {'file':28} {'size':>10} {'write s':>8} {'fin gap':>8} {'tail p-p':>9}  validator")
+        print(f"{'variant':8} {'file':28} {'size':>10} {'write s':>8} {'fin gap':>8} "
+              f"{'tail p-p':>9}  validator")
         for variant in ("morph", "skin"):
             fish = single_fish(variant, args.joints)
             path = folder / f"fish-{variant}.glb"
@@ -267,8 +271,8 @@ def main() -> None:
             path = folder / f"school-{variant}.glb"
             seconds = write_time(scene, path, args.repeat)
             label = f"{args.count:,} fish x {args.frames} frames"
-            print(f"{variant:8} {label:28} {path.stat().st_size:10,} {seconds:8.3f} {fin_gap(scene, 13):8.2%} "
-                  f"{'':>9}  {validator(path)}")
+            print(f"{variant:8} {label:28} {path.stat().st_size:10,} {seconds:8.3f} "
+                  f"{fin_gap(scene, 13):8.2%} {'':>9}  {validator(path)}")
 
 
 if __name__ == "__main__":

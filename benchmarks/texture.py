@@ -243,11 +243,12 @@ def blender() -> None:
         note = next((n for n in r.notes if n.startswith("silhouette IoU") or "not kept" in n), "")
         print(f"{r.photo:12s} {shot.lens:5.0f} {shot.yaw:5.0f} {shot.roll:5.0f} {shot.backdrop:8s} "
               f"{r.base:16s} "
-              f"{r.blender or 0:8.3f} {r.triangles or 0:9.3f} {r.raster:7.3f} {r.own or 0:6.3f} {r.seconds:5.1f} {note}")
+              f"{r.blender or 0:8.3f} {r.triangles or 0:9.3f} {r.raster:7.3f} {r.own or 0:6.3f} "
+              f"{r.seconds:5.1f} {note}")
     for label, ious in (("as Blender shows the file", [r.blender or 0.0 for r in rows]),
                         ("every triangle, fin masks ignored", [r.triangles or 0.0 for r in rows])):
-        print(f"{len(rows)} fits of {len(records)} Blender photos (seeds {','.join(map(str, seeds))}), {label}: "
-              f"IoU min {min(ious):.3f}, median {statistics.median(ious):.3f}, "
+        print(f"{len(rows)} fits of {len(records)} Blender photos (seeds {','.join(map(str, seeds))}), "
+              f"{label}: IoU min {min(ious):.3f}, median {statistics.median(ious):.3f}, "
               f"{sum(i >= 0.85 for i in ious)}/{len(ious)} >= 0.85")
     print(f"photos {shot_s:.0f} s, fits {sum(r.seconds for r in rows):.0f} s, "
           f"whole run {time.perf_counter() - start:.0f} s")

@@ -44,5 +44,6 @@ def test_benchmarks_and_tools_take_harness_code_not_tests():
                 names = ([a.name for a in node.names] if isinstance(node, ast.Import)
                          else [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
                 found += [f"{path.relative_to(ROOT)}: {name}" for name in names
-                          if name.startswith("tests.") and name.rsplit(".", 1)[-1].startswith(("test_", "conftest"))]
+                          if name.startswith("tests.")
+                          and name.rsplit(".", 1)[-1].startswith(("test_", "conftest"))]
     assert found == []

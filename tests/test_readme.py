@@ -7,7 +7,6 @@ import shutil
 import signal
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
@@ -35,7 +34,8 @@ def serves(line: str) -> bool:
 
 def outputs(line: str) -> list[str]:
     """The files an example names as its outputs."""
-    found = re.findall(r"(?:-o|--output|--metrics|--tracks|--plot|--report|--compare|--fxl-out)\s+(\S+)", line)
+    found = re.findall(r"(?:-o|--output|--metrics|--tracks|--plot|--report|--compare|--fxl-out)\s+(\S+)",
+                       line)
     return [f for f in found if not f.endswith("/")]
 
 

@@ -55,4 +55,5 @@ def test_an_integer_of_thousands_of_digits_is_one_line_at_its_place():
 
     with pytest.raises(FishgenError) as caught:
         loads('out = "o"\n\nframes = ' + "9" * 5000 + "\n", "m.toml")
-    assert str(caught.value) == "m.toml:3: expected a number of at most a few hundred digits, found one of 5000 digits"
+    assert str(caught.value) == ("m.toml:3: expected a number of at most a few hundred digits, "
+                                 "found one of 5000 digits")

@@ -39,7 +39,8 @@ def measure(path: Path) -> str:
             mesh = evaluated.to_mesh()
             co = np.empty(len(mesh.vertices) * 3)
             mesh.vertices.foreach_get("co", co)
-            co = co.reshape(-1, 3) @ np.array(evaluated.matrix_world)[:3, :3].T + np.array(evaluated.matrix_world)[:3, 3]
+            co = (co.reshape(-1, 3) @ np.array(evaluated.matrix_world)[:3, :3].T
+                  + np.array(evaluated.matrix_world)[:3, 3])
             points.append(co)
             evaluated.to_mesh_clear()
             keys = ob.data.shape_keys

@@ -49,7 +49,8 @@ BLENDER_SCRIPT = ROOT / "tests" / "clients" / "blender_import.py"
 BLENDER_FORMATS = ("glb", "gltf", "obj", "ply")
 BLENDER_KINDS = ("fish", "cloud")   # the school row is not judged in Blender yet
 # what Blender cannot do, as (substring of the failure, short reason)
-BLENDER_KNOWN = {"fish ply": ("no material", "ply_import ignores `comment TextureFile`: no material or image")}
+BLENDER_KNOWN = {"fish ply": ("no material",
+                              "ply_import ignores `comment TextureFile`: no material or image")}
 
 
 def _bpy_python(explicit: str | None) -> str | None:
@@ -195,7 +196,8 @@ def look(matrix: Matrix, folder: Path) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--blender", action="store_true", help="import each format with Blender's bpy module instead")
+    ap.add_argument("--blender", action="store_true",
+                    help="import each format with Blender's bpy module instead")
     ap.add_argument("--bpy-python", help="a Python that can `import bpy` (default: $FISHGEN_BPY_PYTHON, "
                                          "/tmp/bpyvenv/bin/python, or this one)")
     ap.add_argument("--out", type=Path, help="folder for the generated assets (default: a temporary one)")
@@ -216,7 +218,8 @@ def main(argv: list[str] | None = None) -> int:
             if args.blender:
                 bpy_python = _bpy_python(args.bpy_python)
                 if bpy_python is None:
-                    print("no Python with bpy: python3.11 -m venv /tmp/bpyvenv && /tmp/bpyvenv/bin/pip install bpy",
+                    print("no Python with bpy: "
+                          "python3.11 -m venv /tmp/bpyvenv && /tmp/bpyvenv/bin/pip install bpy",
                           file=sys.stderr)
                     return 1
                 results, version = run_blender(matrix.assets, bpy_python)

@@ -156,8 +156,9 @@ def test_loop_length_error_points_at_the_fin_record():
     sp = parse_species(text, "slow.txt")
     with pytest.raises(FishgenError) as info:
         build_fish(sp)
-    caudal_line = next(i for i, l in enumerate(text.splitlines(), 1) if l.endswith("3.0 10.0 0.0001"))
-    assert info.value.line == caudal_line and "fin cycle (4 x movement angle / step size) of at most 100000" in str(info.value)
+    caudal_line = next(i for i, row in enumerate(text.splitlines(), 1) if row.endswith("3.0 10.0 0.0001"))
+    assert (info.value.line == caudal_line
+            and "fin cycle (4 x movement angle / step size) of at most 100000" in str(info.value))
 
 
 def test_with_the_body_wave_the_tail_fin_rides_the_wave_and_the_loop_closes(bony):

@@ -47,7 +47,8 @@ class Photo:
 def truth_points(species: Species, project) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     rings, _ = ring_positions(profile_for(species.shape_class, species.shape_params), species.body_sections,
                               species.circle_sections, species.scale)
-    fins = {f.name: f for f in build_fins(replace(species, texture_points=None), rings, clear_of_caudal=False)}
+    fins = {f.name: f for f in build_fins(replace(species, texture_points=None), rings,
+                                          clear_of_caudal=False)}
     return project(rings.reshape(-1, 3)), {n: project(fins[p].mesh.positions) for n, p in FIN_PARTS.items()
                                            if p in fins}
 

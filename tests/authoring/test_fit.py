@@ -116,7 +116,8 @@ def test_a_broken_fit_is_not_written(tmp_path, gl_available, photos, monkeypatch
     assert not result.fitted
     assert any(n.startswith("fitted shape not kept: the caudal fin is off the tail") for n in notes)
     written = load_species(tmp_path / "new.txt")
-    assert (written.shape_class, written.scale, written.caudal) == (bream.shape_class, bream.scale, bream.caudal)
+    assert ((written.shape_class, written.scale, written.caudal)
+            == (bream.shape_class, bream.scale, bream.caudal))
 
 
 def test_a_poor_fit_is_tried_at_other_levels(tmp_path, gl_available, photos, monkeypatch):
@@ -169,8 +170,8 @@ def test_plain_texture_advises_fit_shape_below_085(tmp_path, gl_available, photo
     (advice,) = [n for n in notes if "--fit-shape" in n]
     assert advice.startswith(f"silhouette IoU {result.iou:.3f}") and "\n" not in advice
     own: list[str] = []
-    result = make_texture(tmp_path / "p.png", load_species(PARAMS / "threadfingoldie.txt"), tmp_path / "b.txt",
-                          on_note=own.append)
+    result = make_texture(tmp_path / "p.png", load_species(PARAMS / "threadfingoldie.txt"),
+                          tmp_path / "b.txt", on_note=own.append)
     assert result.iou is not None and result.iou >= 0.85 and own == []
 
 
@@ -215,9 +216,11 @@ def test_a_fish_standing_on_end_is_refused_in_one_line(tmp_path):
     from tests.conftest import PARAMS, run_cli
 
     photo = tmp_path / "standing.png"
-    Image.open(PARAMS / "photos" / "bonybream-side.png").rotate(91, expand=True, fillcolor=(125, 156, 180)).save(photo)
+    Image.open(PARAMS / "photos" / "bonybream-side.png").rotate(
+        91, expand=True, fillcolor=(125, 156, 180)).save(photo)
     result = run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "new.txt")
-    assert result.returncode == 2 and result.stderr.startswith(f"{photo}: expected a side view of a fish within 30")
+    assert (result.returncode == 2
+            and result.stderr.startswith(f"{photo}: expected a side view of a fish within 30"))
     assert not (tmp_path / "new.txt").exists()
 
 
@@ -231,7 +234,8 @@ def test_a_photo_too_long_for_its_height_is_refused_before_measuring(tmp_path):
     image = Image.new("RGBA", (8000, 64), (0, 0, 0, 0))
     ImageDraw.Draw(image).ellipse((100, 10, 7900, 54), fill=(200, 150, 50, 255))
     image.save(photo)
-    result = run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "t.txt", "--body-sections", "7")
+    result = run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "t.txt",
+                     "--body-sections", "7")
     assert result.returncode == 2 and "at most 32 times as long as it is tall" in result.stderr
     assert "Traceback" not in result.stderr
 

@@ -71,7 +71,8 @@ def test_faults_name_their_line(text, line, words):
 
 
 @pytest.mark.parametrize("text,line,message", [
-    ("//body\n4\n1 1 0.1 0.1\n1 0 0.2 0.2\n0 1 0.3 0.3\n0 0 0.4 0.4\n", 3, "section and circle 0 0, found 1 1"),
+    ("//body\n4\n1 1 0.1 0.1\n1 0 0.2 0.2\n0 1 0.3 0.3\n0 0 0.4 0.4\n", 3,
+     "section and circle 0 0, found 1 1"),
     ("//body\n2\n0.1 0.1 0.2 0.2\n0.3 0.3 0.4 0.4\n", 3, "whole numbers first, found '0.1'"),
     ("//body\n4\n0 0 0.1 0.1\n0 1 0.2 0.2\n0 3 0.3 0.3\n1 0 0.4 0.4\n", 5, "found 0 3"),
     ("//body\n3\n0 0 0.1 0.1\n0 1 0.2 0.2\n1 0 0.3 0.3\n", 5, "expected 2 points on the last body section"),

@@ -43,7 +43,8 @@ def test_three_js_photo_round_trip(tmp_path, gl_available, three_photos, name):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("subject, base_name", [("sampled_7", "threadfingoldie"), ("forked", "pineapplefish")])
+@pytest.mark.parametrize("subject, base_name",
+                         [("sampled_7", "threadfingoldie"), ("forked", "pineapplefish")])
 def test_unseen_fish_lit_and_turned_fits_any_base(tmp_path, gl_available, camera, subject, base_name):
     """Issue 25: a fish fishgen does not ship, lit by an environment map and a sun, turned 12 degrees
     off side-on in a slight perspective, with translucent fins, made into a species with

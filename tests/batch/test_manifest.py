@@ -127,11 +127,13 @@ def test_a_job_takes_every_option_of_its_command_that_a_manifest_may_set(kind):
     local = {"output", "quiet", "verbose", "json", "help"}  # -o is a manifest's `output`
     declared = manifest_options(command(kind).options)
     assert set(declared) <= names - local
-    assert all(not spec.manifest for f, spec in manifest_options.__globals__["declared"](command(kind).options)
+    assert all(not spec.manifest
+               for f, spec in manifest_options.__globals__["declared"](command(kind).options)
                if f.name.replace("_", "-") in names - local - set(declared))
 
 
 def test_a_seed_the_command_line_takes_a_manifest_takes_too(tmp_path):
     """Issue 19: `--seed 1099511627776` worked on the command line and was refused in a manifest."""
-    manifest = load_manifest(write(tmp_path, '[[clouds]]\ninput = "a.awn"\noutput = "a.ply"\nseed = 1099511627776\n'))
+    manifest = load_manifest(write(tmp_path, '[[clouds]]\ninput = "a.awn"\noutput = "a.ply"\n'
+                                             'seed = 1099511627776\n'))
     assert manifest.jobs[0].options.seed == 1099511627776

@@ -136,14 +136,16 @@ def fake_pool(tmp_path, monkeypatch, names: list[str], fail_fast: bool = False) 
     reported: dict[str, list] = {}
 
     def done(job, result) -> bool:
-        reported.setdefault(job.name, []).append((result.status, result.error.message if result.error else None))
+        reported.setdefault(job.name, []).append((result.status,
+                                                  result.error.message if result.error else None))
         return fail_fast and result.status == "failed"
 
     _pool([Job("build", name, (), tmp_path / f"{name}.glb") for name in names], run_job, done, 2, fail_fast)
     return reported
 
 
-def test_a_job_that_kills_its_worker_fails_alone_and_the_jobs_queued_beside_it_are_built(tmp_path, monkeypatch):
+def test_a_job_that_kills_its_worker_fails_alone_and_the_jobs_queued_beside_it_are_built(
+        tmp_path, monkeypatch):
     names = [f"fish{i:02d}" for i in range(30)]
     names[3:3] = ["kills-always"]
     # dies in a chunk, then once more alone: an outside kill (an OOM killer) is forgiven once

@@ -88,8 +88,8 @@ def test_failed_write_leaves_no_partial_file(tmp_path):
 
 def test_every_format_from_the_command_line(tmp_path):
     for ext in ("glb", "gltf", "obj", "ply"):
-        result = run_cli("build", PARAMS / "pineapplefish.txt", "-o", tmp_path / f"p.{ext}", "--fins", "opaque",
-                         "--length", "0.2")
+        result = run_cli("build", PARAMS / "pineapplefish.txt", "-o", tmp_path / f"p.{ext}",
+                         "--fins", "opaque", "--length", "0.2")
         assert result.returncode == 0, result.stderr
     assert_valid_gltf(tmp_path / "p.glb", tmp_path / "p.gltf")
 
@@ -117,13 +117,15 @@ def test_batch_refuses_two_files_that_would_write_one_output(tmp_path):
     for sub in ("a", "b"):
         (tmp_path / sub).mkdir()
         shutil.copy(PARAMS / "bonybream.txt", tmp_path / sub / "fish.txt")
-    result = run_cli("build", tmp_path / "a" / "fish.txt", tmp_path / "b" / "fish.txt", "-o", f"{tmp_path}/out/")
+    result = run_cli("build", tmp_path / "a" / "fish.txt", tmp_path / "b" / "fish.txt",
+                     "-o", f"{tmp_path}/out/")
     assert result.returncode == 2 and "distinct names" in result.stderr
     assert not (tmp_path / "out").exists()
 
 
 def test_batch_refuses_a_file_name_as_its_folder(tmp_path):
-    result = run_cli("build", PARAMS / "bonybream.txt", PARAMS / "centroberyx.txt", "-o", tmp_path / "two.glb")
+    result = run_cli("build", PARAMS / "bonybream.txt", PARAMS / "centroberyx.txt",
+                     "-o", tmp_path / "two.glb")
     assert result.returncode == 2 and "expected a folder for 2 species files" in result.stderr
     assert not (tmp_path / "two.glb").exists()
 
@@ -134,9 +136,12 @@ def test_damaged_texture_is_reported_at_the_texture_line_and_the_batch_goes_on(t
     (tmp_path / "bonybream.png").write_bytes(png[: len(png) // 3])
     result = run_cli("build", species, PARAMS / "centroberyx.txt", "-o", f"{tmp_path}/batch/")
     assert result.returncode == 2
-    line = next(i for i, l in enumerate(species.read_text().splitlines(), 1) if l.startswith("bonybream.png"))
-    assert f"{species}:{line}: expected a readable texture image, found 'bonybream.png' damaged" in result.stderr
-    assert (tmp_path / "batch" / "centroberyx.glb").is_file() and not (tmp_path / "batch" / "fish.glb").exists()
+    line = next(i for i, row in enumerate(species.read_text().splitlines(), 1)
+                if row.startswith("bonybream.png"))
+    assert (f"{species}:{line}: expected a readable texture image, found 'bonybream.png' damaged"
+            in result.stderr)
+    assert ((tmp_path / "batch" / "centroberyx.glb").is_file()
+            and not (tmp_path / "batch" / "fish.glb").exists())
 
 
 def test_output_names_that_need_percent_encoding(tmp_path):
@@ -152,8 +157,8 @@ def test_an_existing_folder_is_a_folder_whatever_its_name(tmp_path):
 
 
 @pytest.mark.parametrize("output,message", [
-    ("fish", "expected an output file with an extension, or a folder (an existing one, or a name ending in /), "
-             "found"),
+    ("fish", "expected an output file with an extension, or a folder "
+             "(an existing one, or a name ending in /), found"),
     ("fish.txt", "expected an output ending in .glb, .gltf, .obj, .ply"),
 ])
 def test_o_never_turns_silently_into_a_folder(tmp_path, output, message):

@@ -46,7 +46,8 @@ def test_json_errors_are_one_object_with_the_exit_status(tmp_path, args, status,
 def test_json_errors_of_a_multi_file_build_are_one_object_per_bad_file(tmp_path):
     bad = tmp_path / "bad.txt"
     bad.write_text("nothing like a species\n")
-    run = run_cli("build", PARAMS / "bonybream.txt", bad, tmp_path / "none.txt", "-o", f"{tmp_path}/out/", "--json")
+    run = run_cli("build", PARAMS / "bonybream.txt", bad, tmp_path / "none.txt",
+                  "-o", f"{tmp_path}/out/", "--json")
     assert run.returncode == 2 and (tmp_path / "out" / "bonybream.glb").is_file()
     errors = [json.loads(line) for line in run.stderr.splitlines()]
     assert [(e["file"], e["line"], e["exit"], e["kind"]) for e in errors] == [

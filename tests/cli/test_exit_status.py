@@ -28,7 +28,8 @@ def writers(out: Path) -> dict[str, list[str]]:
         "clouds": ["clouds", str(CUBES), "-o", str(out / "cloud.ply")],
         "school": ["school", str(FISH), "--count", "4", "--frames", "10", "-o", str(out / "school.glb")],
         "preview": ["preview", str(FISH), "-o", str(out / "fish.png"), "--size", "320x240"],
-        "view": ["view", str(ROOT / "tests" / "fixtures" / "tiny.glb"), "--no-serve", "-o", str(out / "page.html")],
+        "view": ["view", str(ROOT / "tests" / "fixtures" / "tiny.glb"), "--no-serve",
+                 "-o", str(out / "page.html")],
         "texture": ["texture", str(PHOTO), "-s", str(FISH), "-o", str(out / "new.txt")],
         "species": ["species", "--random", "-o", str(out / "sp.txt")],
         "batch": ["batch", str(PARAMS / "clouds"), "--out", str(out / "all"), "-j", "1"],
@@ -104,7 +105,8 @@ def test_a_port_already_taken_exits_1(tmp_path):
     assert result.returncode == 1 and error["kind"] == "os" and f"port {port}" in error["error"]
 
 
-BLOCK = "import sys; sys.modules[{name!r}] = None; from fishgen.cli import run; sys.argv[0] = 'fishgen'; run()"
+BLOCK = ("import sys; sys.modules[{name!r}] = None; from fishgen.cli import run; "
+         "sys.argv[0] = 'fishgen'; run()")
 
 
 @pytest.mark.parametrize("module,args", [
@@ -118,7 +120,7 @@ def test_a_missing_optional_package_exits_1_before_any_work(tmp_path, module, ar
     result = subprocess.run([sys.executable, "-c", BLOCK.format(name=module), "--json", *filled], cwd=ROOT,
                             capture_output=True, text=True, timeout=60)
     error = one_error(result)
-    assert result.returncode == 1 and error["kind"] == "dependency" and f"fishgen[" in error["error"]
+    assert result.returncode == 1 and error["kind"] == "dependency" and "fishgen[" in error["error"]
     assert list(tmp_path.iterdir()) == []
 
 
@@ -135,7 +137,8 @@ def test_bad_input_exits_2_in_one_line_and_writes_nothing(tmp_path, name):
         args = ["batch", str(bad), "--out", str(tmp_path / "out")]
     result = run(args)
     error = one_error(result)
-    assert result.returncode == 2 and error["exit"] == 2 and error["kind"] in ("input", "usage"), result.stderr
+    assert (result.returncode == 2 and error["exit"] == 2
+            and error["kind"] in ("input", "usage")), result.stderr
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.*"))
 
 

@@ -3,7 +3,6 @@ no traceback, no output, bounded memory."""
 from __future__ import annotations
 
 import os
-import resource
 import subprocess
 import sys
 
@@ -123,7 +122,8 @@ def test_a_huge_line_is_refused_before_it_is_split(tmp_path):
     code = ("import resource, sys; from fishgen.cli import main; "
             f"resource.setrlimit(resource.RLIMIT_AS, ({1 << 30}, {1 << 30})); "
             f"main(['build', {str(species)!r}, '-o', {str(tmp_path / 'x.glb')!r}])")
-    result = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    result = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True,
+                            timeout=60)
     one_line_error(result, f"huge.txt:{at + 1}: expected the shape record", "16,000,0")
 
 
@@ -144,7 +144,8 @@ def test_preview_of_a_tiny_cube_file_of_millions_of_particles_is_subsampled(tmp_
     code = ("import resource; from fishgen.cli import main; "
             f"resource.setrlimit(resource.RLIMIT_AS, ({3 << 30}, {3 << 30})); "  # EGL reserves address space
             f"main(['preview', {str(cubes)!r}, '-o', {str(tmp_path / 'p.png')!r}, '--size', '160x120'])")
-    result = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    result = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True,
+                            timeout=120)
     assert result.returncode == 0, result.stderr
     assert result.stderr == f"{cubes}: previewing 100,000 of its 20,000,000 particles\n"
     assert (tmp_path / "p.png").is_file()

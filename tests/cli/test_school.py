@@ -7,8 +7,8 @@ import subprocess
 import sys
 
 import numpy as np
-import pytest
 import pygltflib
+import pytest
 
 from tests.conftest import PARAMS, ROOT, assert_valid_gltf, run_cli
 
@@ -28,18 +28,21 @@ def test_the_exact_form_writes_a_valid_animated_school(tmp_path):
     assert len(doc.scenes[0].nodes) == 30 and [a.name for a in doc.animations] == ["school"]
     assert len(doc.meshes) == 9                                           # one mesh per part, shared
     again = tmp_path / "again.glb"
-    run_cli("school", PARAMS / "bonybream.txt", "-o", again, "--count", "30", "--frames", "120", "--seed", "5")
+    run_cli("school", PARAMS / "bonybream.txt", "-o", again,
+            "--count", "30", "--frames", "120", "--seed", "5")
     assert again.read_bytes() == out.read_bytes()
 
 
 def test_scene_file_with_tracks_metrics_and_plot(tmp_path):
     out = tmp_path / "reef.glb"
     result = run_cli("school", PARAMS / "reef.toml", "-o", out, "--frames", "60", "--count", "8",
-                     "--tracks", tmp_path / "t.npz", "--metrics", tmp_path / "m.json", "--plot", tmp_path / "p.png")
+                     "--tracks", tmp_path / "t.npz", "--metrics", tmp_path / "m.json",
+                     "--plot", tmp_path / "p.png")
     assert result.returncode == 0, result.stderr
     assert_valid_gltf(out)
     tracks = np.load(tmp_path / "t.npz")
-    assert len(tracks["frame"]) == 60 * 16 and list(tracks["species_names"]) == ["bonybream", "threadfingoldie"]
+    assert (len(tracks["frame"]) == 60 * 16
+            and list(tracks["species_names"]) == ["bonybream", "threadfingoldie"])
     assert np.isfinite(tracks["x"]).all() and set(np.unique(tracks["species"])) == {0, 1}
     metrics = json.loads((tmp_path / "m.json").read_text())
     assert len(metrics["per_frame"]["polarization"]) == 60 and "predator_distance" in metrics["per_frame"]
@@ -81,8 +84,8 @@ def test_metrics_are_strict_json_even_when_a_measure_has_no_value(tmp_path):
     import json
 
     out = tmp_path / "one.json"
-    result = run_cli("school", PARAMS / "bonybream.txt", "--count", "1", "--frames", "20", "-o", tmp_path / "one.glb",
-                     "--metrics", out)
+    result = run_cli("school", PARAMS / "bonybream.txt", "--count", "1", "--frames", "20",
+                     "-o", tmp_path / "one.glb", "--metrics", out)
     assert result.returncode == 0, result.stderr
 
     def refuse(constant):
@@ -135,14 +138,16 @@ def test_school_options_reach_the_run_as_the_scene_file_keys_do(tmp_path):
 def test_compact_stores_the_school_keys_as_16_bit_integers_and_the_file_shrinks(tmp_path):
     plain, compact = tmp_path / "plain.glb", tmp_path / "compact.glb"
     for out, flags in ((plain, ()), (compact, ("--compact",))):
-        result = run_cli("school", PARAMS / "bonybream.txt", "--count", "20", "--frames", "60", "-o", out, *flags)
+        result = run_cli("school", PARAMS / "bonybream.txt", "--count", "20", "--frames", "60",
+                         "-o", out, *flags)
         assert result.returncode == 0, result.stderr
     assert_valid_gltf(compact)
     doc = pygltflib.GLTF2().load(str(compact))
     outputs = {doc.accessors[doc.animations[0].samplers[c.sampler].output].componentType
                for c in doc.animations[0].channels if c.target.path in ("rotation", "weights")}
     assert outputs <= {pygltflib.SHORT, pygltflib.UNSIGNED_SHORT} and outputs
-    assert compact.stat().st_size < plain.stat().st_size  # small here: the meshes weigh most (-35 % at 1,000 fish)
+    # small here: the meshes weigh most (-35 % at 1,000 fish)
+    assert compact.stat().st_size < plain.stat().st_size
 
 
 @pytest.mark.parametrize("count,frames", [(100_000, 2), (3_000, 3_000)])
@@ -159,7 +164,8 @@ def test_a_school_too_big_for_the_memory_allowed_is_refused_before_it_starts(tmp
                           str(count), "--frames", str(frames), "-o", str(tmp_path / "big.glb")],
                          capture_output=True, text=True, preexec_fn=cap, timeout=120)
     assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr
-    assert "fits in 1.5 GiB (this process's address-space limit)" in run.stderr and "needs about" in run.stderr
+    assert ("fits in 1.5 GiB (this process's address-space limit)" in run.stderr
+            and "needs about" in run.stderr)
     assert not (tmp_path / "big.glb").exists()
 
 
@@ -177,8 +183,8 @@ def test_lods_and_merge_give_every_fish_the_engine_layout_over_shared_meshes(tmp
     """`fishgen school --lods ... --merge` (issue 24): each fish is its species' node tree, its
     levels tied by MSFT_lod, two draw calls a fish, the meshes shared by every fish."""
     out = tmp_path / "school.glb"
-    result = run_cli("school", PARAMS / "bonybream.txt", "--count", "6", "--frames", "30", "--lods", "16x12,8x6",
-                     "--merge", "-o", out)
+    result = run_cli("school", PARAMS / "bonybream.txt", "--count", "6", "--frames", "30",
+                     "--lods", "16x12,8x6", "--merge", "-o", out)
     assert result.returncode == 0, result.stderr
     assert_valid_gltf(out)
     doc = pygltflib.GLTF2().load(str(out))
@@ -186,8 +192,8 @@ def test_lods_and_merge_give_every_fish_the_engine_layout_over_shared_meshes(tmp
     drawn = [n for n in doc.nodes if n.mesh is not None]
     lod0 = [n for n in drawn if (n.extensions or {}).get("MSFT_lod")]
     assert len(lod0) == 6 and all(len(n.extensions["MSFT_lod"]["ids"]) == 1 for n in lod0)
-    assert sum(len(doc.meshes[n.mesh].primitives) for n in lod0) == 6 * 2     # two draw calls a fish
-    assert len(doc.skins) == 6 * 2                                         # each fish its own joints per level
+    assert sum(len(doc.meshes[n.mesh].primitives) for n in lod0) == 6 * 2  # two draw calls a fish
+    assert len(doc.skins) == 6 * 2                                      # each fish its own joints per level
     refused = run_cli("school", PARAMS / "bonybream.txt", "--merge", "--tints", "3", "-o", out)
     assert refused.returncode == 2 and "expected --tints 1 with --lods or --merge" in refused.stderr
 

@@ -57,8 +57,8 @@ class BabylonClient(HarnessPage):
         self._clear()
         url = f"{self.base}/assets/{asset.path.resolve().relative_to(self.asset_dir).as_posix()}"
         # one JSON string crosses faster than a large nested object
-        result = json.loads(self.page.evaluate("async ([u, o]) => JSON.stringify(await window.inspectAsset(u, o))",
-                                               [url, {}]))
+        result = json.loads(self.page.evaluate(
+            "async ([u, o]) => JSON.stringify(await window.inspectAsset(u, o))", [url, {}]))
         self.page.wait_for_timeout(50)  # let late console messages and responses land
         return result
 
@@ -98,7 +98,8 @@ def judge(asset: Asset, r: dict) -> str:
     expect(bool(meshes), "no meshes")
     points = [m for m in meshes if m["material"] and m["material"]["points"]]
     solid = [m for m in meshes if m not in points]
-    counts = {"triangles": sum(m["indices"] // 3 for m in solid), "particles": sum(m["vertices"] for m in points)}
+    counts = {"triangles": sum(m["indices"] // 3 for m in solid),
+              "particles": sum(m["vertices"] for m in points)}
     vertices = sum(m["vertices"] for m in solid)
     if asset.fmt.ext not in ("obj", "ply"):
         counts["vertices"] = vertices
@@ -120,9 +121,11 @@ def judge(asset: Asset, r: dict) -> str:
         for m, j in zip(meshes, pairs, strict=True):
             want = expected.primitives[j].targets
             found = [as_box(b) for b in m["targets"]]
-            expect(len(found) == len(want), f"{m['path']}: {len(found)} morph targets, fishgen made {len(want)}")
+            expect(len(found) == len(want),
+                   f"{m['path']}: {len(found)} morph targets, fishgen made {len(want)}")
             for k, (a, b) in enumerate(zip(found, want, strict=True)):
-                expect(box_close(a, b, tol), f"{m['path']}: morph target {k} bounds {show(a)}, fishgen's {show(b)}")
+                expect(box_close(a, b, tol),
+                       f"{m['path']}: morph target {k} bounds {show(a)}, fishgen's {show(b)}")
     if asset.engine is not None:
         notes += _judge_engine(asset, r, tol)
     elif asset.clip:
@@ -135,7 +138,8 @@ def judge(asset: Asset, r: dict) -> str:
         mat = m["material"]
         if textured:
             expect(mat is not None and mat["albedo"] is not None, f"{m['name']}: material has no texture")
-            expect(mat["albedo"]["ready"] and mat["albedo"]["width"] > 0, f"{m['name']}: texture did not arrive")
+            expect(mat["albedo"]["ready"] and mat["albedo"]["width"] > 0,
+                   f"{m['name']}: texture did not arrive")
         if asset.fmt.kind == "cloud":
             expect("color" in m["kinds"] and m["useVertexColors"], f"{m['name']}: particle colours not used")
         if "--billboards" in asset.fmt.flags:
@@ -204,7 +208,8 @@ def _judge_clip(asset: Asset, r: dict, tol: float, clip: ClipBounds | None = Non
     unbound = [t["node"] or t["property"] for t in live if not t["inScene"]]
     expect(not unbound, f"tracks target nothing in the scene: {unbound[:3]}")
     length = (group["to"] - group["from"]) / group["fps"]
-    expect(abs(length - clip.duration) < 1e-3, f"{name} lasts {length:.4f} s, fishgen's {clip.duration:.4f} s")
+    expect(abs(length - clip.duration) < 1e-3,
+           f"{name} lasts {length:.4f} s, fishgen's {clip.duration:.4f} s")
     assert asset.bounds.scene is not None
     truth = ClipTruth(asset.bounds.scene, name)
     tracks = [{"node": _node_of(t["node"]), "kind": "weight" if t["property"] == "influence" else "trs",

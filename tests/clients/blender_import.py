@@ -79,7 +79,8 @@ def inspect(path: Path) -> dict:
                         uv_layers=[u.name for u in me.uv_layers],
                         color_attributes=[c.name for c in me.color_attributes],
                         materials=[{"name": m.name if m else None, "images": _images(m),
-                                    "blend": getattr(m, "surface_render_method", getattr(m, "blend_method", ""))}
+                                    "blend": getattr(m, "surface_render_method",
+                                                     getattr(m, "blend_method", ""))}
                                    for m in me.materials])
         elif ob.type == "POINTCLOUD":
             info.update(points=len(ob.data.points), attributes=sorted(a.name for a in ob.data.attributes))

@@ -89,7 +89,8 @@ def scene_bounds(scene: Scene) -> Bounds:
         targets = tuple(_box(p + np.asarray(t["POSITION"], float)) for t in prim.targets if "POSITION" in t)
         prims.append(PrimitiveBounds(scene.nodes[node].name, prim.mode, _box(moved), _box(p), targets))
     clip = scene.clip()
-    return Bounds(tuple(prims), _union([b.world for b in prims]), _clip_bounds(scene, clip) if clip else None, scene)
+    return Bounds(tuple(prims), _union([b.world for b in prims]),
+                  _clip_bounds(scene, clip) if clip else None, scene)
 
 
 def merged(bounds: Bounds, name: str) -> Bounds:
@@ -112,7 +113,8 @@ def _clip_bounds(scene: Scene, clip) -> ClipBounds:
         mesh = scene.nodes[ch.node].mesh
         if ch.path == "weights" and mesh is not None:
             targets += len(scene.meshes[mesh].primitives[0].targets)
-    return ClipBounds(clip.name, clip.duration, len({ch.node for ch in clip.channels if ch.path != "weights"}),
+    return ClipBounds(clip.name, clip.duration,
+                      len({ch.node for ch in clip.channels if ch.path != "weights"}),
                       paths.count("rotation"), paths.count("translation"), paths.count("scale"),
                       paths.count("weights"), targets)
 
@@ -149,8 +151,8 @@ class ClipTruth:
             return self.paths[plain]
         # a client may hang the asset under a root of its own: try each tail of the path
         parts = plain.split("/")
-        return next((self.paths["/".join(parts[k:])] for k in range(1, len(parts)) if "/".join(parts[k:]) in self.paths),
-                    None)
+        return next((self.paths["/".join(parts[k:])] for k in range(1, len(parts))
+                     if "/".join(parts[k:]) in self.paths), None)
 
     def trs(self, node: int, times) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The node's translation, rotation (x, y, z, w) and scale at each of ``times``, (n, 3|4|3):
@@ -162,7 +164,8 @@ class ClipTruth:
         out = []
         for path, rest in (("translation", n.translation), ("rotation", n.rotation), ("scale", n.scale)):
             ch = self.channels.get((node, path))
-            out.append(sample_many(ch, times) if ch is not None else np.tile(np.asarray(rest, float), (len(times), 1)))
+            out.append(sample_many(ch, times) if ch is not None
+                       else np.tile(np.asarray(rest, float), (len(times), 1)))
         return out[0], out[1], out[2]
 
     def weight(self, node: int, target: int, times) -> np.ndarray | None:
@@ -185,7 +188,8 @@ def sample_many(channel, times) -> np.ndarray:
     k = np.clip(np.searchsorted(keys, times, side="right") - 1, 0, len(keys) - 1)
     k1 = np.minimum(k + 1, len(keys) - 1)
     span = keys[k1] - keys[k]
-    s = np.where(span > 0, (np.clip(times, keys[0], keys[-1]) - keys[k]) / np.where(span > 0, span, 1), 0.0)[:, None]
+    s = np.where(span > 0, (np.clip(times, keys[0], keys[-1]) - keys[k]) / np.where(span > 0, span, 1),
+                 0.0)[:, None]
     if smp.interpolation == "STEP":
         s = np.zeros_like(s)
     a, b = values[k], values[k1]
@@ -294,7 +298,8 @@ def box_close(a: Box | None, b: Box | None, tol: float) -> bool:
 def show(box: Box | None) -> str:
     if box is None:
         return "none"
-    return "[" + ", ".join(f"{v:.4g}" for v in box[0]) + "] to [" + ", ".join(f"{v:.4g}" for v in box[1]) + "]"
+    return ("[" + ", ".join(f"{v:.4g}" for v in box[0]) + "] to ["
+            + ", ".join(f"{v:.4g}" for v in box[1]) + "]")
 
 
 def pair_primitives(found: list[Box], expected: Bounds, what: str = "surface") -> list[int]:
@@ -312,7 +317,8 @@ def pair_primitives(found: list[Box], expected: Bounds, what: str = "surface") -
             nearest = min(left or range(len(expected.primitives)),
                           key=lambda j: _distance(box, expected.primitives[j].world))
             raise AssertionError(f"{what} {i} bounds {show(box)}, fishgen's nearest "
-                                 f"({expected.primitives[nearest].node}) is {show(expected.primitives[nearest].world)}")
+                                 f"({expected.primitives[nearest].node}) "
+                                 f"is {show(expected.primitives[nearest].world)}")
         left.remove(hit)
         pairs.append(hit)
     if left:

@@ -57,11 +57,13 @@ CULL_DISABLED = 2
 # What Godot 3.2.3 prints while importing or loading files that are fine, and why it is not a failure.
 GODOT_NOISE: tuple[tuple[str, str], ...] = (
     ('free_static: Condition "p_ptr == __null" is true',
-     "Debian's 3.2.3 build prints it once per glTF node (+1) for any glTF, a hand-written one-triangle file too"),
+     "Debian's 3.2.3 build prints it once per glTF node (+1) for any glTF, "
+     "a hand-written one-triangle file too"),
     ('store_buffer: Condition "!p_src" is true',
      "the scene importer saving an empty array (godotengine/godot#35637)"),
     ("Couldn't open MTL file",
-     "the OBJ importer opens `mtllib` relative to the working folder first, then beside the .obj, which works"),
+     "the OBJ importer opens `mtllib` relative to the working folder first, then beside the .obj, "
+     "which works"),
     ("Ambient light for material",
      "a warning: Godot's PBR materials have no ambient colour (fishgen writes `Ka 0 0 0`)"),
 )
@@ -234,9 +236,11 @@ def judge(asset: Asset, r: dict) -> str:
         if asset.fmt.ext == "obj":
             continue  # OBJ holds the rest pose only
         found = [as_box(b) for b in s["blend_aabbs"]]
-        expect(len(found) == len(want), f"{mesh['name']}: {len(found)} blend shapes, fishgen made {len(want)}")
+        expect(len(found) == len(want),
+               f"{mesh['name']}: {len(found)} blend shapes, fishgen made {len(want)}")
         for k, (a, b) in enumerate(zip(found, want, strict=True)):
-            expect(box_close(a, b, tol), f"{mesh['name']}: blend shape {k} bounds {show(a)}, fishgen's {show(b)}")
+            expect(box_close(a, b, tol),
+                   f"{mesh['name']}: blend shape {k} bounds {show(a)}, fishgen's {show(b)}")
     if asset.clip:
         if asset.engine is not None:
             limits += _judge_engine(asset, r)
@@ -253,7 +257,8 @@ def judge(asset: Asset, r: dict) -> str:
         if textured:
             expect(mat is not None, f"{mesh['name']}: no material")
             tex = mat.get("albedo_texture")
-            expect(bool(tex) and tex["width"] > 0, f"{mesh['name']}: material {mat.get('name')} has no albedo texture")
+            expect(bool(tex) and tex["width"] > 0,
+                   f"{mesh['name']}: material {mat.get('name')} has no albedo texture")
         if asset.fmt.kind == "cloud":  # COLOR_0 is each particle's colour; glTF multiplies it in
             expect(s["has_color"], f"{mesh['name']}: particle colours missing")
             shown = [] if mat and mat["vertex_color_use_as_albedo"] else ["COLOR_0 imported but not shown"]
@@ -307,10 +312,12 @@ def _judge_clip(asset: Asset, animations: list[dict], tol: float,
     value = [t for t in anim["tracks"] if t["type"] == TRACK_VALUE]
     expect(len(transform) == clip.trs_nodes and len(value) == clip.weight_tracks,
            f"{name}: {len(transform)} transform and {len(value)} blend shape tracks, expected "
-           f"{clip.trs_nodes} and {clip.weight_tracks} ({clip.weight_channels} weights channels x their targets)")
+           f"{clip.trs_nodes} and {clip.weight_tracks} "
+           f"({clip.weight_channels} weights channels x their targets)")
     unbound = [t["path"] for t in anim["tracks"] if not t["bound"] or t.get("property_exists") is False]
     expect(not unbound, f"tracks target nothing: {unbound[:3]}")
-    expect(abs(anim["length"] - clip.duration) < 1e-3, f"{name} lasts {anim['length']} s, fishgen's {clip.duration:.4f} s")
+    expect(abs(anim["length"] - clip.duration) < 1e-3,
+           f"{name} lasts {anim['length']} s, fishgen's {clip.duration:.4f} s")
     assert asset.bounds.scene is not None
     truth = ClipTruth(asset.bounds.scene, name)
     keys = [{"node": _transform_node(truth, t, i, clip), "kind": "trs", "keys": t["keys"]}
@@ -322,12 +329,14 @@ def _judge_clip(asset: Asset, animations: list[dict], tol: float,
     expect_same_keys(key_errors(truth, keys), tol)
     # as the player plays it: Godot's importer resamples node tracks at 15 fps and drops keys
     # its optimizer finds redundant, so between its keys it may differ (a note, with the figure)
-    played = key_errors(truth, [{**k, "keys": t["played"]} for k, t in zip(keys, transform + value, strict=True)])
+    played = key_errors(truth, [{**k, "keys": t["played"]}
+                                for k, t in zip(keys, transform + value, strict=True)])
     notes = []
     if played.translation > 1e-4 or played.rotation > 0.1:
         notes.append(f"plays node keys resampled at 15 fps: within {played.translation * 1000:.1f} mm, "
                      f"{played.rotation:.1f}°")
-    expect(played.weight < 1e-3, f"plays blend shape weights off by {played.weight:.3g} ({played.worst['weight']})")
+    expect(played.weight < 1e-3,
+           f"plays blend shape weights off by {played.weight:.3g} ({played.worst['weight']})")
     if not anim["loop"]:
         notes.append(f"`{name}` imports unlooped")
     return notes
@@ -344,7 +353,8 @@ def read_glb(path: Path) -> tuple[dict, bytes]:
     (json_len, _), offset = struct.unpack_from("<II", data, 12), 20
     doc = json.loads(data[offset:offset + json_len])
     offset += json_len
-    blob = data[offset + 8:offset + 8 + struct.unpack_from("<I", data, offset)[0]] if offset < len(data) else b""
+    blob = (data[offset + 8:offset + 8 + struct.unpack_from("<I", data, offset)[0]]
+            if offset < len(data) else b"")
     return doc, blob
 
 

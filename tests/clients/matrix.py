@@ -78,7 +78,8 @@ FORMATS = (
     Format("fish gltf", "fish", "fish.gltf"),
     Format("fish obj", "fish", "fish.obj"),
     Format("fish ply", "fish", "fish.ply"),
-    Format("school glb", "school", "school.glb", ("--count", str(SCHOOL_FISH), "--frames", str(SCHOOL_FRAMES))),
+    Format("school glb", "school", "school.glb",
+           ("--count", str(SCHOOL_FISH), "--frames", str(SCHOOL_FRAMES))),
     Format("engine fish glb", "fish", "engine.glb", (*ENGINE_FLAGS, "--clips", ",".join(ENGINE_CLIPS))),
     Format("engine school glb", "school", "engine_school.glb",
            ("--count", str(SCHOOL_FISH), "--frames", str(SCHOOL_FRAMES), *ENGINE_FLAGS)),
@@ -102,13 +103,15 @@ APPLIES = {  # Godot 3 has no PLY importer; Babylon.js reads PLY through its spl
 KNOWN_LIMITS: dict[tuple[str, str], tuple[str, str]] = {
     ("fish ply", "three.js"): ("never requested", "PLYLoader ignores `comment TextureFile`: no texture"),
     ("fish ply", "Babylon.js"): ("material has no texture",
-                                 "the splat loader's PLY mesh ignores `comment TextureFile` and s/t: no texture"),
+                                 "the splat loader's PLY mesh ignores `comment TextureFile` and s/t: "
+                                 "no texture"),
     ("fish obj", "Godot 3"): ("map_d", "the OBJ importer ignores `map_d`: fins opaque and one-sided"),
     ("cloud glb points", "Godot 3"): ("COLOR_0 imported but not shown",
                                       "COLOR_0 kept but not shown (the importer uses vertex colours only for "
                                       "materials named `…-vcol`): particles white"),
     ("cloud glb billboards", "Godot 3"): ("COLOR_0 imported but not shown, KHR_materials_unlit ignored",
-                                          "COLOR_0 not shown, KHR_materials_unlit ignored: particles white and lit"),
+                                          "COLOR_0 not shown, KHR_materials_unlit ignored: "
+                                          "particles white and lit"),
     ("fish obj", "trimesh"): ("map_d", "trimesh ignores map_d (fins keep the skin png's alpha)"),
     # Babylon's MSFT_lod loader disposes a replaced level's materials when no mesh of the *scene* uses
     # them; a container's meshes are not the scene's yet, so the levels' shared materials go with LOD1
@@ -202,7 +205,8 @@ class Asset:
 
 
 def _summary_counts(line: str) -> dict[str, int]:
-    found = {k: int(m[1]) for k in ("triangles", "particles", "frames") if (m := re.search(rf"(\d+) {k}\b", line))}
+    found = {k: int(m[1]) for k in ("triangles", "particles", "frames")
+             if (m := re.search(rf"(\d+) {k}\b", line))}
     if m := re.search(r": (\d+) \w+;", line):  # a school: "school.glb: 10 bonybream; 30 frames (1.0 s), ..."
         found["fish"] = int(m[1])
     return found
@@ -241,7 +245,8 @@ def make_assets(folder: Path) -> dict[str, Asset]:
         lines = result.stdout.strip().splitlines()
         # one summary line; a school's is followed by its table of measures
         if len(lines) != 1 and fmt.kind != "school":
-            raise RuntimeError(f"fishgen printed {len(lines)} lines, expected one summary line: {result.stdout!r}")
+            raise RuntimeError(f"fishgen printed {len(lines)} lines, expected one summary line: "
+                               f"{result.stdout!r}")
         files = [fmt.filename] + sorted(p.name for p in out_dir.iterdir() if p.name != fmt.filename)
         return Asset(fmt, out, files, lines[0], _summary_counts(lines[0]), {})
 
@@ -255,7 +260,8 @@ def make_assets(folder: Path) -> dict[str, Asset]:
         fish = fish_scene.counts()
         if a.fmt.kind == "fish":
             if a.reported.get("triangles") != fish["triangles"]:
-                raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, the scene has {fish['triangles']} triangles")
+                raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, "
+                                   f"the scene has {fish['triangles']} triangles")
             a.expected = {"vertices": fish["vertices"], "triangles": a.reported["triangles"], "particles": 0}
             a.bounds = scene_bounds(fish_scene)
             if a.fmt.ext == "ply":  # one mesh of every part
@@ -271,8 +277,8 @@ def make_assets(folder: Path) -> dict[str, Asset]:
             if n != SCHOOL_FISH or a.reported.get("frames") != SCHOOL_FRAMES:
                 raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, asked for {SCHOOL_FISH} fish "
                                    f"and {SCHOOL_FRAMES} frames")
-            a.expected = {"vertices": n * fish["vertices"], "triangles": n * fish["triangles"], "particles": 0,
-                          "fish": n}
+            a.expected = {"vertices": n * fish["vertices"], "triangles": n * fish["triangles"],
+                          "particles": 0, "fish": n}
             from fishgen.exchange.gltf_reader import read_gltf
 
             school = read_gltf(a.path)
@@ -285,7 +291,8 @@ def make_assets(folder: Path) -> dict[str, Asset]:
         else:
             n = a.reported["particles"]
             if n != points["particles"]:
-                raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, fill_cloud made {points['particles']}")
+                raise RuntimeError(f"{a.label}: fishgen printed {a.summary!r}, "
+                                   f"fill_cloud made {points['particles']}")
             if "--billboards" in a.fmt.flags:  # QUADS crossed quads (4 vertices, 2 triangles each) a particle
                 from fishgen.clouds.scene import QUADS
 
@@ -373,7 +380,8 @@ def check_trimesh(asset: Asset) -> str:
             img = getattr(mat, "image", None) or getattr(mat, "baseColorTexture", None)
             expect(_image_ok(img), f"{g.metadata.get('name', 'mesh')}: texture did not arrive")
         if asset.fmt.ext == "obj":
-            masked = [g for g in loaded.geometry.values() if "map_d" in getattr(g.visual.material, "kwargs", {})]
+            masked = [g for g in loaded.geometry.values()
+                      if "map_d" in getattr(g.visual.material, "kwargs", {})]
             expect(not masked, "map_d mask png named in the .mtl is not loaded (only kept as text)")
     if "--billboards" in asset.fmt.flags:
         expect(counts["triangles"] == 2 * asset.expected["quads"], "quads != particles")
@@ -499,7 +507,8 @@ def check_numpy(asset: Asset) -> str:
     expect(data.dtype.names is not None, "not a table with named columns")
     expect(set(CLOUD_COLUMNS) <= set(data.dtype.names), f"columns {data.dtype.names}")
     expect_counts({"particles": len(data)}, asset.expected)
-    expect(bool(np.isfinite(data["radius"]).all() and (data["radius"] > 0).all()), "radius not positive finite")
+    expect(bool(np.isfinite(data["radius"]).all() and (data["radius"] > 0).all()),
+           "radius not positive finite")
     return ""
 
 
@@ -591,7 +600,8 @@ class HarnessPage(LocalBrowser):
         self.console: list[str] = []
         self.requests: list[tuple[str, int | str]] = []
         self.outside: list[str] = []
-        self.page.on("console", lambda m: self.console.append(f"{m.type}: {m.text}") if m.type == "error" else None)
+        self.page.on("console",
+                     lambda m: self.console.append(f"{m.type}: {m.text}") if m.type == "error" else None)
         self.page.on("pageerror", lambda e: self.console.append(f"pageerror: {e}"))
         self.page.on("response", lambda r: self.requests.append((r.url, r.status)))
         self.page.on("requestfailed", lambda r: self.requests.append((r.url, f"failed {r.failure}")))
@@ -663,7 +673,8 @@ class ThreeClient(HarnessPage):
     def tail_track(self, relative: str, times: list[float]) -> dict:
         """The tail tip as three.js plays the file at /assets/RELATIVE (harness.js tailTrack)."""
         self._clear()
-        result = self.page.evaluate("([u, t]) => window.tailTrack(u, t)", [f"{self.base}/assets/{relative}", times])
+        result = self.page.evaluate("([u, t]) => window.tailTrack(u, t)",
+                                    [f"{self.base}/assets/{relative}", times])
         expect("error" not in result, f"three.js: {result.get('error')}")
         expect(not self._problems(), "; ".join(self._problems()[:3]))
         return result
@@ -681,7 +692,8 @@ class ThreeClient(HarnessPage):
             counts["vertices"] = sum(o["positions"] for o in meshes)
         else:  # OBJLoader de-indexes: three positions per triangle, the file's sharing is gone
             positions = sum(o["positions"] for o in meshes)
-            expect(positions == 3 * counts["triangles"], f"{positions} positions for {counts['triangles']} triangles")
+            expect(positions == 3 * counts["triangles"],
+                   f"{positions} positions for {counts['triangles']} triangles")
             notes.append(f"non-indexed ({positions} positions)")
         expect_counts(counts, asset.expected)
         if "--billboards" in asset.fmt.flags:
@@ -713,9 +725,11 @@ class ThreeClient(HarnessPage):
             materials = [m for o in objects for m in o["materials"]]
             expect(all(m["vertexColors"] for m in materials), "particle colours (COLOR_0) not used")
             if "--billboards" in asset.fmt.flags:
-                expect(all(m["type"] == "MeshBasicMaterial" for m in materials), "KHR_materials_unlit ignored")
+                expect(all(m["type"] == "MeshBasicMaterial" for m in materials),
+                       "KHR_materials_unlit ignored")
         if points:
-            want = {"color", "_radius", "_density", "_cube"} if asset.fmt.ext == "glb" else {"color", "radius", "density"}
+            want = ({"color", "_radius", "_density", "_cube"} if asset.fmt.ext == "glb"
+                    else {"color", "radius", "density"})
             have = set().union(*(o["attributes"] for o in points))
             expect(want <= have, f"attributes missing: {sorted(want - have)}")
             if asset.fmt.ext == "ply":

@@ -12,7 +12,8 @@ import pytest
 from tests.clients.matrix import KNOWN_LIMITS, ROOT, Asset, Format, cells
 
 
-@pytest.mark.parametrize(("label", "client"), cells(), ids=[f"{c}-{fmt.replace(' ', '_')}" for fmt, c in cells()])
+@pytest.mark.parametrize(("label", "client"), cells(),
+                         ids=[f"{c}-{fmt.replace(' ', '_')}" for fmt, c in cells()])
 def test_cell(matrix, label, client):
     cell = matrix.run(label, client)
     if cell.status == "skip":
@@ -41,8 +42,8 @@ def _broken_copy(matrix, label: str, name: str) -> Asset:
     if folder.exists():
         shutil.rmtree(folder)
     shutil.copytree(good.path.parent, folder)
-    return Asset(fmt, folder / fmt.filename, list(good.files), good.summary, dict(good.reported), dict(good.expected),
-                 good.clip, good.bounds, good.engine)
+    return Asset(fmt, folder / fmt.filename, list(good.files), good.summary, dict(good.reported),
+                 dict(good.expected), good.clip, good.bounds, good.engine)
 
 
 @pytest.fixture

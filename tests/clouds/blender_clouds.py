@@ -81,7 +81,8 @@ def render(path: Path, prefix: str) -> list[str]:
     scene.collection.objects.link(camera)
     scene.camera = camera
     written = []
-    for name, direction, up in (("front", (0, -1, 0), "Z"), ("side", (1, 0, 0), "Z"), ("above", (0, 0, 1), "Y")):
+    for name, direction, up in (("front", (0, -1, 0), "Z"), ("side", (1, 0, 0), "Z"),
+                                ("above", (0, 0, 1), "Y")):
         d = Vector(direction)
         camera.location = centre + d * radius * 1.05 / math.tan(math.radians(15))
         camera.rotation_euler = (-d).to_track_quat("-Z", up).to_euler()
@@ -99,7 +100,8 @@ def main(argv: list[str]) -> int:
     for arg in argv:
         print(json.dumps(inspect(Path(arg).resolve())), flush=True)
         if prefix:
-            print(json.dumps({"rendered": render(Path(arg).resolve(), f"{prefix}{Path(arg).stem}")}), flush=True)
+            print(json.dumps({"rendered": render(Path(arg).resolve(), f"{prefix}{Path(arg).stem}")}),
+                  flush=True)
     return 0
 
 

@@ -48,7 +48,8 @@ class ThreePage:
     """``page(name)`` opens PAGES/name; ``url(path)`` serves a file of ``assets``."""
 
     def __init__(self, assets: Path):
-        handler = type("Handler", (_Handler,), {"mounts": {"/three/": THREE.resolve(), "/page/": PAGES.resolve(),
+        handler = type("Handler", (_Handler,), {"mounts": {"/three/": THREE.resolve(),
+                                                           "/page/": PAGES.resolve(),
                                                            "/assets/": assets.resolve()}})
         self.assets = assets.resolve()
         self.server = ThreadingHTTPServer(("127.0.0.1", 0), partial(handler))
@@ -58,8 +59,9 @@ class ThreePage:
         self.errors: list[str] = []
         self.page.on("pageerror", lambda e: self.errors.append(str(e)))
         self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
-        self.page.route("**/*", lambda r: r.continue_() if r.request.url.startswith((self.base, "blob:", "data:"))
-                        else r.abort())
+        self.page.route("**/*", lambda r: (r.continue_()
+                                           if r.request.url.startswith((self.base, "blob:", "data:"))
+                                           else r.abort()))
         self.page.goto(f"{self.base}/page/coverage.html")
         self.page.wait_for_function("window.coveragePageReady === true", timeout=30_000)
 

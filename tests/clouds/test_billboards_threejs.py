@@ -8,13 +8,11 @@ opacity must reach 70 % of the spheres' too.
 """
 from __future__ import annotations
 
-import numpy as np
 import pytest
-
-from fishgen.clouds import export_cloud, fill_cloud, light_cloud, load_cubes
-
 from browser import ThreePage, image, unavailable
 from cloud_tables import TABLES
+
+from fishgen.clouds import export_cloud, fill_cloud, light_cloud, load_cubes
 
 pytestmark = pytest.mark.skipif(unavailable() is not None, reason=str(unavailable()))
 SIDES = ("front", "side", "above")
@@ -38,7 +36,8 @@ def test_billboards_cover_what_the_particles_cover_from_every_side(three, table,
                             SIDES, pixels=True)
     assert not three.errors, three.errors
     (material,) = result["materials"]   # as three.js made it from the file: blended, vertex colours
-    assert material["transparent"] and not material["depthWrite"] and material["vertexColors"] and material["map"]
+    assert (material["transparent"] and not material["depthWrite"] and material["vertexColors"]
+            and material["map"])
     for side in SIDES:
         billboards, spheres = result[side]["billboards"], result[side]["spheres"]
         assert billboards["pixels"] >= 0.7 * spheres["pixels"], side

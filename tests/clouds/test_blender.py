@@ -13,10 +13,9 @@ import subprocess
 from pathlib import Path
 
 import pytest
+from cloud_tables import PARAMS, TABLES
 
 from fishgen.clouds import Lighting, export_cloud, fill_cloud, light_cloud, load_cubes
-
-from cloud_tables import PARAMS, TABLES
 
 SCRIPT = Path(__file__).with_name("blender_clouds.py")
 BPY = next((p for p in (os.environ.get("FISHGEN_BPY_PYTHON"), "/tmp/bpyvenv/bin/python")

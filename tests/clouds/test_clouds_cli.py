@@ -127,7 +127,8 @@ def test_bad_options_are_one_line_errors(cli, tmp_path, args, message):
 
 def test_unknown_output_extension(cli, tmp_path):
     result = cli("clouds", TABLES["4.3"], "-o", tmp_path / "cloud.obj")
-    assert_one_line_error(result, f"{tmp_path / 'cloud.obj'}: expected a format that holds points, found .obj")
+    assert_one_line_error(result,
+                          f"{tmp_path / 'cloud.obj'}: expected a format that holds points, found .obj")
     assert list(tmp_path.iterdir()) == []
 
 

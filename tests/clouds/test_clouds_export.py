@@ -9,14 +9,13 @@ import struct
 import numpy as np
 import pytest
 import trimesh
+from cloud_tables import TABLES
 from PIL import Image
 
 from fishgen.clouds import export_cloud, fill_cloud, load_cubes
 from fishgen.clouds.scene import TRIANGLES_PER_BILLBOARD, cloud_scene, turns
-from fishgen.exchange import particles
 from fishgen.errors import FishgenError, SystemFailure
-
-from cloud_tables import TABLES
+from fishgen.exchange import particles
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +67,8 @@ def test_glb_points(cloud, tmp_path, gltf_validator):
     prim = doc["meshes"][0]["primitives"][0]
     assert prim["mode"] == 0 and set(prim["attributes"]) == {"POSITION", "COLOR_0", "_RADIUS", "_DENSITY",
                                                              "_CUBE"}
-    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["POSITION"], "<f4", 3), cloud.centers)
+    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["POSITION"], "<f4", 3),
+                                  cloud.centers)
     # glTF's COLOR_0 is linear (16 bits, so each sRGB byte stays distinct); the cloud's are sRGB bytes
     from fishgen.numeric import linear_to_srgb
     rgb = accessor_array(doc, blob, prim["attributes"]["COLOR_0"], "<u2", 3)
@@ -76,8 +76,10 @@ def test_glb_points(cloud, tmp_path, gltf_validator):
     np.testing.assert_array_equal(np.round(linear_to_srgb(rgb / 65535.0) * 255), cloud.colors)
     np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_CUBE"], "<f4", 1)[:, 0],
                                   cloud.cube_index)
-    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_RADIUS"], "<f4", 1)[:, 0], cloud.radii)
-    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_DENSITY"], "<f4", 1)[:, 0], cloud.density)
+    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_RADIUS"], "<f4", 1)[:, 0],
+                                  cloud.radii)
+    np.testing.assert_array_equal(accessor_array(doc, blob, prim["attributes"]["_DENSITY"], "<f4", 1)[:, 0],
+                                  cloud.density)
     pygltflib = pytest.importorskip("pygltflib")
     gltf = pygltflib.GLTF2().load(str(path))
     assert gltf.accessors[gltf.meshes[0].primitives[0].attributes.POSITION].count == len(cloud)
@@ -262,7 +264,8 @@ def test_streaming_in_small_blocks_gives_the_same_bytes(cloud, tmp_path, monkeyp
 
 
 def test_unknown_extension_and_billboards_outside_gltf(cloud, tmp_path):
-    with pytest.raises(FishgenError, match=r"expected a format that holds points, found .obj .*use .glb or .gltf or .ply or .csv or .npy"):
+    with pytest.raises(FishgenError, match=r"expected a format that holds points, found .obj .*"
+                                           r"use .glb or .gltf or .ply or .csv or .npy"):
         export_cloud(cloud, tmp_path / "cloud.obj")
     with pytest.raises(FishgenError, match="with --billboards"):
         export_cloud(cloud, tmp_path / "cloud.ply", billboards=True)

@@ -5,11 +5,10 @@ import math
 
 import numpy as np
 import pytest
+from cloud_tables import TABLES
 from scipy import stats
 
 from fishgen.clouds import Cube, CubeFile, Lighting, fill_cloud, light_cloud, load_cubes, merge_clouds
-
-from cloud_tables import TABLES
 
 METHODS = ("paper", "uniform")
 
@@ -130,10 +129,11 @@ def test_offset_moves_the_cloud():
     cubes = load_cubes(TABLES["4.3"])
     here = fill_cloud(cubes, seed=4)
     there = fill_cloud(cubes, seed=4, offset=(10, 20, 30))
-    np.testing.assert_allclose(there.centers - here.centers, np.broadcast_to([10, 20, 30], here.centers.shape),
-                               atol=1e-5)
+    np.testing.assert_allclose(there.centers - here.centers,
+                               np.broadcast_to([10, 20, 30], here.centers.shape), atol=1e-5)
     np.testing.assert_array_equal(there.radii, here.radii)
-    np.testing.assert_allclose(there.cube_bounds - here.cube_bounds, np.broadcast_to([10, 20, 30], here.cube_bounds.shape))
+    np.testing.assert_allclose(there.cube_bounds - here.cube_bounds,
+                               np.broadcast_to([10, 20, 30], here.cube_bounds.shape))
 
 
 def test_merge_renumbers_cubes_and_keeps_everything():

@@ -4,11 +4,10 @@ from __future__ import annotations
 import warnings
 
 import pytest
+from cloud_tables import TABLES, TOTALS
 
 from fishgen.clouds import CubeFileWarning, load_cubes
 from fishgen.errors import FishgenError
-
-from cloud_tables import TABLES, TOTALS
 
 
 @pytest.mark.parametrize("table", sorted(TABLES))
@@ -86,7 +85,8 @@ FAULTS = [
     ("too many fields", "1\n1\n1, 1, 1, 1, 0, 0, 0, 1, 9\n", 3, "maximum radius), found 9 fields"),
     ("two fields on line 1", "1 2\n1\n" + GOOD, 1, "expected 1 field (the total particle count)"),
     ("empty field", "1\n1\n1, 1,, 1, 0, 0, 0, 1\n", 3, "found an empty field"),
-    ("negative count", "1\n1\n-1, 1, 1, 1, 0, 0, 0, 1\n", 3, "a whole number of 0 or more for the particle count, found '-1'"),
+    ("negative count", "1\n1\n-1, 1, 1, 1, 0, 0, 0, 1\n", 3,
+     "a whole number of 0 or more for the particle count, found '-1'"),
     ("negative total", "-5\n1\n" + GOOD, 1, "found '-5'"),
     ("fractional count", "1\n1\n2.5, 1, 1, 1, 0, 0, 0, 1\n", 3, "whole number for the particle count"),
     ("non-number", "1\n1\n1, 1, wide, 1, 0, 0, 0, 1\n", 3, "a number for the y size, found 'wide'"),
@@ -94,16 +94,21 @@ FAULTS = [
     ("NaN", "1\n1\n1, 1, 1, 1, nan, 0, 0, 1\n", 3, "finite number for the centre x, found 'nan'"),
     ("infinity", "1\n1\n1, inf, 1, 1, 0, 0, 0, 1\n", 3, "finite number for the x size, found 'inf'"),
     ("overflow", "1\n1\n1, 1, 1, 1, 0, 1e999, 0, 1\n", 3, "finite number for the centre y"),
-    ("NaN count", "1\n1\nNaN, 1, 1, 1, 0, 0, 0, 1\n", 3, "a whole number for the particle count, found 'NaN'"),
+    ("NaN count", "1\n1\nNaN, 1, 1, 1, 0, 0, 0, 1\n", 3,
+     "a whole number for the particle count, found 'NaN'"),
     ("inf total", "inf\n1\n" + GOOD, 1, "expected a whole number for the total particle count, found 'inf'"),
     ("yes total", "yes\n1\n" + GOOD, 1, "expected a whole number for the total particle count, found 'yes'"),
-    ("negative cube count", "1\n-2\n" + GOOD, 2, "expected a whole number of 0 or more for the number of cubes, found '-2'"),
+    ("negative cube count", "1\n-2\n" + GOOD, 2,
+     "expected a whole number of 0 or more for the number of cubes, found '-2'"),
     ("4300+ digit total", "9" * 5000 + "\n1\n" + GOOD, 1,
-     "expected a whole number of at most 18 digits for the total particle count, found a number with 5,000 digits"),
-    ("4300+ digit cube count", "1\n" + "1" * 4301 + "\n" + GOOD, 2, "at most 18 digits for the number of cubes"),
+     "expected a whole number of at most 18 digits for the total particle count, "
+     "found a number with 5,000 digits"),
+    ("4300+ digit cube count", "1\n" + "1" * 4301 + "\n" + GOOD, 2,
+     "at most 18 digits for the number of cubes"),
     ("4300+ digit particles", "1\n1\n" + "7" * 4400 + ", 1, 1, 1, 0, 0, 0, 1\n", 3,
      "at most 18 digits for the particle count, found a number with 4,400 digits"),
-    ("4300+ digit negative", "1\n1\n-" + "7" * 4400 + ", 1, 1, 1, 0, 0, 0, 1\n", 3, "of 0 or more for the particle count"),
+    ("4300+ digit negative", "1\n1\n-" + "7" * 4400 + ", 1, 1, 1, 0, 0, 0, 1\n", 3,
+     "of 0 or more for the particle count"),
     ("centre out of float32", "1\n1\n1, 1, 1, 1, 0, -1e39, 0, 1\n", 3,
      "centre y within float32 range (-3.4e+38 to 3.4e+38), found '-1e39'"),
     ("zero size", "1\n1\n1, 1, 1, 0, 0, 0, 0, 1\n", 3, "z size greater than 0, found '0'"),

@@ -146,7 +146,8 @@ def test_moving_cloud_and_sun_together_changes_nothing():
     np.testing.assert_allclose(moved, base, atol=1e-4)
     for axis, angle in (((0, 0, 1), 0.7), ((1, 2, 3), 2.1)):
         r = _rotation(axis, angle)
-        turned = incident_light((centers @ r.T).astype(np.float32), radii, density, Lighting(sun=tuple(r @ sun)))
+        turned = incident_light((centers @ r.T).astype(np.float32), radii, density,
+                                Lighting(sun=tuple(r @ sun)))
         np.testing.assert_allclose(turned, base, atol=1e-4)       # float32 positions, turned
 
 
@@ -176,7 +177,8 @@ def test_luminance_falls_with_optical_depth_towards_the_sun(sun):
     lighting = Lighting(sun=SUNS[sun])
     lit = light_cloud(cloud, lighting)
     _, tau = brute_force(cloud.centers, cloud.radii, cloud.density, lighting)
-    linear = lighting.albedo * (np.array(lighting.sky_color) + np.array(lighting.sun_color) * lit.light[:, None])
+    linear = lighting.albedo * (np.array(lighting.sky_color)
+                                + np.array(lighting.sun_color) * lit.light[:, None])
     assert stats.spearmanr(linear @ [0.2126, 0.7152, 0.0722], tau).statistic < -0.8
     order = np.argsort(lit.light)
     assert (np.diff(luminance(lit.colors)[order]) >= 0).all()      # the bytes never invert it
@@ -271,7 +273,8 @@ def test_unlit_files_stay_as_they_were(tmp_path):
     from tests.clouds.test_clouds_export import glb_parts
 
     doc, _ = glb_parts(tmp_path / "plain.glb")
-    assert "_LIGHT" not in doc["meshes"][0]["primitives"][0]["attributes"] and "extras" not in doc["scenes"][0]
+    assert ("_LIGHT" not in doc["meshes"][0]["primitives"][0]["attributes"]
+            and "extras" not in doc["scenes"][0])
 
 
 # -- the lighting parameters ------------------------------------------------------------------

@@ -13,7 +13,6 @@ from __future__ import annotations
 import warnings
 
 import pytest
-
 from sun_reference import FRESH, HELD_OUT, TUNED, correlations
 
 GOAL = 0.8

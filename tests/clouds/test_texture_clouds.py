@@ -6,13 +6,12 @@ import os
 
 import numpy as np
 import pytest
+from cloud_tables import PARAMS
 from PIL import Image
 
 from fishgen.clouds import export_cloud, fill_cloud, light_cloud, load_cubes
 from fishgen.clouds.scene import cloud_scene, cube_file_scene
 from fishgen.errors import FishgenError
-
-from cloud_tables import PARAMS
 
 SKY = PARAMS / "sky.awa"
 TEXTURES = PARAMS.parents[1] / "textures" / "clouds"
@@ -43,7 +42,8 @@ def test_the_shipped_example_reads_like_the_reports_tables():
     assert used == {"billow.png", "cumulus.png", "wisp.png"}
     assert all(os.path.dirname(c.texture) == str(TEXTURES) for c in cubes.cubes)
     first = cubes.cubes[0]
-    assert (first.particles, first.size, first.centre, first.max_radius) == (14, (7.4, 1.1, 2.9), (-3.4, -3.3, -0.6), 3.6)
+    assert ((first.particles, first.size, first.centre, first.max_radius)
+            == (14, (7.4, 1.1, 2.9), (-3.4, -3.3, -0.6), 3.6))
 
 
 def test_textures_resolve_beside_the_file_and_in_textures_beside_it(folder):
@@ -88,12 +88,14 @@ def test_a_link_out_of_the_folders_is_refused(folder, tmp_path_factory):
 
 def test_a_texture_that_is_not_an_image_is_refused(folder):
     (folder / "sky" / "fake.png").write_bytes(b"not a png")
-    with pytest.raises(FishgenError, match=r"test.awa:3: expected a texture image .* found 'fake.png' unreadable"):
+    with pytest.raises(FishgenError,
+                       match=r"test.awa:3: expected a texture image .* found 'fake.png' unreadable"):
         load_cubes(write(folder, "1\n1\n1, 1, 1, 1, 0, 0, 0, 1, fake.png\n"))
 
 
 def test_header_counts_say_billboards(folder):
-    with pytest.raises(FishgenError, match=r"test.awa:1: expected a whole number for the total billboard count"):
+    with pytest.raises(FishgenError,
+                       match=r"test.awa:1: expected a whole number for the total billboard count"):
         load_cubes(write(folder, "many\n1\n1, 1, 1, 1, 0, 0, 0, 1, near.png\n"))
 
 

@@ -9,7 +9,8 @@ from fishgen.options import Lods, Names
 from tests.conftest import PARAMS, assert_valid_gltf, run_cli
 
 
-@pytest.mark.parametrize("text,levels", [("32x24,16x12,8x6", ((32, 24), (16, 12), (8, 6))), ("12X8", ((12, 8),)),
+@pytest.mark.parametrize("text,levels", [("32x24,16x12,8x6", ((32, 24), (16, 12), (8, 6))),
+                                         ("12X8", ((12, 8),)),
                                          (" 24 x 16 , 8x6 ", ((24, 16), (8, 6)))])
 def test_levels_parse_finest_first(text, levels):
     assert Lods().convert(text, None, None) == levels
@@ -35,14 +36,16 @@ def test_the_issues_command_line(tmp_path):
     run = run_cli("build", PARAMS / "bonybream.txt", "--lods", "32x24,16x12,8x6", "--merge",
                   "--clips", "swim,idle,turn_left,turn_right,burst", "-o", out)
     assert run.returncode == 0, run.stderr
-    assert "levels 32x24 (1518), 16x12 (376), 8x6 (92)" in run.stdout and "merged (2 draw calls)" in run.stdout
+    assert ("levels 32x24 (1518), 16x12 (376), 8x6 (92)" in run.stdout
+            and "merged (2 draw calls)" in run.stdout)
     assert "clips idle 2.00 s, turn_left 3.20 s, turn_right 3.20 s, burst 0.60 s" in run.stdout
     assert_valid_gltf(out)
 
 
 @pytest.mark.parametrize("args,words", [(["--lods", "8x6,16x12"], "Invalid value for '--lods'"),
                                         (["--clips", "swim,dance"], "Invalid value for '--clips'"),
-                                        (["--swim", "fins", "--clips", "swim,burst"], "a rigid body cannot bend")])
+                                        (["--swim", "fins", "--clips", "swim,burst"],
+                                         "a rigid body cannot bend")])
 def test_bad_engine_options_are_one_line_and_write_nothing(tmp_path, args, words):
     out = tmp_path / "fish.glb"
     run = run_cli("build", PARAMS / "bonybream.txt", *args, "-o", out)
@@ -91,7 +94,8 @@ def test_the_build_options_check_each_value_by_its_declaration():
     for bad, words in (({"fps": 0}, "'--fps'"), ({"speed": 1e9}, "'--speed'"),
                        ({"length": -1}, "'--length'"),
                        ({"fins": "glass"}, "'--fins'"), ({"swim": "crawl"}, "'--swim'"),
-                       ({"lods": [(16, 12), (16, 12)]}, "finest to coarsest"), ({"lods": [(16,)]}, "'--lods'"),
+                       ({"lods": [(16, 12), (16, 12)]}, "finest to coarsest"),
+                       ({"lods": [(16,)]}, "'--lods'"),
                        ({"lods": [(9, 8)] * 9}, "at most 8"), ({"clips": ("swim", "swim")}, "'--clips'"),
                        ({"merge": "yes"}, "'--merge': expected true or false"),
                        ({"swim": "fins", "clips": ("burst",)}, "--swim body")):

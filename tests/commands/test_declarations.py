@@ -26,17 +26,18 @@ def test_an_option_declared_once_is_in_help_in_a_manifest_and_in_the_function(wi
     assert "--brightness" in help_text and "How bright the toy shines.  [default: 2.5]" in help_text
 
     (tmp_path / "in.txt").write_text("x")
-    ran = CliRunner().invoke(cli, ["toy", str(tmp_path / "in.txt"), "-o", str(tmp_path / "a.csv"), "--brightness",
-                                   "7"])
+    ran = CliRunner().invoke(cli, ["toy", str(tmp_path / "in.txt"), "-o", str(tmp_path / "a.csv"),
+                                   "--brightness", "7"])
     assert ran.exit_code == 0 and ran.output == "toy 7.0\n"
-    bad = CliRunner().invoke(cli, ["toy", str(tmp_path / "in.txt"), "-o", str(tmp_path / "a.csv"), "--brightness",
-                                   "11"])
+    bad = CliRunner().invoke(cli, ["toy", str(tmp_path / "in.txt"), "-o", str(tmp_path / "a.csv"),
+                                   "--brightness", "11"])
     assert bad.exit_code == 2
 
     manifest = tmp_path / "m.toml"
     manifest.write_text('[[toy]]\ninput = "in.txt"\noutput = "b.csv"\nbrightness = 4\n')
     outcomes = run_batch(load_manifest(manifest, tmp_path / "out", kinds=job_kinds()), run_job)
-    assert [o.status for o in outcomes] == ["built"] and (tmp_path / "out" / "b.csv").read_text() == "4.0 red\n"
+    assert ([o.status for o in outcomes] == ["built"]
+            and (tmp_path / "out" / "b.csv").read_text() == "4.0 red\n")
     assert [o.brightness for o in toy.SEEN] == [7.0, 4.0]
 
     manifest.write_text('[[toy]]\ninput = "in.txt"\noutput = "b.csv"\n\nbrightness = 11\n')
@@ -73,7 +74,8 @@ def test_the_school_scene_file_checks_its_keys_with_the_options_declarations(tmp
     scene.write_text('seed = 1099511627776\n[[species]]\nfile = "a.txt"\n')
     assert load_scene_file(scene).seed == 1099511627776
     scene.write_text('frames = 1\n[[species]]\nfile = "a.txt"\n')
-    with pytest.raises(FishgenError, match=r":1: expected frames as a whole number from 2 to 100000, found '1'"):
+    with pytest.raises(FishgenError,
+                       match=r":1: expected frames as a whole number from 2 to 100000, found '1'"):
         load_scene_file(scene)
 
 

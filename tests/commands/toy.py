@@ -20,7 +20,8 @@ class ToyOptions:
 
 
 COMMAND = Command(name="toy", summary="A toy.", help="A toy command.", options=ToyOptions,
-                  run="tests.commands.toy:toy", inputs=Inputs("INPUT..."), output=Output("Where."), batch=True)
+                  run="tests.commands.toy:toy", inputs=Inputs("INPUT..."), output=Output("Where."),
+                  batch=True)
 
 
 def toy(inputs: tuple[Path, ...], output, options: ToyOptions, events: Events) -> Made:

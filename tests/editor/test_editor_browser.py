@@ -279,7 +279,8 @@ def test_undo_redo_duplicate_snapping_and_scale_all(skies, open_editor):
     ed.page.keyboard.press("Control+Shift+z")
     assert ed.state("cubes.length") == 18 and ed.state("dirty")
     ed.button("Delete All").click()
-    assert ed.state("cubes.length") == 0 and ed.page.locator("#totals").inner_text() == "0 particles in 0 cubes"
+    assert (ed.state("cubes.length") == 0
+            and ed.page.locator("#totals").inner_text() == "0 particles in 0 cubes")
     ed.button("Undo").click()
     assert ed.state("cubes.length") == 18
 

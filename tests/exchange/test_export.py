@@ -43,10 +43,12 @@ def test_glb_round_trips_through_pygltflib(assets, tmp_path):
     export(assets["bonybream"], out)
     doc = pygltflib.GLTF2().load(str(out))
     names = [n.name for n in doc.nodes]
-    assert doc.scenes[0].nodes == [0] and names[0] == "bonybream" and doc.nodes[0].children == list(range(1, 10))
+    assert (doc.scenes[0].nodes == [0] and names[0] == "bonybream"
+            and doc.nodes[0].children == list(range(1, 10)))
     assert "caudal_fin" in names and "pelvic_fin_right" in names
     (anim,) = doc.animations
-    assert anim.name == "swim" and sorted(c.target.path for c in anim.channels) == ["rotation"] * 4 + ["weights"] * 9
+    assert (anim.name == "swim"
+            and sorted(c.target.path for c in anim.channels) == ["rotation"] * 4 + ["weights"] * 9)
     assert {m.alphaMode for m in doc.materials} == {"OPAQUE", "MASK"}
     assert doc.materials[1].doubleSided
 
@@ -103,7 +105,7 @@ def test_same_input_same_bytes(tmp_path, ext):
     sp = load_species(PARAMS / "bonybream.txt")
     a = export(build_fish(sp), tmp_path / "a" / f"fish{ext}")
     b = export(build_fish(load_species(PARAMS / "bonybream.txt")), tmp_path / "b" / f"fish{ext}")
-    for fa, fb in zip(a, b):
+    for fa, fb in zip(a, b, strict=True):
         assert fa.read_bytes() == fb.read_bytes(), fa.name
 
 
@@ -129,7 +131,8 @@ def test_animation_pose_matches_fin_motion(assets):
 
 
 def test_unknown_extension(assets, tmp_path):
-    with pytest.raises(FishgenError, match="expected an output ending in .glb, .gltf, .obj, .ply, .csv, .npy"):
+    with pytest.raises(FishgenError,
+                       match="expected an output ending in .glb, .gltf, .obj, .ply, .csv, .npy"):
         export(assets["bonybream"], tmp_path / "fish.fbx")
     with pytest.raises(FishgenError, match="holds node animation, found .obj .* use .glb or .gltf or "
                                              ".usdc or .usda or .usdz instead"):

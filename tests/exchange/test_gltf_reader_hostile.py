@@ -143,18 +143,23 @@ STRUCTURE = {
                               r"accessor index from 0 to \d+ at meshes\[0\]\.primitives\[0\]\.attributes"),
     "bufferView out of range": (_set("accessors.0.bufferView", 99), r"bufferView index"),
     "buffer out of range": (_set("bufferViews.0.buffer", 3), r"buffer index from 0 to 0"),
-    "animation sampler out of range": (_set("animations.0.channels.0.sampler", 5), r"sampler index from 0 to 0"),
+    "animation sampler out of range": (_set("animations.0.channels.0.sampler", 5),
+                                       r"sampler index from 0 to 0"),
     "animation node out of range": (_set("animations.0.channels.0.target.node", 7), r"node index"),
     "index not an integer": (_set("nodes.0.mesh", 0.5), r"mesh index .* found 0\.5"),
-    "3-number rotation": (_set("nodes.0.rotation", [0, 0, 0]), r"4 finite numbers at nodes\[0\]\.rotation, found 3"),
-    "2-number translation": (_set("nodes.0.translation", [0, 0]), r"3 finite numbers at nodes\[0\]\.translation"),
+    "3-number rotation": (_set("nodes.0.rotation", [0, 0, 0]),
+                          r"4 finite numbers at nodes\[0\]\.rotation, found 3"),
+    "2-number translation": (_set("nodes.0.translation", [0, 0]),
+                             r"3 finite numbers at nodes\[0\]\.translation"),
     "4-number scale": (_set("nodes.0.scale", [1, 1, 1, 1]), r"3 finite numbers at nodes\[0\]\.scale"),
     "15-number matrix": (_set("nodes.0.matrix", [1] * 15), r"16 finite numbers at nodes\[0\]\.matrix"),
     "string in translation": (_set("nodes.0.translation", [0, "a", 0]), r"3 finite numbers"),
     "3-number baseColorFactor": (_set("materials.0.pbrMetallicRoughness.baseColorFactor", [1, 1, 1]),
-                                 r"4 finite numbers at materials\[0\]\.pbrMetallicRoughness\.baseColorFactor"),
+                                 r"4 finite numbers at materials\[0\]"
+                                 r"\.pbrMetallicRoughness\.baseColorFactor"),
     "bad alphaMode": (_set("materials.0.alphaMode", "GLASS"), r"one of OPAQUE, MASK, BLEND"),
-    "bad interpolation": (_set("animations.0.samplers.0.interpolation", "SMOOTH"), r"LINEAR, STEP, CUBICSPLINE"),
+    "bad interpolation": (_set("animations.0.samplers.0.interpolation", "SMOOTH"),
+                          r"LINEAR, STEP, CUBICSPLINE"),
     "version 1": (_set("asset.version", "1.0"), r'asset\.version "2\.0", found \'1\.0\''),
     "required extension": (_set("extensionsRequired", ["KHR_draco_mesh_compression"]),
                            r"found 'KHR_draco_mesh_compression'"),
@@ -162,7 +167,8 @@ STRUCTURE = {
     "negative count": (_set("accessors.0.count", -1), r"integer of at least 1 at accessors\[0\]\.count"),
     "bad componentType": (_set("accessors.0.componentType", 5130), r"componentType"),
     "bad byteStride": (_set("bufferViews.0.byteStride", 3), r"byteStride from 4 to 252"),
-    "stride below element": (lambda d: (_set("bufferViews.0.byteStride", 4)(d)), r"byteStride of at least 12"),
+    "stride below element": (lambda d: (_set("bufferViews.0.byteStride", 4)(d)),
+                             r"byteStride of at least 12"),
 }
 
 
@@ -237,13 +243,15 @@ SEMANTICS = {
                                                                        "SCALAR", 5123)),
                                 r"vertex indices below 3 at meshes\[0\]\.primitives\[0\], found 7"),
     "NaN position": (lambda d: d.prim["attributes"].update(POSITION=d.add(
-        np.array([[0, 0, 0], [np.nan, 0, 0], [0, 1, 0]], np.float32), "VEC3")), r"finite numbers .* found nan"),
+        np.array([[0, 0, 0], [np.nan, 0, 0], [0, 1, 0]], np.float32), "VEC3")),
+                     r"finite numbers .* found nan"),
     "infinite normal": (_attr("NORMAL", np.array([[0, 0, np.inf]] * 3, np.float32), "VEC3"), r"found inf"),
     "rotation output count": (lambda d: _channel(d, "rotation", [[0, 0, 0, 1]], "VEC4"),
                               r"2 output values \(2 keyframes\) .* found 1"),
     "cubic output count": (lambda d: _channel(d, "translation", np.zeros((2, 3)), "VEC3", "CUBICSPLINE"),
                            r"6 output values \(2 keyframes x 3\) .* found 2"),
-    "rotation as VEC3": (lambda d: _channel(d, "rotation", np.zeros((2, 3)), "VEC3"), r"rotation keyframes as VEC4"),
+    "rotation as VEC3": (lambda d: _channel(d, "rotation", np.zeros((2, 3)), "VEC3"),
+                         r"rotation keyframes as VEC4"),
     "NaN time": (lambda d: _channel(d, "scale", np.ones((2, 3)), "VEC3", times=(0, np.nan)),
                  r"finite numbers .* found nan"),
     "decreasing times": (lambda d: _channel(d, "scale", np.ones((3, 3)), "VEC3", times=(0, 2, 1)),
@@ -254,7 +262,8 @@ SEMANTICS = {
                                 r"a node with morph targets .* found node 0 without any"),
     "weights output count": (lambda d: (_morph(d, (2,)), _channel(d, "weights", [0, 1], "SCALAR")),
                              r"4 output values \(2 keyframes x 2\)"),
-    "joint out of range": (lambda d: _skin(d, joints=(0, 9)), r"node index from 0 to 1 at skins\[0\]\.joints\[1\]"),
+    "joint out of range": (lambda d: _skin(d, joints=(0, 9)),
+                           r"node index from 0 to 1 at skins\[0\]\.joints\[1\]"),
     "no joints": (lambda d: _skin(d, joints=(), ibm_count=1), r"at least one joint"),
     "inverse bind count": (lambda d: _skin(d, joints=(0, 1), ibm_count=1),
                            r"2 inverseBindMatrices \(one per joint\) .* found 1"),
@@ -398,7 +407,8 @@ def _textured(doc: Doc, image: bytes) -> None:
 def test_huge_texture_is_refused_from_its_header(tmp_path):
     doc = Doc()
     _textured(doc, _png_header(12000, 12000))
-    refused(doc.write(tmp_path), r"at most 8192 px a side and 67,108,864 pixels at images\[0\].*found 12000x12000")
+    refused(doc.write(tmp_path),
+            r"at most 8192 px a side and 67,108,864 pixels at images\[0\].*found 12000x12000")
     doc = Doc()
     _textured(doc, _png_header(8192, 8193))
     refused(doc.write(tmp_path), r"found 8192x8193")
@@ -425,7 +435,8 @@ def test_glb_container_faults(tmp_path):
         b"glTF": r"a glTF 2\.0 file \(JSON, or GLB with a 12-byte header\), found 4 bytes",
         good[:8] + struct.pack("<I", 10**9) + good[12:]: r"a GLB of 1,000,000,000 bytes",
         good[:4] + struct.pack("<I", 1) + good[8:]: r"a GLB of version 2, found version 1",
-        good[:12] + struct.pack("<I", 10**9) + good[16:]: r"a GLB chunk of 1,000,000,000 bytes within the file",
+        good[:12] + struct.pack("<I", 10**9) + good[16:]: r"a GLB chunk of 1,000,000,000 bytes "
+                                                          r"within the file",
         b"\xff\xfe{}": r"found bytes that are not UTF-8",
         b"[1, 2]": r"holding a JSON object, found a JSON list",
         b"[" * 100000: r"found JSON nested too deeply|found invalid JSON",
@@ -439,7 +450,8 @@ def test_glb_container_faults(tmp_path):
 def test_glb_bytes_cannot_name_side_files():
     doc = Doc()
     doc.d["images"] = [{"uri": "skin.png"}]
-    with pytest.raises(FishgenError, match=r"^<glb>: expected only embedded data, found a reference to 'skin.png'"):
+    with pytest.raises(FishgenError,
+                       match=r"^<glb>: expected only embedded data, found a reference to 'skin.png'"):
         read_gltf(data=doc.glb())
 
 

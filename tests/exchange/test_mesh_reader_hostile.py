@@ -122,8 +122,8 @@ def test_ply_declaring_more_than_its_bytes_is_refused_before_allocating(tmp_path
     refused(path, r"at least 12,000,000,000 bytes of binary_little_endian data for 1,000,000,000 vertex, "
                   r"found 36 bytes after the header")
     ascii_ply = tmp_path / "huge_ascii.ply"
-    ascii_ply.write_text("ply\nformat ascii 1.0\nelement vertex 1000000000\nproperty float x\nproperty float y\n"
-                         "property float z\nend_header\n0 0 0\n")
+    ascii_ply.write_text("ply\nformat ascii 1.0\nelement vertex 1000000000\nproperty float x\n"
+                         "property float y\nproperty float z\nend_header\n0 0 0\n")
     refused(ascii_ply, r"at least 6,000,000,000 bytes of ascii data")
     faces = tmp_path / "faces.ply"
     faces.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
@@ -136,7 +136,8 @@ def test_ply_declaring_more_than_its_bytes_is_refused_before_allocating(tmp_path
 @pytest.mark.parametrize("header,pattern", [
     ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n", r"no end_header"),
     ("solid\n", r"expected a PLY header \(ply \.\.\. end_header\), found no 'ply' first"),
-    ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nend_header\n0 0\n0 0\n0 0\n",
+    ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nend_header\n"
+     "0 0\n0 0\n0 0\n",
      r"vertex properties x, y and z, found x, y"),
     ("ply\nformat ascii 1.0\nelement vertex 3\nproperty quad x\nend_header\n", r"property TYPE NAME"),
     ("ply\nformat ascii 1.0\nelement vertex -3\nend_header\n", r"element NAME COUNT"),
@@ -199,7 +200,8 @@ def test_a_library_fault_is_said_about_the_file_not_named_by_its_exception():
     reader cannot parse; a message about the data is kept (issue 26)."""
     from fishgen.exchange.guards import what_was_found
 
-    assert what_was_found(TypeError("unhashable type: 'list'"), "OBJ") == "content the OBJ reader cannot parse"
+    assert what_was_found(TypeError("unhashable type: 'list'"), "OBJ") == (
+        "content the OBJ reader cannot parse")
     assert what_was_found(UnboundLocalError("cannot access local variable 'v'"), "PLY") == (
         "content the PLY reader cannot parse")
     assert what_was_found(ValueError("could not convert string to float: 'x'"), "OBJ") == (

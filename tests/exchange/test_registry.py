@@ -6,10 +6,19 @@ from pathlib import Path
 import pytest
 
 from fishgen.errors import FishgenError
-from tests.conftest import PARAMS
 from fishgen.exchange import export, registry
-from fishgen.exchange.registry import (FORMATS, MESHES, NODE_ANIMATION, POINTS, Format, formats,
-                                       lost, output_format, register_format)
+from fishgen.exchange.registry import (
+    FORMATS,
+    MESHES,
+    NODE_ANIMATION,
+    POINTS,
+    Format,
+    formats,
+    lost,
+    output_format,
+    register_format,
+)
+from tests.conftest import PARAMS
 
 
 def test_every_writer_and_reader_entry_point_resolves():
@@ -45,7 +54,8 @@ def test_summary_names_what_a_rest_pose_format_drops(tmp_path):
     from tests.conftest import PARAMS
 
     fish = build_fish(load_species(PARAMS / "bonybream.txt"))
-    assert lost(FORMATS["obj"], fish) == [NODE_ANIMATION, "morph targets", "alpha cutoff", "double-sided faces"]
+    assert lost(FORMATS["obj"], fish) == [NODE_ANIMATION, "morph targets", "alpha cutoff",
+                                          "double-sided faces"]
     assert lost(FORMATS["glb"], fish) == []
 
 

@@ -21,8 +21,8 @@ from fishgen.errors import FishgenError
 from fishgen.fuzz import TARGETS, load_seeds, make_case, run
 from fishgen.fuzz.cases import NEW_TARGETS, run_case
 from fishgen.fuzz.inputs import DEFAULT_CORPUS, Case
-from fishgen.fuzz.verdict import classify
 from fishgen.fuzz.mutate import NUMBERS, pack_glb, unpack_glb
+from fishgen.fuzz.verdict import classify
 
 CI_SEED = 20240601
 #: Inputs per target (the seed corpus comes first). About 25 s on 2 cores; rates in docs/fuzzing.md.

@@ -17,7 +17,8 @@ def assets(tmp_path_factory):
     for ext in ("glb", "gltf", "obj", "ply"):
         out[f"fish.{ext}"] = folder / f"fish.{ext}"
         fishgen.export(fish, out[f"fish.{ext}"])
-    cloud = light_cloud(fill_cloud(load_cubes(PARAMS / "clouds" / "table_4_3.awn"), seed=0))  # as `clouds` does
+    # as `clouds` does
+    cloud = light_cloud(fill_cloud(load_cubes(PARAMS / "clouds" / "table_4_3.awn"), seed=0))
     for ext in ("glb", "ply"):
         out[f"cloud.{ext}"] = folder / f"cloud.{ext}"
         export_cloud(cloud, out[f"cloud.{ext}"])

@@ -73,7 +73,8 @@ def part_coverage(scene, view: str, size: tuple[int, int]) -> dict[str, np.ndarr
             flat = Material(f"id {name}", (*rgb, 1.0), unlit=True, double_sided=old.double_sided)
             prim.attributes.pop("COLOR_0", None)
             if old.texture is not None and old.alpha_mode != "OPAQUE":
-                white = s.images[old.texture].rgba().copy()  # keep only the texture's alpha: it cuts the outline
+                # keep only the texture's alpha: it cuts the outline
+                white = s.images[old.texture].rgba().copy()
                 white[..., :3] = 255
                 flat.texture = s.add_image(Image("alpha only", b"", pixels=white))
                 flat.alpha_mode = "MASK"
@@ -81,7 +82,7 @@ def part_coverage(scene, view: str, size: tuple[int, int]) -> dict[str, np.ndarr
             prim.material = s.add_material(flat)
         scenes.append(s)
     out = {}
-    for group, image in zip(groups, _render(scenes, view, size, (0, 0, 0, 255))):
+    for group, image in zip(groups, _render(scenes, view, size, (0, 0, 0, 255)), strict=True):
         for k, name in enumerate(group):
             out[name] = image[..., k].astype(np.float32) / 255.0
     return out
@@ -117,7 +118,8 @@ def upside_down(scene):
     from fishgen.scene.model import Node
 
     s = copy.deepcopy(scene)
-    s.nodes.append(Node("flip", rotation=(0.0, 0.0, 1.0, 0.0), children=list(s.roots)))  # 180 degrees about +Z
+    # 180 degrees about +Z
+    s.nodes.append(Node("flip", rotation=(0.0, 0.0, 1.0, 0.0), children=list(s.roots)))
     s.roots = [len(s.nodes) - 1]
     return s
 

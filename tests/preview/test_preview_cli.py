@@ -96,7 +96,8 @@ def test_help_lists_every_option_with_default():
 @pytest.mark.parametrize("args,message", [
     (["-o", "x.bmp"], "expected an output ending in"),
     (["-o", "x.png", "--frames", "5"], "expected a .gif or .webp output"),
-    (["-o", "x.png", "--size", "800"], "Invalid value for '--size': expected WxH with 16 to 8192 pixels a side"),
+    (["-o", "x.png", "--size", "800"],
+     "Invalid value for '--size': expected WxH with 16 to 8192 pixels a side"),
     (["-o", "x.png", "--background", "mauvish"], "Invalid value for '--background': expected a colour"),
     (["-o", "x.gif", "--background", "transparent"], "expected an opaque --background"),
     (["-o", "x.png", "--clip", "dance"], "expected --clip to name one of swim"),
@@ -133,8 +134,14 @@ def test_negative_seed_for_a_cube_file_is_a_one_line_error(tmp_path):
 
 def test_pixel_budget_is_checked_before_any_input_is_read(tmp_path):
     from fishgen.errors import FishgenError
-    from fishgen.preview.pipeline import (MAX_SHEET_PIXELS, MAX_TOTAL_PIXELS, PreviewOptions, preview,
-                                          sheet_size, total_pixels)
+    from fishgen.preview.pipeline import (
+        MAX_SHEET_PIXELS,
+        MAX_TOTAL_PIXELS,
+        PreviewOptions,
+        preview,
+        sheet_size,
+        total_pixels,
+    )
 
     missing = [tmp_path / "a.glb", tmp_path / "b.glb"]
     huge = PreviewOptions(width=8192, height=8192, frames=1000)

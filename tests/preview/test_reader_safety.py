@@ -11,8 +11,8 @@ import pytest
 
 from fishgen.errors import FishgenError
 from fishgen.preview.inputs import load_input
-from tests.preview.test_readers import point_sets
 from tests.conftest import run_cli
+from tests.preview.test_readers import point_sets
 
 SECRET = b"top secret, not part of any asset\n"
 

@@ -44,7 +44,8 @@ def test_posing_swings_the_fins_and_bends_the_body():
     assert np.allclose(a.world[body], b.world[body])                  # the body node stays put...
     prim = scene.meshes[scene.nodes[body].mesh].primitives[0]
     bend = deformed(scene, body, prim, b)[0] - deformed(scene, body, prim, a)[0]
-    assert np.abs(bend[:, 0]).max() > 0.02 and np.abs(bend[:, 1:]).max() == 0  # ...and its mesh bends sideways
+    assert (np.abs(bend[:, 0]).max() > 0.02
+            and np.abs(bend[:, 1:]).max() == 0)                       # ...and its mesh bends sideways
 
 
 @pytest.mark.parametrize("ext", ["glb", "gltf", "obj", "ply"])

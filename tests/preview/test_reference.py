@@ -164,7 +164,8 @@ def fish_problems(species: str, flanks: dict[str, Flank]) -> list[str]:
             expected = record.get(side, {}).get(part)
             if expected is None:
                 problems.append(f"{side} flank: {part} has no recorded area (run --update)")
-            elif abs(p.area - expected) > max(AREA_TOLERANCE * expected, AREA_SLACK_PIXELS / (SIZE[0] * SIZE[1])):
+            elif abs(p.area - expected) > max(AREA_TOLERANCE * expected,
+                                              AREA_SLACK_PIXELS / (SIZE[0] * SIZE[1])):
                 problems.append(f"{side} flank: {part} covers {p.area:.5f} of the frame, recorded "
                                 f"{expected:.5f} (within {AREA_TOLERANCE:.0%} or {AREA_SLACK_PIXELS} px)")
         for part in view.parts:
@@ -242,7 +243,8 @@ class Cloud:
         h, w = alpha.shape
         if len(xs) == 0:
             return Cloud(0.0, (0.0, 0.0, 0.0, 0.0))
-        return Cloud(float(alpha.mean()), (xs.min() / w, ys.min() / h, (xs.max() + 1) / w, (ys.max() + 1) / h))
+        return Cloud(float(alpha.mean()),
+                     (xs.min() / w, ys.min() / h, (xs.max() + 1) / w, (ys.max() + 1) / h))
 
 
 def cloud_problems(name: str, cloud: Cloud) -> list[str]:
@@ -344,7 +346,8 @@ def test_checks_hold_under_softpipe():
                            env=env, capture_output=True, text=True, check=False)
     assert "softpipe" in probe.stdout, f"expected Mesa softpipe, found {probe.stdout!r} {probe.stderr}"
     run = subprocess.run([sys.executable, "-m", "pytest", __file__, "-q", "-p", "no:cacheprovider",
-                          "-k", "not softpipe and not catches"], cwd=ROOT, env=env, capture_output=True, text=True, check=False)
+                          "-k", "not softpipe and not catches"],
+                         cwd=ROOT, env=env, capture_output=True, text=True, check=False)
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-2000:]
 
 

@@ -15,7 +15,8 @@ def channel(node, path, times, values, interpolation="LINEAR"):
 
 
 def scene_of(*nodes, roots=(0,), meshes=(), skins=(), clips=()):
-    return Scene(nodes=list(nodes), roots=list(roots), meshes=list(meshes), skins=list(skins), clips=list(clips))
+    return Scene(nodes=list(nodes), roots=list(roots), meshes=list(meshes), skins=list(skins),
+                 clips=list(clips))
 
 
 def _qy(deg: float) -> np.ndarray:
@@ -117,7 +118,8 @@ def test_skin_follows_its_joints_and_ignores_its_own_node():
 
 
 def test_normals_follow_mirrors_and_survive_a_zero_scale():
-    prim = Primitive({"POSITION": np.array([[1, 0, 0]], np.float32), "NORMAL": np.array([[1, 0, 0]], np.float32)},
+    prim = Primitive({"POSITION": np.array([[1, 0, 0]], np.float32),
+                      "NORMAL": np.array([[1, 0, 0]], np.float32)},
                      mode="POINTS")
     for scale, expected in (((-1.0, 1.0, 1.0), [-1, 0, 0]), ((2.0, 1.0, 1.0), [1, 0, 0]),
                             ((0.0, 1.0, 1.0), [1, 0, 0])):

@@ -24,7 +24,8 @@ def circling(count=12, frames=90, fps=30.0):
     t = np.arange(frames) / fps
     angle = np.linspace(0, 2 * np.pi, count, endpoint=False)[None] + 0.4 * t[:, None]
     radius = 2 + 0.1 * np.arange(count)[None]
-    pos = np.stack([radius * np.cos(angle), 0.05 * np.sin(3 * t)[:, None] + 0 * angle, radius * np.sin(angle)], -1)
+    pos = np.stack([radius * np.cos(angle), 0.05 * np.sin(3 * t)[:, None] + 0 * angle,
+                    radius * np.sin(angle)], -1)
     vel = np.gradient(pos, axis=0) * fps
     yaw = np.arctan2(vel[..., 0], vel[..., 2])
     q = np.zeros((frames, count, 4))
@@ -38,7 +39,7 @@ def test_meshes_are_shared_and_every_fish_is_a_node(fish):
     assert len(scene.meshes) == sum(len(f.meshes) for f in fish)          # one mesh per species part
     fish_nodes = [scene.nodes[r] for r in scene.roots]
     assert len(fish_nodes) == 12 and all(len(n.children) == len(f.nodes) - 1
-                                         for n, f in zip(fish_nodes, [fish[0], fish[1]] * 6))
+                                         for n, f in zip(fish_nodes, [fish[0], fish[1]] * 6, strict=True))
     assert fish_nodes[1].scale[0] == pytest.approx(tracks.scale[1])
     used = {scene.nodes[c].mesh for n in fish_nodes for c in n.children}
     assert used == set(range(len(scene.meshes)))

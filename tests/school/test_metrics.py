@@ -108,7 +108,8 @@ def test_summary_table_has_mean_and_the_bad_extreme_per_species():
                     ("heading vs velocity (deg)", "45.0", "90.0")]
     # the rotation order parameter's worst: the least of a mill, the most of a school that does not mill
     rotation = summary_table({"rotation": np.array([[0.0, 0.1], [0.9, 0.05], [0.7, 0.2]])}, 1, ["a", "b"])
-    assert rotation == [("rotation (1 = milling), a", "0.80", "0.70"), ("rotation (1 = milling), b", "0.12", "0.20")]
+    assert rotation == [("rotation (1 = milling), a", "0.80", "0.70"),
+                        ("rotation (1 = milling), b", "0.12", "0.20")]
     text = format_table(rows, "after warm-up").splitlines()
     assert len(text) == 5 and len({len(line) for line in text}) == 1
 

@@ -189,4 +189,5 @@ def test_a_ring_layout_starts_each_species_milling_round_its_own_ring():
         pos = tr.positions[0, tr.group == g]
         out = pos - pos.mean(axis=0)
         assert np.ptp(out[:, 1]) < 0.6 * np.ptp(out[:, 0])
-        assert np.linalg.norm(out[:, [0, 2]], axis=1).min() > 0.3 * np.linalg.norm(out[:, [0, 2]], axis=1).max()
+        assert (np.linalg.norm(out[:, [0, 2]], axis=1).min()
+                > 0.3 * np.linalg.norm(out[:, [0, 2]], axis=1).max())

@@ -40,7 +40,7 @@ def served():
                                 cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         procs.append(proc)
         lines: queue.Queue = queue.Queue()
-        threading.Thread(target=lambda: [lines.put(l) for l in proc.stdout], daemon=True).start()
+        threading.Thread(target=lambda: [lines.put(printed) for printed in proc.stdout], daemon=True).start()
         while True:
             try:
                 line = lines.get(timeout=20)
@@ -64,8 +64,9 @@ def _open(browser, url):
     page.on("pageerror", lambda e: problems.append(str(e)))
     page.on("request", lambda r: requests.append(r.url))
     page.goto(url)
-    page.wait_for_function("window.fishgenViewer && (window.fishgenViewer.loaded || window.fishgenViewer.error)",
-                           timeout=LOAD_TIMEOUT_MS)
+    page.wait_for_function(
+        "window.fishgenViewer && (window.fishgenViewer.loaded || window.fishgenViewer.error)",
+        timeout=LOAD_TIMEOUT_MS)
     state = page.evaluate("window.fishgenViewer")
     assert state["error"] is None, state["error"]
     return page, problems, requests
@@ -211,8 +212,8 @@ def test_a_school_plays_and_its_fish_move_in_three_js(browser, served, tmp_path)
     from fishgen.preview.inputs import load_input
 
     school = tmp_path / "school.glb"
-    made = run_cli("school", ROOT / "params" / "bonybream.txt", "-o", school, "--count", "12", "--frames", "150",
-                   "--seed", "2")
+    made = run_cli("school", ROOT / "params" / "bonybream.txt", "-o", school,
+                   "--count", "12", "--frames", "150", "--seed", "2")
     assert made.returncode == 0, made.stderr
     page, problems, requests = _open(browser, served(school))
     try:

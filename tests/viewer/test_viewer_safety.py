@@ -160,8 +160,8 @@ def test_server_refuses_a_request_without_this_runs_token(server):
         assert status == 403 and page.read_bytes()[:200] not in body, path
 
 
-@pytest.mark.parametrize("host", ["evil.example:{port}", "127.0.0.1", "localhost:1", "127.0.0.1.nip.io:{port}",
-                                  "", False])
+@pytest.mark.parametrize("host", ["evil.example:{port}", "127.0.0.1", "localhost:1",
+                                  "127.0.0.1.nip.io:{port}", "", False])
 def test_server_refuses_other_host_headers(server, host):
     srv, page = server
     if isinstance(host, str):
