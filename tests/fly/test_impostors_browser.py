@@ -28,7 +28,7 @@ def open_page(assets, **config):
     session.serve_in_background()
     page = shared_browser().new_page(viewport={"width": SIZE[0], "height": SIZE[1]})
     page.goto(session.url())
-    page.wait_for_function("window.fishgenFly.loaded && window.fishgenFly.frames >= 0", timeout=180_000)
+    page.wait_for_function("window.fishgenFly.loaded", timeout=180_000)
     return page, session
 
 
