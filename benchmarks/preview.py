@@ -32,9 +32,8 @@ def whole_command(inp: str, out: Path, size: str) -> float:
 def breakdown(inp: str, size: str) -> dict[str, float]:
     from PIL import Image
 
-    from fishgen.preview.camera import frame
     from fishgen.preview.inputs import load_input
-    from fishgen.preview.pipeline import PreviewOptions, encode, parse_size, subject_points
+    from fishgen.preview.pipeline import PreviewOptions, encode, frame_scene, parse_size
     from fishgen.preview.render import Renderer
 
     w, h = parse_size(size)
@@ -44,7 +43,7 @@ def breakdown(inp: str, size: str) -> dict[str, float]:
     t.append(time.perf_counter())
     renderer = Renderer(w, h)
     t.append(time.perf_counter())
-    cam = frame(subject_points(scene, [None], None), opts.view, w / h)
+    cam = frame_scene(scene, opts.view, w / h)
     img = Image.fromarray(renderer.render(scene, cam, None, tuple(c / 255 for c in opts.background)))
     t.append(time.perf_counter())
     encode([img], Path("x.png"), 0)

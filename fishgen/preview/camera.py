@@ -69,15 +69,18 @@ def view_basis(view: str, azimuth: float = 0.0) -> tuple[np.ndarray, np.ndarray]
 
 
 def frame(points: np.ndarray, view: str, aspect: float, azimuths=(0.0,),
-          target: np.ndarray | None = None, ortho: bool = False) -> Camera:
-    """A camera on ``view`` that keeps every point of ``points`` (N, 3) in frame.
+          target: np.ndarray | None = None, ortho: bool = False,
+          reach: np.ndarray | None = None) -> Camera:
+    """A camera on ``view`` that keeps every point of ``points`` (N, 3) in frame, and with ``reach``
+    (N,) everything within that distance of it across the view: a particle's camera-facing quad.
 
     With several ``azimuths`` (a turntable), one distance and target serve them all.
     """
     points = np.asarray(points, float).reshape(-1, 3)
+    r = np.zeros(len(points)) if reach is None else np.asarray(reach, float).ravel()
     if len(points) == 0:
-        points = np.zeros((1, 3))
-    lo, hi = points.min(0), points.max(0)
+        points, r = np.zeros((1, 3)), np.zeros(1)
+    lo, hi = (points - r[:, None]).min(0), (points + r[:, None]).max(0)
     tan_y = math.tan(FOV_Y / 2) * FILL
     tan_x = tan_y * aspect
     fixed_target = target is not None or len(azimuths) > 1
@@ -91,10 +94,12 @@ def frame(points: np.ndarray, view: str, aspect: float, azimuths=(0.0,),
             centre = (lo + hi) / 2 if target is None else np.asarray(target, float)
             cx, cy = centre @ right, centre @ up
         else:
-            cx, cy = (x.min() + x.max()) / 2, (y.min() + y.max()) / 2
+            cx, cy = ((x - r).min() + (x + r).max()) / 2, ((y - r).min() + (y + r).max()) / 2
             centre = right * cx + up * cy + d * ((z.min() + z.max()) / 2)
         zc = centre @ d
-        dist = float(np.max(np.maximum(np.abs(x - cx) / tan_x, np.abs(y - cy) / tan_y) + (z - zc)))
+        # a quad lies at its centre's depth, r either side of it across the view
+        dist = float(np.max(np.maximum((np.abs(x - cx) + r) / tan_x, (np.abs(y - cy) + r) / tan_y)
+                            + (z - zc)))
         if best is None or dist > best[0]:
             best = (dist, centre)
     if best is None:

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from fishgen.errors import FishgenError
-from fishgen.preview.camera import VIEWS, frame, turned
+from fishgen.preview.camera import VIEWS, Camera, frame, turned
 from fishgen.scene.model import Scene
 
 if TYPE_CHECKING:
@@ -138,21 +138,36 @@ def total_pixels(options: PreviewOptions, frames: int, inputs: int = 1) -> int:
     return frames * per_frame
 
 
-def subject_points(scene: Scene, times: Sequence[float | None], clip: str | None) -> np.ndarray:
-    """Every vertex (and particle extent) the camera must keep in frame, at each of ``times``."""
+def subject_points(scene: Scene, times: Sequence[float | None],
+                   clip: str | None) -> tuple[np.ndarray, np.ndarray]:
+    """Every vertex and particle centre the camera must keep in frame, at each of ``times``, and how
+    far each reaches round it: (points (N, 3), reach (N,)), a particle's world radius, else 0."""
     from fishgen.preview.posing import poser_for
     from fishgen.preview.render import particles
 
     poser = poser_for(scene, clip)
     points = [(node, prim) for node, prim in scene.drawn() if prim.mode == "POINTS"]
-    out = []
+    out, reach = [], []
     for t in times:
         posed, worlds = poser.frame(t, keep=True)  # the renderer draws these same vertices
         for node, prim in points:
             c, r, _ = particles(scene, node, prim, posed)
-            out += [c - r[:, None], c + r[:, None]]
+            out.append(c)
+            reach.append(r)
         out += [pos for pos, _ in worlds]
-    return np.concatenate(out) if out else np.zeros((1, 3))
+        reach += [np.zeros(len(pos)) for pos, _ in worlds]
+    if not out:
+        return np.zeros((1, 3)), np.zeros(1)
+    return np.concatenate(out), np.concatenate(reach)
+
+
+def frame_scene(scene: Scene, view: str, aspect: float, times: Sequence[float | None] = (None,),
+                clip: str | None = None, *, azimuths: tuple[float, ...] = (0.0,),
+                ortho: bool = False) -> Camera:
+    """A camera on ``view`` that keeps all of ``scene`` in frame at each of ``times``, particles'
+    quads whole (:func:`subject_points`, :func:`fishgen.preview.camera.frame`)."""
+    points, reach = subject_points(scene, times, clip)
+    return frame(points, view, aspect, azimuths=azimuths, ortho=ortho, reach=reach)
 
 
 def start_time(scene: Scene, options: PreviewOptions) -> float | None:
@@ -218,10 +233,9 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
     try:
         for scene, (times, azimuths, step) in zip(scenes, plans, strict=True):
             seconds.append(step)
-            points = subject_points(scene, sorted(set(times), key=lambda t: -1 if t is None else t),
-                                    options.clip)
-            base = frame(points, options.view, options.width / options.height,
-                         azimuths=tuple(sorted(set(azimuths))), ortho=options.ortho)
+            base = frame_scene(scene, options.view, options.width / options.height,
+                               sorted(set(times), key=lambda t: -1 if t is None else t), options.clip,
+                               azimuths=tuple(sorted(set(azimuths))), ortho=options.ortho)
             images = []
             shots = [(turned(base, options.view, az) if az else base, t)
                      for t, az in zip(times, azimuths, strict=True)]

@@ -19,8 +19,7 @@ from fishgen.assembly.fish import METRES_PER_WORLD_UNIT, THESIS_TO_GLTF, build_f
 from fishgen.authoring.photo.sideview import FIN_PARTS
 from fishgen.geometry.body import ring_positions
 from fishgen.geometry.shapes import profile_for
-from fishgen.preview.camera import frame
-from fishgen.preview.pipeline import subject_points
+from fishgen.preview.pipeline import frame_scene
 from fishgen.species.model import Species
 
 SIZE = (1024, 512)
@@ -59,7 +58,7 @@ def render_photo(species: Species, size=SIZE) -> Photo:
 
     w, h = size
     scene = build_fish(species)
-    cam = frame(subject_points(scene, [None], None), "side", w / h, ortho=True)
+    cam = frame_scene(scene, "side", w / h, ortho=True)
     renderer = Renderer(w, h)
     try:
         rgba = renderer.render(scene, cam, None, (0.0, 0.0, 0.0, 0.0))

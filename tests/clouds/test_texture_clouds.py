@@ -129,15 +129,14 @@ def test_export_makes_textured_lit_billboards(tmp_path, gltf_validator):
 
 
 def test_the_preview_reader_takes_awa(gl_available):
-    from fishgen.preview.camera import frame
-    from fishgen.preview.pipeline import subject_points
+    from fishgen.preview.pipeline import frame_scene
     from fishgen.preview.render import Renderer
 
     scene = cube_file_scene(SKY)
     assert scene.counts()["triangles"] == 6 * 60 and len(scene.images) == 3
     renderer = Renderer(200, 150)
     try:
-        image = renderer.render(scene, frame(subject_points(scene, [None], None), "front", 4 / 3), None,
+        image = renderer.render(scene, frame_scene(scene, "front", 4 / 3), None,
                                 (0, 0, 0, 0))
     finally:
         renderer.release()

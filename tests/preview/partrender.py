@@ -137,15 +137,14 @@ _CAMERAS = {"left": ("side", 0.0), "right": ("side", math.pi), "top": ("top", 0.
 
 def _render(scenes, view: str, size, background) -> list[np.ndarray]:
     """Each scene framed alone on ``view``; (H, W, 4) uint8 RGBA each, straight alpha."""
-    from fishgen.preview.camera import frame
-    from fishgen.preview.pipeline import subject_points
+    from fishgen.preview.pipeline import frame_scene
     from fishgen.preview.render import Renderer
 
     named, azimuth = _CAMERAS[view]
     w, h = size
     renderer = Renderer(w, h)  # its upload cache is keyed by id(scene): every scene stays alive here
     try:
-        return [renderer.render(s, frame(subject_points(s, [None], None), named, w / h, azimuths=(azimuth,)),
+        return [renderer.render(s, frame_scene(s, named, w / h, azimuths=(azimuth,)),
                                 None, tuple(c / 255.0 for c in background)) for s in scenes]
     finally:
         renderer.release()

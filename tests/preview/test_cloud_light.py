@@ -12,8 +12,7 @@ from scipy import ndimage
 
 from fishgen.clouds import Lighting, fill_cloud, light_cloud, load_cubes
 from fishgen.clouds.scene import cloud_scene, cube_file_scene
-from fishgen.preview.camera import frame
-from fishgen.preview.pipeline import subject_points
+from fishgen.preview.pipeline import frame_scene
 from fishgen.preview.render import Renderer
 from tests.conftest import PARAMS
 
@@ -51,8 +50,8 @@ def renderer():
 
 
 def shots(renderer, scene, views=("front", "side", "top")) -> dict[str, np.ndarray]:
-    points = subject_points(scene, [None], None)
-    return {v: renderer.render(scene, frame(points, v, SIZE[0] / SIZE[1]), None, (0, 0, 0, 0)) for v in views}
+    return {v: renderer.render(scene, frame_scene(scene, v, SIZE[0] / SIZE[1]), None, (0, 0, 0, 0))
+            for v in views}
 
 
 def test_billboards_preview_as_a_soft_cloud_from_every_side(renderer):

@@ -25,7 +25,7 @@ def render_side(species: Species, width: int, height: int, distance: float | Non
     from fishgen.preview.render import Renderer
 
     scene = build_fish(species)
-    points = subject_points(scene, [None], None)
+    points, _ = subject_points(scene, [None], None)   # a fish: vertices, which reach no farther
     camera = frame(points, "side", width / height, ortho=distance is None)
     if distance is not None:
         camera = _from_afar(camera, points, distance)
@@ -69,10 +69,9 @@ def render_scale(species: Species, width: int, height: int) -> float:
     """Pixels a thesis unit spans in :func:`render_side`'s picture of ``species`` at this size:
     the camera frames the whole fish, so this follows from its extents alone (nothing is drawn)."""
     from fishgen.assembly.fish import METRES_PER_WORLD_UNIT, THESIS_TO_GLTF, build_fish
-    from fishgen.preview.camera import frame
-    from fishgen.preview.pipeline import subject_points
+    from fishgen.preview.pipeline import frame_scene
 
-    camera = frame(subject_points(build_fish(species), [None], None), "side", width / height, ortho=True)
+    camera = frame_scene(build_fish(species), "side", width / height, ortho=True)
     vp = camera.projection() @ camera.view()
     # one thesis unit along the body, from the origin, in clip space (orthographic: w stays 1)
     ends = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]) @ THESIS_TO_GLTF.T
