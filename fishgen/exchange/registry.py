@@ -17,11 +17,13 @@ batch manifest. Each such format declares a ``sniff`` that tells its files by th
 """
 from __future__ import annotations
 
+import bisect
 import importlib
 import os
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 from fishgen.errors import FishgenError
 
@@ -48,6 +50,7 @@ class Format:
     writes_with: tuple[str, ...] = ()  # the options its writer takes, of WRITER_OPTIONS
     sniff: str | None = None        # "module:function(path) -> bool": is this file of this format?
     extra: tuple[str, str, str] | None = None  # (module, pip package, extra) its writer needs
+    sides: tuple[str, ...] = ()     # files written beside a target: "{stem}.bin", "{stem}_*.png" (* any text)
 
     def write(self, scene, path: Path, **offered) -> list[Path]:
         """Write ``scene`` to ``path``; of the ``offered`` options (each one of WRITER_OPTIONS, or it
@@ -182,6 +185,77 @@ def input_format(path: str | os.PathLike, *, kinds: Iterable[Format], command: s
                        path)
 
 
+class Written(NamedTuple):
+    """A file name writing a target may make: ``before`` alone, or with a wildcard, any name that
+    starts with ``before`` and ends with ``after`` (an image's name goes between)."""
+
+    before: str
+    after: str | None = None
+
+    def __str__(self) -> str:
+        return self.before if self.after is None else f"{self.before}*{self.after}"
+
+    def matches(self, name: str) -> bool:
+        """Whether the file ``name`` is one this stands for."""
+        if self.after is None:
+            return name == self.before
+        return (len(name) >= len(self.before) + len(self.after) and name.startswith(self.before)
+                and name.endswith(self.after))
+
+    def shared(self, other: Written) -> Written | None:
+        """A name both may stand for, or None."""
+        if self.after is None:
+            return self if other.matches(self.before) else None
+        if other.after is None:
+            return other if self.matches(other.before) else None
+        a, b, x, y = self.before, other.before, self.after, other.after
+        if (a.startswith(b) or b.startswith(a)) and (x.endswith(y) or y.endswith(x)):
+            return Written(max(a, b, key=len), max(x, y, key=len))
+        return None
+
+
+def written_names(target: str | os.PathLike) -> tuple[Written, ...]:
+    """Every file name writing ``target`` may make in its folder: its own, then the side files its
+    format declares (``sides``)."""
+    path = Path(target)
+    fmt = by_extension(path)
+    found = [Written(path.name)]
+    for side in fmt.sides if fmt is not None else ():
+        before, star, after = side.partition("*")  # split before the stem goes in: it may hold a *
+        found.append(Written(before.replace("{stem}", path.stem),
+                             after.replace("{stem}", path.stem) if star else None))
+    return tuple(found)
+
+
+def first_shared(targets: Sequence[str | os.PathLike]) -> tuple[int, int, Written] | None:
+    """The first two of ``targets`` whose writes may make one file (their own names and their
+    formats' side files, in one folder): their indices and that name, or None. Sorted by name, so
+    that a batch of many outputs is checked in n log n."""
+    by_folder: dict[Path, list[tuple[Written, int]]] = {}
+    for k, target in enumerate(targets):
+        path = Path(os.path.abspath(target))
+        by_folder.setdefault(path.parent, []).extend((name, k) for name in written_names(path))
+    found: list[tuple[int, int, Written]] = []
+    for names in by_folder.values():
+        names.sort(key=lambda item: item[0].before)
+        starts = [name.before for name, _ in names]
+        by_start: dict[str, list[tuple[Written, int]]] = {}
+        for item in names:
+            by_start.setdefault(item[0].before, []).append(item)
+        for name, k in names:
+            if name.after is None:  # a plain name meets a plain one of the same start, seen from there
+                others = [o for o in by_start[name.before] if o[0].after is None]
+            else:  # a pattern meets names starting with its start, and patterns whose start begins it
+                end = bisect.bisect_left(starts, name.before + "\U0010ffff")
+                others = names[bisect.bisect_left(starts, name.before):end]
+                others += [o for n in range(len(name.before)) for o in by_start.get(name.before[:n], ())
+                           if o[0].after is not None]
+            for other, j in others:
+                if j != k and (shared := name.shared(other)) is not None:
+                    found.append((min(j, k), max(j, k), shared))
+    return min(found, key=lambda f: (f[0], f[1])) if found else None
+
+
 def lost(fmt: Format, scene) -> list[str]:
     """What ``scene`` holds that ``fmt`` cannot: said once in a command's summary."""
     return [k for k in CONTENT if k in scene.has() and k not in fmt.holds]
@@ -193,15 +267,15 @@ register_format(Format("glb", (".glb",), "binary glTF 2.0", _ALL,
                        viewer=True))
 register_format(Format("gltf", (".gltf",), "glTF 2.0 JSON with .bin and images beside it", _ALL,
                        "fishgen.exchange.gltf:write_gltf", "fishgen.exchange.gltf_reader:read_gltf",
-                       viewer=True))
+                       viewer=True, sides=("{stem}.bin", "{stem}_*.png", "{stem}_*.jpg")))
 register_format(Format("obj", (".obj",), "Wavefront OBJ with .mtl and images (rest pose)",
                        frozenset({MESHES, TEXTURES}),
                        "fishgen.exchange.obj:write_obj", "fishgen.exchange.mesh_reader:read_mesh_file",
-                       viewer=True))
+                       viewer=True, sides=("{stem}.mtl", "{stem}_*.png")))
 register_format(Format("ply", (".ply",), "binary PLY: a rest-pose mesh or particles",
                        frozenset({MESHES, POINTS, TEXTURES}),
                        "fishgen.exchange.ply:write_ply", "fishgen.exchange.mesh_reader:read_mesh_file",
-                       viewer=True))
+                       viewer=True, sides=("{stem}_*.png",)))
 register_format(Format("csv", (".csv",), "CSV table of particles", frozenset({POINTS}),
                        "fishgen.exchange.table:write_csv"))
 register_format(Format("npy", (".npy",), "NumPy structured array of particles", frozenset({POINTS}),
@@ -215,7 +289,7 @@ register_format(Format("vdb", (".vdb",), "OpenVDB volume: a cloud's density and 
 register_format(Format("species", (".txt",), "a VRFish species file",
                        frozenset({MESHES, TEXTURES, NODE_ANIMATION}),
                        reader="fishgen.assembly.fish:species_scene", command="build",
-                       reads_with=("textures_dir",)))
+                       reads_with=("textures_dir",), sides=("{stem}.png", "{stem}_mask.png")))
 register_format(Format("school scene", (".toml",), "a school scene file", frozenset({MESHES, NODE_ANIMATION}),
                        command="school", sniff="fishgen.tomlfile:is_school_scene"))
 register_format(Format("batch manifest", (".toml",), "a batch manifest", command="batch",
@@ -233,4 +307,5 @@ for _name, _what in (("usdc", "binary"), ("usda", "text"),
                      ("usdz", "a package of binary USD and its textures")):
     register_format(Format(_name, (f".{_name}",), f"OpenUSD, {_what}: a fish as a skinned UsdSkel mesh, a "
                            "school as a PointInstancer (needs usd-core)", _USD,
-                           "fishgen.exchange.usd:write_usd", extra=("pxr", "usd-core", "usd")))
+                           "fishgen.exchange.usd:write_usd", extra=("pxr", "usd-core", "usd"),
+                           sides=() if _name == "usdz" else ("{stem}_*.png",)))

@@ -107,3 +107,37 @@ def test_readers_take_exactly_the_options_their_format_declares(tmp_path):
         FORMATS["cubes"].read(PARAMS / "clouds" / "table_4_3.awn", sed=3)
     scene = FORMATS["cubes"].read(PARAMS / "clouds" / "table_4_3.awn", seed=3, textures_dir=None)
     assert scene.counts()["particles"] == 554
+
+
+def test_every_file_a_writer_writes_is_a_name_its_format_declares(tmp_path):
+    """What a format writes beside a target (``sides``) is known before it writes: the commands
+    check those names against their inputs and their other outputs up front."""
+    from fishgen.assembly.fish import fish_of
+    from fishgen.assembly.fish_options import FishOptions
+    from fishgen.exchange.registry import written_names
+    from fishgen.species.parser import load_species
+
+    scene = fish_of(load_species(PARAMS / "bonybream.txt"), FishOptions(fins="mask")).scene
+    for name in ("glb", "gltf", "obj", "ply"):
+        target = tmp_path / name / f"fish.{name}"
+        files = export(scene, target)
+        declared = written_names(target)
+        assert declared[0].matches(target.name) and len(files) > (name != "glb") * 2 - 1
+        assert all(any(w.matches(f.name) for w in declared) for f in files), (name, files, declared)
+
+
+@pytest.mark.parametrize("targets,shared", [
+    (["o/a.gltf", "o/b.glb", "o/a.obj"], (0, 2, "a_*.png")),   # both write a_skin.png
+    (["o/a.gltf", "o/a_skin.png"], (0, 1, "a_skin.png")),
+    (["o/e.txt", "o/e.png"], (0, 1, "e.png")),                  # a species file's texture
+    (["o/h.txt", "o/h_mask.png"], (0, 1, "h_mask.png")),
+    (["o/a.glb", "o/./a.glb"], (0, 1, "a.glb")),
+    (["o/a.gltf", "p/a.obj"], None),                            # other folders
+    (["o/a.gltf", "o/a.glb", "o/b.obj"], None),
+    ([f"o/f{k}.gltf" for k in range(200)], None),
+])
+def test_two_targets_share_a_file_when_their_names_or_side_files_meet(targets, shared):
+    from fishgen.exchange.registry import first_shared
+
+    found = first_shared(targets)
+    assert (found if found is None else (found[0], found[1], str(found[2]))) == shared
