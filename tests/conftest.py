@@ -43,6 +43,19 @@ def assert_valid_gltf(*paths: Path) -> None:
             + json.dumps(bad[:10], indent=1))
 
 
+def species_textured_as(folder: Path, colour: str, mask: str) -> dict[Path, bytes]:
+    """The shipped bonybream in ``folder`` with its textures renamed ``colour`` and ``mask``: what
+    each of its three files holds, to check that none was written over."""
+    import shutil
+
+    text = (PARAMS / "bonybream.txt").read_text()
+    named = text.replace("bonybream.png bonybream_mask.png", f"{colour} {mask}")
+    (folder / "bonybream.txt").write_text(named)
+    shutil.copy(ROOT / "textures" / "bonybream.png", folder / colour)
+    shutil.copy(ROOT / "textures" / "bonybream_mask.png", folder / mask)
+    return {p: p.read_bytes() for p in (folder / "bonybream.txt", folder / colour, folder / mask)}
+
+
 @pytest.fixture
 def gltf_validator():
     """The validator as a fixture: ``gltf_validator(path, ...)`` asserts a clean report."""

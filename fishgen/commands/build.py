@@ -59,6 +59,7 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
     through ``events.failed`` and the others are built."""
     inputs = tuple(Path(p) for p in inputs)
     from fishgen.assembly.fish import fish_of
+    from fishgen.atomic import protecting
     from fishgen.commands.paths import check_inputs, check_targets, targets
     from fishgen.exchange import export
     from fishgen.exchange.registry import FORMATS
@@ -75,9 +76,10 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
     for source, target in zip(inputs, outputs, strict=True):
         with each_input(events, errors, len(inputs) > 1):
             species = load_species(source, options.textures)
-            check_targets([target], species.side_files)
+            check_targets([target], species.side_files)  # its textures are inputs, and the side files'
             fish = fish_of(species, options)
-            files = export(fish.scene, target, require=[MESHES])
+            with protecting(species.side_files):
+                files = export(fish.scene, target, require=[MESHES])
             read += [source, *species.side_files]
             written += files
             facts.append(fish.facts)

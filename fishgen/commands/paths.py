@@ -15,6 +15,7 @@ Optional dependencies a chosen feature needs are checked before any work too (:f
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -39,6 +40,26 @@ def check_inputs(paths: Iterable[str | os.PathLike], command: str, kinds: Sequen
         if path.is_dir():
             raise FishgenError("expected a file, found a directory", path)
         found.append(input_format(path, kinds=kinds, command=command, default=default))
+    return found
+
+
+def read_beside(inputs: Sequence[Path], kinds: Sequence[Format],
+                textures: str | os.PathLike | None = None) -> list[Path]:
+    """The files source inputs read besides themselves, found before any work so that no output
+    replaces one: a species file's textures, a texture cloud's pictures (``kinds``: each input's
+    format, as :func:`check_inputs` found it; ``textures``: the command's ``--textures``)."""
+    found: list[Path] = []
+    for path, kind in zip(inputs, kinds, strict=True):
+        if kind.name == "species":
+            from fishgen.species.parser import load_species
+
+            found += load_species(path, textures).side_files
+        elif kind.name == "texture cubes":
+            from fishgen.clouds.pipeline import cloud_textures, read_cube_files
+
+            # every cube line, however many particles: the command's own read says if they are too many
+            found += cloud_textures(read_cube_files([path], max_particles=sys.maxsize, textures_dir=textures,
+                                                    note=lambda _: None))
     return found
 
 
@@ -79,12 +100,50 @@ def targets(inputs: Sequence[Path], given: str | os.PathLike | None, *, fmt: str
 
 
 def check_targets(outputs: Iterable[str | os.PathLike | None], inputs: Iterable[str | os.PathLike]) -> None:
-    """Every output may be written: a missing or regular file, and none of the command's inputs
-    (checked before any work; the writers check again, see :func:`fishgen.atomic.protecting`)."""
-    with protecting(inputs):
-        for target in outputs:
-            if target is not None:
-                check_target(Path(target))
+    """Every output may be written: a missing or regular file, none of the command's inputs, none
+    of the side files its format writes beside it an input either (a glTF's ``NAME_skin.png`` over a
+    species' texture), and no two outputs one file (checked before any work; the writers check
+    again, see :func:`fishgen.atomic.protecting`)."""
+    targets = [Path(t) for t in outputs if t is not None]
+    read = [Path(p) for p in inputs]
+    with protecting(read):
+        for target in targets:
+            check_target(target)
+    check_beside(targets, read)
+    check_apart(targets)
+
+
+def check_beside(outputs: Iterable[Path], inputs: Iterable[Path]) -> None:
+    """No input is a file that writing one of ``outputs`` may make beside it (its side files)."""
+    from fishgen.exchange.registry import written_names
+
+    folders: dict[Path, list[Path]] = {}
+    for path in inputs:
+        folders.setdefault(Path(os.path.abspath(path)).parent.resolve(), []).append(path)
+    for target in outputs:
+        sides = written_names(target)[1:]
+        for path in folders.get(Path(os.path.abspath(target)).parent.resolve(), ()) if sides else ():
+            side = next((s for s in sides if s.matches(path.name)), None)
+            if side is not None:
+                raise UsageError(f"expected an output that is not one of the command's inputs, found "
+                                 f"{os.fspath(target)!r}, which writes {str(side)!r} beside it, and the "
+                                 f"input {os.fspath(path)!r} is one")
+
+
+def check_apart(outputs: Sequence[str | os.PathLike]) -> None:
+    """No two of a command's outputs, their side files included, may be one file."""
+    from fishgen.exchange.registry import first_shared
+
+    clash = first_shared(outputs)
+    if clash is not None:
+        first, second, name = (Path(outputs[clash[0]]), Path(outputs[clash[1]]), clash[2])
+        shown, both = first.parent / str(name), f" ({first} and {second} both write it)"
+        if os.path.abspath(first) == os.path.abspath(second):
+            shown, both = first, ""
+        elif name.after is None and name.before in (first.name, second.name):
+            both = ""
+        raise UsageError(f"expected every output of one run to be a different file, found {shown} "
+                         f"twice{both}")
 
 
 def suffix_of(path: Path, allowed: Sequence[str], what: str) -> None:

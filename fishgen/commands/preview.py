@@ -82,13 +82,14 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
     """Render the inputs to one image or loop."""
     inputs = tuple(Path(p) for p in inputs)
     output = Path(output)
-    from fishgen.commands.paths import check_inputs, check_targets
+    from fishgen.atomic import protecting
+    from fishgen.commands.paths import check_inputs, check_targets, read_beside
     from fishgen.preview.inputs import input_formats
     from fishgen.preview.pipeline import PreviewOptions
     from fishgen.preview.pipeline import preview as render
 
-    check_inputs(inputs, "preview", input_formats())
-    check_targets([output], inputs)
+    beside = read_beside(inputs, check_inputs(inputs, "preview", input_formats()), options.textures)
+    check_targets([output], [*inputs, *beside])
     width, height = options.size
     settings = PreviewOptions(view=options.view, width=width, height=height, time=options.time,
                               background=options.background, frames=options.frames, fps=options.fps,
@@ -96,6 +97,7 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
                               seed=options.seed, textures_dir=options.textures, ortho=options.ortho,
                               lighting=options.lighting)
     with ExitStack() as stack:
+        stack.enter_context(protecting(beside))
         bar: list = []
 
         def start(total: int) -> None:  # a bar over the frames of a loop or sheet, not one still
@@ -104,4 +106,4 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
 
         out = render(inputs, output, settings, progress=lambda n: bar[0].update(n) if bar else None,
                      on_loaded=start, on_note=events.note)
-    return Made((out,), tuple(inputs), (f"wrote {out}",))
+    return Made((out,), (*inputs, *beside), (f"wrote {out}",))

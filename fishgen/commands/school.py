@@ -128,7 +128,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     only when the glb was, and every target is checked before the simulation starts."""
     inputs = tuple(Path(p) for p in inputs)
     output = Path(output)
-    from fishgen.commands.paths import check_inputs, check_targets, needs, suffix_of
+    from fishgen.commands.paths import check_inputs, check_targets, needs, read_beside, suffix_of
     from fishgen.errors import UsageError
     from fishgen.exchange.registry import FORMATS, INSTANCES, MESHES, NODE_ANIMATION, output_format
     from fishgen.school.scene_file import SceneFile, SpeciesEntry, check_size, load_scene_file, with_options
@@ -162,7 +162,8 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
                          variety=variety)
     check_size(scene, scene_files[0] if scene_files else None)  # before anything is built
     species_files = [e.file for e in scene.species]
-    check_targets([output, *sides.values()], [*inputs, *species_files, *scene.read])
+    textures = read_beside(species_files, [FORMATS["species"]] * len(species_files), options.textures)
+    check_targets([output, *sides.values()], [*inputs, *species_files, *scene.read, *textures])
 
     from fishgen.school import run_school
 

@@ -101,7 +101,7 @@ class SkyFacts:
 def sky(inputs: Sequence[Path], output: str | os.PathLike, options: SkyOptions = SkyOptions(),
         events: Events = QUIET) -> Made:
     """Build the sky and write it atomically; the summary says its clouds, particles and size."""
-    from fishgen.commands.paths import check_inputs, check_targets
+    from fishgen.commands.paths import check_inputs, check_targets, read_beside
     from fishgen.errors import UsageError
     from fishgen.exchange import export
     from fishgen.exchange.clouds import check_output
@@ -112,8 +112,9 @@ def sky(inputs: Sequence[Path], output: str | os.PathLike, options: SkyOptions =
         raise UsageError(f"expected a .glb or .gltf output (a sky's nodes and levels of detail need glTF), "
                          f"found {output.suffix or 'no extension'!r}")
     models = tuple(Path(p) for p in options.clouds)
-    check_inputs(models, "sky", [FORMATS["cubes"], FORMATS["texture cubes"]], default=FORMATS["cubes"])
-    check_targets([output], models)
+    kinds = check_inputs(models, "sky", [FORMATS["cubes"], FORMATS["texture cubes"]],
+                         default=FORMATS["cubes"])
+    check_targets([output], [*models, *read_beside(models, kinds, options.textures)])
     total = options.particles if options.particles is not None else MODES[options.mode].particles
     check_output(output, options.billboards, particles=total)
     from fishgen.sky.build import build_sky

@@ -82,9 +82,10 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     if options.species is None:
         raise UsageError("expected -s/--species BASE.txt, the species to start from, found none")
     sides = [options.mask, options.fxl_in]
-    outputs = [output, options.compare, options.fxl_out]  # the texture and mask beside it: atomic.protecting
+    outputs = [output, options.compare, options.fxl_out]  # and NEW.png, NEW_mask.png beside NEW.txt
     check_targets(outputs, [photo, options.species, *(p for p in sides if p is not None)])
     species = load_species(options.species)
+    check_targets(outputs, species.side_files)  # the textures it names are inputs too
     settings = TextureOptions(mask=options.mask, fit_shape=options.fit_shape,
                               body_sections=options.body_sections,
                               circle_sections=options.circle_sections, spacing=options.spacing,

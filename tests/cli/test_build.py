@@ -188,3 +188,20 @@ def test_a_batch_manifest_given_to_build_points_to_batch(tmp_path):
     result = run_cli("build", PARAMS / "assets.toml", "-o", tmp_path / "x.glb")
     assert result.returncode == 2 and result.stderr.count("\n") == 1
     assert "found a batch manifest; use `fishgen batch` for it" in result.stderr
+
+
+@pytest.mark.parametrize("output", ["o.gltf", "o.obj", "o.ply", "p.gltf"])
+def test_an_output_whose_side_files_are_the_species_textures_is_refused(tmp_path, output):
+    """A species whose textures are o_skin.png and o_skin_mask.png: `-o o.gltf` (or .obj) wrote its
+    own o_skin.png over them, exit 0. The textures a species file names are inputs too."""
+    from tests.conftest import species_textured_as
+
+    inputs = species_textured_as(tmp_path, "o_skin.png", "o_skin_mask.png")
+    result = run_cli("build", "bonybream.txt", "-o", output, cwd=tmp_path)
+    if output == "p.gltf":  # p_skin.png: another name
+        assert result.returncode == 0, result.stderr
+    else:
+        assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+        assert "not one of the command's inputs" in result.stderr and "o_skin" in result.stderr
+        assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in inputs)
+    assert {p: p.read_bytes() for p in inputs} == inputs

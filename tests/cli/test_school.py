@@ -217,3 +217,13 @@ def test_two_outputs_naming_one_file_are_refused_and_nothing_is_written(tmp_path
     assert result.stderr == (f"fishgen: expected every output of one run to be a different file, found "
                              f"{tmp_path / 's_skin.png'} twice\n")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_output_whose_side_files_are_a_species_textures_is_refused(tmp_path):
+    """The textures of a school's species are its inputs too: `-o o.gltf` writes o_*.png beside it."""
+    from tests.conftest import species_textured_as
+
+    inputs = species_textured_as(tmp_path, "o_skin.png", "o_skin_mask.png")
+    result = run_cli("school", "bonybream.txt", "--count", "2", "--frames", "2", "-o", "o.gltf", cwd=tmp_path)
+    assert result.returncode == 2 and "not one of the command's inputs" in result.stderr, result.stderr
+    assert {p: p.read_bytes() for p in inputs} == inputs and not (tmp_path / "o.gltf").exists()

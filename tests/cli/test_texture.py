@@ -232,3 +232,31 @@ def test_focal_length_measures_the_rebuilt_fish_in_that_perspective(tmp_path, cl
               "--focal-length", "0")
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1, bad.stderr
     assert "--focal-length" in bad.stderr
+
+
+@pytest.mark.parametrize("args,twice", [
+    (["-o", "out/d.txt", "--compare", "out/d.txt"], "out/d.txt"),
+    (["-o", "out/c.txt", "--compare", "out/c.png"], "out/c.png"),        # the new species' texture
+    (["-o", "out/h.txt", "--compare", "out/h_mask.png"], "out/h_mask.png"),  # and its mask
+    (["-o", "out/e.txt", "--fxl-out", "out/e.png"], "out/e.png"),
+])
+def test_outputs_that_name_one_file_are_refused_before_fitting(tmp_path, args, twice):
+    """The comparison picture or the .FXL file over the species file, its texture or its mask:
+    the later write replaced the earlier, exit 0."""
+    result = run_cli("texture", PARAMS / "photos" / "bonybream-side.png", "-s", PARAMS / "bonybream.txt",
+                     *args, cwd=tmp_path)
+    assert result.returncode == 2 and result.stderr.count("\n") == 1 and "Traceback" not in result.stderr
+    assert f"found {twice} twice" in result.stderr and list(tmp_path.iterdir()) == []
+
+
+def test_an_output_over_the_base_species_texture_is_refused(tmp_path):
+    import shutil
+
+    shutil.copy(PARAMS / "bonybream.txt", tmp_path)
+    for name in ("bonybream.png", "bonybream_mask.png"):
+        shutil.copy(PARAMS.parent / "textures" / name, tmp_path)
+    before = (tmp_path / "bonybream.png").read_bytes()
+    result = run_cli("texture", PARAMS / "photos" / "bonybream-side.png", "-s", "bonybream.txt", "-o",
+                     "new.txt", "--compare", "bonybream.png", cwd=tmp_path)
+    assert result.returncode == 2 and "not one of the command's inputs" in result.stderr, result.stderr
+    assert (tmp_path / "bonybream.png").read_bytes() == before and not (tmp_path / "new.txt").exists()

@@ -159,3 +159,26 @@ def test_pixel_budget_is_checked_before_any_input_is_read(tmp_path):
     assert total_pixels(PreviewOptions(), 36, inputs=16) < MAX_TOTAL_PIXELS
     assert sheet_size(PreviewOptions(width=1920, height=1080), 16)[0] == 4 * 1920
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("output", ["bonybream.png", "bonybream_mask.png"])
+def test_a_render_over_the_species_texture_is_refused(tmp_path, output):
+    """Run where the species file's texture is bonybream.png, `-o bonybream.png` replaced it."""
+    from tests.conftest import species_textured_as
+
+    inputs = species_textured_as(tmp_path, "bonybream.png", "bonybream_mask.png")
+    result = run_cli("preview", "bonybream.txt", "-o", output, cwd=tmp_path)
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "not one of the command's inputs" in result.stderr
+    assert {p: p.read_bytes() for p in inputs} == inputs
+
+
+def test_a_render_over_a_texture_clouds_picture_is_refused(tmp_path):
+    import shutil
+
+    shutil.copy(PARAMS / "clouds" / "sky.awa", tmp_path)
+    shutil.copytree(PARAMS.parent / "textures" / "clouds", tmp_path / "clouds")
+    before = (tmp_path / "clouds" / "billow.png").read_bytes()
+    result = run_cli("preview", "sky.awa", "-o", "clouds/billow.png", cwd=tmp_path)
+    assert result.returncode == 2 and "not one of the command's inputs" in result.stderr, result.stderr
+    assert (tmp_path / "clouds" / "billow.png").read_bytes() == before
