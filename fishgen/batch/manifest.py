@@ -30,7 +30,7 @@ from pathlib import Path, PurePosixPath
 from typing import Any
 
 from fishgen.errors import FishgenError
-from fishgen.exchange.registry import output_format
+from fishgen.exchange.registry import first_shared, output_format
 from fishgen.options import build, check_value, manifest_options
 from fishgen.tomlfile import Where, loads
 
@@ -120,7 +120,20 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None,
             jobs.append(job)
     if not jobs:
         raise FishgenError(f"expected at least one job ({tables}), found none", file)
+    _apart(jobs)
     return Manifest(path, out_dir, tuple(jobs))
+
+
+def _apart(jobs: Sequence[Job]) -> None:
+    """No two jobs may write one file, side files included (a.gltf's and a.obj's ``a_skin.png``):
+    the later would replace the earlier's, and each run would rebuild both."""
+    clash = first_shared([job.output for job in jobs])
+    if clash is not None:
+        first, second = sorted((jobs[clash[0]], jobs[clash[1]]), key=lambda job: job.line or 0)
+        name = clash[2]
+        raise FishgenError(f"expected jobs whose outputs are different files, found {first.name} "
+                           f"({first.where}) and {second.name}, which both write {name}", second.source,
+                           second.line)
 
 
 def _job(where: Where, of: Kind, nth: int, entry: dict[str, Any], folder: Path, out: Path) -> Job:

@@ -15,7 +15,7 @@ from fishgen.errors import FishgenError
 from fishgen.options import FILE, FOLDER, option
 
 if TYPE_CHECKING:
-    from fishgen.batch.manifest import Job, Kind
+    from fishgen.batch.manifest import Job, Kind, Manifest
 
 
 @dataclass(frozen=True)
@@ -129,6 +129,8 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
         manifest = scan_folder(source, options.out, kinds=job_kinds())
     else:
         manifest = load_manifest(source, options.out, kinds=job_kinds())
+    if options.report is not None:
+        _check_report(options.report, manifest)
     workers = options.jobs or os.cpu_count() or 1
     with ExitStack() as stack:
         bar: list[Progress] = []
@@ -179,6 +181,33 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
     written += [manifest.out / p for o in outcomes if o.status == "built" for p in o.outputs]
     return Made(tuple(written), (manifest.file,) if manifest.file else (), (line,),
                 BatchFacts(tuple(outcomes), seconds, workers), errors, verdict)
+
+
+def _check_report(report: Path, manifest: Manifest) -> None:
+    """``--report`` is none of the files the jobs read or write, checked before any job runs: the
+    manifest, each job's inputs and the files they name (a species' textures, a texture cloud's
+    pictures, what the record says a job read last time), and each job's output and side files."""
+    from fishgen.batch.record import Record
+    from fishgen.commands.paths import check_inputs, check_targets, read_beside
+    from fishgen.errors import UsageError
+    from fishgen.exchange.registry import FORMATS, first_shared
+
+    recorded = Record(manifest.out).jobs  # first: a file named again below is then named as given
+    read = [Path(os.path.normpath(manifest.out / name)) for job in manifest.jobs
+            if isinstance(inputs := recorded.get(job.name, {}).get("inputs"), dict) for name in inputs]
+    read += [*([manifest.file] if manifest.file else []), *(p for job in manifest.jobs for p in job.inputs)]
+    for job in manifest.jobs:
+        try:  # a bad input fails its own job when it runs, not the batch
+            kinds = check_inputs(job.inputs, job.kind, list(FORMATS.values()), default=FORMATS["species"])
+            read += read_beside(job.inputs, kinds, getattr(job.options, "textures", None))
+        except FishgenError:
+            pass
+    check_targets([report], read)
+    clash = first_shared([report, *(job.output for job in manifest.jobs)])
+    if clash is not None and clash[0] == 0:
+        job = manifest.jobs[clash[1] - 1]
+        raise UsageError(f"expected a report that is none of the jobs' outputs, found {os.fspath(report)!r}, "
+                         f"which job {job.name} ({job.where}) writes as {clash[2]}")
 
 
 def _job_error(outcome) -> FishgenError:

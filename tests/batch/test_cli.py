@@ -4,6 +4,8 @@ from __future__ import annotations
 import json
 import shutil
 
+import pytest
+
 from fishgen.batch.manifest import derived_seed
 from tests.batch.conftest import batch, hashes, statuses
 from tests.conftest import ROOT
@@ -121,3 +123,20 @@ def test_a_full_disk_says_one_line_per_failed_job_and_one_summary(shipped, monke
         f"No space left on device; cannot write {shipped / 'report.json'}: No space left on device"]
     assert run.stdout.startswith(f"{out}: 2 jobs, 0 built, 0 skipped, 2 failed in ")
     assert [p.name for p in out.rglob("*") if p.is_file()] == [".fishgen-batch.lock"]
+
+
+@pytest.mark.parametrize("report", ["params/bonybream.txt", "textures/bonybream.png", "params/assets.toml",
+                                    "out/assets/fish/bonybream.glb", "out/assets/clouds/sky.bin"])
+def test_a_report_that_is_a_jobs_input_or_output_is_refused_before_any_job_runs(shipped, report):
+    """--report over a job's species file, its texture, the manifest itself or a job's output (its
+    side files too) replaced that file with JSON; the manifest was refused only once the jobs ran."""
+    manifest = shipped / "params" / "assets.toml"
+    manifest.write_text(manifest.read_text() + '\n[[clouds]]\ninput = "clouds/table_4_2.awn"\n'
+                        'output = "clouds/sky.gltf"\n')
+    target = shipped / report
+    before = target.read_bytes() if target.exists() else None
+    run = batch(manifest, "--report", target)
+    assert run.returncode == 2 and run.stdout == "" and run.stderr.count("\n") == 1, run.stderr
+    assert "Traceback" not in run.stderr and str(target) in run.stderr
+    assert (target.read_bytes() if target.exists() else None) == before
+    assert not (shipped / "out").exists()

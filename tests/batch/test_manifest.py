@@ -90,6 +90,12 @@ output = "ab.glb"
     ('[[clouds]]\ninput = "a.awn"\noutput = "a.ply"\nbillboards = "yes"\n', 4, "true or false"),
     ('[[build]]\ninput = "a.txt"\noutput = "a.glb"\n\n[[build]]\ninput = "b.txt"\noutput = "a.glb"\n', 7,
      "one job per output, the first at"),
+    ('[[build]]\ninput = "a.txt"\noutput = "a.gltf"\n\n[[build]]\ninput = "b.txt"\noutput = "a.obj"\n', 7,
+     "expected jobs whose outputs are different files, found a.gltf (FILE:3) and a.obj, which both write "
+     "a_*.png"),
+    ('[[build]]\ninput = "a.txt"\noutput = "f/a.txt.glb"\n\n[[clouds]]\ninput = "c.awn"\n'
+     'output = "f/a.gltf"\n\n[[build]]\ninput = "b.txt"\noutput = "f/a_c.ply"\n', 11,
+     "found f/a.gltf (FILE:7) and f/a_c.ply"),
     ('[[bild]]\ninput = "a.txt"\n', 1, "expected one of out, [[build]]"),
     ('[[build]\ninput = "a.txt"\n', 1, "expected TOML"),
     ('out = "o"\n', None, "expected at least one job ([[build]], [[clouds]], [[school]])"),
@@ -99,7 +105,7 @@ def test_every_mistake_is_one_line_at_its_place(tmp_path, text, line, message):
     with pytest.raises(FishgenError) as caught:
         load_manifest(path)
     assert caught.value.file == str(path) and caught.value.line == line
-    assert message in caught.value.message and "\n" not in str(caught.value)
+    assert message.replace("FILE", str(path)) in caught.value.message and "\n" not in str(caught.value)
 
 
 def test_a_folder_scan_makes_one_default_job_per_species_and_cube_file(tmp_path):
