@@ -25,6 +25,8 @@ class ViewOptions:
     instancing: bool = instancing_option()
 
 
+PAGES = (".html", ".htm")
+
 COMMAND = Command(
     name="view",
     summary="Open an asset in a self-contained three.js viewer page.",
@@ -53,16 +55,27 @@ def view(inputs: Sequence[Path], output: str | os.PathLike | None,
     from fishgen.viewer.page import write_page
 
     (asset,) = inputs
+    from fishgen.commands.paths import check_targets, suffix_of
+    from fishgen.viewer.page import page_path
+
+    page = output if output is not None else page_path(asset)
+    suffix_of(page, PAGES, "a page")  # `-o -` too: a page is a file
+    check_targets([page], [asset])
     colour = "#{:02x}{:02x}{:02x}".format(*options.background[:3])
-    page = Path(write_page(asset, output, colour, instancing=options.instancing))
     if options.no_serve:
+        page = Path(write_page(asset, page, colour, instancing=options.instancing))
         return Made((page,), (asset,), (f"wrote {page}",))
     from fishgen.viewer.server import make_server, url_of
 
-    try:
+    try:  # bound before the page is written: a taken port leaves no page behind
         server = make_server(page, options.port)  # that one page, never its folder
     except OSError as err:
         raise SystemFailure(f"expected a free port {options.port} on 127.0.0.1, found it taken "
                             f"({err.strerror}); try --port 0") from None
+    try:
+        page = Path(write_page(asset, page, colour, instancing=options.instancing))
+    except BaseException:
+        server.server_close()
+        raise
     return Made((page,), (asset,), (f"wrote {page}", f"serving {url_of(server, page)}  (Ctrl-C to stop)"),
                 server=server)

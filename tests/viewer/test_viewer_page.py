@@ -103,3 +103,23 @@ def test_help_documents_options():
         assert option in text
     assert "default: 8765" in text
     assert "to compare (the page's ?instancing=0 does too). [default: on]" in text
+
+
+@pytest.mark.parametrize("page", ["x.xyz", "-", "x"])
+def test_a_page_that_is_not_html_is_refused(tmp_path, viewer_assets, page):
+    """`-o outv/x.xyz` and `-o -` (a file named -) were written, exit 0; every command refuses
+    an output extension it does not write."""
+    result = run_cli("view", viewer_assets["fish"], "-o", page, "--no-serve", cwd=tmp_path)
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "expected a page ending in .html or .htm" in result.stderr and list(tmp_path.iterdir()) == []
+
+
+def test_a_taken_port_leaves_no_page(tmp_path, viewer_assets):
+    import socket
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        result = run_cli("view", viewer_assets["fish"], "-o", tmp_path / "p.html", "--port",
+                         str(taken.getsockname()[1]))
+    assert result.returncode == 1 and "port" in result.stderr and list(tmp_path.iterdir()) == []
