@@ -47,14 +47,23 @@ MAX_TEXTURE_SIDE = 8192
 
 def _check_image(path: Path, name: str, file: str, line: int) -> None:
     """Read only the image header: a readable picture of a sane size, or a clear error."""
+    import re
+    import warnings
+
     from PIL import Image, UnidentifiedImageError
 
+    too_big = f"expected a texture of at most {MAX_TEXTURE_SIDE} pixels a side, found {name!r}"
     try:
-        with Image.open(path) as img:
-            width, height = img.size
-    except (UnidentifiedImageError, OSError):
+        with warnings.catch_warnings():  # a large header's warning: the size is refused below
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            with Image.open(path) as img:
+                width, height = img.size
+    except Image.DecompressionBombError as err:  # Pillow's own limit, before the size is ours to see
+        pixels = re.search(r"\((\d+) pixels\)", str(err))
+        raise FishgenError(f"{too_big} of {int(pixels[1]):,} pixels" if pixels else f"{too_big} larger",
+                           file, line) from None
+    except (UnidentifiedImageError, OSError, ValueError, SyntaxError):
         raise FishgenError(f"expected a texture image (PNG, GIF, JPEG, ...), found {name!r} unreadable",
                            file, line) from None
     if max(width, height) > MAX_TEXTURE_SIDE:
-        raise FishgenError(f"expected a texture of at most {MAX_TEXTURE_SIDE} pixels a side, found {name!r} "
-                           f"{width}x{height}", file, line)
+        raise FishgenError(f"{too_big} {width}x{height}", file, line)

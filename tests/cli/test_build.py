@@ -205,3 +205,15 @@ def test_an_output_whose_side_files_are_the_species_textures_is_refused(tmp_path
         assert "not one of the command's inputs" in result.stderr and "o_skin" in result.stderr
         assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in inputs)
     assert {p: p.read_bytes() for p in inputs} == inputs
+
+
+def test_a_texture_past_pillows_own_limit_is_one_line(tmp_path):
+    from tests.species.test_parser import png_header
+
+    shutil.copy(PARAMS / "bonybream.txt", tmp_path)
+    shutil.copy(ROOT / "textures" / "bonybream_mask.png", tmp_path)
+    (tmp_path / "bonybream.png").write_bytes(png_header(100_000, 100_000))
+    result = run_cli("build", tmp_path / "bonybream.txt", "-o", tmp_path / "b.glb")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "expected a texture of at most 8192 pixels a side, found 'bonybream.png' of 10,000,000,000" \
+        in result.stderr

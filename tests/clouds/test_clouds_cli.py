@@ -280,3 +280,24 @@ def test_a_switch_given_off_with_no_light_is_named_as_given(cli, tmp_path):
     assert_one_line_error(result,
                           "fishgen: expected no lighting options with --no-light, found --no-scattering")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("json", [False, True])
+def test_a_texture_past_pillows_own_limit_is_one_line_at_its_cube(cli, tmp_path, json):
+    from tests.species.test_parser import png_header
+
+    (tmp_path / "huge.png").write_bytes(png_header(100_000, 100_000))
+    awa = tmp_path / "x.awa"
+    awa.write_text("1\n1\n1, 1, 1, 1, 0, 0, 0, 1, huge.png\n")
+    result = cli("clouds", awa, "-o", tmp_path / "x.glb", *(["--json"] if json else []))
+    message = (f"{awa}:3: expected a texture of at most 8192 pixels a side, found 'huge.png' "
+               "of 10,000,000,000 pixels")
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    if json:
+        import json as json_module
+
+        error = json_module.loads(result.stderr)
+        assert (error["error"], error["line"], error["kind"]) == (message, 3, "input")
+    else:
+        assert result.stderr == message + "\n"
+    assert not (tmp_path / "x.glb").exists()

@@ -236,6 +236,29 @@ def test_absurd_texture_size_is_refused_from_its_header(tmp_path):
         load_species(path)
 
 
+def png_header(width: int, height: int) -> bytes:
+    """A PNG that is only its header: what Pillow reads before it decides whether to decode."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+            + chunk(b"IEND", b""))
+
+
+@pytest.mark.parametrize("side,found", [(100_000, "of 10,000,000,000 pixels"), (10_000, "10000x10000")])
+def test_a_header_past_pillows_own_limit_is_the_same_one_line(tmp_path, recwarn, side, found):
+    path = write(tmp_path, BONY)
+    (tmp_path / "bonybream.png").write_bytes(png_header(side, side))
+    with pytest.raises(FishgenError) as err:
+        load_species(path)
+    assert str(err.value) == (f"{path}:{line_number(BONY, 'bonybream.png bonybream_mask.png')}: expected a "
+                              f"texture of at most 8192 pixels a side, found 'bonybream.png' {found}")
+    assert not [w for w in recwarn if "DecompressionBomb" in type(w.message).__name__]
+
+
 @pytest.mark.parametrize("old,new,needle", [
     ("0.26 0.1 0.04", "1e300 0.1 0.04", "scaleX as a number > 0 and <= 100"),
     ("bonybream 25.5", "bonybream 1e308", "world_scale as a number > 0 and <= 10000"),
