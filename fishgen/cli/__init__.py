@@ -65,8 +65,8 @@ def _interrupt(signum: int, _frame: object) -> None:
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry: bad input becomes a one-line error, never a traceback.
 
-    Exit status: 0 done, 1 a file could not be read or written (or, in a batch, a job failed for
-    another reason than its input), 2 bad input or usage, 130 Ctrl-C, 143 SIGTERM.
+    Exit status: 0 done, 1 a file could not be read or written, or memory ran out (or, in a batch,
+    a job failed for another reason than its input), 2 bad input or usage, 130 Ctrl-C, 143 SIGTERM.
     """
     from fishgen.errors import FishgenError
 
@@ -97,6 +97,9 @@ def main(argv: list[str] | None = None) -> None:
     except (KeyboardInterrupt, Interrupted) as err:
         interrupts.stopped()
         _fail("fishgen: interrupted", err.status if isinstance(err, Interrupted) else 130, kind="interrupted")
+    except MemoryError as err:  # the estimates err high, but a system can refuse less than they foresee
+        detail = str(err).strip()  # numpy names the array it could not allocate; Python names nothing
+        _fail(f"fishgen: out of memory{': ' + detail if detail else ''}", 1, kind="os")
     except OSError as err:  # one no layer below turned into a SystemFailure with its path
         where = f"{err.filename}: " if err.filename else ""
         _fail(f"fishgen: {where}{err.strerror or err}", 1, err.filename, kind="os")

@@ -160,7 +160,8 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
                          seed=options.seed, model=options.model, speed=options.speed, bounds=options.bounds,
                          length=options.length, warmup=options.warmup, preset=options.preset,
                          variety=variety)
-    check_size(scene, scene_files[0] if scene_files else None)  # before anything is built
+    # before anything is built
+    check_size(scene, scene_files[0] if scene_files else None, tracks="tracks" in sides)
     species_files = [e.file for e in scene.species]
     textures = read_beside(species_files, [FORMATS["species"]] * len(species_files), options.textures)
     check_targets([output, *sides.values()], [*inputs, *species_files, *scene.read, *textures])

@@ -3,8 +3,9 @@
 A leaf module (no numpy). The figures are `fishgen school`'s peak address space (VmPeak),
 measured on BonyBream with the body wave (docs/decisions.md, "A school's memory, estimated"):
 about 360 MiB for the interpreter and its libraries, 13-41 KiB per fish (its nodes, channels
-and neighbour lists) and 190 bytes per fish-frame (tracks, keys, the file). The constants are
-rounded up, so the estimate is 10-25 % above what was measured.
+and neighbour lists) and 190 bytes per fish-frame (tracks, keys, the file), and 150-200 bytes more
+per fish-frame with ``--tracks`` (the table of rows and its file). The constants are rounded up,
+so the estimate is 10-35 % above what was measured.
 """
 from __future__ import annotations
 
@@ -14,11 +15,13 @@ import resource
 BASE = 400 * 2**20
 PER_FISH = 46 * 2**10
 PER_FISH_FRAME = 230
+PER_TRACK_FRAME = 240  # --tracks: float64 rows, float32 columns and the compressed or CSV file
 
 
-def estimate(fish: int, frames: int) -> int:
-    """Bytes of address space a run of ``fish`` x ``frames`` is expected to peak at."""
-    return BASE + PER_FISH * fish + PER_FISH_FRAME * fish * frames
+def estimate(fish: int, frames: int, tracks: bool = False) -> int:
+    """Bytes of address space a run of ``fish`` x ``frames`` is expected to peak at; ``tracks``
+    when the raw tracks are written too (``--tracks``)."""
+    return BASE + PER_FISH * fish + (PER_FISH_FRAME + PER_TRACK_FRAME * tracks) * fish * frames
 
 
 def allowed() -> tuple[int, str] | None:

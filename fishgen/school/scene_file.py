@@ -190,20 +190,23 @@ def with_options(scene: SceneFile, *, count: int | None = None, frames: int | No
     return replace(scene, **given)
 
 
-def check_size(scene: SceneFile, file: str | os.PathLike | None = None, line: int | None = None) -> None:
+def check_size(scene: SceneFile, file: str | os.PathLike | None = None, line: int | None = None,
+               tracks: bool = False) -> None:
     """Refuse absurd schools before anything is built: MAX_FISH fish, MAX_FISH_FRAMES fish x frames,
-    and a run whose estimated peak memory is more than this process may use."""
+    and a run whose estimated peak memory (with ``tracks``, writing the raw tracks too) is more
+    than this process may use."""
     from fishgen.school import memory
 
     total = sum(e.count for e in scene.species)
     if total > MAX_FISH or total * scene.frames > MAX_FISH_FRAMES:
         raise FishgenError(f"expected at most {MAX_FISH:,} fish and {MAX_FISH_FRAMES:,} fish x frames, "
                            f"found {total:,} fish x {scene.frames:,} frames", file, line)
-    need, limit = memory.estimate(total, scene.frames), memory.allowed()
+    need, limit = memory.estimate(total, scene.frames, tracks), memory.allowed()
     if limit is not None and need > limit[0]:
         raise FishgenError(f"expected a school that fits in {memory.size_text(limit[0])} ({limit[1]}), found "
                            f"{total:,} fish x {scene.frames:,} frames, which needs about "
-                           f"{memory.size_text(need)}: use fewer fish or frames", file, line)
+                           f"{memory.size_text(need)}{' with --tracks' if tracks else ''}: "
+                           "use fewer fish or frames", file, line)
 
 
 def _number(where: _Where, value: Any, key: str, low: float, high: float, table: str | None = None,

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import PARAMS, ROOT
+from tests.conftest import PARAMS, ROOT, run_cli
 
 FISH = PARAMS / "bonybream.txt"
 CUBES = PARAMS / "clouds" / "table_4_3.awn"
@@ -153,3 +153,36 @@ def test_a_batch_whose_record_cannot_be_saved_still_says_what_it_built_and_exits
     lines = result.stdout.strip().splitlines()
     assert result.returncode == 1 and lines and lines[-1].startswith(f"{full}: 1 jobs, 1 built"), result
     assert "Traceback" not in result.stderr and ".fishgen-batch.json" in result.stderr
+
+
+@pytest.mark.parametrize("json_errors", [False, True])
+def test_running_out_of_memory_exits_1_in_one_line(tmp_path, json_errors):
+    """A fill the address-space limit cannot hold ended in numpy's _ArrayMemoryError traceback."""
+    cubes = tmp_path / "big.awn"
+    cubes.write_text("2000000000\n1\n2000000000, 1, 1, 1, 0, 0, 0, 1\n")
+
+    def cap() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (4 * 10**9, 4 * 10**9))
+
+    run = subprocess.run([sys.executable, "-m", "fishgen", "clouds", str(cubes), "--max-particles",
+                          "2000000000", "-o", str(tmp_path / "x.ply"), *(["--json"] if json_errors else [])],
+                         capture_output=True, text=True, preexec_fn=cap, timeout=120, cwd=ROOT)
+    assert run.returncode == 1 and run.stderr.count("\n") == 1 and "Traceback" not in run.stderr, run.stderr
+    if json_errors:
+        error = json.loads(run.stderr)
+        assert (error["kind"], error["exit"]) == ("os", 1)
+        assert error["error"].startswith("fishgen: out of memory")
+    else:
+        assert run.stderr.startswith("fishgen: out of memory: Unable to allocate")
+    assert not (tmp_path / "x.ply").exists()
+
+
+def test_a_bare_memory_error_is_one_line_too(monkeypatch):
+    from fishgen.commands import build
+
+    def starve(*args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(build, "build", starve)
+    result = run_cli("build", FISH, "-o", "/nonexistent/never.glb")
+    assert (result.returncode, result.stderr) == (1, "fishgen: out of memory\n")

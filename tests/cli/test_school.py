@@ -179,6 +179,30 @@ def test_the_memory_estimate_is_above_what_a_run_peaks_at():
         assert mib * 2**20 < estimate(fish, frames) < 1.4 * mib * 2**20
 
 
+def test_the_memory_estimate_with_tracks_is_above_what_a_run_peaks_at():
+    """--tracks adds 150-200 bytes a fish-frame (VmPeak, BonyBream, .npz)."""
+    from fishgen.school.memory import estimate
+
+    measured = {(1_000, 1_000): 716, (2_000, 1_000): 1139, (2_000, 2_000): 1718, (5_000, 300): 1150}
+    for (fish, frames), mib in measured.items():
+        assert mib * 2**20 < estimate(fish, frames, tracks=True) < 1.4 * mib * 2**20
+
+
+def test_tracks_count_in_the_memory_a_school_is_refused_for(tmp_path, monkeypatch):
+    """Under a limit the run fits without --tracks, writing the tracks ended in a MemoryError."""
+    from fishgen.school import memory
+
+    fish, frames = 200, 300
+    between = (memory.estimate(fish, frames) + memory.BASE + memory.PER_FISH * fish
+               + (memory.PER_FISH_FRAME + 150) * fish * frames) // 2
+    monkeypatch.setattr(memory, "allowed", lambda: (between, "this process's address-space limit"))
+    args = ("school", PARAMS / "bonybream.txt", "--count", str(fish), "--frames", str(frames))
+    result = run_cli(*args, "-o", tmp_path / "s.glb", "--tracks", tmp_path / "t.npz")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "which needs about" in result.stderr and "with --tracks: use fewer fish or frames" in result.stderr
+    assert not (tmp_path / "s.glb").exists() and not (tmp_path / "t.npz").exists()
+
+
 def test_lods_and_merge_give_every_fish_the_engine_layout_over_shared_meshes(tmp_path):
     """`fishgen school --lods ... --merge` (issue 24): each fish is its species' node tree, its
     levels tied by MSFT_lod, two draw calls a fish, the meshes shared by every fish."""
