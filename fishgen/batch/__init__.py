@@ -22,7 +22,7 @@ from pathlib import Path
 from fishgen.batch.jobs import Work
 from fishgen.batch.manifest import Job, Manifest
 from fishgen.batch.record import Hashes, Record, relative
-from fishgen.errors import FishgenError, SystemFailure
+from fishgen.errors import FishgenError, SystemFailure, cannot
 
 LOCK_NAME = ".fishgen-batch.lock"
 STATUSES = ("built", "skipped", "failed", "not run")
@@ -121,8 +121,10 @@ def _locked(out: Path) -> Iterator[None]:
     try:
         out.mkdir(parents=True, exist_ok=True)
         handle = open(out / LOCK_NAME, "a+b")  # held open for the whole batch
-    except OSError as err:
-        raise FishgenError(f"expected a writable out folder, found {err.strerror or err}", out) from None
+    except (NotADirectoryError, FileExistsError):  # a file where --out names a folder: the command line's
+        raise FishgenError("expected an out folder, found a file in its path", out) from None
+    except OSError as err:  # the system refused (read-only, permissions, full): not the input
+        raise cannot("write", out, err) from None
     try:
         try:
             import fcntl

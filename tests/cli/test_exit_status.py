@@ -186,3 +186,20 @@ def test_a_bare_memory_error_is_one_line_too(monkeypatch):
     monkeypatch.setattr(build, "build", starve)
     result = run_cli("build", FISH, "-o", "/nonexistent/never.glb")
     assert (result.returncode, result.stderr) == (1, "fishgen: out of memory\n")
+
+
+def test_a_batch_into_a_read_only_folder_exits_1_with_the_path(small_disk):
+    _, readonly = small_disk
+    result = run(writers(readonly)["batch"])
+    error = one_error(result)
+    assert result.returncode == 1 and error["kind"] == "os", result.stderr
+    assert error["error"] == f"fishgen: cannot write {readonly / 'all'}: Read-only file system"
+    assert error["file"] == str(readonly / "all")
+
+
+def test_a_batch_out_folder_that_is_a_file_is_bad_input(tmp_path):
+    (tmp_path / "taken").write_text("")
+    result = run(["batch", str(PARAMS / "clouds"), "--out", str(tmp_path / "taken" / "all")])
+    error = one_error(result)
+    assert result.returncode == 2 and error["kind"] == "input", result.stderr
+    assert error["error"] == f"{tmp_path / 'taken' / 'all'}: expected an out folder, found a file in its path"
