@@ -52,14 +52,19 @@ class Volume:
 def voxel_box(lo, hi, voxel_size: float, where=None) -> tuple[np.ndarray, np.ndarray]:
     """The leaf-aligned voxel index box ``[first, last)`` covering world ``lo``..``hi``; refused
     (FishgenError) above ``MAX_VOXELS`` or beyond int32 indices, before anything is allocated."""
-    lo_v = np.floor(np.asarray(lo, np.float64) / voxel_size + 0.5)
-    hi_v = np.floor(np.asarray(hi, np.float64) / voxel_size + 0.5)
+    with np.errstate(over="ignore", invalid="ignore"):  # a tiny voxel overflows: refused just below
+        lo_v = np.floor(np.asarray(lo, np.float64) / voxel_size + 0.5)
+        hi_v = np.floor(np.asarray(hi, np.float64) / voxel_size + 0.5)
+        total = math.prod(float(n) for n in hi_v - lo_v + 1)  # Python floats: inf, never a warning
     limit = 2.0 ** 30
-    total = float(np.prod(hi_v - lo_v + 1)) if np.all(np.isfinite([lo_v, hi_v])) else math.inf
+    if not np.all(np.isfinite([lo_v, hi_v])) or math.isnan(total):
+        total = math.inf
     if not total <= MAX_VOXELS or np.abs(lo_v).max() > limit or np.abs(hi_v).max() > limit:
         least = _least_voxel_size(np.asarray(hi, np.float64) - np.asarray(lo, np.float64))
+        found = (f"{total:,.0f}" if total < 1e15 else f"about {total:.2g}" if math.isfinite(total)
+                 else "too many to count")
         raise FishgenError(f"expected at most {MAX_VOXELS:,} voxels in the volume's bounding box, found "
-                           f"{total:,.0f} at voxel size {voxel_size:g}; use --voxel-size {least:.3g} or more",
+                           f"{found} at voxel size {voxel_size:g}; use --voxel-size {least:.3g} or more",
                            where)
     first = (np.floor_divide(lo_v, LEAF) * LEAF).astype(np.int64)
     last = ((np.floor_divide(hi_v, LEAF) + 1) * LEAF).astype(np.int64)

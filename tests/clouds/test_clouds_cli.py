@@ -301,3 +301,12 @@ def test_a_texture_past_pillows_own_limit_is_one_line_at_its_cube(cli, tmp_path,
     else:
         assert result.stderr == message + "\n"
     assert not (tmp_path / "x.glb").exists()
+
+
+def test_a_voxel_size_too_small_to_count_is_one_line_and_no_warning(tmp_path):
+    from tests.conftest import run_cli_process  # a process: pytest would catch the warning in this one
+
+    result = run_cli_process("clouds", PARAMS / "clouds" / "table_4_3.awn", "-o", tmp_path / "x.vdb",
+                             "--voxel-size", "1e-300")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "found too many to count at voxel size 1e-300; use --voxel-size" in result.stderr

@@ -86,6 +86,18 @@ def test_a_box_of_too_many_voxels_is_refused_naming_a_size_that_fits():
         voxel_box((-100, -100, -100), (100, 100, 100), least * 0.9)
 
 
+@pytest.mark.parametrize("voxel_size,found", [(1e-300, "too many to count"), (1e-10, "about 8e+36")])
+def test_a_voxel_too_small_to_count_is_refused_without_a_numpy_warning(voxel_size, found):
+    """At 1e-300 the box's product overflowed, and numpy's RuntimeWarning reached stderr."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(FishgenError) as refused:
+            voxel_box((-100, -100, -100), (100, 100, 100), voxel_size, "cloud.vdb")
+    assert f"found {found} at voxel size {voxel_size:g}; use --voxel-size " in str(refused.value)
+
+
 def test_cube_files_are_refused_before_filling_from_their_cubes_alone():
     cubes = load_cubes(TABLES["4.4"])
     check_cube_files([cubes], (), 0.2)
