@@ -51,9 +51,10 @@ class CubeFileWarning(UserWarning):
 
 
 def load_cubes(path: str | os.PathLike, *, max_particles: int = DEFAULT_MAX_PARTICLES,
-               textures_dir: str | os.PathLike | None = None) -> CubeFile:
+               textures_dir: str | os.PathLike | None = None, raise_with: str | None = None) -> CubeFile:
     """Read and check a .awn cube file, or a .awa texture cloud file (by its extension);
-    raise FishgenError naming FILE:LINE on bad input.
+    raise FishgenError naming FILE:LINE on bad input. ``raise_with``: the option that raises
+    ``max_particles``, named when the limit is met (only a command that has one).
 
     A .awa file's textures are resolved in ``textures_dir`` if given, else in the file's
     folder and the ``textures/`` folder beside it (``texture_roots``), and must exist.
@@ -62,9 +63,9 @@ def load_cubes(path: str | os.PathLike, *, max_particles: int = DEFAULT_MAX_PART
     data = _read_capped(name)
     if name.lower().endswith(TEXTURE_SUFFIX):
         roots = texture_roots(Path(name), textures_dir)
-        return parse_cubes(data, name, max_particles=max_particles,
+        return parse_cubes(data, name, max_particles=max_particles, raise_with=raise_with,
                            textures=lambda texture, number: _texture(texture, roots, name, number))
-    return parse_cubes(data, name, max_particles=max_particles)
+    return parse_cubes(data, name, max_particles=max_particles, raise_with=raise_with)
 
 
 TEXTURE_SUFFIX = ".awa"
@@ -152,9 +153,10 @@ def _reason(err: OSError) -> str:
 
 def parse_cubes(data: bytes, name: str = "<cubes>", *,
                 max_particles: int = DEFAULT_MAX_PARTICLES,
-                textures: Callable[[str, int], str] | None = None) -> CubeFile:
+                textures: Callable[[str, int], str] | None = None, raise_with: str | None = None) -> CubeFile:
     """Parse the bytes of a cube file; ``name`` is used in messages. With ``textures`` (a .awa
-    file) each cube line ends with a texture name, which ``textures(name, line)`` resolves."""
+    file) each cube line ends with a texture name, which ``textures(name, line)`` resolves.
+    ``raise_with`` names the option that raises ``max_particles``, if the caller has one."""
     text = _decode(data, name)
     rows = [(number, row) for number, line in enumerate(_LINE_END.split(text), 1)
             if (row := line.strip(" \t"))]
@@ -164,7 +166,7 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
 
     declared_total = _header(rows[0], f"total {noun} count", name)
     if declared_total > max_particles:
-        raise _over_limit(declared_total, max_particles, name, rows[0][0])
+        raise _over_limit(declared_total, max_particles, name, rows[0][0], raise_with)
     if len(rows) < 2:
         raise expected("the number of cubes on the next line", "the end of the file",
                        name, rows[0][0] + 1)
@@ -190,7 +192,7 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
         cube = _cube(line, name, number, textures)
         running += cube.particles
         if running > max_particles:
-            raise _over_limit(running, max_particles, name, number)
+            raise _over_limit(running, max_particles, name, number, raise_with)
         cubes.append(cube)
 
     total = sum(cube.particles for cube in cubes)
@@ -292,6 +294,6 @@ def _cube(line: str, name: str, number: int, textures: Callable[[str, int], str]
     return Cube(particles, size, centre, radius, number, texture)  # type: ignore[arg-type]
 
 
-def _over_limit(count: int, limit: int, name: str, number: int) -> FishgenError:
-    return expected(f"at most {limit:,} particles (raise the limit with --max-particles)",
-                    f"{count:,}", name, number)
+def _over_limit(count: int, limit: int, name: str, number: int, raise_with: str | None) -> FishgenError:
+    hint = f" (raise the limit with {raise_with})" if raise_with else ""
+    return expected(f"at most {limit:,} particles{hint}", f"{count:,}", name, number)

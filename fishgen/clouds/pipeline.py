@@ -31,20 +31,23 @@ about 2.5 s, and a 46-byte file of 2x10^7 particles took 6.6 GB and 42 s before 
 
 
 def read_cube_files(paths: Iterable[str | os.PathLike], *, max_particles: int = DEFAULT_MAX_PARTICLES,
-                    textures_dir: str | os.PathLike | None = None,
-                    note: Callable[[str], None] | None = None) -> list[CubeFile]:
-    """Parse each cube file (``max_particles`` per file). The parser's warnings go to ``note`` when
-    given, else out as Python warnings (:class:`~fishgen.clouds.parser.CubeFileWarning`)."""
+                    textures_dir: str | os.PathLike | None = None, note: Callable[[str], None] | None = None,
+                    raise_with: str | None = None) -> list[CubeFile]:
+    """Parse each cube file (``max_particles`` per file; ``raise_with``, the option that raises
+    it, if any). The parser's warnings go to ``note`` when given, else out as Python warnings
+    (:class:`~fishgen.clouds.parser.CubeFileWarning`)."""
     from fishgen.clouds.parser import CubeFileWarning, load_cubes
 
     models = []
     for path in paths:
         if note is None:
-            models.append(load_cubes(path, max_particles=max_particles, textures_dir=textures_dir))
+            models.append(load_cubes(path, max_particles=max_particles, textures_dir=textures_dir,
+                                     raise_with=raise_with))
             continue
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", CubeFileWarning)
-            models.append(load_cubes(path, max_particles=max_particles, textures_dir=textures_dir))
+            models.append(load_cubes(path, max_particles=max_particles, textures_dir=textures_dir,
+                                     raise_with=raise_with))
         for warning in caught:
             note(str(warning.message))
     return models

@@ -118,7 +118,7 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     if options.offset and len(options.offset) != len(inputs):
         raise UsageError(f"expected one --offset per input ({len(inputs)}), found {len(options.offset)}")
     files = read_cube_files(inputs, max_particles=options.max_particles, textures_dir=options.textures,
-                            note=events.note)
+                            note=events.note, raise_with="--max-particles")
     textures = cloud_textures(files)
     if textures and not billboards:
         events.note(f"{output}: {output.suffix.upper()[1:]} holds no textures; the billboards' centres are "

@@ -112,7 +112,8 @@ def cube_files_scene(paths: Sequence[Path], *, seed: int = 0, lighting: Lighting
 
     files = [Path(p) for p in paths]
     # filled each in its own frame (no offsets) and lit as a sky: each cloud on its own shadow map
-    made = cube_clouds(read_cube_files(files, max_particles=max_particles, textures_dir=textures_dir),
+    made = cube_clouds(read_cube_files(files, max_particles=max_particles, textures_dir=textures_dir,
+                                       raise_with="--max-particles"),
                        seed=seed, light=False, max_particles=max_particles)
     clouds, edge = [], None
     for i, (model, cloud, path) in enumerate(zip(made.models, made.clouds, files, strict=True)):

@@ -47,7 +47,8 @@ def load_models(paths: Sequence[str | os.PathLike] = (), *, max_particles: int =
     from fishgen.clouds.pipeline import read_cube_files
 
     files = [Path(p) for p in paths] or shipped_models()
-    return read_cube_files(files, max_particles=max_particles, textures_dir=textures_dir), files
+    return read_cube_files(files, max_particles=max_particles, textures_dir=textures_dir,
+                           raise_with="--max-particles"), files
 
 
 def build_sky(mode: str = "medium", *, seed: int = 0, area: tuple[float, float] = AREA,

@@ -144,7 +144,15 @@ def test_declared_total_over_the_limit_is_refused_on_line_1(write_awn):
     path = write_awn(f"{10**15}\n1\n{GOOD}\n")
     with pytest.raises(FishgenError, match=r":1: expected at most 50,000,000 particles "
                                            r"\(raise the limit with --max-particles\)"):
+        load_cubes(path, raise_with="--max-particles")
+
+
+def test_the_limit_names_an_option_only_where_the_caller_has_one(write_awn):
+    """`fishgen preview` and `fishgen edit` have no --max-particles: the message said to use it."""
+    path = write_awn(f"{10**15}\n1\n{GOOD}\n")
+    with pytest.raises(FishgenError) as caught:
         load_cubes(path)
+    assert str(caught.value) == f"{path}:1: expected at most 50,000,000 particles, found {10**15:,}"
 
 
 def test_cube_counts_over_the_limit_are_refused_at_the_line_that_crosses_it(write_awn):

@@ -98,3 +98,11 @@ def test_its_help_loads_no_numpy():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert out.stdout.strip().splitlines()[-1] == "False"
     assert "--no-open" in out.stdout and "--sun X,Y,Z" in out.stdout and "--seed" in out.stdout
+
+
+def test_a_cube_file_over_the_particle_limit_names_no_option_edit_lacks(tmp_path):
+    big = tmp_path / "big.awn"
+    big.write_text("2000000000\n1\n2000000000, 1, 1, 1, 0, 0, 0, 1\n")
+    out = run_cli("edit", big, "--no-open")
+    assert out.returncode == 2 and "--max-particles" not in out.stderr, out.stderr
+    assert out.stderr == f"{big}:1: expected at most 50,000,000 particles, found 2,000,000,000\n"

@@ -182,3 +182,11 @@ def test_a_render_over_a_texture_clouds_picture_is_refused(tmp_path):
     result = run_cli("preview", "sky.awa", "-o", "clouds/billow.png", cwd=tmp_path)
     assert result.returncode == 2 and "not one of the command's inputs" in result.stderr, result.stderr
     assert (tmp_path / "clouds" / "billow.png").read_bytes() == before
+
+
+def test_a_cube_file_over_the_particle_limit_names_no_option_preview_lacks(tmp_path):
+    big = tmp_path / "big.awn"
+    big.write_text("2000000000\n1\n2000000000, 1, 1, 1, 0, 0, 0, 1\n")
+    result = run_cli("preview", big, "-o", tmp_path / "p.png")
+    assert result.returncode == 2 and "--max-particles" not in result.stderr, result.stderr
+    assert result.stderr == f"{big}:1: expected at most 50,000,000 particles, found 2,000,000,000\n"
