@@ -9,6 +9,9 @@ too, so ``fishgen --json build ...`` works), so a new command gets them for free
   commands may say more (``fishgen batch`` says why each job ran).
 - ``--json``: an error that ends the command is one JSON object on stderr,
   ``{"error": ..., "file": ..., "line": ..., "exit": ..., "kind": ...}``.
+
+A :class:`fishgen.errors.UsageError` from the use-case layer leaves the command as click's own
+usage errors do, so that every bad command line reads ``fishgen COMMAND: ...``.
 """
 from __future__ import annotations
 
@@ -20,6 +23,8 @@ from contextlib import nullcontext, redirect_stdout
 from typing import Any
 
 import click
+
+from fishgen.errors import UsageError
 
 QUIET, NORMAL, VERBOSE = 0, 1, 2
 _state: dict[str, Any] = {"verbosity": NORMAL, "json": False}
@@ -91,7 +96,13 @@ def _wrapped(callback, name: str):
         # every summary line without each command checking a flag.
         with _devnull() if level <= QUIET else nullcontext() as sink:
             with redirect_stdout(sink) if sink is not None else nullcontext():
-                result = callback(*args, **kwargs)
+                try:
+                    result = callback(*args, **kwargs)
+                except UsageError as err:
+                    if err.file is not None:  # FILE: ... already says where
+                        raise
+                    # the use-case layer's own usage errors read as click's: `fishgen COMMAND: ...`
+                    raise click.UsageError(err.message, ctx=click.get_current_context()) from None
         if level >= VERBOSE:
             click.echo(f"fishgen {name}: done in {time.perf_counter() - start:.2f} s", err=True)
         return result

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, UsageError
 from fishgen.preview.camera import VIEWS, Camera, frame, turned
 from fishgen.scene.model import Scene
 
@@ -77,7 +77,7 @@ def parse_background(text: str) -> tuple[int, int, int, int]:
     try:
         return Colour().convert(text, None, None)
     except click.BadParameter:
-        raise FishgenError(f"expected --background as a colour (#8cadcc, white) or transparent, "
+        raise UsageError(f"expected --background as a colour (#8cadcc, white) or transparent, "
                            f"found {text!r}") from None
 
 
@@ -90,32 +90,32 @@ def check_output(out: Path, options: PreviewOptions, inputs: int = 1) -> int:
     """
     ext = out.suffix.lower()
     if ext not in OUTPUTS:
-        raise FishgenError(f"expected an output ending in {', '.join(OUTPUTS)}, found {out.name!r}")
+        raise UsageError(f"expected an output ending in {', '.join(OUTPUTS)}, found {out.name!r}")
     frames = options.frames
     if frames is not None and not 1 <= frames <= MAX_FRAMES:
-        raise FishgenError(f"expected --frames from 1 to {MAX_FRAMES}, found {frames}")
+        raise UsageError(f"expected --frames from 1 to {MAX_FRAMES}, found {frames}")
     if frames is None:  # the most a loop can have: the pixel budget is checked before loading
         frames = (max(2, math.ceil((options.duration or LOOP_SECONDS) * options.fps))
                   if ext == ".gif" else 1)
     if frames > MAX_FRAMES:
-        raise FishgenError(f"expected at most {MAX_FRAMES} frames, found {frames} "
+        raise UsageError(f"expected at most {MAX_FRAMES} frames, found {frames} "
                            f"(--duration x --fps); use a shorter --duration or a lower --fps")
     if frames > 1 and ext not in ANIMATED:
-        raise FishgenError(f"expected a .gif or .webp output for --frames {frames}, found {out.name!r}")
+        raise UsageError(f"expected a .gif or .webp output for --frames {frames}, found {out.name!r}")
     if options.view not in VIEWS:
-        raise FishgenError(f"expected --view {'|'.join(VIEWS)}, found {options.view!r}")
+        raise UsageError(f"expected --view {'|'.join(VIEWS)}, found {options.view!r}")
     if ext in (".gif", ".jpg", ".jpeg") and options.background[3] < 255:
-        raise FishgenError(f"expected an opaque --background for {ext} (it has no alpha channel), "
+        raise UsageError(f"expected an opaque --background for {ext} (it has no alpha channel), "
                            "found transparent")
     if inputs > 1:
         w, h = sheet_size(options, inputs)
         if w * h > MAX_SHEET_PIXELS:
-            raise FishgenError(f"expected a contact sheet of at most {MAX_SHEET_PIXELS} pixels (2^28), "
+            raise UsageError(f"expected a contact sheet of at most {MAX_SHEET_PIXELS} pixels (2^28), "
                                f"found {w}x{h} = {w * h} for {inputs} inputs at {options.width}x"
                                f"{options.height}; use a smaller --size or fewer --columns")
     total = total_pixels(options, frames, inputs)
     if total > MAX_TOTAL_PIXELS:
-        raise FishgenError(f"expected at most {MAX_TOTAL_PIXELS} pixels (2^30) in all frames and "
+        raise UsageError(f"expected at most {MAX_TOTAL_PIXELS} pixels (2^30) in all frames and "
                            f"contact sheets, found {total} for {inputs} input(s) x {frames} frame(s) "
                            f"at {options.width}x{options.height}; use a smaller --size or fewer --frames")
     return frames

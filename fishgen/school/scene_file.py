@@ -50,7 +50,7 @@ from typing import Any
 
 import click
 
-from fishgen.errors import FishgenError, describe
+from fishgen.errors import FishgenError, UsageError, describe
 from fishgen.options import SEED, FiniteRange, Option, check_value
 from fishgen.school.model import (
     COUZIN_PRESETS,
@@ -197,16 +197,18 @@ def check_size(scene: SceneFile, file: str | os.PathLike | None = None, line: in
     than this process may use."""
     from fishgen.school import memory
 
+    # without a scene file, the fish and frames came from the command line (--count, --frames)
+    refused = FishgenError if file is not None else UsageError
     total = sum(e.count for e in scene.species)
     if total > MAX_FISH or total * scene.frames > MAX_FISH_FRAMES:
-        raise FishgenError(f"expected at most {MAX_FISH:,} fish and {MAX_FISH_FRAMES:,} fish x frames, "
-                           f"found {total:,} fish x {scene.frames:,} frames", file, line)
+        raise refused(f"expected at most {MAX_FISH:,} fish and {MAX_FISH_FRAMES:,} fish x frames, "
+                      f"found {total:,} fish x {scene.frames:,} frames", file, line)
     need, limit = memory.estimate(total, scene.frames, tracks), memory.allowed()
     if limit is not None and need > limit[0]:
-        raise FishgenError(f"expected a school that fits in {memory.size_text(limit[0])} ({limit[1]}), found "
-                           f"{total:,} fish x {scene.frames:,} frames, which needs about "
-                           f"{memory.size_text(need)}{' with --tracks' if tracks else ''}: "
-                           "use fewer fish or frames", file, line)
+        raise refused(f"expected a school that fits in {memory.size_text(limit[0])} ({limit[1]}), found "
+                      f"{total:,} fish x {scene.frames:,} frames, which needs about "
+                      f"{memory.size_text(need)}{' with --tracks' if tracks else ''}: "
+                      "use fewer fish or frames", file, line)
 
 
 def _number(where: _Where, value: Any, key: str, low: float, high: float, table: str | None = None,

@@ -57,3 +57,31 @@ def test_json_errors_of_a_multi_file_build_are_one_object_per_bad_file(tmp_path)
 def test_version():
     run = run_cli("--version")
     assert run.returncode == 0 and run.stdout.startswith("fishgen, version ")
+
+
+@pytest.mark.parametrize("args,message", [
+    (["build", "{fish}", "-o", "{out}/o"], "expected an output file with an extension"),
+    (["build", "{fish}", "-o", "-"], "expected an output file with an extension"),
+    (["clouds", "{cubes}", "--offset", "0,0,0", "--offset", "1,1,1", "-o", "{out}/x.ply"],
+     "expected one --offset per input (1), found 2"),
+    (["school", "{fish}", "--count", "100000", "--frames", "100000", "-o", "{out}/s.glb"],
+     "expected at most 100,000 fish and 200,000,000 fish x frames"),
+    (["sky", "-o", "{out}/s.ply"], "expected a .glb or .gltf output"),
+    (["preview", "{fish}", "--size", "8192x8192", "--frames", "1000", "-o", "{out}/p.gif"],
+     "expected at most 1073741824 pixels (2^30)"),
+    (["species", "--random", "-o", "{out}/a.xyz"], "expected -o to name a species file (.txt)"),
+    (["fly"], "expected INPUT... (cube files, .awa, .glb) or --mode thin|medium|thick, found neither"),
+    (["school", str(PARAMS / "reef.toml"), "{fish}", "-o", "{out}/s.glb"],
+     "expected one scene file alone or species files, found 2 inputs"),
+])
+def test_a_usage_error_from_the_command_names_the_command_as_clicks_own_do(tmp_path, args, message):
+    """They printed `fishgen: ...` while click's own usage errors print `fishgen build: ...`."""
+    filled = [a.format(fish=PARAMS / "bonybream.txt", cubes=PARAMS / "clouds" / "table_4_3.awn", out=tmp_path)
+              for a in args]
+    plain = run_cli(*filled)
+    assert plain.returncode == 2 and plain.stderr.startswith(f"fishgen {args[0]}: {message}"), plain.stderr
+    assert plain.stderr.count("\n") == 1
+    as_json = run_cli("--json", *filled)
+    error = json.loads(as_json.stderr)
+    assert (error["error"], error["kind"], error["exit"]) == (plain.stderr.strip(), "usage", 2)
+    assert list(tmp_path.iterdir()) == []

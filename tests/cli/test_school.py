@@ -238,8 +238,8 @@ def test_two_outputs_naming_one_file_are_refused_and_nothing_is_written(tmp_path
     result = run_cli("school", PARAMS / "bonybream.txt", "-o", tmp_path / "s.gltf", "--count", "3",
                      "--frames", "10", "--plot", tmp_path / "s_skin.png")
     assert result.returncode == 2, result.stderr
-    assert result.stderr == (f"fishgen: expected every output of one run to be a different file, found "
-                             f"{tmp_path / 's_skin.png'} twice\n")
+    assert result.stderr == ("fishgen school: expected every output of one run to be a different file, "
+                             f"found {tmp_path / 's_skin.png'} twice\n")
     assert list(tmp_path.iterdir()) == []
 
 

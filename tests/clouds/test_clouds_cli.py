@@ -86,7 +86,7 @@ def test_limit_is_refused_at_once_naming_the_limit_and_the_option(cli, write_awn
     assert_one_line_error(result, f"{huge}:1: expected at most 50,000,000 particles")
     assert "--max-particles" in result.stderr
     small = cli("clouds", TABLES["4.3"], TABLES["4.4"], "--max-particles", "1000", "-o", tmp_path / "y.ply")
-    assert_one_line_error(small, "fishgen: expected at most 1,000 particles in the scene")
+    assert_one_line_error(small, "fishgen clouds: expected at most 1,000 particles in the scene")
     assert "--max-particles" in small.stderr and "found 1,169" in small.stderr
     assert not (tmp_path / "x.ply").exists() and not (tmp_path / "y.ply").exists()
 
@@ -103,7 +103,8 @@ def test_total_mismatch_is_a_warning_on_stderr(cli, write_awn, tmp_path):
 @pytest.mark.parametrize("args,message", [
     (["--offset", "1,2"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z with three finite "
                           "numbers within float32 range, found '1,2'"),
-    (["--offset", "0,0,0", "--offset", "1,1,1"], "fishgen: expected one --offset per input (1), found 2"),
+    (["--offset", "0,0,0", "--offset", "1,1,1"],
+     "fishgen clouds: expected one --offset per input (1), found 2"),
     (["--seed", "-4"], "fishgen clouds: Invalid value for '--seed': -4 is not in the range "
                        "0<=x<=9223372036854775807."),
     (["--offset", "1e300,0,0"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z with three "
@@ -245,7 +246,7 @@ def test_no_light_writes_the_same_particles_white_and_unlit(cli, tmp_path, gltf_
 
 def test_no_light_with_a_lighting_option_is_refused(cli, tmp_path):
     result = cli("clouds", TABLES["4.4"], "-o", tmp_path / "c.ply", "--no-light", "--sun", "1,0,0")
-    assert_one_line_error(result, "fishgen: expected no lighting options with --no-light, found --sun")
+    assert_one_line_error(result, "fishgen clouds: expected no lighting options with --no-light, found --sun")
     assert list(tmp_path.iterdir()) == []
 
 
@@ -277,8 +278,8 @@ def test_a_volume_of_too_many_voxels_is_refused_before_filling(cli, tmp_path, ex
 
 def test_a_switch_given_off_with_no_light_is_named_as_given(cli, tmp_path):
     result = cli("clouds", TABLES["4.4"], "-o", tmp_path / "c.ply", "--no-light", "--no-scattering")
-    assert_one_line_error(result,
-                          "fishgen: expected no lighting options with --no-light, found --no-scattering")
+    assert_one_line_error(result, "fishgen clouds: expected no lighting options with --no-light, "
+                                  "found --no-scattering")
     assert list(tmp_path.iterdir()) == []
 
 
