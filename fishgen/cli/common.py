@@ -6,7 +6,7 @@ too, so ``fishgen --json build ...`` works), so a new command gets them for free
 - ``--quiet``: nothing on stdout (no summary line, no progress); warnings and errors still go to
   stderr.
 - ``--verbose``: each file written (from :mod:`fishgen.atomic`) and the command's time, on stderr;
-  commands may say more (``fishgen batch`` says why each job ran).
+  commands may say more (``fishgen batch`` says why each job ran). With ``--quiet`` too, quiet wins.
 - ``--json``: an error that ends the command is one JSON object on stderr,
   ``{"error": ..., "file": ..., "line": ..., "exit": ..., "kind": ...}``.
 
@@ -27,16 +27,18 @@ import click
 from fishgen.errors import UsageError
 
 QUIET, NORMAL, VERBOSE = 0, 1, 2
-_state: dict[str, Any] = {"verbosity": NORMAL, "json": False}
+_state: dict[str, Any] = {"quiet": False, "verbose": False, "json": False}
 
 
 def reset(json_errors: bool = False) -> None:
     """Back to the defaults (one process may run several commands: the tests do)."""
-    _state.update(verbosity=NORMAL, json=json_errors)
+    _state.update(quiet=False, verbose=False, json=json_errors)
 
 
 def verbosity() -> int:
-    return int(_state["verbosity"])
+    """QUIET, NORMAL or VERBOSE. --quiet wins over --verbose, wherever each is given: a script
+    that asks for silence on stdout gets it (docs/decisions.md)."""
+    return QUIET if _state["quiet"] else VERBOSE if _state["verbose"] else NORMAL
 
 
 def json_errors() -> bool:
@@ -61,11 +63,11 @@ def _set(key: str, value: Any):
 def _options() -> list[click.Option]:
     return [
         click.Option(["-q", "--quiet"], is_flag=True, expose_value=False, is_eager=True,
-                     callback=_set("verbosity", QUIET),
-                     help="Print nothing on stdout (no summary, no progress); errors still go to stderr.  "
-                          "[default: off]"),
+                     callback=_set("quiet", True),
+                     help="Print nothing on stdout (no summary, no progress); errors still go to stderr. "
+                          "Wins over --verbose.  [default: off]"),
         click.Option(["-v", "--verbose"], is_flag=True, expose_value=False, is_eager=True,
-                     callback=_set("verbosity", VERBOSE),
+                     callback=_set("verbose", True),
                      help="Also print each file written and the time taken, on stderr.  [default: off]"),
         click.Option(["--json"], is_flag=True, expose_value=False, is_eager=True, callback=_set("json", True),
                      help='Print an error as one JSON object on stderr: {"error", "file", "line", "exit", '

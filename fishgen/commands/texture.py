@@ -94,8 +94,10 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     result = make_texture(photo, species, output, settings, on_note=events.note)
     turned = (["head on the right"] if result.mirrored else []) + (
         [f"turned {result.angle:+.1f} degrees"] if result.angle else [])
-    events.note(f"silhouette from the {result.source}" + (f" ({', '.join(turned)})" if turned else ""))
+    # the summary, on stdout (and silenced by --quiet); a warning about the fit stays a note
+    lines = [f"silhouette from the {result.source}" + (f" ({', '.join(turned)})" if turned else "")]
     if result.iou is not None:
-        events.note(f"silhouette IoU of the rebuilt fish: {result.iou:.3f}")
+        lines.append(f"silhouette IoU of the rebuilt fish: {result.iou:.3f}")
+    lines += [f"wrote {p}" for p in result.written]
     read = [photo, options.species, *species.side_files, *(p for p in sides if p is not None)]
-    return Made(tuple(result.written), tuple(read), tuple(f"wrote {p}" for p in result.written), result)
+    return Made(tuple(result.written), tuple(read), tuple(lines), result)

@@ -26,6 +26,13 @@ def test_quiet_drops_the_summary_and_verbose_lists_each_file_written(tmp_path):
     assert "fishgen clouds: done in" in verbose.stderr
 
 
+@pytest.mark.parametrize("args", [["-q", "-v", "build"], ["-v", "build", "-q"], ["build", "-q", "-v"]])
+def test_quiet_wins_over_verbose_wherever_each_is_given(tmp_path, args):
+    out = tmp_path / "b.glb"
+    result = run_cli(*args, PARAMS / "bonybream.txt", "-o", out)
+    assert (result.returncode, result.stdout, result.stderr) == (0, "", "") and out.is_file()
+
+
 @pytest.mark.parametrize("args,status,kind,line", [
     (["build", "{missing}", "-o", "{out}"], 2, "input", None),
     (["build", str(PARAMS.parent / "tests" / "fixtures" / "appendix_a_as_printed.txt"), "-o", "{out}"], 2,

@@ -38,7 +38,7 @@ def test_photo_to_fish_in_one_command(tmp_path, cli, bream_photo):
     r = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", out, "--compare", tmp_path / "cmp.png",
             "--fxl-out", tmp_path / "pts.FXL")
     assert r.returncode == 0, r.stderr
-    assert "silhouette from the alpha" in r.stderr and "IoU" in r.stderr
+    assert "silhouette from the alpha" in r.stdout and "IoU" in r.stdout
     for name in ("mybream.txt", "mybream.png", "mybream_mask.png"):
         assert (out.parent / name).is_file()
     assert (tmp_path / "cmp.png").is_file() and (tmp_path / "pts.FXL").is_file()
@@ -62,7 +62,7 @@ def test_mirrored_jpeg_and_level_of_detail_options(tmp_path, cli, bream_photo):
     r = cli("texture", tmp_path / "p.jpg", "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "n.txt",
             "--body-sections", "24", "--circle-sections", "16", "--spacing", "even")
     assert r.returncode == 0, r.stderr
-    assert "background model" in r.stderr and "head on the right" in r.stderr
+    assert "background model" in r.stdout and "head on the right" in r.stdout
     lines = (tmp_path / "n.txt").read_text().splitlines()
     assert str(24 * 16) in lines
 
@@ -225,7 +225,7 @@ def test_focal_length_measures_the_rebuilt_fish_in_that_perspective(tmp_path, cl
         out = tmp_path / f"x{len(extra)}.txt"
         r = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", out, *extra)
         assert r.returncode == 0, r.stderr
-        return float(re.search(r"silhouette IoU of the rebuilt fish: ([0-9.]+)", r.stderr).group(1))
+        return float(re.search(r"silhouette IoU of the rebuilt fish: ([0-9.]+)", r.stdout).group(1))
 
     assert figure("--focal-length", "18") < figure() - 0.01
     bad = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "y.txt",
@@ -260,3 +260,14 @@ def test_an_output_over_the_base_species_texture_is_refused(tmp_path):
                      "new.txt", "--compare", "bonybream.png", cwd=tmp_path)
     assert result.returncode == 2 and "not one of the command's inputs" in result.stderr, result.stderr
     assert (tmp_path / "bonybream.png").read_bytes() == before and not (tmp_path / "new.txt").exists()
+
+
+def test_quiet_silences_the_summary_and_without_it_the_summary_is_on_stdout(tmp_path, cli, bream_photo):
+    """The silhouette's source and IoU went to stderr, where -q left them."""
+    path, _ = bream_photo
+    loud = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "a.txt")
+    assert loud.returncode == 0 and loud.stderr == "", loud.stderr
+    assert loud.stdout.startswith("silhouette from the alpha")
+    assert "silhouette IoU of the rebuilt fish" in loud.stdout
+    quiet = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "b.txt", "-q")
+    assert (quiet.returncode, quiet.stdout, quiet.stderr) == (0, "", "")
