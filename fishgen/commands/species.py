@@ -11,13 +11,17 @@ import click
 from fishgen.commands import QUIET, Command, Events, Made, Output
 from fishgen.options import option
 
+MAX_SEED = 2**63 - 1
+"""The last seed (documented as 0..2^63-1); a --count running past it is refused."""
+
 
 @dataclass(frozen=True)
 class SpeciesOptions:
     random: bool = option(click.BOOL,
                           "Sample species at random (the only mode so far; say it so a typo never "
                           "samples).", False, flag=True, required=True)
-    seed: int = option(click.IntRange(0, 2**63 - 1), "Seed of the first species.", 0)
+    seed: int = option(click.IntRange(0, MAX_SEED), "Seed of the first species; seed + count - 1 may "
+                       "not pass 2^63-1.", 0)
     count: int = option(click.IntRange(1, 10_000), "Species to write; more than one go into the folder -o "
                         "names, seeds seed..seed+K-1.", 1)
 
@@ -59,5 +63,10 @@ def species(inputs: Sequence[Path], output: str | os.PathLike, options: SpeciesO
     if not folder and path.suffix.lower() != ".txt":
         raise UsageError(f"expected -o to name a species file (.txt) or a folder (an existing one, or a name "
                          f"ending in /), found {os.fspath(output)!r}")
+    last = options.seed + options.count - 1
+    if last > MAX_SEED:  # refused, not wrapped: species_0.txt after the last seed would be a surprise
+        raise UsageError(f"expected seeds within 0..2^63-1 (--seed {MAX_SEED - options.count + 1} at most "
+                         f"for --count {options.count}), found --seed {options.seed} --count {options.count} "
+                         f"reaching {last}")
     written = write_samples(options.seed, options.count, path, folder=folder)
     return Made(tuple(written), (), tuple(f"wrote {p}" for p in written))

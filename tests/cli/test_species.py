@@ -43,3 +43,15 @@ def test_mistakes_are_one_line(tmp_path, cli):
     (tmp_path / "file").write_text("")
     r = cli("species", "--random", "--count", "2", "-o", tmp_path / "file")
     assert r.returncode == 2 and "expected a folder" in r.stderr
+
+
+def test_a_count_running_past_the_last_seed_is_refused_not_wrapped(tmp_path, cli):
+    """--seed 2^63-1 --count 2 wrote species_9223372036854775808.txt, a seed outside 0..2^63-1."""
+    last = 2**63 - 1
+    r = cli("species", "--random", "--seed", str(last), "--count", "2", "-o", f"{tmp_path}/s/")
+    assert r.returncode == 2 and r.stderr == (
+        f"fishgen species: expected seeds within 0..2^63-1 (--seed {last - 1} at most for --count 2), "
+        f"found --seed {last} --count 2 reaching {last + 1}\n")
+    assert not (tmp_path / "s").exists() or list((tmp_path / "s").iterdir()) == []
+    ok = cli("species", "--random", "--seed", str(last - 1), "--count", "2", "-o", f"{tmp_path}/t/")
+    assert ok.returncode == 0 and (tmp_path / "t" / f"species_{last}.txt").is_file(), ok.stderr
