@@ -284,9 +284,12 @@ def write_glb(scene: Scene, path: Path) -> list[Path]:
 
 def write_gltf(scene: Scene, path: Path) -> list[Path]:
     """``.gltf`` JSON with the buffer and images as files beside it (URIs percent-encoded)."""
+    from fishgen.exchange.sidefiles import image_side_stems
+
     stem = path.stem
-    names = [f"{stem}_{image.name}.{'jpg' if image.mime_type == 'image/jpeg' else 'png'}"
-             for image in scene.images]
+    stems = image_side_stems(stem, [image.name for image in scene.images])
+    names = [f"{side}.{'jpg' if image.mime_type == 'image/jpeg' else 'png'}"
+             for side, image in zip(stems, scene.images, strict=True)]
     doc, buf = build_document(scene, path, image_uri=lambda k: quote(names[k]))
     doc["buffers"][0] = {"uri": quote(f"{stem}.bin"), **doc["buffers"][0]}
     files: dict[Path, bytes] = {path: document_json(doc, path),

@@ -7,6 +7,7 @@ import numpy as np
 
 from fishgen.atomic import write_files
 from fishgen.exchange.rest import rest_meshes
+from fishgen.exchange.sidefiles import image_side_stems
 from fishgen.scene.model import Scene
 
 
@@ -40,7 +41,8 @@ def _alpha_png(rgba: np.ndarray) -> bytes:
 def write_obj(scene: Scene, path: Path) -> list[Path]:
     stem = path.stem
     mtl_name = f"{stem}.mtl"
-    textures = {k: f"{stem}_{image.name}.png" for k, image in enumerate(scene.images)}
+    stems = image_side_stems(stem, [image.name for image in scene.images])
+    textures = {k: f"{side}.png" for k, side in enumerate(stems)}
     lines = [f"# fishgen: {scene.name} (rest pose, metres, +Y up, head towards +Z)", f"mtllib {mtl_name}"]
     offset = 0
     for part in rest_meshes(scene):
@@ -51,7 +53,7 @@ def write_obj(scene: Scene, path: Path) -> list[Path]:
         lines += [f"o {part.name}", _rows("v", part.positions), _rows("vt", uv), _rows("vn", part.normals),
                   f"usemtl {material}", "s 1", _face_rows(part.faces + offset + 1)]
         offset += len(part.positions)
-    masks = {mat.texture: f"{stem}_{scene.images[mat.texture].name}_mask.png" for mat in scene.materials
+    masks = {mat.texture: f"{stems[mat.texture]}_mask.png" for mat in scene.materials
              if mat.texture is not None and mat.alpha_mode == "MASK"}
     mtl = []
     for mat in scene.materials:

@@ -16,6 +16,7 @@ from fishgen.atomic import atomic_open, write_files
 from fishgen.errors import FishgenError
 from fishgen.exchange.particles import only_points, particle_chunks, particle_columns
 from fishgen.exchange.rest import rest_meshes
+from fishgen.exchange.sidefiles import image_side_stems
 from fishgen.scene.model import Scene
 
 VERTEX = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("nx", "<f4"), ("ny", "<f4"),
@@ -58,7 +59,7 @@ def _write_mesh(scene: Scene, path: Path) -> list[Path]:
     faces["n"] = 3
     faces["v"] = faces_idx
     image = next((scene.images[m.texture] for m in scene.materials if m.texture is not None), None)
-    texture = f"{path.stem}_{image.name}.png" if image is not None else None
+    texture = f"{image_side_stems(path.stem, [image.name])[0]}.png" if image is not None else None
     header = ["ply", "format binary_little_endian 1.0",
               f"comment fishgen {_ascii(scene.name)} rest pose, metres, +Y up"]
     if texture:

@@ -49,3 +49,23 @@ def side_file(asset: str | Path, ref: str, *, uri: bool = False, must_exist: boo
     if must_exist and not target.is_file():
         raise expected(f"the file {ref.strip()!r} it refers to beside the asset", "none", asset)
     return target
+
+
+_IMAGE_SUFFIX = re.compile(r"\.(png|jpe?g|gif|webp)$", re.IGNORECASE)
+
+
+def image_side_stems(asset_stem: str, image_names: list[str]) -> list[str]:
+    """The stems of the files a writer puts images in beside ``asset_stem``'s asset, one per
+    image and all different: ``x_billow`` for an image named ``billow.png`` (a texture cloud
+    names its images by their files), never ``x_billow.png``, to which the writer adds its own
+    extension; ``x_billow_2`` for a second image of that name (two clouds' different
+    ``billow.png``), which would otherwise overwrite the first."""
+    stems: list[str] = []
+    for name in image_names:
+        stem = f"{asset_stem}_{_IMAGE_SUFFIX.sub('', name) or name}"
+        unique, n = stem, 1
+        while unique in stems:
+            n += 1
+            unique = f"{stem}_{n}"
+        stems.append(unique)
+    return stems

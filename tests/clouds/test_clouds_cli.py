@@ -311,3 +311,14 @@ def test_a_voxel_size_too_small_to_count_is_one_line_and_no_warning(tmp_path):
                              "--voxel-size", "1e-300")
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert "found too many to count at voxel size 1e-300; use --voxel-size" in result.stderr
+
+
+def test_a_texture_cloud_to_gltf_names_its_textures_with_one_extension(cli, tmp_path):
+    made = cli("clouds", PARAMS / "clouds" / "sky.awa", "-o", tmp_path / "x.gltf")
+    assert made.returncode == 0, made.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["x.bin", "x.gltf", "x_billow.png", "x_cumulus.png",
+                                                          "x_wisp.png"]
+    import json
+
+    uris = [image["uri"] for image in json.loads((tmp_path / "x.gltf").read_text())["images"]]
+    assert sorted(uris) == ["x_billow.png", "x_cumulus.png", "x_wisp.png"]

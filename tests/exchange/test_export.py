@@ -152,3 +152,20 @@ def test_a_read_obj_exports_to_glb_with_its_texture(assets, tmp_path):
     doc = pygltflib.GLTF2().load(str(tmp_path / "again.glb"))
     view = doc.bufferViews[doc.images[0].bufferView]
     assert doc.images[0].mimeType == "image/png" and view.byteLength > 1000
+
+
+def test_images_named_by_their_files_get_one_extension_beside_a_gltf_and_never_share_a_file(tmp_path):
+    """A texture cloud's images are named 'billow.png': side files were x_billow.png.png, and two
+    different images of one name went to one file."""
+    from fishgen.exchange.sidefiles import image_side_stems
+    from fishgen.scene.model import Image, Material, Scene
+
+    assert image_side_stems("x", ["billow.png", "skin", "Wisp.JPEG", "billow.png", "billow"]) == \
+        ["x_billow", "x_skin", "x_Wisp", "x_billow_2", "x_billow_3"]
+    scene = Scene("two billows")
+    first, second = (np.zeros((2, 2, 4), np.uint8), np.full((2, 2, 4), 255, np.uint8))
+    for k, pixels in enumerate((first, second)):
+        texture = scene.add_image(Image("billow.png", b"", pixels=pixels))
+        scene.add_material(Material(f"m{k}", texture=texture))
+    written = export(scene, tmp_path / "x.gltf")
+    assert sorted(p.name for p in written) == ["x.bin", "x.gltf", "x_billow.png", "x_billow_2.png"]
