@@ -106,3 +106,11 @@ def test_a_cube_file_over_the_particle_limit_names_no_option_edit_lacks(tmp_path
     out = run_cli("edit", big, "--no-open")
     assert out.returncode == 2 and "--max-particles" not in out.stderr, out.stderr
     assert out.stderr == f"{big}:1: expected at most 50,000,000 particles, found 2,000,000,000\n"
+
+
+def test_a_bad_file_is_named_as_it_was_given_not_as_resolved(tmp_path):
+    (tmp_path / "garbage.awn").write_text("garbage\n")
+    out = run_cli("edit", "garbage.awn", "--no-open", cwd=tmp_path)
+    assert out.returncode == 2
+    assert out.stderr == ("garbage.awn:1: expected a whole number for the total particle count, "
+                          "found 'garbage'\n")
