@@ -131,7 +131,14 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     from fishgen.commands.paths import check_inputs, check_targets, needs, read_beside, suffix_of
     from fishgen.errors import UsageError
     from fishgen.exchange.registry import FORMATS, INSTANCES, MESHES, NODE_ANIMATION, output_format
-    from fishgen.school.scene_file import SceneFile, SpeciesEntry, check_size, load_scene_file, with_options
+    from fishgen.school.scene_file import (
+        SceneFile,
+        SpeciesEntry,
+        check_size,
+        check_species_files,
+        load_scene_file,
+        with_options,
+    )
 
     instanced = INSTANCES in output_format(output, [MESHES, NODE_ANIMATION]).holds
     kinds = check_inputs(inputs, "school", [FORMATS["school scene"], FORMATS["species"]],
@@ -147,6 +154,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         needs("matplotlib", "plot", "--plot")
     if scene_files:
         scene = load_scene_file(scene_files[0])
+        check_species_files(scene, scene_files[0])
     else:
         scene = SceneFile(species=tuple(SpeciesEntry(p) for p in inputs))
     if (options.lods or options.merge) and (options.tints or 1) > 1:

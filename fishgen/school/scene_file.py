@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -144,6 +144,20 @@ class SpeciesEntry:
     file: Path
     count: int = DEFAULT_COUNT
     speed: float = 1.0
+    line: int | None = field(default=None, compare=False)   # where a scene file names it, and as
+    named: str | None = field(default=None, compare=False)  # it is written there
+
+
+def check_species_files(scene: SceneFile, file: str | os.PathLike) -> None:
+    """Refuse, at the scene file's line, a species file it names that is missing or not a file
+    (else the species parser would name the resolved path alone)."""
+    for entry in scene.species:
+        if entry.line is None or entry.file.is_file():
+            continue
+        what = (", a folder" if entry.file.is_dir() else ", a device, pipe or other special file"
+                if entry.file.exists() else " missing beside the scene file")
+        named = describe(entry.named or str(entry.file))
+        raise FishgenError(f"expected an existing species file, found {named}{what}", file, entry.line)
 
 
 @dataclass(frozen=True)
@@ -387,7 +401,8 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
                              "species", k)
         count = _declared(where, COUNT, entry.get("count", COUNT.default), "count", "species", k)
         speed = _declared(where, SPEED, entry.get("speed", SPEED.default), "speed", "species", k)
-        species.append(SpeciesEntry(_inside(where, path, name, "file", "species", k), count, speed))
+        species.append(SpeciesEntry(_inside(where, path, name, "file", "species", k), count, speed,
+                                    where.line("file", "species", k), name))
     scene = replace(scene, species=tuple(species))
     if "target" in data:
         target, csv = _path(where, data["target"], "target", path.parent)

@@ -251,3 +251,15 @@ def test_an_output_whose_side_files_are_a_species_textures_is_refused(tmp_path):
     result = run_cli("school", "bonybream.txt", "--count", "2", "--frames", "2", "-o", "o.gltf", cwd=tmp_path)
     assert result.returncode == 2 and "not one of the command's inputs" in result.stderr, result.stderr
     assert {p: p.read_bytes() for p in inputs} == inputs and not (tmp_path / "o.gltf").exists()
+
+
+@pytest.mark.parametrize("folder,found", [(False, "'nothere.txt' missing beside the scene file"),
+                                          (True, "'nothere.txt', a folder")])
+def test_a_scene_naming_a_missing_species_says_so_at_its_line(tmp_path, folder, found):
+    """It was reported as /abs/nothere.txt: ..., without the scene file's line."""
+    if folder:
+        (tmp_path / "nothere.txt").mkdir()
+    (tmp_path / "scene.toml").write_text('frames = 10\n\n[[species]]\nfile = "nothere.txt"\ncount = 3\n')
+    result = run_cli("school", "scene.toml", "-o", "s.glb", cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr == f"scene.toml:4: expected an existing species file, found {found}\n"
