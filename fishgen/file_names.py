@@ -25,6 +25,7 @@ def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> P
         raise FishgenError(f"expected a texture file name of at most {NAME_MAX} bytes a part, found "
                            f"{describe(name)}", file, line)
     escaped = False
+    folder = None
     for root in roots:
         candidate = (root / name).resolve()
         if not candidate.is_relative_to(root):
@@ -33,10 +34,14 @@ def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> P
         if candidate.is_file():
             _check_image(candidate, name, file, line)
             return candidate
+        if candidate.is_dir() and folder is None:
+            folder = candidate
     if escaped or os.path.isabs(name):
         raise FishgenError(f"expected a texture path inside {shown}, found {name!r} "
                            "(texture paths may not leave the texture folder; use --textures DIR)",
                            file, line)
+    if folder is not None:
+        raise FishgenError(f"expected a texture file, found {name!r}, a folder", file, line)
     raise FishgenError(f"expected an existing texture file, found {name!r} missing from {shown}",
                        file, line)
 

@@ -236,6 +236,16 @@ def test_absurd_texture_size_is_refused_from_its_header(tmp_path):
         load_species(path)
 
 
+def test_a_texture_name_that_is_a_folder_is_called_a_folder_not_missing(tmp_path):
+    path = write(tmp_path, BONY)
+    (tmp_path / "bonybream.png").unlink()
+    (tmp_path / "bonybream.png").mkdir()
+    with pytest.raises(FishgenError) as err:
+        load_species(path)
+    assert str(err.value) == (f"{path}:{line_number(BONY, 'bonybream.png bonybream_mask.png')}: expected a "
+                              "texture file, found 'bonybream.png', a folder")
+
+
 def png_header(width: int, height: int) -> bytes:
     """A PNG that is only its header: what Pillow reads before it decides whether to decode."""
     import struct
