@@ -18,6 +18,23 @@ def too_long(name: str) -> bool:
     return any(len(part.encode("utf-8", "surrogateescape")) > NAME_MAX for part in parts)
 
 
+def texture_token_problem(name: str) -> str | None:
+    """Why ``name`` cannot stand in a species file's texture record and be read back as the same
+    file beside it, or None when it can. The parser splits a record on any whitespace (str.split),
+    reads the file as UTF-8, and resolves a name inside the texture roots."""
+    if any(c.isspace() for c in name):
+        return "holds whitespace, which separates a species file's values"
+    if "/" in name or "\\" in name:
+        return "holds a path separator (/ or \\)"
+    try:
+        size = len(name.encode("utf-8"))
+    except UnicodeEncodeError:
+        return "is not valid UTF-8, as species files are"
+    if size > NAME_MAX:
+        return f"would be longer than {NAME_MAX} bytes"
+    return None
+
+
 def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> Path:
     """Resolve a texture name inside one of ``roots``; never outside them."""
     shown = " or ".join(str(r) for r in roots)

@@ -1,14 +1,102 @@
-"""Sampled species as files: the species text, its painted texture and fin mask, written atomically."""
+"""Sampled species as files: the species text, its painted texture and fin mask, written atomically.
+
+Naming, for `fishgen species` and `fishgen texture` alike: the species file is written exactly where
+``-o`` says. Its textures are ``NEW.png`` and ``NEW_mask.png`` beside it (``NEW`` the file's name
+without ``.txt``) whenever those names can stand in the species file's texture record
+(:func:`fishgen.file_names.texture_token_problem`); otherwise each offending run of characters
+becomes ``_`` (and a name too long is cut), the command says so in one line, and refuses names
+that would be another output or a file already there that the species file does not name. The
+species' own name, inside the file, is ``NEW`` with every run of characters other than ASCII
+letters, digits and ``_`` made ``_``."""
 from __future__ import annotations
 
+import os
 import re
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, UsageError
+from fishgen.file_names import NAME_MAX, texture_token_problem
+
+MASK_SUFFIX = "_mask.png"
 
 
-def sample_files(seed: int, stem: str) -> dict[str, bytes]:
-    """File name -> bytes of sample ``seed`` written as ``stem``.txt/.png/_mask.png."""
+@dataclass(frozen=True)
+class TextureNames:
+    """The texture and fin mask names a species file at ``species_file`` names (beside it)."""
+
+    species_file: Path
+    colour: str
+    mask: str
+    why: str | None = None   # why the names are not NEW.png and NEW_mask.png; None when they are
+
+    @property
+    def paths(self) -> tuple[Path, Path]:
+        return self.species_file.with_name(self.colour), self.species_file.with_name(self.mask)
+
+    @property
+    def note(self) -> str | None:
+        """The one line that says the names were derived, or None when they were not."""
+        if self.why is None:
+            return None
+        stem = self.species_file.stem
+        return (f"note: textures named {self.colour} and {self.mask}, not {stem!r} + .png and _mask.png: "
+                f"that name {self.why}")
+
+
+def texture_names(species_file: str | os.PathLike) -> TextureNames:
+    """``NEW.png`` and ``NEW_mask.png`` for ``NEW.txt`` when both are legal texture tokens, else a
+    derived pair that is (see the module's text)."""
+    path = Path(species_file)
+    stem = path.stem
+    why = texture_token_problem(stem + MASK_SUFFIX) or texture_token_problem(stem + ".png")
+    if why is None:
+        return TextureNames(path, stem + ".png", stem + MASK_SUFFIX)
+    safe = re.sub(r"[\s/\\\ud800-\udfff]+", "_", stem)
+    raw = safe.encode("utf-8")[:NAME_MAX - len(MASK_SUFFIX)]
+    safe = raw.decode("utf-8", "ignore") or "_"  # never half a character
+    return TextureNames(path, safe + ".png", safe + MASK_SUFFIX, why)
+
+
+def check_texture_names(names: TextureNames, others: Iterable[str | os.PathLike | None] = ()) -> None:
+    """Derived texture names may be neither another output of the run (``others``) nor a file that
+    is already there and that the species file at ``names.species_file`` does not name (a rerun
+    replaces its own textures). Names kept as ``-o`` gave them are the documented pair."""
+    if names.why is None:
+        return
+    taken = {os.path.abspath(p) for p in others if p is not None}
+    named = _named_textures(names.species_file)
+    for path in names.paths:
+        if os.path.abspath(path) in taken:
+            raise UsageError(f"expected texture names that are no other output, found {path.name!r} "
+                             f"(derived from -o {os.fspath(names.species_file)!r}) also named as an "
+                             f"output; choose another -o")
+        if os.path.lexists(path) and (names.colour, names.mask) != named:
+            raise UsageError(f"expected texture names that are no file already there, found "
+                             f"{os.fspath(path)!r} (derived from -o {os.fspath(names.species_file)!r}, "
+                             f"which does not name it); choose another -o")
+
+
+def _named_textures(species_file: Path) -> tuple[str, str] | None:
+    """The texture record of an existing species file, or None (none there, or unreadable)."""
+    from fishgen.species.parser import parse_species
+
+    try:
+        text = species_file.read_text(encoding="utf-8")
+        parse_species(text, species_file)
+    except (OSError, UnicodeDecodeError, FishgenError, ValueError):
+        return None
+    for line in text.splitlines():  # the parser read a record of two tokens after the fins
+        tokens = line.split()
+        if len(tokens) == 2 and tokens[1].endswith(".png") and not line.lstrip().startswith("//"):
+            return tokens[0], tokens[1]
+    return None
+
+
+def sample_files(seed: int, stem: str, textures: TextureNames | None = None) -> dict[str, bytes]:
+    """File name -> bytes of sample ``seed`` named ``stem`` inside: ``stem``.txt/.png/_mask.png, or
+    the species file and texture names ``textures`` gives."""
     from dataclasses import replace
 
     from fishgen.authoring.painter import texture_files
@@ -16,18 +104,23 @@ def sample_files(seed: int, stem: str) -> dict[str, bytes]:
     from fishgen.species.parser import parse_species
     from fishgen.species.writer import format_species
 
+    names = textures or TextureNames(Path(f"{stem}.txt"), f"{stem}.png", f"{stem}{MASK_SUFFIX}")
     sample = sample_species(seed, stem)
     sp = replace(sample.species, name=stem)
-    text = format_species(sp, f"{stem}.png", f"{stem}_mask.png")
-    parse_species(text, f"{stem}.txt")   # a sample the parser would refuse is a bug here, not the user's
+    text = format_species(sp, names.colour, names.mask)
+    file_name = names.species_file.name
+    parse_species(text, file_name)   # a sample the parser would refuse is a bug here, not the user's
     colour, mask = texture_files(sp, sample.palette, seed)
-    return {f"{stem}.txt": text.encode(), f"{stem}.png": colour, f"{stem}_mask.png": mask}
+    return {file_name: text.encode(), names.colour: colour, names.mask: mask}
 
 
-def write_samples(seed: int, count: int, output: Path, folder: bool | None = None) -> list[Path]:
+def write_samples(seed: int, count: int, output: Path, folder: bool | None = None,
+                  note: Callable[[str], None] | None = None) -> list[Path]:
     """Write ``count`` sampled species from ``seed`` on: into the folder ``output`` when ``folder``
-    (default: when it has no extension), else as the one species file ``output``."""
-    from fishgen.atomic import write_files
+    (default: when it has no extension), else as the one species file ``output``, exactly there.
+    Every file of every species is one atomic set (:func:`fishgen.atomic.together`): an interrupt
+    or a failure leaves none of them. ``note`` is told when texture names had to be derived."""
+    from fishgen.atomic import together, write_files
 
     if folder is None:
         folder = not output.suffix
@@ -35,17 +128,24 @@ def write_samples(seed: int, count: int, output: Path, folder: bool | None = Non
         if count != 1 or output.suffix.lower() != ".txt":
             raise FishgenError(f"expected -o to name one species file (.txt) or a folder, found "
                                f"{output.name!r}")
-        where, stems = output.parent, [_stem(output.stem)]
+        names = texture_names(output)
+        check_texture_names(names)
+        if note is not None and names.note is not None:
+            note(names.note)
+        plan: list[tuple[Path, str, TextureNames | None]] = [(output.parent, species_name(output), names)]
     else:
         if output.exists() and not output.is_dir():
             raise FishgenError("expected a folder, found a file", output)
-        where, stems = output, [f"species_{seed + k}" for k in range(count)]
+        plan = [(output, stem, None) for stem in (f"species_{seed + k}" for k in range(count))]
     written: list[Path] = []
-    for k, stem in enumerate(stems):
-        write_files({where / name: data for name, data in sample_files(seed + k, stem).items()})
-        written.append(where / f"{stem}.txt")
+    with together():
+        for k, (where, stem, given) in enumerate(plan):
+            files = sample_files(seed + k, stem, given)
+            write_files({where / name: data for name, data in files.items()})
+            written.append(where / next(iter(files)))
     return written
 
 
-def _stem(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_]+", "_", text).strip("_") or "species"
+def species_name(species_file: Path) -> str:
+    """The species' name inside its file: ASCII letters, digits and ``_`` of the file's name."""
+    return re.sub(r"[^A-Za-z0-9_]+", "_", species_file.stem).strip("_") or "species"

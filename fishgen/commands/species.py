@@ -40,15 +40,20 @@ COMMAND = Command(
     """,
     options=SpeciesOptions,
     run="fishgen.commands.species:species",
-    output=Output("Species file (.txt) for one species, or a folder (an existing one, or a name ending in /) "
-                  "for any count. Textures (NAME.png, NAME_mask.png) are written beside each species file.",
+    output=Output("Species file (.txt) for one species, written exactly there; or a folder (an existing "
+                  "one, or a name ending in /) for any count, holding species_SEED.txt. Beside OUT.txt go "
+                  "OUT.png (texture) and OUT_mask.png (fin mask); where a species file cannot name those "
+                  "(whitespace, / or \\, not UTF-8, over 255 bytes), each such run becomes _ and a note "
+                  "says so, and a derived name that is a file already there, not named by OUT.txt, is "
+                  "refused. Every file lands, or none.",
                   metavar="OUT"),
+    together=True,
 )
 
 
 def species(inputs: Sequence[Path], output: str | os.PathLike, options: SpeciesOptions = SpeciesOptions(),
             events: Events = QUIET) -> Made:
-    """Sample ``count`` species from ``seed`` on and write them, each all or nothing."""
+    """Sample ``count`` species from ``seed`` on and write them: every file of every species, or none."""
     from fishgen.authoring.species_files import write_samples
     from fishgen.commands.paths import names_folder
     from fishgen.errors import UsageError
@@ -68,5 +73,5 @@ def species(inputs: Sequence[Path], output: str | os.PathLike, options: SpeciesO
         raise UsageError(f"expected seeds within 0..2^63-1 (--seed {MAX_SEED - options.count + 1} at most "
                          f"for --count {options.count}), found --seed {options.seed} --count {options.count} "
                          f"reaching {last}")
-    written = write_samples(options.seed, options.count, path, folder=folder)
+    written = write_samples(options.seed, options.count, path, folder=folder, note=events.note)
     return Made(tuple(written), (), tuple(f"wrote {p}" for p in written))

@@ -63,7 +63,11 @@ COMMAND = Command(
     options=TextureCommandOptions,
     run="fishgen.commands.texture:texture",
     inputs=Inputs("PHOTO", many=False),
-    output=Output("New species file; NEW.png (texture) and NEW_mask.png (fin mask) are written beside it.",
+    output=Output("New species file, written exactly there; NEW.png (texture) and NEW_mask.png (fin mask) "
+                  "go beside it. Where a species file cannot name those (whitespace, / or \\, not UTF-8, "
+                  "over 255 bytes), each such run becomes _ and a note says so, and a derived name that is "
+                  "another output or a file already there, not named by NEW.txt, is refused. The species "
+                  "file, its textures and --compare/--fxl-out land together, or none.",
                   metavar="NEW.txt"),
 )
 
@@ -74,6 +78,7 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     inputs = tuple(Path(p) for p in inputs)
     output = Path(output)
     from fishgen.authoring.photo.run import TextureOptions, make_texture
+    from fishgen.authoring.species_files import check_texture_names, texture_names
     from fishgen.commands.paths import check_targets
     from fishgen.errors import UsageError
     from fishgen.species.parser import load_species
@@ -84,6 +89,8 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     sides = [options.mask, options.fxl_in]
     outputs = [output, options.compare, options.fxl_out]  # and NEW.png, NEW_mask.png beside NEW.txt
     check_targets(outputs, [photo, options.species, *(p for p in sides if p is not None)])
+    names = texture_names(output)
+    check_texture_names(names, [options.compare, options.fxl_out, photo, options.species, *sides])
     species = load_species(options.species)
     check_targets(outputs, species.side_files)  # the textures it names are inputs too
     settings = TextureOptions(mask=options.mask, fit_shape=options.fit_shape,
@@ -91,6 +98,8 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
                               circle_sections=options.circle_sections, spacing=options.spacing,
                               compare=options.compare, fxl_in=options.fxl_in, fxl_out=options.fxl_out,
                               focal_length=options.focal_length)
+    if names.note is not None:
+        events.note(names.note)
     result = make_texture(photo, species, output, settings, on_note=events.note)
     turned = (["head on the right"] if result.mirrored else []) + (
         [f"turned {result.angle:+.1f} degrees"] if result.angle else [])

@@ -55,3 +55,51 @@ def test_a_count_running_past_the_last_seed_is_refused_not_wrapped(tmp_path, cli
     assert not (tmp_path / "s").exists() or list((tmp_path / "s").iterdir()) == []
     ok = cli("species", "--random", "--seed", str(last - 1), "--count", "2", "-o", f"{tmp_path}/t/")
     assert ok.returncode == 0 and (tmp_path / "t" / f"species_{last}.txt").is_file(), ok.stderr
+
+
+def test_o_names_the_species_file_exactly_and_its_textures_beside_it(tmp_path, cli):
+    """QA: `-o "out/my fish.txt"` wrote out/my_fish.txt, `-o out/ünï🐟.txt` out/n.txt."""
+    for name in ("Ab-c.d.txt", "ünï🐟.txt"):
+        r = cli("species", "--random", "-o", tmp_path / name)
+        assert r.returncode == 0 and r.stderr == "", r.stderr
+        stem = name[:-4]
+        assert {p.name for p in tmp_path.glob(f"{stem}*")} == {name, f"{stem}.png", f"{stem}_mask.png"}
+    r = cli("species", "--random", "-o", tmp_path / "sp" / "my fish.txt")
+    assert r.returncode == 0, r.stderr
+    assert r.stderr.count("\n") == 1 and "my_fish.png" in r.stderr   # a note says so, in one line
+    assert sorted(p.name for p in (tmp_path / "sp").iterdir()) == ["my fish.txt", "my_fish.png",
+                                                                    "my_fish_mask.png"]
+    b = cli("build", tmp_path / "sp" / "my fish.txt", "-o", tmp_path / "sp.glb")
+    assert b.returncode == 0, b.stderr
+
+
+def test_a_derived_texture_name_never_replaces_another_species_texture(tmp_path, cli):
+    assert cli("species", "--random", "--seed", "1", "-o", tmp_path / "my_fish.txt").returncode == 0
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    r = cli("species", "--random", "--seed", "2", "-o", tmp_path / "my fish.txt")
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "my_fish.png" in r.stderr
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_an_interrupted_count_leaves_none_of_its_files(tmp_path):
+    """QA: SIGTERM after minutes of `--count 10000` left ~17,900 files of a set promised whole."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from tests.cli.test_interrupt import _wait_for_handlers
+    from tests.conftest import ROOT
+
+    out = tmp_path / "many"
+    proc = subprocess.Popen([sys.executable, "-m", "fishgen", "species", "--random", "--count", "10000", "-o",
+                             f"{out}/"], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _wait_for_handlers(proc)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and proc.poll() is None and len(list(out.glob("*species_1?*"))) < 30:
+        time.sleep(0.05)   # a partial set is there as whole files (before) or as temporary files
+    assert proc.poll() is None, "the command ended before it could be interrupted"
+    proc.send_signal(signal.SIGTERM)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 143 and stderr == "fishgen: interrupted\n"
+    assert list(tmp_path.iterdir()) == []   # no species, no temporary file, not even the folder

@@ -271,3 +271,25 @@ def test_quiet_silences_the_summary_and_without_it_the_summary_is_on_stdout(tmp_
     assert "silhouette IoU of the rebuilt fish" in loud.stdout
     quiet = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "b.txt", "-q")
     assert (quiet.returncode, quiet.stdout, quiet.stderr) == (0, "", "")
+
+
+def test_o_names_the_species_file_exactly_and_its_textures_beside_it(tmp_path, cli, bream_photo):
+    """QA: the README's `-o out/bream-fit.txt` wrote bream_fit.png, `-o "out/ünï 🐟.txt"` n.png."""
+    path, _ = bream_photo
+    r = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "bream-fit.txt")
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bream-fit.png", "bream-fit.txt",
+                                                          "bream-fit_mask.png"]
+    out = tmp_path / "u" / "ünï 🐟.txt"
+    r = cli("texture", path, "-s", PARAMS / "bonybream.txt", "-o", out)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr.startswith("note: textures named ünï_🐟.png and ünï_🐟_mask.png")
+    assert sorted(p.name for p in out.parent.iterdir()) == ["ünï 🐟.txt", "ünï_🐟.png", "ünï_🐟_mask.png"]
+    assert cli("build", out, "-o", tmp_path / "u.glb").returncode == 0
+
+
+def test_a_derived_texture_name_that_is_another_output_is_refused_before_any_work(tmp_path, cli):
+    r = cli("texture", PARAMS / "photos" / "bonybream-side.png", "-s", PARAMS / "bonybream.txt",
+            "-o", tmp_path / "a b.txt", "--compare", tmp_path / "a_b.png")
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "a_b.png" in r.stderr
+    assert list(tmp_path.iterdir()) == []

@@ -149,6 +149,7 @@ def measure(photo: Photo, base: Species, mask: np.ndarray, spacing: str = "proje
 
 
 def species_name(out: Path) -> str:
+    """The species' name inside its file (its texture names: :func:`texture_names`)."""
     name = re.sub(r"[^A-Za-z0-9_]+", "_", out.stem).strip("_")
     return name or "fish"
 
@@ -357,8 +358,11 @@ def _candidate(photo: Photo, mask: np.ndarray, base: Species, out: Path, options
                                f"{len(values)}", options.fxl_in)
         pts = replace(pts, **{part: tuple(values)})
     measured = replace(measured, unseen=tuple(n for n in measured.unseen if n not in imported))
+    from fishgen.authoring.species_files import texture_names
+
     name = species_name(out)
-    colour_name, mask_name = f"{name}.png", f"{name}_mask.png"
+    names = texture_names(out)   # NEW.png and NEW_mask.png, unless a species file cannot name them
+    colour_name, mask_name = names.colour, names.mask
     species = replace(base, name=name, textured=True, texture_points=pts, colour_texture=None,
                       mask_texture=None, source=None)
     text = format_species(species, colour_name, mask_name)
