@@ -34,6 +34,8 @@ from fishgen.file_names import NAME_MAX
 _PathT = TypeVar("_PathT", bound="str | os.PathLike[str]")
 _log = logging.getLogger("fishgen")  # `--verbose` shows each file written; silent otherwise
 _staging: ContextVar[list[tuple[str, Path]] | None] = ContextVar("fishgen_staging", default=None)
+#: the targets staged in the innermost :func:`together`, resolved
+_taken: ContextVar[set[Path] | None] = ContextVar("fishgen_taken", default=None)
 _inputs: ContextVar[dict[tuple[int, int], str] | None] = ContextVar("fishgen_inputs", default=None)
 
 
@@ -44,17 +46,20 @@ def together() -> Iterator[list[tuple[str, Path]]]:
     (the CLI prints a school's summary before anything lands, so a failed print leaves no file).
     Yields the (temporary file, target) pairs staged so far, to be read inside the block."""
     staged: list[tuple[str, Path]] = []
-    outer = _staging.get()
+    outer, outer_taken = _staging.get(), _taken.get()
     try:  # set inside, and reset in both clauses: an interrupt just before one of them would
         # leave every later write staged here
         _staging.set(staged)
+        _taken.set(set())
         try:
             yield staged
         finally:
             _staging.set(outer)
+            _taken.set(outer_taken)
         _land(staged)
     except BaseException:
         _staging.set(outer)
+        _taken.set(outer_taken)
         for tmp, _ in reversed(staged):  # the last first: a folder made for the first is then empty
             _discard(tmp)
         raise
@@ -84,14 +89,20 @@ def _land(staged: list[tuple[str, Path]]) -> None:
     if pending is None:
         _commit(staged)
         return
-    taken = {target.resolve() for _, target in pending}
-    for _, target in staged:
-        if target.resolve() in taken:  # the later one would silently replace the earlier
-            for tmp, _ in reversed(staged):
-                _discard(tmp)
-            raise UsageError(f"expected every output of one run to be a different file, found {target} "
-                             f"twice")
-        taken.add(target.resolve())
+    # the targets staged so far, resolved once each: resolving all of them at every write made a
+    # set of 30,000 files (species --count 10000) quadratic, half an hour of resolve() calls
+    taken = _taken.get()
+    if taken is None:
+        taken = {target.resolve() for _, target in pending}
+    mine = [target.resolve() for _, target in staged]
+    if len(set(mine)) < len(mine) or not taken.isdisjoint(mine):  # a later one would replace the earlier
+        target = next(t for t, r in zip((t for _, t in staged), mine, strict=True)
+                      if r in taken or mine.count(r) > 1)
+        for tmp, _ in reversed(staged):
+            _discard(tmp)
+        raise UsageError(f"expected every output of one run to be a different file, found {target} "
+                         f"twice")
+    taken.update(mine)
     pending.extend(staged)
 
 
