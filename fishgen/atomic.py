@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import logging
 import os
+import re
 import stat
 import time
 from collections.abc import Iterable, Iterator, Mapping
@@ -194,7 +195,7 @@ def _temporary(path: Path, into: list[tuple[str, Path]]) -> tuple[int, str]:
             _folders[tmp] = made
         into.append((tmp, path))
         path.parent.mkdir(parents=True, exist_ok=True)
-        sweep(path)
+        sweep(path, listed=True)
         try:
             fd = os.open(tmp, _CREATE, 0o600)
         except FileExistsError:  # 48 random bits: another writer's name, once in a lifetime
@@ -252,34 +253,64 @@ def _lock(fd: int) -> bool:
     return True
 
 
-def sweep(path: Path) -> list[Path]:
-    """Remove ``path``'s stale temporary files: ours by their name (``.NAME.XXXX.tmp``), older than
-    STALE_SECONDS, and not locked, so no running writer holds them. Returns what was removed."""
+def sweep(path: Path, *, listed: bool = False) -> list[Path]:
+    """Remove ``path``'s stale temporary files: ours by their name (``.NAME.XXXXXXXXXXXX.tmp``),
+    older than STALE_SECONDS, and not locked, so no running writer holds them. Returns what was
+    removed. ``listed``: from the folder's listing of the last STALE_SECONDS (:func:`_stale_names`),
+    as every write does, rather than listing it again."""
     removed: list[Path] = []
-    prefix = _prefix(path)
-    try:
-        entries = list(os.scandir(path.parent))
-    except OSError:
-        return removed
+    folder = os.fspath(path.parent)
+    names = _stale_names(folder, fresh=not listed).get(_prefix(path), [])
     now = time.time()
-    for entry in entries:
-        if not (entry.name.startswith(prefix) and entry.name.endswith(".tmp")) or entry.path in _live:
+    for name in list(names):
+        full = os.path.join(folder, name)
+        if full in _live:
             continue
         try:
-            if not entry.is_file(follow_symlinks=False) or now - entry.stat().st_mtime < STALE_SECONDS:
+            info = os.lstat(full)
+            if not stat.S_ISREG(info.st_mode) or now - info.st_mtime < STALE_SECONDS:
                 continue
-            fd = os.open(entry.path, os.O_RDONLY | os.O_NONBLOCK)
+            fd = os.open(full, os.O_RDONLY | os.O_NONBLOCK)
         except OSError:
             continue
         try:
             if _lock(fd):
-                os.unlink(entry.path)
-                removed.append(Path(entry.path))
+                os.unlink(full)
+                names.remove(name)
+                removed.append(Path(full))
         except OSError:
             pass
         finally:
             os.close(fd)
     return removed
+
+
+_HEX = re.compile(r"[0-9a-f]{12}")
+_listings: dict[str, tuple[float, dict[str, list[str]]]] = {}
+"""Per folder: when this process last listed it, and the temporary files of our pattern there by
+their target's prefix."""
+
+
+def _stale_names(folder: str, fresh: bool) -> dict[str, list[str]]:
+    """The folder's files named as our temporary files are (``PREFIX`` + 12 hex digits + ``.tmp``),
+    by prefix. A write lists its folder at most once every STALE_SECONDS: listing it at every write
+    made a set of N files in one folder cost N^2 (10,000 species: 30,000 files)."""
+    now = time.monotonic()
+    known = _listings.get(folder)
+    if known is not None and not fresh and now - known[0] < STALE_SECONDS:
+        return known[1]
+    index: dict[str, list[str]] = {}
+    try:
+        with os.scandir(folder) as entries:
+            for entry in entries:
+                name = entry.name
+                if len(name) > 18 and name.endswith(".tmp") and _HEX.fullmatch(name, len(name) - 16,
+                                                                                  len(name) - 4):
+                    index.setdefault(name[:-16], []).append(name)
+    except OSError:
+        pass
+    _listings[folder] = (now, index)
+    return index
 
 
 def _writer(tmp: str, fd: int) -> BinaryIO:

@@ -155,7 +155,7 @@ def test_a_fresh_temporary_file_is_never_swept(tmp_path):
     """One that may be a writer's between creating and locking it: younger than STALE_SECONDS."""
     import fishgen.atomic as atomic
 
-    fresh = tmp_path / ".a.txt.abcd.tmp"
+    fresh = tmp_path / ".a.txt.0123456789ab.tmp"
     fresh.write_bytes(b"x")
     assert atomic.sweep(tmp_path / "a.txt") == [] and fresh.exists()
 
