@@ -45,6 +45,14 @@ class FishgenError(Exception):
         clone.args = (str(clone),)
         return clone
 
+    def naming(self, file: str | os.PathLike) -> FishgenError:
+        """This error with its place named as ``file`` (the path as a user gave it, where a layer
+        below read another spelling of it)."""
+        clone = copy.copy(self)
+        clone.file = os.fspath(file)
+        clone.args = (str(clone),)
+        return clone
+
     def __str__(self) -> str:
         where = ""
         if self.file is not None:
@@ -67,6 +75,14 @@ class SystemFailure(FishgenError):
 
     status = 1
     kind = "os"
+
+    def naming(self, file: str | os.PathLike) -> FishgenError:
+        """This error with its place named as ``file`` (the path as a user gave it, where a layer
+        below read another spelling of it)."""
+        clone = copy.copy(self)
+        clone.file = os.fspath(file)
+        clone.args = (str(clone),)
+        return clone
 
     def __str__(self) -> str:  # the path is in the message ("cannot write PATH: reason")
         return self.message

@@ -82,16 +82,17 @@ def _named_textures(species_file: Path) -> tuple[str, str] | None:
     """The texture record of an existing species file, or None (none there, or unreadable)."""
     from fishgen.species.parser import parse_species
 
+    names: list[str] = []
+
+    def note(name: str, _line) -> Path:  # the parser's texture resolver, here only listening
+        names.append(name)
+        return Path(name)
+
     try:
-        text = species_file.read_text(encoding="utf-8")
-        parse_species(text, species_file)
+        parse_species(species_file.read_text(encoding="utf-8"), species_file, note)
     except (OSError, UnicodeDecodeError, FishgenError, ValueError):
         return None
-    for line in text.splitlines():  # the parser read a record of two tokens after the fins
-        tokens = line.split()
-        if len(tokens) == 2 and tokens[1].endswith(".png") and not line.lstrip().startswith("//"):
-            return tokens[0], tokens[1]
-    return None
+    return (names[0], names[1]) if len(names) == 2 else None
 
 
 def sample_files(seed: int, stem: str, textures: TextureNames | None = None) -> dict[str, bytes]:

@@ -72,7 +72,7 @@ def edit(inputs: Sequence[Path], output: str | os.PathLike | None = None,
         except FishgenError as err:  # the session reads the file's real path: say the one given
             if err.file is None or os.path.realpath(err.file) != os.path.realpath(file):
                 raise
-            raise _as_given(err, file) from None
+            raise err.naming(file) from None
         state = "editing"
     elif not session.workspace.folder.is_dir():
         raise FishgenError(f"expected an existing folder for {file.name}, found none", file.parent)
@@ -88,16 +88,6 @@ def edit(inputs: Sequence[Path], output: str | os.PathLike | None = None,
         _open_browser(url)
     lines = (url, f"{state} {file}; serving until Ctrl-C")
     return Made((), (file,), lines, server=server)
-
-
-def _as_given(err, file: Path):
-    """``err`` naming ``file`` as the command line gave it, not as the session resolved it."""
-    import copy
-
-    clone = copy.copy(err)
-    clone.file = os.fspath(file)
-    clone.args = (str(clone),)
-    return clone
 
 
 def _open_browser(url: str) -> None:

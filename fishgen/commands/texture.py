@@ -88,11 +88,12 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
         raise UsageError("expected -s/--species BASE.txt, the species to start from, found none")
     sides = [options.mask, options.fxl_in]
     outputs = [output, options.compare, options.fxl_out]  # and NEW.png, NEW_mask.png beside NEW.txt
-    check_targets(outputs, [photo, options.species, *(p for p in sides if p is not None)])
-    names = texture_names(output)
-    check_texture_names(names, [options.compare, options.fxl_out, photo, options.species, *sides])
+    given = [p for p in sides if p is not None]
+    check_targets(outputs, [photo, options.species, *given])  # before the base species is even read
     species = load_species(options.species)
     check_targets(outputs, species.side_files)  # the textures it names are inputs too
+    names = texture_names(output)
+    check_texture_names(names, [options.compare, options.fxl_out, photo, options.species, *sides])
     settings = TextureOptions(mask=options.mask, fit_shape=options.fit_shape,
                               body_sections=options.body_sections,
                               circle_sections=options.circle_sections, spacing=options.spacing,
@@ -108,5 +109,5 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     if result.iou is not None:
         lines.append(f"silhouette IoU of the rebuilt fish: {result.iou:.3f}")
     lines += [f"wrote {p}" for p in result.written]
-    read = [photo, options.species, *species.side_files, *(p for p in sides if p is not None)]
+    read = [photo, options.species, *species.side_files, *given]
     return Made(tuple(result.written), tuple(read), tuple(lines), result)
