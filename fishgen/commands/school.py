@@ -29,6 +29,7 @@ from fishgen.school.scene_file import (
     FRAMES,
     LENGTH,
     MODEL,
+    PREROLL,
     PRESET,
     SEED_KEY,
     SIZE_VARIETY,
@@ -58,6 +59,7 @@ class SchoolOptions:
     length: float | None = declare(LENGTH)
     bounds: Any = declare(BOUNDS, shown_default=f"the scene file's, else {BOUNDS.shown_default}")
     warmup: float | None = declare(WARMUP, shown_default=f"the scene file's, else {WARMUP.shown_default}")
+    preroll: float | None = declare(PREROLL, shown_default=f"the scene file's, else {PREROLL.shown_default}")
     size_variety: float | None = declare(SIZE_VARIETY, default=None,
                                          shown_default=f"the scene file's, else {SIZE_VARIETY.default:g}")
     tints: int | None = declare(TINTS, default=None, shown_default=f"the scene file's, else {TINTS.default}")
@@ -137,6 +139,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         check_size,
         check_species_files,
         load_scene_file,
+        preroll_seconds,
         with_options,
     )
 
@@ -167,7 +170,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     scene = with_options(scene, count=options.count, frames=options.frames, fps=options.fps,
                          seed=options.seed, model=options.model, speed=options.speed, bounds=options.bounds,
                          length=options.length, warmup=options.warmup, preset=options.preset,
-                         variety=variety)
+                         variety=variety, preroll=options.preroll)
     # before anything is built
     check_size(scene, scene_files[0] if scene_files else None, tracks="tracks" in sides)
     species_files = [e.file for e in scene.species]
@@ -176,7 +179,8 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
 
     from fishgen.school import run_school
 
-    with events.progress("simulating", scene.frames) as bar:
+    steps = scene.frames + int(round(preroll_seconds(scene) * scene.fps))
+    with events.progress("simulating", steps) as bar:
         run = run_school(scene, fins=options.fins, swim=options.swim, tolerance=options.tolerance,
                          textures_dir=options.textures, progress=bar.update, lods=options.lods,
                          merge=options.merge, prototypes=options.prototypes if instanced else None)

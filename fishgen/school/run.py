@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -26,7 +26,8 @@ DEFAULT_BOUNDS_BODY_LENGTHS = 4.0
 """Without bounds in the scene file, the region is this many body lengths per cube-root of the count."""
 EXTRAS_KEY = "fishgen_school"
 """The member of a school file's glTF scene extras that records the run: {"warmup": seconds,
-"model": name, "fps": frames per second, "frames": count}."""
+"model": name, "fps": frames per second, "frames": count, "preroll": seconds simulated before the
+first frame}."""
 
 
 def warmup_frames(frames: int, fps: float, seconds: float | None = None) -> int:
@@ -68,7 +69,10 @@ class SchoolRun:
 
         per_frame = self.measures() if per_frame is None else per_frame
         rows = summary_table(per_frame, self.warmup_frames, self.species_names)
-        return format_table(rows, f"after {self.warmup_frames / self.config.fps:.1f} s warm-up")
+        settled = [f"{self.config.preroll:g} s pre-roll"] if self.config.preroll else []
+        if self.warmup_frames or not settled:
+            settled.append(f"{self.warmup_frames / self.config.fps:.1f} s warm-up")
+        return format_table(rows, "after " + " and ".join(settled))
 
 
 def brain_of(species, body_length_units: float) -> Brain:
@@ -124,9 +128,10 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
     else:
         scene = bake(fishes, tracks, tolerance=tolerance, seed=scene_file.seed, body_lengths=lengths,
                      tints=variety.tints, tint=variety.tint)
-    settle = warmup_frames(config.frames, config.fps, warmup)
+    # a pre-rolled school is formed at frame 0: no warm-up unless one is asked for
+    settle = warmup_frames(config.frames, config.fps, 0.0 if warmup is None and config.preroll else warmup)
     scene.extras[EXTRAS_KEY] = {"warmup": round(settle / config.fps, 6), "model": config.model,
-                                "fps": config.fps, "frames": config.frames}
+                                "fps": config.fps, "frames": config.frames, "preroll": config.preroll}
     return SchoolRun(config, tracks, scene, lengths, [g.name for g in groups], read, warmup_frames=settle)
 
 
@@ -138,6 +143,7 @@ def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "
     """What run_school simulates, each species built once (as `fishgen build` builds it), and
     the files that took (species files and the textures they name)."""
     from fishgen.assembly.fish import make_fish
+    from fishgen.school.scene_file import preroll_seconds
     from fishgen.species.parser import load_species
 
     couzin = _given(couzin, scene_file, "couzin", CouzinParams())
@@ -163,7 +169,8 @@ def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "
                           frames=scene_file.frames, fps=scene_file.fps, seed=scene_file.seed, bounds=region,
                           layout=scene_file.layout, target=scene_file.target,  # type: ignore[arg-type]
                           pso=scene_file.pso, predator=scene_file.predator, couzin=couzin,
-                          size_jitter=variety.size)
+                          size_jitter=variety.size,
+                          preroll=preroll_seconds(replace(scene_file, couzin=couzin)))
     return config, fishes, tuple(dict.fromkeys(read))
 
 

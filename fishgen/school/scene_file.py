@@ -33,6 +33,7 @@
     tint = 0.15
 
     warmup = 3.0               # seconds the school takes to form (the summary skips them)
+    preroll = 60.0             # seconds simulated before the first frame, not baked
     length = 0.3               # every species' nose-to-tail length, metres
 
 Every mistake is one ``FILE:LINE: expected ..., found ...`` line; absurd sizes are refused
@@ -57,6 +58,7 @@ from fishgen.school.model import (
     COUZIN_RANGES,
     LAYOUTS,
     MODELS,
+    PREROLL_PAPER_SECONDS,
     VARIETY_HELP,
     VARIETY_RANGES,
     WARMUP_SECONDS,
@@ -125,7 +127,14 @@ LENGTH = Option(FiniteRange(0.01, 100), "Every species' nose-to-tail length, met
                 shown_default="each species file's own", metavar="METRES")
 WARMUP = Option(FiniteRange(0, 1e4), "Seconds the school takes to form from its start layout; the summary "
                 "skips them, and `fishgen preview` of the file starts after them.", None,
-                shown_default=f"a third of the run, at most {WARMUP_SECONDS:g} s", metavar="SECONDS")
+                shown_default=f"0 after a pre-roll, else a third of the run, at most {WARMUP_SECONDS:g} s",
+                metavar="SECONDS")
+MAX_PREROLL = 600.0
+PREROLL = Option(FiniteRange(0, MAX_PREROLL), "Seconds simulated before the first frame and not baked: the "
+                 "school forms in them, so the animation starts with it formed.", None,
+                 shown_default=f"couzin: {PREROLL_PAPER_SECONDS:g} s of the paper's clock at the slowest "
+                               "species' speed (60 s at 1 body length/s, at most "
+                               f"{MAX_PREROLL:g}); boids and pso: 0", metavar="SECONDS")
 PRESET = Option(click.Choice(tuple(COUZIN_PRESETS)),
                 "Couzin et al. (2002)'s collective state for the couzin model (sets --model couzin): "
                 + ", ".join(f"{name} (orientation zone {p.orientation:g} body lengths)"
@@ -177,6 +186,7 @@ class SceneFile:
     couzin: CouzinParams | None = None   # None: CouzinParams()
     variety: Variety | None = None       # None: Variety()
     warmup: float | None = None          # seconds; None: WARMUP_SHARE of the run, at most WARMUP_SECONDS
+    preroll: float | None = None         # seconds; None: preroll_seconds' default
     length: float | None = None          # metres, every species; None: each species file's own
     read: tuple[Path, ...] = ()      # the files it named and were read: path CSVs
 
@@ -185,7 +195,7 @@ def with_options(scene: SceneFile, *, count: int | None = None, frames: int | No
                  fps: float | None = None, seed: int | None = None, model: str | None = None,
                  speed: float | None = None, bounds: Any = None, length: float | None = None,
                  warmup: float | None = None, preset: str | None = None,
-                 variety: dict[str, Any] | None = None) -> SceneFile:
+                 variety: dict[str, Any] | None = None, preroll: float | None = None) -> SceneFile:
     """``scene`` with the options given (not None) overriding it, as `fishgen school`'s flags do;
     ``count`` and ``speed`` set every species'; ``preset`` a Couzin preset (and the couzin model
     unless ``model`` says otherwise); ``variety`` the Variety fields given."""
@@ -199,9 +209,22 @@ def with_options(scene: SceneFile, *, count: int | None = None, frames: int | No
         scene = replace(scene, variety=replace(scene.variety or Variety(), **variety))
     given: dict[str, Any] = {name: value for name, value in
                              (("frames", frames), ("fps", fps), ("seed", seed), ("model", model),
-                              ("bounds", bounds), ("length", length), ("warmup", warmup))
+                              ("bounds", bounds), ("length", length), ("warmup", warmup),
+                              ("preroll", preroll))
                              if value is not None}
     return replace(scene, **given)
+
+
+def preroll_seconds(scene: SceneFile) -> float:
+    """Seconds simulated before the first frame: the scene's, else for the couzin model
+    PREROLL_PAPER_SECONDS of the paper's clock, which runs at the paper's speed over the fish's
+    (the slowest species' sets it), else none."""
+    if scene.preroll is not None:
+        return scene.preroll
+    if scene.model != "couzin" or not scene.species:
+        return 0.0
+    paper = (scene.couzin or CouzinParams()).speed
+    return min(MAX_PREROLL, PREROLL_PAPER_SECONDS * paper / min(e.speed for e in scene.species))
 
 
 def check_size(scene: SceneFile, file: str | os.PathLike | None = None, line: int | None = None,
@@ -214,9 +237,11 @@ def check_size(scene: SceneFile, file: str | os.PathLike | None = None, line: in
     # without a scene file, the fish and frames came from the command line (--count, --frames)
     refused = FishgenError if file is not None else UsageError
     total = sum(e.count for e in scene.species)
-    if total > MAX_FISH or total * scene.frames > MAX_FISH_FRAMES:
+    pre = int(round(preroll_seconds(scene) * scene.fps))
+    if total > MAX_FISH or total * (scene.frames + pre) > MAX_FISH_FRAMES:
+        steps = f" and {pre:,} pre-roll steps" if pre else ""
         raise refused(f"expected at most {MAX_FISH:,} fish and {MAX_FISH_FRAMES:,} fish x frames, "
-                      f"found {total:,} fish x {scene.frames:,} frames", file, line)
+                      f"found {total:,} fish x {scene.frames:,} frames{steps}", file, line)
     need, limit = memory.estimate(total, scene.frames, tracks), memory.allowed()
     if limit is not None and need > limit[0]:
         raise refused(f"expected a school that fits in {memory.size_text(limit[0])} ({limit[1]}), found "
@@ -374,13 +399,13 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
     data = _loads(text, file)
     where = _Where(text, file)
     known = {"model", "frames", "fps", "seed", "bounds", "layout", "species", "target", "predator", "pso",
-             "couzin", "variety", "warmup", "length"}
+             "couzin", "variety", "warmup", "preroll", "length"}
     for key in data:
         if key not in known:
             raise where.fail(f"one of {', '.join(sorted(known))}", key, key)
     scene = SceneFile()
     for key, spec in (("model", MODEL), ("frames", FRAMES), ("fps", FPS), ("seed", SEED_KEY),
-                      ("warmup", WARMUP), ("length", LENGTH), ("bounds", BOUNDS)):
+                      ("warmup", WARMUP), ("preroll", PREROLL), ("length", LENGTH), ("bounds", BOUNDS)):
         if key in data:
             scene = replace(scene, **{key: _declared(where, spec, data[key], key)})
     if "layout" in data:

@@ -41,30 +41,41 @@ START_SEPARATION_PASSES = 4
 
 
 def simulate(config: SchoolConfig, progress: Progress | None = None) -> Tracks:
-    """Run `config.frames` frames at `config.fps`; frame 0 is the start layout.
+    """Run `config.frames` frames at `config.fps`; frame 0 is the start layout, or with
+    `config.preroll` the school that many seconds after it (the steps before are not recorded).
 
-    `progress(frames_done)` is called after each frame when given (frames_done = 1 .. frames).
+    `progress(steps_done)` is called after each step when given (1 .. preroll_frames + frames).
     """
     _check(config)
     state = SchoolState.start(config)
     model = behaviour(config, state)
+    frames = int(config.frames)
+    pre = config.preroll_frames
+    times = np.arange(frames, dtype=np.float64) / config.fps
+    target = path_positions(config.target, times) if config.model == "pso" else None
+    predator = path_positions(config.predator, times) if config.predator is not None else None
     log = NeighbourLog()
-    nbrs = Neighbours(state, model.neighbours, log)
+    # the pre-roll's neighbour lists are not the measures' to reuse: not logged
+    nbrs = Neighbours(state, model.neighbours, None if pre else log)
     nbrs.refresh(0)
     for _ in range(START_SEPARATION_PASSES):
         separate(state, nbrs)
     clamp(state)
+    if pre:
+        # the school forms round the target's start, and meets the predator only at frame 0
+        for k in range(1, pre + 1):
+            step(state, nbrs, model, k, None if target is None else target[0], None)
+            if progress is not None:
+                progress(k)
+        nbrs.log = log
+        nbrs.refresh(0)
 
-    frames = int(config.frames)
     n = state.n
     polar, rotation = np.empty((frames, state.n_groups)), np.empty((frames, state.n_groups))
     member = membership_matrix(state.group, state.n_groups)
     positions = np.empty((frames, n, 3))
     velocities = np.empty((frames, n, 3))
     headings = np.empty((frames, n, 4))
-    times = np.arange(frames, dtype=np.float64) / config.fps
-    target = path_positions(config.target, times) if config.model == "pso" else None
-    predator = path_positions(config.predator, times) if config.predator is not None else None
     for f in range(frames):
         if f > 0:
             step(state, nbrs, model, f, None if target is None else target[f],
@@ -73,7 +84,7 @@ def simulate(config: SchoolConfig, progress: Progress | None = None) -> Tracks:
         velocities[f] = state.vel.T
         polar[f], rotation[f] = order_parameters(state.pos, state.dir, state.group, state.n_groups, member)
         if progress is not None:
-            progress(f + 1)
+            progress(pre + f + 1)
     # headings for all frames, a few frames at a time: small chunks keep numpy's temporaries in the
     # CPU cache (at 1,000 fish, 64-frame chunks ran 2.5x slower than 4-frame ones). Each chunk's
     # sign follows the previous chunk's last frame (q and -q are one rotation, but a sign flip

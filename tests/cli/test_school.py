@@ -112,7 +112,10 @@ def test_the_shipped_bait_ball_mills_as_one_torus(tmp_path):
     assert summary_row(result.stdout, "separate groups")[1] <= 2
     assert_valid_gltf(out)
     extras = pygltflib.GLTF2().load(str(out)).scenes[0].extras
-    assert extras["fishgen_school"]["model"] == "couzin" and extras["fishgen_school"]["warmup"] > 0
+    # formed before the first frame: 20 of the paper's seconds at its speed, 3 body lengths/s
+    assert extras["fishgen_school"] == {"model": "couzin", "warmup": 0.0, "preroll": 20.0, "fps": 30.0,
+                                        "frames": 180}
+    assert "after 20 s pre-roll" in result.stdout
 
 
 def test_school_options_reach_the_run_as_the_scene_file_keys_do(tmp_path):
@@ -122,7 +125,9 @@ def test_school_options_reach_the_run_as_the_scene_file_keys_do(tmp_path):
                      "--speed", "2", "--length", "0.5", "--bounds", "-3,-1,-3,3,1,3", "--warmup", "1",
                      "--preset", "highly parallel", "--tints", "3", "--size-variety", "0")
     assert result.returncode == 0, result.stderr
-    assert "couzin" in result.stdout.splitlines()[0] and "after 1.0 s warm-up" in result.stdout
+    # at 2 body lengths/s the paper's 20 s (at 3) are 30 s; a warm-up given still counts after them
+    assert "couzin" in result.stdout.splitlines()[0]
+    assert "after 30 s pre-roll and 1.0 s warm-up" in result.stdout
     assert_valid_gltf(out)
     doc = pygltflib.GLTF2().load(str(out))
     assert doc.scenes[0].extras["fishgen_school"]["warmup"] == 1.0
@@ -263,3 +268,20 @@ def test_a_scene_naming_a_missing_species_says_so_at_its_line(tmp_path, folder, 
     result = run_cli("school", "scene.toml", "-o", "s.glb", cwd=tmp_path)
     assert result.returncode == 2
     assert result.stderr == f"scene.toml:4: expected an existing species file, found {found}\n"
+
+
+@pytest.mark.parametrize("preset, low, high", [("highly parallel", 0.97, 1.0),
+                                               ("dynamic parallel", 0.8, 0.97)])
+def test_the_readmes_preset_school_is_in_its_state_from_the_first_frame(tmp_path, preset, low, high):
+    """`fishgen school params/bonybream.txt --preset "highly parallel"` as the README runs it. At 1
+    body length/s the paper's clock runs 3x slower than ours, and 10 s from a random start read
+    polarization 0.78 (worst 0.49, 5 groups): the default pre-roll (60 s) forms the school first,
+    and the summary covers the whole clip."""
+    out = tmp_path / "parallel.glb"
+    result = run_cli("school", PARAMS / "bonybream.txt", "--preset", preset, "-o", out)
+    assert result.returncode == 0, result.stderr
+    assert "after 60 s pre-roll" in result.stdout
+    assert low < summary_row(result.stdout, "polarization")[0] < high
+    assert summary_row(result.stdout, "rotation")[0] < 0.2
+    assert summary_row(result.stdout, "separate groups") == (1, 1)
+    assert_valid_gltf(out)

@@ -24,7 +24,8 @@ def test_the_file_records_its_warmup_for_the_preview(tmp_path):
     path.write_bytes(glb_bytes(run.scene))
     assert_valid_gltf(path)
     record = school_extras(read_gltf(path))
-    assert record == {"warmup": pytest.approx(20 / 30), "model": "boids", "fps": 30.0, "frames": 60}
+    assert record == {"warmup": pytest.approx(20 / 30), "model": "boids", "fps": 30.0, "frames": 60,
+                      "preroll": 0.0}
     # a scene file's (or the caller's) warm-up wins; broken records read as none
     assert run_school(scene(), warmup=0.5).scene.extras[EXTRAS_KEY]["warmup"] == 0.5
     bad = read_gltf(path)

@@ -86,3 +86,33 @@ def test_options_override_the_scene_file_as_the_command_line_does():
     assert changed.model == "couzin" and changed.couzin == COUZIN_PRESETS["swarm"]
     assert changed.variety == Variety(tints=4)
     assert with_options(scene, preset="torus", model="couzin").model == "couzin"
+
+
+def test_a_couzin_school_pre_rolls_twenty_of_the_papers_seconds_at_its_own_speed(tmp_path):
+    """The paper's clock runs at its speed (3 body lengths/s) over the fish's: 20 of its seconds are
+    60 s at 1 body length/s, 20 s at 3; the slowest species sets it. Other models start at once, and
+    a scene file's `preroll` (or --preroll) wins."""
+    from fishgen.errors import UsageError
+    from fishgen.school.scene_file import check_size, preroll_seconds
+
+    bream = SpeciesEntry(PARAMS / "bonybream.txt")
+    couzin = SceneFile(species=(bream,), model="couzin")
+    assert preroll_seconds(couzin) == 60.0
+    assert preroll_seconds(with_options(couzin, speed=3.0)) == 20.0
+    two = SceneFile(species=(bream, SpeciesEntry(bream.file, speed=2.0)), model="couzin")
+    assert preroll_seconds(two) == 60.0
+    assert preroll_seconds(SceneFile(species=(bream,))) == 0.0
+    assert preroll_seconds(with_options(couzin, preroll=5.0)) == 5.0
+    assert preroll_seconds(with_options(couzin, speed=0.05)) == 600.0          # at most MAX_PREROLL
+    (tmp_path / "a.txt").write_text("")
+    scene = tmp_path / "s.toml"
+    scene.write_text('model = "couzin"\npreroll = 12.5\n[[species]]\nfile = "a.txt"\n')
+    assert load_scene_file(scene).preroll == 12.5
+    scene.write_text('model = "couzin"\n[[species]]\nfile = "a.txt"\n\npreroll = -1\n')
+    with pytest.raises(FishgenError, match="preroll"):
+        load_scene_file(scene)
+    # the pre-roll's steps count towards the work refused before it starts
+    big = with_options(couzin, count=1_000, frames=2, fps=1000.0, speed=0.1)    # 600 s at 1,000 frames/s
+    check_size(with_options(big, preroll=0.0))
+    with pytest.raises(UsageError, match="1,000 fish x 2 frames and 600,000 pre-roll steps"):
+        check_size(big)

@@ -191,3 +191,18 @@ def test_a_ring_layout_starts_each_species_milling_round_its_own_ring():
         assert np.ptp(out[:, 1]) < 0.6 * np.ptp(out[:, 0])
         assert (np.linalg.norm(out[:, [0, 2]], axis=1).min()
                 > 0.3 * np.linalg.norm(out[:, [0, 2]], axis=1).max())
+
+
+@pytest.mark.parametrize("model", ["boids", "couzin"])
+def test_a_preroll_is_the_same_school_run_on_and_only_its_frames_are_kept(model):
+    """A pre-roll of P seconds gives the frames a run P seconds longer has after them: the
+    school forms in the steps before frame 0, which are neither recorded nor logged."""
+    long = simulate(_cfg(model=model, frames=90, seed=2))
+    steps: list[int] = []
+    rolled = simulate(_cfg(model=model, frames=60, seed=2, preroll=1.0), progress=steps.append)
+    assert rolled.positions.shape == (60, 40, 3) and rolled.times[0] == 0.0
+    assert np.allclose(rolled.positions, long.positions[30:], atol=1e-9)
+    assert np.allclose(rolled.velocities, long.velocities[30:], atol=1e-9)
+    assert rolled.neighbours.starts == list(range(60))        # the frames' lists, from frame 0
+    assert steps == list(range(1, 91))                        # progress counts every step
+
