@@ -44,7 +44,8 @@ def simulate(config: SchoolConfig, progress: Progress | None = None) -> Tracks:
     """Run `config.frames` frames at `config.fps`; frame 0 is the start layout, or with
     `config.preroll` the school that many seconds after it (the steps before are not recorded).
 
-    `progress(steps_done)` is called after each step when given (1 .. preroll_frames + frames).
+    `progress(1)` is called after each step when given, preroll_frames + frames times in all: as a
+    progress bar's ``update`` adds what it is given.
     """
     _check(config)
     state = SchoolState.start(config)
@@ -66,7 +67,7 @@ def simulate(config: SchoolConfig, progress: Progress | None = None) -> Tracks:
         for k in range(1, pre + 1):
             step(state, nbrs, model, k, None if target is None else target[0], None)
             if progress is not None:
-                progress(k)
+                progress(1)
         nbrs.log = log
         nbrs.refresh(0)
 
@@ -84,7 +85,7 @@ def simulate(config: SchoolConfig, progress: Progress | None = None) -> Tracks:
         velocities[f] = state.vel.T
         polar[f], rotation[f] = order_parameters(state.pos, state.dir, state.group, state.n_groups, member)
         if progress is not None:
-            progress(pre + f + 1)
+            progress(1)
     # headings for all frames, a few frames at a time: small chunks keep numpy's temporaries in the
     # CPU cache (at 1,000 fish, 64-frame chunks ran 2.5x slower than 4-frame ones). Each chunk's
     # sign follows the previous chunk's last frame (q and -q are one rotation, but a sign flip

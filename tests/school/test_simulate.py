@@ -204,5 +204,5 @@ def test_a_preroll_is_the_same_school_run_on_and_only_its_frames_are_kept(model)
     assert np.allclose(rolled.positions, long.positions[30:], atol=1e-9)
     assert np.allclose(rolled.velocities, long.velocities[30:], atol=1e-9)
     assert rolled.neighbours.starts == list(range(60))        # the frames' lists, from frame 0
-    assert steps == list(range(1, 91))                        # progress counts every step
+    assert steps == [1] * 90                                  # a bar's update: one step each
 
