@@ -3,6 +3,8 @@ may come from. Below every parser and writer, so that each of them can use it.""
 from __future__ import annotations
 
 import os
+import re
+import unicodedata
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -16,6 +18,13 @@ def too_long(name: str) -> bool:
     """Whether a relative file name has a part longer than the file system allows."""
     parts = name.replace("\\", "/").split("/")
     return any(len(part.encode("utf-8", "surrogateescape")) > NAME_MAX for part in parts)
+
+
+def ascii_name(text: str, fallback: str) -> str:
+    """ASCII letters, digits and ``_`` of ``text`` (a name inside a file), its accents dropped
+    rather than the letters that carry them: ``ünï🐟`` is ``uni``; ``fallback`` when none is left."""
+    plain = unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode("ascii")
+    return re.sub(r"[^A-Za-z0-9_]+", "_", plain).strip("_") or fallback
 
 
 def texture_token_problem(name: str) -> str | None:

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fishgen.errors import FishgenError, UsageError
-from fishgen.file_names import NAME_MAX, texture_token_problem
+from fishgen.file_names import NAME_MAX, ascii_name, texture_token_problem
 
 MASK_SUFFIX = "_mask.png"
 
@@ -149,4 +149,4 @@ def write_samples(seed: int, count: int, output: Path, folder: bool | None = Non
 
 def species_name(species_file: Path) -> str:
     """The species' name inside its file: ASCII letters, digits and ``_`` of the file's name."""
-    return re.sub(r"[^A-Za-z0-9_]+", "_", species_file.stem).strip("_") or "species"
+    return ascii_name(species_file.stem, "species")

@@ -79,3 +79,15 @@ def test_a_set_of_species_lands_whole_or_not_at_all(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         write_samples(10, 5, tmp_path / "reef", folder=True)
     assert not (tmp_path / "reef").exists() and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name,inside", [("ünï🐟.txt", "uni"), ("Crème brûlée.txt", "Creme_brulee"),
+                                         ("🐟.txt", "species"), ("bream-fit.txt", "bream_fit")])
+def test_the_name_inside_a_species_file_keeps_the_letters_of_its_file_name(tmp_path, name, inside):
+    """The name a species file holds is ASCII: accents are dropped, not the letters under them
+    (`ünï🐟.txt` held `n`)."""
+    from fishgen.authoring.species_files import species_name
+
+    assert species_name(tmp_path / name) == inside
+    write_samples(7, 1, tmp_path / name)
+    assert load_species(tmp_path / name).name == inside

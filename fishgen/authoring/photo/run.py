@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import io
 import os
-import re
 import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -146,12 +145,6 @@ def measure(photo: Photo, base: Species, mask: np.ndarray, spacing: str = "proje
             parts[name] = uv(np.tile(a.body[0, 0], (count, 1)))
     unseen = tuple(name for name, res in a.fins.items() if not res.seen)
     return Measured(TexturePoints(**parts), a.frame.mask, a.frame.angle, a.frame.mirrored, unseen, a.frame)
-
-
-def species_name(out: Path) -> str:
-    """The species' name inside its file (its texture names: :func:`texture_names`)."""
-    name = re.sub(r"[^A-Za-z0-9_]+", "_", out.stem).strip("_")
-    return name or "fish"
 
 
 def texture_bytes(original: Photo, work: Photo, mask: np.ndarray) -> tuple[bytes, bytes]:
@@ -358,7 +351,7 @@ def _candidate(photo: Photo, mask: np.ndarray, base: Species, out: Path, options
                                f"{len(values)}", options.fxl_in)
         pts = replace(pts, **{part: tuple(values)})
     measured = replace(measured, unseen=tuple(n for n in measured.unseen if n not in imported))
-    from fishgen.authoring.species_files import texture_names
+    from fishgen.authoring.species_files import species_name, texture_names
 
     name = species_name(out)
     names = texture_names(out)   # NEW.png and NEW_mask.png, unless a species file cannot name them
