@@ -165,8 +165,8 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
         if options.report is not None:
             write_report(report, options.report)
             events.note(f"wrote {options.report}")
-        for line in summary(report):
-            events.note(line)
+        for line in summary(report):    # the summary, on stdout as every command's (-q silences it)
+            events.line(line, None)
         server = holder["session"].server
         threading.Timer(0.2, server.shutdown).start()   # Pakawan closed its window at the time-out
 
