@@ -48,7 +48,7 @@ def execute(cmd: Command, inputs: tuple[Path, ...], output: str | None, options:
     from fishgen.atomic import together
     from fishgen.commands import run
 
-    events = TerminalEvents()
+    events = TerminalEvents(cmd.name)
     # A summary that cannot be printed (stdout on a full disk) fails the run: with `together`, its
     # files are still staged then, and none lands.
     with together() if cmd.together else nullcontext():
@@ -75,8 +75,9 @@ class TerminalEvents:
     """Notes and failures on stderr; a progress bar when a person watches (stderr is a terminal and
     not --quiet), else one plain line per step on stdout, with the reason under --verbose."""
 
-    def __init__(self) -> None:
+    def __init__(self, command: str = "") -> None:
         self.bars = 0
+        self.command = command
 
     def as_events(self) -> Events:
         return Events(note=lambda text: click.echo(text, err=True), failed=self.failed,
@@ -86,7 +87,12 @@ class TerminalEvents:
     def failed(self, err: Any) -> None:
         if self.bars:
             click.echo("", err=True)  # off the bar's line
-        click.echo(error_line(str(err), err.status, file=err.file, line=err.line, kind=err.kind,
+        from fishgen.errors import UsageError
+
+        message = str(err)
+        if isinstance(err, UsageError) and err.file is None and self.command:
+            message = f"fishgen {self.command}: {message}"     # as a usage error that stops the command
+        click.echo(error_line(message, err.status, file=err.file, line=err.line, kind=err.kind,
                               **({"job": err.job} if err.job else {})), err=True)
         detail = getattr(err, "detail", "")
         if detail and verbosity() >= VERBOSE:

@@ -217,3 +217,18 @@ def test_a_texture_past_pillows_own_limit_is_one_line(tmp_path):
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert "expected a texture of at most 8192 pixels a side, found 'bonybream.png' of 10,000,000,000" \
         in result.stderr
+
+
+def test_with_several_inputs_one_refused_output_is_a_usage_line_naming_the_command(tmp_path):
+    """Each input's refusal reads as every usage error does, `fishgen build: ...`, and the other
+    inputs are built (the line had no command before it)."""
+    from tests.conftest import species_textured_as
+
+    inputs = species_textured_as(tmp_path, "bonybream_skin.png", "bonybream_skin_mask.png")
+    result = run_cli("build", "bonybream.txt", PARAMS / "pineapplefish.txt", "-o", "./", "--format", "gltf",
+                     cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.startswith("fishgen build: expected an output that is not one of the command's "
+                                    "inputs, found 'bonybream.gltf'") and result.stderr.count("\n") == 1
+    assert (tmp_path / "pineapplefish.gltf").is_file() and not (tmp_path / "bonybream.gltf").exists()
+    assert {p: p.read_bytes() for p in inputs} == inputs
