@@ -54,6 +54,11 @@ def side_file(asset: str | Path, ref: str, *, uri: bool = False, must_exist: boo
 _IMAGE_SUFFIX = re.compile(r"\.(png|jpe?g|gif|webp)$", re.IGNORECASE)
 
 
+def image_stem(name: str) -> str:
+    """An image's name without the picture extension a texture cloud's names carry (``billow.png``)."""
+    return _IMAGE_SUFFIX.sub("", name) or name
+
+
 def image_side_stems(asset_stem: str, image_names: list[str]) -> list[str]:
     """The stems of the files a writer puts images in beside ``asset_stem``'s asset, one per
     image and all different: ``x_billow`` for an image named ``billow.png`` (a texture cloud
@@ -62,7 +67,7 @@ def image_side_stems(asset_stem: str, image_names: list[str]) -> list[str]:
     ``billow.png``), which would otherwise overwrite the first."""
     stems: list[str] = []
     for name in image_names:
-        stem = f"{asset_stem}_{_IMAGE_SUFFIX.sub('', name) or name}"
+        stem = f"{asset_stem}_{image_stem(name)}"
         unique, n = stem, 1
         while unique in stems:
             n += 1

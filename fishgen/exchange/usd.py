@@ -76,7 +76,9 @@ class _Pictures:
     def name(self, image: Image) -> str:
         data = image.encoded()
         if data not in self.named:
-            base = f"{self.stem}_{_identifier(image.name or 'texture')}"
+            from fishgen.exchange.sidefiles import image_stem
+
+            base = f"{self.stem}_{_identifier(image_stem(image.name or 'texture'))}"
             name, k = f"{base}.png", 1
             while name in self.files:
                 k += 1

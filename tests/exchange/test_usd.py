@@ -332,3 +332,22 @@ def test_blender_imports_the_school_with_its_instances_frame_range_and_bounds(tm
         expected = np.stack([every.min(axis=0), every.max(axis=0)])
         # fishgen turns by the float orientations, Blender by the file's halves
         assert np.abs(_from_blender(seen["low"], seen["high"]) - expected).max() < 1e-3
+
+
+
+
+def test_an_image_named_by_its_file_keeps_one_extension_beside_a_usd_file(tmp_path):
+    """An image named 'billow.png' (as a texture cloud names its images) was written x_billow_png.png
+    beside a USD file, where glTF, OBJ and PLY write x_billow.png."""
+    import dataclasses
+
+    from fishgen.assembly.fish import make_fish
+    from fishgen.exchange import export
+    from fishgen.species.parser import load_species
+    from tests.conftest import PARAMS
+
+    scene = make_fish(load_species(PARAMS / "bonybream.txt")).scene
+    scene.images[0] = dataclasses.replace(scene.images[0], name="billow.png")
+    written = export(scene, tmp_path / "x.usda")
+    assert sorted(p.name for p in written) == ["x.usda", "x_billow.png"]
+    assert "@./x_billow.png@" in (tmp_path / "x.usda").read_text()
