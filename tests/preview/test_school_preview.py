@@ -2,8 +2,6 @@
 the frames, and the whole-scene posing the renderer uses equals `fishgen.scene.pose`."""
 from __future__ import annotations
 
-from contextlib import contextmanager
-
 import numpy as np
 import pytest
 from PIL import Image
@@ -58,23 +56,11 @@ def test_a_school_still_is_posed_after_its_warmup_and_time_overrides(school, tmp
 
 
 def test_the_progress_bar_counts_each_frame_once(school, tmp_path):
-    from fishgen.commands import Events, Progress
+    from fishgen.commands import Events
     from fishgen.commands.preview import PreviewCommandOptions, preview
+    from tests.progress_bars import recorded_bars
 
-    bars: list[tuple[str, int, list[int]]] = []
-
-    class Counter(Progress):
-        def __init__(self, updates: list[int]):
-            self.updates = updates
-
-        def update(self, n: int) -> None:
-            self.updates.append(n)
-
-    @contextmanager
-    def progress(label: str, total: int):
-        bars.append((label, total, []))
-        yield Counter(bars[-1][2])
-
+    bars, progress = recorded_bars()
     options = PreviewCommandOptions(size=(64, 48), frames=5, view="top")
     preview([school], tmp_path / "loop.gif", options, Events(progress=progress))
     assert bars == [("rendering", 5, [1, 1, 1, 1, 1])]
