@@ -142,9 +142,9 @@ def make_corpus(dest: Path = DEFAULT_CORPUS) -> None:
     add_new_inputs(dest)
 
 
-#: A scene file using every key of issue 24's school (couzin, variety, warm-up, length, bounds) and a
-#: target path read from a CSV.
-FULL_SCENE = """# Every scene key: couzin zones, variety, warm-up, length, bounds, a CSV target path.
+#: A scene file using every key of issue 24's school (couzin, variety, warm-up, pre-roll, length,
+#: bounds) and a target path read from a CSV.
+FULL_SCENE = """# Every scene key: couzin zones, variety, warm-up, pre-roll, length, bounds, a CSV path.
 model = "couzin"
 frames = 60
 fps = 30
@@ -152,6 +152,7 @@ seed = 3
 bounds = [[-3.0, -1.0, -3.0], [3.0, 1.0, 3.0]]
 layout = "ring"
 warmup = 1.0
+preroll = 2.0
 length = 0.3
 
 [[species]]
