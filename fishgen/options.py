@@ -301,13 +301,14 @@ def click_params(record: type) -> list[click.Parameter]:
         switch = f"--{long_name(f)}" + (f"/{spec.off}" if spec.off else "")
         decls = [switch, *([spec.short] if spec.short else []), f.name]
         help_text = f"{spec.help}  [default: {spec.default_text()}]" if not spec.required else spec.help
+        # a required option gets no default at all: click 8.3 takes an explicit default=None as a value
+        default = {} if spec.required else {"default": bool(spec.default) if spec.flag else spec.default}
         if spec.flag:
-            params.append(click.Option(decls, is_flag=True, default=bool(spec.default), help=help_text,
-                                       required=spec.required))
+            params.append(click.Option(decls, is_flag=True, help=help_text, required=spec.required,
+                                       **default))
         else:
-            params.append(click.Option(decls, type=spec.type, default=spec.default, multiple=spec.multiple,
-                                       metavar=spec.metavar, help=help_text, show_default=False,
-                                       required=spec.required))
+            params.append(click.Option(decls, type=spec.type, multiple=spec.multiple, metavar=spec.metavar,
+                                       help=help_text, show_default=False, required=spec.required, **default))
     return params
 
 

@@ -29,9 +29,10 @@ def click_command(cmd: Command) -> click.Command:
     if cmd.output is not None:
         shown = f"  [default: {cmd.output.shown_default}]" if cmd.output.shown_default else ""
         # a str, not a Path: `-o out/` keeps the slash that makes it a folder
-        params.append(click.Option(["-o", "--output"], type=click.Path(), default=None,
-                                   required=cmd.output.required, metavar=cmd.output.metavar,
-                                   help=cmd.output.help + shown))
+        # no default when required: click 8.3 takes an explicit default=None as a value given
+        default: dict[str, Any] = {} if cmd.output.required else {"default": None}
+        params.append(click.Option(["-o", "--output"], type=click.Path(), required=cmd.output.required,
+                                   metavar=cmd.output.metavar, help=cmd.output.help + shown, **default))
     params += click_params(cmd.options)
 
     def callback(inputs: Any = (), output: str | None = None, **values: Any) -> None:

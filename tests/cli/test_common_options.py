@@ -92,3 +92,33 @@ def test_a_usage_error_from_the_command_names_the_command_as_clicks_own_do(tmp_p
     error = json.loads(as_json.stderr)
     assert (error["error"], error["kind"], error["exit"]) == (plain.stderr.strip(), "usage", 2)
     assert list(tmp_path.iterdir()) == []
+
+
+def _required(name: str) -> list[str]:
+    """The options ``fishgen NAME --help`` marks [required]: -o and the declared ones."""
+    from fishgen.commands import command
+    from fishgen.options import declared, long_name
+
+    cmd = command(name)
+    found = ["-o"] if cmd.output is not None and cmd.output.required else []
+    return found + [f"--{long_name(f)}" for f, spec in declared(cmd.options) if spec.required]
+
+
+@pytest.mark.parametrize("name", [n for n in sorted(COMMANDS) if _required(n)])
+def test_a_required_option_left_out_is_a_usage_error_in_one_line(tmp_path, name):
+    """click 8.3 took an explicit default of None as a value given: `fishgen school SPECIES` with no
+    -o (and `texture` without -s, `species` without --random) got past it into a traceback."""
+    inputs = {"build": [PARAMS / "bonybream.txt"], "school": [PARAMS / "bonybream.txt"],
+              "clouds": [PARAMS / "clouds" / "table_4_3.awn"], "preview": [PARAMS / "bonybream.txt"],
+              "texture": [PARAMS / "photos" / "bonybream-side.png"], "edit": [tmp_path / "new.awn"],
+              "fly": [PARAMS / "clouds" / "table_4_3.awn"], "view": [PARAMS / "bonybream.txt"]}
+    values = {"-o": str(tmp_path / "x.txt"), "--species": str(PARAMS / "bonybream.txt"), "--random": None}
+    required = _required(name)
+    for left_out in required:
+        given = [part for option in required if option != left_out
+                 for part in ([option] if values[option] is None else [option, values[option]])]
+        result = run_cli(name, *inputs.get(name, []), *given, cwd=tmp_path)
+        assert result.returncode == 2, result.stderr
+        assert result.stderr.startswith(f"fishgen {name}: Missing option"), result.stderr
+        assert result.stderr.count("\n") == 1 and left_out in result.stderr
+    assert not (tmp_path / "x.txt").exists()
