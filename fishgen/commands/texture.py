@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
-from fishgen.options import FILE, option
+from fishgen.options import FILE, FiniteRange, option
 
 SPACINGS = ("projected", "even")   # fishgen.authoring.photo.points.SPACINGS, without numpy
 
@@ -38,7 +38,7 @@ class TextureCommandOptions:
     fxl_out: Path | None = option(FILE, "Also write the points as a Fixel .FXL file.", shown_default="none",
                                   metavar="POINTS.FXL")
     focal_length: float | None = option(
-        click.FloatRange(4.0, 2000.0), "The photo's focal length in mm on a 36 mm wide sensor (EXIF's "
+        FiniteRange(4.0, 2000.0), "The photo's focal length in mm on a 36 mm wide sensor (EXIF's "
         "FocalLengthIn35mmFilm): the rebuilt fish is measured in that perspective and, with --fit-shape, "
         "its fins are refined in it.", shown_default="none: seen from afar, no perspective", metavar="MM")
 

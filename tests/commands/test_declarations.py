@@ -61,6 +61,23 @@ def test_every_option_of_every_command_says_its_default(name):
             assert "[default: " in text or param.required, f"fishgen {name} {param.opts[0]}: {text!r}"
 
 
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_no_number_option_of_any_command_takes_nan_or_infinity(name):
+    """click's FloatRange lets NaN through (every comparison with it is false): `texture
+    --focal-length nan` got past it into a traceback. Every number option refuses both."""
+    import click
+
+    from fishgen.options import declared, long_name
+
+    for f, spec in declared(command(name).options):
+        kind = spec.type
+        if isinstance(kind, click.FloatRange) or kind is click.FLOAT:
+            for value in ("nan", "inf", "-inf"):
+                with pytest.raises(click.BadParameter):
+                    kind.convert(value, None, None)
+                    pytest.fail(f"fishgen {name} --{long_name(f)} took {value}")
+
+
 def test_the_school_scene_file_checks_its_keys_with_the_options_declarations(tmp_path):
     """The scene file's ranges are the options' own: a seed the command line takes, it takes."""
     from fishgen.commands.school import SchoolOptions
