@@ -254,6 +254,7 @@ def _metrics_json(run, per_frame: dict, numbers: dict, warmup: int) -> bytes:
         return value
 
     doc = {"species": run.species_names, "fps": run.config.fps, "frames": run.config.frames,
-           "model": run.config.model, "warmup_frames": warmup, "summary": plain(numbers),
+           "model": run.config.model, "warmup_frames": warmup, "preroll_frames": run.config.preroll_frames,
+           "summary": plain(numbers),
            "per_frame": plain(per_frame)}
     return json.dumps(doc, indent=1, sort_keys=True, allow_nan=False).encode("utf-8")

@@ -69,7 +69,8 @@ class SchoolRun:
 
         per_frame = self.measures() if per_frame is None else per_frame
         rows = summary_table(per_frame, self.warmup_frames, self.species_names)
-        settled = [f"{self.config.preroll:g} s pre-roll"] if self.config.preroll else []
+        steps = self.config.preroll_frames
+        settled = [f"{steps / self.config.fps:.3g} s pre-roll"] if steps else []
         if self.warmup_frames or not settled:
             settled.append(f"{self.warmup_frames / self.config.fps:.1f} s warm-up")
         return format_table(rows, "after " + " and ".join(settled))
@@ -129,9 +130,11 @@ def run_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "b
         scene = bake(fishes, tracks, tolerance=tolerance, seed=scene_file.seed, body_lengths=lengths,
                      tints=variety.tints, tint=variety.tint)
     # a pre-rolled school is formed at frame 0: no warm-up unless one is asked for
-    settle = warmup_frames(config.frames, config.fps, 0.0 if warmup is None and config.preroll else warmup)
+    pre = config.preroll_frames
+    settle = warmup_frames(config.frames, config.fps, 0.0 if warmup is None and pre else warmup)
     scene.extras[EXTRAS_KEY] = {"warmup": round(settle / config.fps, 6), "model": config.model,
-                                "fps": config.fps, "frames": config.frames, "preroll": config.preroll}
+                                "fps": config.fps, "frames": config.frames,
+                                "preroll": round(pre / config.fps, 6)}   # as simulated: whole steps
     return SchoolRun(config, tracks, scene, lengths, [g.name for g in groups], read, warmup_frames=settle)
 
 

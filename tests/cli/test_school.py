@@ -37,7 +37,7 @@ def test_scene_file_with_tracks_metrics_and_plot(tmp_path):
     out = tmp_path / "reef.glb"
     result = run_cli("school", PARAMS / "reef.toml", "-o", out, "--frames", "60", "--count", "8",
                      "--tracks", tmp_path / "t.npz", "--metrics", tmp_path / "m.json",
-                     "--plot", tmp_path / "p.png")
+                     "--plot", tmp_path / "p.png", "--preroll", "0.5")
     assert result.returncode == 0, result.stderr
     assert_valid_gltf(out)
     tracks = np.load(tmp_path / "t.npz")
@@ -46,6 +46,7 @@ def test_scene_file_with_tracks_metrics_and_plot(tmp_path):
     assert np.isfinite(tracks["x"]).all() and set(np.unique(tracks["species"])) == {0, 1}
     metrics = json.loads((tmp_path / "m.json").read_text())
     assert len(metrics["per_frame"]["polarization"]) == 60 and "predator_distance" in metrics["per_frame"]
+    assert (metrics["preroll_frames"], metrics["warmup_frames"]) == (15, 0)    # what came before frame 0
     assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 

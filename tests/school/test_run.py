@@ -56,3 +56,16 @@ def test_keyword_options_reach_the_simulation_and_the_bake():
     assert np.allclose(run.body_lengths, 0.5, rtol=1e-3)
     assert len(run.scene.meshes) == 3 * len(run_school(scene(count=2, frames=30)).scene.meshes)
     assert run.scene.extras[EXTRAS_KEY]["model"] == "couzin"
+
+
+def test_a_pre_roll_counts_in_whole_steps_as_it_was_simulated():
+    """A pre-roll under one frame simulates nothing: it is no pre-roll, and the default warm-up stays
+    (the summary said "after 0.001 s pre-roll" and dropped the warm-up). Others are said as run."""
+    tiny = run_school(scene(frames=30, preroll=0.001))
+    assert tiny.config.preroll_frames == 0 and tiny.warmup_frames == warmup_frames(30, 30.0) == 10
+    assert tiny.summary().startswith("after 0.3 s warm-up")
+    assert tiny.scene.extras[EXTRAS_KEY]["preroll"] == 0.0
+    odd = run_school(scene(frames=30, preroll=0.05))                     # 1.5 frames: 2 steps
+    assert odd.config.preroll_frames == 2 and odd.warmup_frames == 0
+    assert odd.summary().startswith("after 0.0667 s pre-roll")
+    assert odd.scene.extras[EXTRAS_KEY]["preroll"] == pytest.approx(2 / 30, abs=1e-6)
