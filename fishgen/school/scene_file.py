@@ -32,6 +32,8 @@
     tints = 3                  # colour variants per species (1: its own colours only)
     tint = 0.15
 
+and, among the first keys (before any [table], where TOML would put them inside it):
+
     warmup = 3.0               # seconds the school takes to form (the summary skips them)
     preroll = 60.0             # seconds simulated before the first frame, not baked
     length = 0.3               # every species' nose-to-tail length, metres
@@ -138,7 +140,9 @@ PREROLL = Option(FiniteRange(0, MAX_PREROLL), "Seconds simulated before the firs
 PRESET = Option(click.Choice(tuple(COUZIN_PRESETS)),
                 "Couzin et al. (2002)'s collective state for the couzin model (sets --model couzin): "
                 + ", ".join(f"{name} (orientation zone {p.orientation:g} body lengths)"
-                            for name, p in COUZIN_PRESETS.items()) + ".", None,
+                            for name, p in COUZIN_PRESETS.items())
+                + ". From a random start the torus rarely mills in the default region; "
+                "params/bait-ball.toml starts one as a ring.", None,
                 shown_default="the scene file's [couzin], else zones of 1, 1 and 15 body lengths (torus)")
 SIZE_VARIETY = Option(FiniteRange(*VARIETY_RANGES["size"]), VARIETY_HELP["size"].capitalize() + ".",
                       Variety.size)
