@@ -202,8 +202,12 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     files, sizes = _write_all(output, run, sides, per_frame, numbers, warmup)
     size = sum(n for p, n in sizes.items() if p not in sides.values())
     kinds_line = ", ".join(f"{e.count} {Path(e.file).stem}" for e in scene.species)
+    # an instancer's prototypes keep the finest level and their own keys: said, as `build` says it
+    dropped = [what for what, given in (("levels of detail", options.lods), ("compact keys", options.compact))
+               if instanced and given]
+    note = f" ({output.suffix[1:].upper()} holds no {' or '.join(dropped)})" if dropped else ""
     line = (f"{output}: {kinds_line}; {scene.frames} frames ({scene.frames / scene.fps:.1f} s), "
-            f"{scene.model}, {size / 1e6:.2f} MB")
+            f"{scene.model}, {size / 1e6:.2f} MB{note}")
     facts = SchoolFacts(tuple((Path(e.file).stem, e.count) for e in scene.species), scene.frames, scene.fps,
                         scene.model, size, warmup, table)
     read = tuple(dict.fromkeys([*inputs, *scene.read, *run.read]))

@@ -351,3 +351,16 @@ def test_an_image_named_by_its_file_keeps_one_extension_beside_a_usd_file(tmp_pa
     written = export(scene, tmp_path / "x.usda")
     assert sorted(p.name for p in written) == ["x.usda", "x_billow.png"]
     assert "@./x_billow.png@" in (tmp_path / "x.usda").read_text()
+
+
+def test_a_school_to_usd_says_what_its_prototypes_leave_out(tmp_path):
+    """`--lods` keeps the finest level in USD and `--compact` changes nothing there; `fishgen build`
+    said so and `fishgen school` did not."""
+    from tests.conftest import PARAMS
+
+    args = ("school", PARAMS / "bonybream.txt", "--count", "3", "--frames", "10", "--lods", "16x12,8x6")
+    usd = run_cli(*args, "--compact", "-o", tmp_path / "s.usdc")
+    assert usd.returncode == 0, usd.stderr
+    assert usd.stdout.splitlines()[0].endswith("(USDC holds no levels of detail or compact keys)")
+    glb = run_cli(*args, "-o", tmp_path / "s.glb")
+    assert glb.returncode == 0 and "holds no" not in glb.stdout
