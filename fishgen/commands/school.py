@@ -189,6 +189,9 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
 
         compact_clips(run.scene)
     warmup = run.warmup_frames
+    if scene.warmup is not None and round(scene.warmup * scene.fps) > warmup:
+        events.note(f"{output}: a warm-up of {scene.warmup:g} s is as long as the run or longer "
+                    f"({scene.frames / scene.fps:.1f} s): the summary measures its last frame only")
     per_frame: dict = {}
     numbers: dict = {}
     table = ""
@@ -201,14 +204,15 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         table = run.summary(per_frame or None)
     files, sizes = _write_all(output, run, sides, per_frame, numbers, warmup)
     size = sum(n for p, n in sizes.items() if p not in sides.values())
-    kinds_line = ", ".join(f"{e.count} {Path(e.file).stem}" for e in scene.species)
+    counted = tuple(zip(run.species_names, (e.count for e in scene.species), strict=True))
+    kinds_line = ", ".join(f"{count} {name}" for name, count in counted)
     # an instancer's prototypes keep the finest level and their own keys: said, as `build` says it
     dropped = [what for what, given in (("levels of detail", options.lods), ("compact keys", options.compact))
                if instanced and given]
     note = f" ({output.suffix[1:].upper()} holds no {' or '.join(dropped)})" if dropped else ""
     line = (f"{output}: {kinds_line}; {scene.frames} frames ({scene.frames / scene.fps:.1f} s), "
             f"{scene.model}, {size / 1e6:.2f} MB{note}")
-    facts = SchoolFacts(tuple((Path(e.file).stem, e.count) for e in scene.species), scene.frames, scene.fps,
+    facts = SchoolFacts(counted, scene.frames, scene.fps,
                         scene.model, size, warmup, table)
     read = tuple(dict.fromkeys([*inputs, *scene.read, *run.read]))
     return Made(tuple(files), read, (line, table) if table else (line,), facts)

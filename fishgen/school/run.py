@@ -152,7 +152,8 @@ def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "
     couzin = _given(couzin, scene_file, "couzin", CouzinParams())
     variety = _given(variety, scene_file, "variety", Variety())
     length = _given(length, scene_file, "length", None)
-    fishes, groups = [], []
+    fishes: list[Scene] = []
+    groups: list[Group] = []
     read: list[Path] = []
     for entry in scene_file.species:
         species = load_species(entry.file, textures_dir)
@@ -161,8 +162,11 @@ def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "
                          lods=lods, merge=merge)
         units = species.world_scale * species.scale[0]
         fishes.append(fish.scene)
-        groups.append(Group(Path(entry.file).stem, entry.count, fish.facts.body_length, entry.speed,
-                            brain_of(species, units)))
+        # a species listed twice is two schools: told apart by number in the summary and the tracks
+        name = Path(entry.file).stem
+        before = [Path(e.file).stem for e in scene_file.species[:len(groups)]].count(name)
+        groups.append(Group(f"{name} ({before + 1})" if before else name, entry.count, fish.facts.body_length,
+                            entry.speed, brain_of(species, units)))
     count = sum(g.count for g in groups)
     region = scene_file.bounds
     if region is None:

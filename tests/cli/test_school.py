@@ -286,3 +286,32 @@ def test_the_readmes_preset_school_is_in_its_state_from_the_first_frame(tmp_path
     assert summary_row(result.stdout, "rotation")[0] < 0.2
     assert summary_row(result.stdout, "separate groups") == (1, 1)
     assert_valid_gltf(out)
+
+
+def test_a_species_listed_twice_is_two_schools_told_apart(tmp_path):
+    """Two [[species]] of one file: the summary's rows and the tracks' names read bonybream and
+    bonybream (2); before, both rows read bonybream."""
+    from tests.conftest import species_textured_as
+
+    species_textured_as(tmp_path, "bonybream.png", "bonybream_mask.png")
+    scene = tmp_path / "d.toml"
+    scene.write_text('[[species]]\nfile = "bonybream.txt"\ncount = 4\n'
+                     '[[species]]\nfile = "bonybream.txt"\ncount = 3\n')
+    result = run_cli("school", scene, "--frames", "12", "-o", tmp_path / "o.glb",
+                     "--tracks", tmp_path / "t.npz")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith(f"{tmp_path / 'o.glb'}: 4 bonybream, 3 bonybream (2);")
+    assert summary_row(result.stdout, "polarization (1 = parallel), bonybream (2)")
+    assert list(np.load(tmp_path / "t.npz")["species_names"]) == ["bonybream", "bonybream (2)"]
+
+
+def test_a_warm_up_as_long_as_the_run_is_said_in_a_note(tmp_path):
+    out = tmp_path / "e.glb"
+    long = run_cli("school", PARAMS / "bonybream.txt", "--count", "3", "--frames", "10", "--warmup", "5",
+                   "-o", out)
+    assert long.returncode == 0 and "after 0.3 s warm-up" in long.stdout
+    assert long.stderr == (f"{out}: a warm-up of 5 s is as long as the run or longer (0.3 s): the summary "
+                           "measures its last frame only\n")
+    short = run_cli("school", PARAMS / "bonybream.txt", "--count", "3", "--frames", "10", "--warmup", "0.2",
+                    "-o", out)
+    assert short.returncode == 0 and short.stderr == ""
