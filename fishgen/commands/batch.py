@@ -108,6 +108,22 @@ class BatchFacts:
     workers: int
 
 
+def _manifest(source: Path, out: Path | None):
+    """The manifest at ``source``; a file that is not one but another command's input says which."""
+    from fishgen.batch.manifest import load_manifest
+    from fishgen.errors import FishgenError, SystemFailure
+    from fishgen.exchange.registry import detect
+
+    try:
+        return load_manifest(source, out, kinds=job_kinds())
+    except FishgenError as err:
+        fmt = None if isinstance(err, SystemFailure) else detect(source)
+        if fmt is None or fmt.command in (None, "batch"):
+            raise
+        raise FishgenError(f"expected a batch manifest or a folder, found {fmt.description}; use "
+                           f"`fishgen {fmt.command}` for it", source) from None
+
+
 def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOptions(),
           events: Events = QUIET) -> Made:
     """Run every job that is not up to date; each finished job is told through ``events``."""
@@ -115,7 +131,7 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
     import time
 
     from fishgen.batch import RecordNotSaved, run_batch
-    from fishgen.batch.manifest import load_manifest, scan_folder
+    from fishgen.batch.manifest import scan_folder
     from fishgen.errors import JobsFailed, SystemFailure, UsageError
     from fishgen.extras import needs
 
@@ -128,7 +144,7 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
             raise UsageError("expected --out FOLDER with a folder of inputs, found none", source)
         manifest = scan_folder(source, options.out, kinds=job_kinds())
     else:
-        manifest = load_manifest(source, options.out, kinds=job_kinds())
+        manifest = _manifest(source, options.out)
     if options.report is not None:
         _check_report(options.report, manifest)
     workers = options.jobs or os.cpu_count() or 1

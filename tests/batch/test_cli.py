@@ -8,7 +8,7 @@ import pytest
 
 from fishgen.batch.manifest import derived_seed
 from tests.batch.conftest import batch, hashes, statuses
-from tests.conftest import ROOT
+from tests.conftest import PARAMS, ROOT, run_cli
 
 
 def test_one_plain_line_per_job_and_a_summary_when_not_on_a_terminal(shipped):
@@ -140,3 +140,22 @@ def test_a_report_that_is_a_jobs_input_or_output_is_refused_before_any_job_runs(
     assert "Traceback" not in run.stderr and str(target) in run.stderr
     assert (target.read_bytes() if target.exists() else None) == before
     assert not (shipped / "out").exists()
+
+
+@pytest.mark.parametrize("given, command", [("reef.toml", "school"), ("bonybream.txt", "build"),
+                                            ("clouds/table_4_3.awn", "clouds")])
+def test_another_commands_input_given_to_batch_names_that_command(tmp_path, given, command):
+    """A school scene given to batch read `expected one of out, [[build]], ..., found 'model'`, a
+    species file `expected TOML`; as `build` does for a manifest, they now name their command."""
+    result = run_cli("batch", PARAMS / given, "--out", tmp_path / "out")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert result.stderr.endswith(f"; use `fishgen {command}` for it\n")
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_manifest_named_as_another_format_still_runs(tmp_path):
+    """The hint comes only for a file that is not a manifest: `jobs.txt` holding jobs is one."""
+    (tmp_path / "jobs.txt").write_text(f'[[build]]\ninput = "{PARAMS / "bonybream.txt"}"\noutput = "b.glb"\n')
+    result = run_cli("batch", tmp_path / "jobs.txt", "--out", tmp_path / "out")
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "out" / "b.glb").is_file()
