@@ -84,6 +84,19 @@ def protecting(paths: Iterable[str | os.PathLike]) -> Iterator[None]:
         _inputs.set(outer)
 
 
+def protect(path: str | os.PathLike) -> None:
+    """Protect ``path`` too inside the :func:`protecting` under way, if any: a file an input names
+    (a glTF's image, an OBJ's material), found only as the input is read."""
+    ids = _inputs.get()
+    if ids is None:
+        return
+    try:
+        info = os.stat(path)
+    except OSError:
+        return
+    ids[(info.st_dev, info.st_ino)] = os.fspath(path)
+
+
 def _land(staged: list[tuple[str, Path]]) -> None:
     """Rename staged files into place now, or leave them to the enclosing :func:`together`."""
     pending = _staging.get()

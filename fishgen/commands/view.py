@@ -55,6 +55,7 @@ def view(inputs: Sequence[Path], output: str | os.PathLike | None,
     from fishgen.viewer.page import write_page
 
     (asset,) = inputs
+    from fishgen.atomic import protecting
     from fishgen.commands.paths import check_targets, suffix_of
     from fishgen.viewer.page import page_path
 
@@ -63,7 +64,8 @@ def view(inputs: Sequence[Path], output: str | os.PathLike | None,
     check_targets([page], [asset])
     colour = "#{:02x}{:02x}{:02x}".format(*options.background[:3])
     if options.no_serve:
-        page = Path(write_page(asset, page, colour, instancing=options.instancing))
+        with protecting([asset]):
+            page = Path(write_page(asset, page, colour, instancing=options.instancing))
         return Made((page,), (asset,), (f"wrote {page}",))
     from fishgen.viewer.server import make_server, url_of
 
@@ -73,7 +75,8 @@ def view(inputs: Sequence[Path], output: str | os.PathLike | None,
         raise SystemFailure(f"expected a free port {options.port} on 127.0.0.1, found it taken "
                             f"({err.strerror}); try --port 0") from None
     try:
-        page = Path(write_page(asset, page, colour, instancing=options.instancing))
+        with protecting([asset]):  # and the files it names, as they are read
+            page = Path(write_page(asset, page, colour, instancing=options.instancing))
     except BaseException:
         server.server_close()
         raise

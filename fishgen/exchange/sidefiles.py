@@ -48,6 +48,9 @@ def side_file(asset: str | Path, ref: str, *, uri: bool = False, must_exist: boo
         raise expected("a file inside the asset's folder", f"{describe(ref)}, which leads outside it", asset)
     if must_exist and not target.is_file():
         raise expected(f"the file {ref.strip()!r} it refers to beside the asset", "none", asset)
+    from fishgen.atomic import protect
+
+    protect(target)  # an input too: no output of the command under way may replace it
     return target
 
 

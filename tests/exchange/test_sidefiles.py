@@ -1,0 +1,36 @@
+"""fishgen.exchange.sidefiles: a file an asset names is an input of the command that reads it."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from tests.conftest import PARAMS, run_cli
+
+
+@pytest.mark.parametrize("asset, target", [("bb.gltf", "bb_skin.png"), ("bb.obj", "bb_skin.png"),
+                                           ("bb.obj", "bb_skin_mask.png")])
+def test_a_preview_never_replaces_a_file_its_asset_names(tmp_path, asset, target):
+    """`fishgen preview bb.gltf -o bb_skin.png` wrote the render over the fish's own texture, exit 0:
+    the files a glTF or OBJ names were not inputs, as a species file's textures were."""
+    built = run_cli("build", PARAMS / "bonybream.txt", "-o", tmp_path / asset)
+    assert built.returncode == 0, built.stderr
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    result = run_cli("preview", tmp_path / asset, "-o", tmp_path / target, "--size", "64x48")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "expected an output that is not one of the command's inputs" in result.stderr
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_a_page_never_replaces_a_file_its_asset_names(tmp_path):
+    """A glTF whose image is named page.html: `fishgen view --no-serve -o page.html` wrote over it."""
+    built = run_cli("build", PARAMS / "bonybream.txt", "-o", tmp_path / "bb.gltf")
+    assert built.returncode == 0, built.stderr
+    gltf = json.loads((tmp_path / "bb.gltf").read_text())
+    (tmp_path / "bb_skin.png").rename(tmp_path / "page.html")
+    gltf["images"][0]["uri"] = "page.html"
+    (tmp_path / "bb.gltf").write_text(json.dumps(gltf))
+    image = (tmp_path / "page.html").read_bytes()
+    result = run_cli("view", "--no-serve", tmp_path / "bb.gltf", "-o", tmp_path / "page.html")
+    assert result.returncode == 2 and "not one of the command's inputs" in result.stderr, result.stderr
+    assert (tmp_path / "page.html").read_bytes() == image
