@@ -77,7 +77,7 @@ MAX_TEXTURE_SIDE = 8192
 
 
 def _check_image(path: Path, name: str, file: str, line: int) -> None:
-    """Read only the image header: a readable picture of a sane size, or a clear error."""
+    """A readable picture of a sane size, read to its end but not decoded, or a clear error."""
     import re
     import warnings
 
@@ -89,6 +89,8 @@ def _check_image(path: Path, name: str, file: str, line: int) -> None:
             warnings.simplefilter("ignore", Image.DecompressionBombWarning)
             with Image.open(path) as img:
                 width, height = img.size
+                if max(width, height) <= MAX_TEXTURE_SIDE:
+                    img.verify()  # every chunk there and its checksum right: a cut-off file is damaged
     except Image.DecompressionBombError as err:  # Pillow's own limit, before the size is ours to see
         pixels = re.search(r"\((\d+) pixels\)", str(err))
         raise FishgenError(f"{too_big} of {int(pixels[1]):,} pixels" if pixels else f"{too_big} larger",

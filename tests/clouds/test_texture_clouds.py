@@ -93,6 +93,19 @@ def test_a_texture_that_is_not_an_image_is_refused(folder):
         load_cubes(write(folder, "1\n1\n1, 1, 1, 1, 0, 0, 0, 1, fake.png\n"))
 
 
+def test_a_texture_cut_off_after_its_header_is_refused(folder):
+    """200 bytes of a PNG: its header read well, so a sky embedded it, and fishgen's own preview of
+    that sky refused it (QA)."""
+    import io
+
+    data = io.BytesIO()
+    Image.new("RGBA", (64, 64), (200, 200, 255, 128)).save(data, "PNG")
+    (folder / "sky" / "cut.png").write_bytes(data.getvalue()[:60])
+    with pytest.raises(FishgenError,
+                       match=r"test.awa:3: expected a texture image .* found 'cut.png' unreadable"):
+        load_cubes(write(folder, "1\n1\n1, 1, 1, 1, 0, 0, 0, 1, cut.png\n"))
+
+
 def test_header_counts_say_billboards(folder):
     with pytest.raises(FishgenError,
                        match=r"test.awa:1: expected a whole number for the total billboard count"):
