@@ -157,7 +157,8 @@ class _FolderResolver(Resolver):
 
 
 def _check_obj_vertices(text: str, path: Path) -> None:
-    """Every ``v`` statement has 3 finite coordinates (then optionally w, or r g b)."""
+    """Every ``v`` statement has 3 finite coordinates (then optionally w, or r g b), and every ``f``
+    statement 3 corners or more."""
     for m in re.finditer(r"^[ \t]*v[ \t]+([^\n]*)", text, re.M):
         words = m.group(1).split("#", 1)[0].split()
         ok = 3 <= len(words) <= 7
@@ -170,6 +171,12 @@ def _check_obj_vertices(text: str, path: Path) -> None:
             line = text.count("\n", 0, m.start()) + 1
             raise expected("a vertex of 3 finite coordinates (v x y z)",
                            describe(m.group(0).strip()), path, line)
+    # a face of fewer corners is no face: trimesh drops it, and a file cut off mid-line showed half
+    # a fish with no word
+    for m in re.finditer(r"^[ \t]*f(?![^ \t\r\n])([^\n]*)", text, re.M):
+        if len(m.group(1).split("#", 1)[0].split()) < 3:
+            raise expected("a face of 3 or more corners (f a b c)", describe(m.group(0).strip()), path,
+                           text.count("\n", 0, m.start()) + 1)
 
 
 def _mtl_libraries(obj: Path, text: str) -> list[Path]:

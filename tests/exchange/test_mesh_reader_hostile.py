@@ -47,6 +47,15 @@ def test_obj_vertex_without_three_finite_coordinates(tmp_path, vertex):
     assert text.startswith(f"{path}:5: ")
 
 
+@pytest.mark.parametrize("face", ["f 1 2", "f 1", "f", "f 1/1/1 2/2/2 # and a comment"])
+def test_obj_face_of_fewer_than_three_corners(tmp_path, face):
+    """A file cut off mid-face (or a face of two corners) was half a fish, read with no word."""
+    path = tmp_path / "bad.obj"
+    path.write_text(f"{TRI}f 1 2 3\n{face}\n")
+    text = refused(path, r"expected a face of 3 or more corners \(f a b c\), found ")
+    assert text.startswith(f"{path}:5: ")
+
+
 def test_obj_vertex_colours_and_w_are_fine(tmp_path):
     path = tmp_path / "ok.obj"
     path.write_text("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 1.0\nf 1 2 3\n")
