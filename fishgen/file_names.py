@@ -90,7 +90,7 @@ def _check_image(path: Path, name: str, file: str, line: int) -> None:
             with Image.open(path) as img:
                 width, height = img.size
                 if max(width, height) <= MAX_TEXTURE_SIDE:
-                    img.verify()  # every chunk there and its checksum right: a cut-off file is damaged
+                    _verify(img, name, file, line)
     except Image.DecompressionBombError as err:  # Pillow's own limit, before the size is ours to see
         pixels = re.search(r"\((\d+) pixels\)", str(err))
         raise FishgenError(f"{too_big} of {int(pixels[1]):,} pixels" if pixels else f"{too_big} larger",
@@ -100,3 +100,13 @@ def _check_image(path: Path, name: str, file: str, line: int) -> None:
                            file, line) from None
     if max(width, height) > MAX_TEXTURE_SIDE:
         raise FishgenError(f"{too_big} {width}x{height}", file, line)
+
+
+def _verify(img, name: str, file: str, line: int) -> None:
+    """Every chunk of the picture there and its checksum right, read but not decoded: a file cut
+    off after its header is damaged, said at its line rather than by whatever decodes it later."""
+    try:
+        img.verify()
+    except (OSError, ValueError, SyntaxError, EOFError):
+        raise FishgenError(f"expected a readable texture image, found {name!r} damaged", file, line) from None
+

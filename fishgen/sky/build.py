@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -60,23 +61,25 @@ def build_sky(mode: str = "medium", *, seed: int = 0, area: tuple[float, float] 
     """Compose, fill, light and level a sky of ``mode`` (thin, medium, thick) from ``models`` (cube
     files, .awn or .awa; default: the shipped ones). Same arguments, same scene, bit for bit."""
     from fishgen.clouds.pipeline import cloud_textures
-    from fishgen.errors import FishgenError
+    from fishgen.errors import UsageError
     from fishgen.sky.compose import fill_sky, plan_sky
     from fishgen.sky.light import light_sky
     from fishgen.sky.scene import sky_scene
 
-    # the parser refuses a file without particles, so every model has some
-    cubes, files = load_models(models, max_particles=max_particles, textures_dir=textures_dir)
+    # the parser refuses a file without particles, so every model has some. A model's own count is
+    # no size: each cloud re-fills it with its share of the sky's, and the sky's is checked below
+    cubes, files = load_models(models, max_particles=sys.maxsize, textures_dir=textures_dir)
     sky_mode = MODES[mode]
     total = sky_mode.particles if particles is None else particles
+    # the sky's size is the command line's (--particles, --mode), so a usage error
     if total > max_particles:
-        raise FishgenError(f"expected at most {max_particles:,} particles (raise --max-particles), found "
-                           f"{total:,} for a {mode} sky")
+        raise UsageError(f"expected at most {max_particles:,} particles (raise --max-particles), found "
+                         f"{total:,} for a {mode} sky")
     # every cloud needs a particle in each of its model's cubes: fewer leaves clouds empty
     need = sky_mode.clouds * max(sum(1 for c in f.cubes if c.particles) for f in cubes)
     if total < need:
-        raise FishgenError(f"expected at least {need:,} particles for a {mode} sky of {sky_mode.clouds} "
-                           f"clouds (one in each cube of every cloud), found {total:,}")
+        raise UsageError(f"expected --particles of at least {need:,} for a {mode} sky of {sky_mode.clouds} "
+                         f"clouds (one in each cube of every cloud), found {total:,}")
     plan = plan_sky(sky_mode, cubes, seed=seed, area=area, altitude=altitude, particles=total)
     filled = fill_sky(plan, cubes, noise=noise, max_particles=max_particles)
     clouds = light_sky(filled, lighting or Lighting(), method=shadow_map)

@@ -102,7 +102,7 @@ def test_a_texture_cut_off_after_its_header_is_refused(folder):
     Image.new("RGBA", (64, 64), (200, 200, 255, 128)).save(data, "PNG")
     (folder / "sky" / "cut.png").write_bytes(data.getvalue()[:60])
     with pytest.raises(FishgenError,
-                       match=r"test.awa:3: expected a texture image .* found 'cut.png' unreadable"):
+                       match=r"test.awa:3: expected a readable texture image, found 'cut.png' damaged"):
         load_cubes(write(folder, "1\n1\n1, 1, 1, 1, 0, 0, 0, 1, cut.png\n"))
 
 

@@ -162,3 +162,26 @@ def test_a_bad_cube_file_is_its_own_line(tmp_path, cli):
     run = cli("sky", "--clouds", bad, "-o", tmp_path / "s.glb")
     assert run.returncode == 2 and run.stderr.startswith(f"{bad}:3: expected")
     assert not (tmp_path / "s.glb").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--particles", "1"], "fishgen sky: expected --particles of at least 368 for a thin sky"),
+    (["--max-particles", "19999"], "fishgen sky: expected at most 19,999 particles (raise --max-particles), "
+                                   "found 20,000 for a thin sky"),
+])
+def test_a_sky_of_the_wrong_size_is_a_usage_error(tmp_path, cli, args, message):
+    run = cli("sky", "--mode", "thin", *args, "-o", tmp_path / "s.glb")
+    assert run.returncode == 2 and run.stderr.startswith(message) and run.stderr.count("\n") == 1, run.stderr
+    assert not list(tmp_path.iterdir())
+
+
+def test_max_particles_bounds_the_sky_not_the_model_files_it_re_fills(tmp_path, cli):
+    """--max-particles 600 refused a 500-particle sky, naming a shipped model's own count (615) in a
+    file inside the package; a model declaring 10^9 particles is re-filled to its share too."""
+    huge = tmp_path / "huge.awn"
+    huge.write_text("1000000000\n1\n1000000000, 10, 10, 10, 0, 0, 0, 1\n")
+    for extra in ([], ["--clouds", huge]):
+        run = cli("sky", "--mode", "thin", "--particles", "500", "--max-particles", "600", *extra,
+                  "-o", tmp_path / "s.glb")
+        assert run.returncode == 0, run.stderr
+        assert "500 particles" in run.stdout
