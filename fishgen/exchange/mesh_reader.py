@@ -348,6 +348,9 @@ def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path, scene: Scene) -
         diffuse = getattr(mat, "diffuse", None)
         if diffuse is None:
             diffuse = getattr(mat, "baseColorFactor", None)
+        if path.suffix.lower() == ".ply":
+            # PLY names a texture but no colour; trimesh's own default grey (102) darkened it 2.5x
+            diffuse = None
         rgba = np.asarray(diffuse if diffuse is not None else [255] * 4, np.float32).ravel()
         rgba = rgba / 255.0 if rgba.max() > 1.0 else rgba
         rgb = srgb_to_linear(rgba[:3])  # MTL Kd is authored as a display (sRGB) colour

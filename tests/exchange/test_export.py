@@ -169,3 +169,17 @@ def test_images_named_by_their_files_get_one_extension_beside_a_gltf_and_never_s
         scene.add_material(Material(f"m{k}", texture=texture))
     written = export(scene, tmp_path / "x.gltf")
     assert sorted(p.name for p in written) == ["x.bin", "x.gltf", "x_billow.png", "x_billow_2.png"]
+
+
+def test_a_textured_ply_reads_back_at_the_textures_own_colour(tmp_path):
+    """PLY names a texture and no colour: trimesh's default grey (102) multiplied the texture, and a
+    PLY fish previewed 2.5x darker than the same fish as OBJ or glTF (QA)."""
+    from fishgen.exchange.mesh_reader import read_mesh_file
+
+    fish = build_fish(load_species(PARAMS / "bonybream.txt"))
+    export(fish, tmp_path / "bb.ply")
+    export(fish, tmp_path / "bb.obj")
+    ply, obj = (read_mesh_file(tmp_path / name) for name in ("bb.ply", "bb.obj"))
+    textured = [m for m in ply.materials if m.texture is not None]
+    assert textured and all(m.base_color[:3] == (1.0, 1.0, 1.0) for m in textured)
+    assert [m.base_color for m in obj.materials if m.texture is not None][0][:3] == (1.0, 1.0, 1.0)
