@@ -173,7 +173,7 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
     session = _session(assets, config, options.port, title, reported)
     holder["session"] = session
     lines = (session.url(), f"flying {title}: W/S/A/D move, arrows look and turn, 1/2/3 speed, drag to look"
-             + (f"; stops after {timeout:g} s" if timeout else "; Ctrl-C to stop"))
+             + (f"; stops {timeout:g} s after the page starts flying" if timeout else "; Ctrl-C to stop"))
     return Made((), tuple(read), lines, server=session.server)
 
 
