@@ -146,7 +146,8 @@ def summary(report: dict[str, Any]) -> list[str]:
     return [f"flew {report['seconds']:.1f} s at {w['width']}x{w['height']}: {report['frames']:,} frames, "
             f"{fps['median']:.1f} FPS median (5th percentile {fps['p5']:.1f}, min {fps['min']:.1f}, "
             f"max {fps['max']:.1f})",
-            f"{things} in {scene['clouds']:,} clouds; drawn on average {drawn['particles']:,.0f} particles"
+            f"{things} in {scene['clouds']:,} cloud{'' if scene['clouds'] == 1 else 's'}; drawn on average "
+            f"{drawn['particles']:,.0f} particles"
             + (f", {drawn['billboards']:,.0f} billboards" if scene["billboards"] else "")
             + f" in {drawn['clouds']:.1f} clouds",
             *impostor_lines(report["impostors"]),
