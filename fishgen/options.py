@@ -116,7 +116,11 @@ class Colour(click.ParamType):
     """A CSS colour (``#8cadcc``, ``#rrggbbaa``, ``white``) or ``transparent``, as sRGB 0-255 RGBA."""
 
     name = "COLOUR"
-    what = "a colour (#8cadcc, white) or transparent"
+
+    def __init__(self, opaque: bool = False) -> None:
+        self.opaque = opaque  # a page's background: a browser shows no see-through one
+        self.what = ("an opaque colour (#8cadcc, white)" if opaque
+                     else "a colour (#8cadcc, white) or transparent")
 
     def convert(self, value, param, ctx):
         if isinstance(value, tuple):
@@ -124,13 +128,17 @@ class Colour(click.ParamType):
         from PIL import ImageColor
 
         text = str(value).strip()
+        rgba: tuple[int, ...] | int | None = None
         if text.lower() in ("transparent", "none"):
-            return (0, 0, 0, 0)
-        try:
-            rgba = ImageColor.getcolor(text, "RGBA")
-        except ValueError:
-            self.fail(f"expected {self.what}, found {value!r}", param, ctx)
+            rgba = (0, 0, 0, 0)
+        else:
+            try:
+                rgba = ImageColor.getcolor(text, "RGBA")
+            except ValueError:
+                self.fail(f"expected {self.what}, found {value!r}", param, ctx)
         r, g, b, a = rgba if isinstance(rgba, tuple) else (rgba, rgba, rgba, 255)
+        if self.opaque and a != 255:
+            self.fail(f"expected {self.what}, found {value!r}", param, ctx)
         return int(r), int(g), int(b), int(a)
 
 

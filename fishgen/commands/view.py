@@ -19,8 +19,9 @@ class ViewOptions:
                        8765)
     no_serve: bool = option(click.BOOL, "Only write the page (it works opened from disk "
                                         "too).", False, flag=True)
-    background: tuple[int, int, int, int] = option(Colour(),
-                                                   "Background colour of the 3D view (a CSS colour).",
+    background: tuple[int, int, int, int] = option(Colour(opaque=True),
+                                                   "Background colour of the 3D view (#8cadcc, white: "
+                                                   "opaque).",
                                                    (140, 173, 204, 255), shown_default="#8cadcc")
     instancing: bool = instancing_option()
 

@@ -123,3 +123,13 @@ def test_a_taken_port_leaves_no_page(tmp_path, viewer_assets):
         result = run_cli("view", viewer_assets["fish"], "-o", tmp_path / "p.html", "--port",
                          str(taken.getsockname()[1]))
     assert result.returncode == 1 and "port" in result.stderr and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("colour", ["transparent", "#ff000080"])
+def test_a_see_through_background_is_refused_for_a_page(tmp_path, viewer_assets, colour):
+    """`--background transparent` was taken and gave a black page: a page's background is opaque."""
+    result = run_cli("view", "--no-serve", viewer_assets["fish"], "-o", tmp_path / "p.html",
+                     "--background", colour)
+    assert result.returncode == 2 and result.stderr.count("\n") == 1
+    assert "expected an opaque colour (#8cadcc, white)" in result.stderr
+    assert not (tmp_path / "p.html").exists()
