@@ -61,6 +61,7 @@ class Output:
     metavar: str = "PATH"
     shown_default: str | None = None
     holds: tuple[str, ...] = ()         # what its format must hold, in the registry's words
+    folder: bool = False                # -o may name a folder (build's several inputs, species --count)
 
 
 @dataclass(frozen=True)
@@ -145,9 +146,16 @@ QUIET = Events()
 
 def run(cmd: Command, inputs: tuple[Path, ...], output: str | os.PathLike | None, options: Any,
         events: Events = QUIET) -> Made:
-    """Run a command as the CLI and batch jobs do: no file it writes may be one of its inputs."""
+    """Run a command as the CLI and batch jobs do: no file it writes may be one of its inputs, and
+    a command that writes one file is given a file, not a folder."""
     from fishgen.atomic import protecting
 
+    if output is not None and cmd.output is not None and not cmd.output.folder:
+        from fishgen.commands.paths import names_folder
+        from fishgen.errors import UsageError
+
+        if names_folder(output):
+            raise UsageError(f"expected -o to name an output file, found the folder {os.fspath(output)!r}")
     with protecting(inputs):
         return cmd.function()(inputs, output, options, events)
 

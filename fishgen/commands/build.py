@@ -47,7 +47,7 @@ COMMAND = Command(
     output=Output(f"Output file for one species (its extension picks the format: "
                   f"{', '.join(extensions(FISH_FORMATS))}), or a folder: an existing one, or a name "
                   "ending in /.", required=False, shown_default="out/<species file stem>.<format>",
-                  holds=(MESHES,)),
+                  holds=(MESHES,), folder=True),
     batch=True,
 )
 

@@ -46,7 +46,7 @@ COMMAND = Command(
                   "(whitespace, / or \\, not UTF-8, over 255 bytes), each such run becomes _ and a note "
                   "says so, and a derived name that is a file already there, not named by OUT.txt, is "
                   "refused. Every file lands, or none.",
-                  metavar="OUT"),
+                  metavar="OUT", folder=True),
     together=True,
 )
 

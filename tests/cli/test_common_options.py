@@ -122,3 +122,24 @@ def test_a_required_option_left_out_is_a_usage_error_in_one_line(tmp_path, name)
         assert result.stderr.startswith(f"fishgen {name}: Missing option"), result.stderr
         assert result.stderr.count("\n") == 1 and left_out in result.stderr
     assert not (tmp_path / "x.txt").exists()
+
+
+@pytest.mark.parametrize("args", [
+    ["sky", "--mode", "thin", "--particles", "500"], ["preview", "{fish}"], ["view", "--no-serve", "{glb}"],
+    ["school", "{fish}", "--count", "3", "--frames", "5"], ["clouds", "{cubes}"],
+    ["texture", "{photo}", "-s", "{fish}"],
+])
+def test_a_folder_as_the_one_output_file_is_a_usage_error(tmp_path, args):
+    """`-o` names a folder only for commands that write several files there (build, species): the
+    others read 'found no extension', or 'fishgen: ... found a folder' with no command."""
+    folder = tmp_path / "dirout"
+    folder.mkdir()
+    fill = {"fish": PARAMS / "bonybream.txt", "cubes": PARAMS / "clouds" / "table_4_3.awn",
+            "photo": PARAMS / "photos" / "bonybream-side.png", "glb": tmp_path / "x.glb"}
+    if "{glb}" in args:
+        assert run_cli("build", PARAMS / "bonybream.txt", "-o", fill["glb"]).returncode == 0
+    filled = [str(fill[a[1:-1]]) if a.startswith("{") else a for a in args]
+    result = run_cli(*filled, "-o", folder)
+    assert result.returncode == 2 and result.stderr == (
+        f"fishgen {args[0]}: expected -o to name an output file, found the folder {str(folder)!r}\n")
+    assert list(folder.iterdir()) == []
