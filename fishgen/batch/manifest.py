@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, UsageError
 from fishgen.exchange.registry import first_shared, output_format
 from fishgen.options import build, check_value, manifest_options
 from fishgen.tomlfile import Where, loads
@@ -45,6 +45,7 @@ class Kind:
     name: str                        # its [[table]] in a manifest, and Job.kind
     options: type                    # its frozen options record, whose manifest keys a job may set
     holds: tuple[str, ...] = ()      # what its output's format must hold
+    check: Callable[[Any], None] | None = None  # refuses options that cannot go together (UsageError)
 
 
 @dataclass(frozen=True)
@@ -180,6 +181,12 @@ def _job(where: Where, of: Kind, nth: int, entry: dict[str, Any], folder: Path, 
     offsets = getattr(options, "offset", None)
     if offsets and len(offsets) != len(inputs):
         raise fail_at("offset")(f"one [x, y, z] per input ({len(inputs)})")
+    if of.check is not None:
+        try:
+            of.check(options)
+        except UsageError as err:  # said at the job's line, before any job runs
+            line = where.line("output", kind, nth)
+            raise FishgenError(err.message.replace("--", ""), where.file, line) from None
     return Job(kind, name, inputs, out / relative, _seeded(kind, options, inputs, name), where.file,
                where.line("output", kind, nth))
 

@@ -67,7 +67,8 @@ def job_kinds() -> tuple[Kind, ...]:
     """The commands a manifest may list jobs of, as the batch reads them."""
     from fishgen.batch.manifest import Kind
 
-    return tuple(Kind(name, cmd.options, cmd.holds) for name in MODULES if (cmd := command(name)).batch)
+    return tuple(Kind(name, cmd.options, cmd.holds, cmd.check)
+                 for name in MODULES if (cmd := command(name)).batch)
 
 
 def run_job(job: Job, note: Callable[[str], None]) -> tuple[tuple[Path, ...], tuple[Path, ...]]:

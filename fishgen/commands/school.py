@@ -85,6 +85,17 @@ class SchoolOptions:
     prototypes: int = prototypes_option()
 
 
+def check_options(options: SchoolOptions) -> None:
+    """Options that cannot go together, refused before any work (and at a manifest job's line)."""
+    from fishgen.errors import UsageError
+
+    if (options.lods or options.merge) and (options.tints or 1) > 1:
+        raise UsageError("expected --tints 1 with --lods or --merge (colour variants copy the part meshes), "
+                         f"found --tints {options.tints}")
+    if options.preset is not None and options.model not in (None, "couzin"):
+        raise UsageError(f"expected --preset with the couzin model, found --model {options.model}")
+
+
 COMMAND = Command(
     name="school",
     summary="Simulate a fish school and bake it into an animated glb, tracks and measures.",
@@ -109,6 +120,7 @@ COMMAND = Command(
                   holds=(MESHES, NODE_ANIMATION)),
     batch=True,
     together=True,
+    check=check_options,
 )
 
 
@@ -160,11 +172,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         check_species_files(scene, scene_files[0])
     else:
         scene = SceneFile(species=tuple(SpeciesEntry(p) for p in inputs))
-    if (options.lods or options.merge) and (options.tints or 1) > 1:
-        raise UsageError("expected --tints 1 with --lods or --merge (colour variants copy the part meshes), "
-                         f"found --tints {options.tints}")
-    if options.preset is not None and options.model not in (None, "couzin"):
-        raise UsageError(f"expected --preset with the couzin model, found --model {options.model}")
+    check_options(options)
     variety = {key: value for key, value in (("size", options.size_variety), ("tints", options.tints),
                                              ("tint", options.tint)) if value is not None}
     scene = with_options(scene, count=options.count, frames=options.frames, fps=options.fps,

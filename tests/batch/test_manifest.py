@@ -97,6 +97,11 @@ output = "ab.glb"
      'output = "f/a.gltf"\n\n[[build]]\ninput = "b.txt"\noutput = "f/a_c.ply"\n', 11,
      "found f/a.gltf (FILE:7) and f/a_c.ply"),
     ('[[bild]]\ninput = "a.txt"\n', 1, "expected one of out, [[build]]"),
+    # options that cannot go together, as `fishgen school` refuses them, at the job's output line
+    ('[[school]]\ninput = "a.txt"\noutput = "s.glb"\npreset = "torus"\nmodel = "boids"\n', 3,
+     "expected preset with the couzin model, found model boids"),
+    ('[[school]]\ninput = "a.txt"\noutput = "s.glb"\ntints = 3\nmerge = true\n', 3,
+     "expected tints 1 with lods or merge"),
     ('[[build]\ninput = "a.txt"\n', 1, "expected TOML"),
     ('out = "o"\n', None, "expected at least one job ([[build]], [[clouds]], [[school]])"),
 ])
