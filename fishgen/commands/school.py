@@ -62,7 +62,8 @@ class SchoolOptions:
     preroll: float | None = declare(PREROLL, shown_default=f"the scene file's, else {PREROLL.shown_default}")
     size_variety: float | None = declare(SIZE_VARIETY, default=None,
                                          shown_default=f"the scene file's, else {SIZE_VARIETY.default:g}")
-    tints: int | None = declare(TINTS, default=None, shown_default=f"the scene file's, else {TINTS.default}")
+    tints: int | None = declare(TINTS, default=None, shown_default=f"the scene file's, else {TINTS.default}",
+                                help=TINTS.help + " Only 1 with --lods or --merge.")
     tint: float | None = declare(TINT, default=None, shown_default=f"the scene file's, else {TINT.default:g}")
     tolerance: float = option(FiniteRange(0, 1),
                               "How far thinned keyframes may stray from the simulated path.",
