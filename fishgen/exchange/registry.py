@@ -168,16 +168,21 @@ def input_format(path: str | os.PathLike, *, kinds: Iterable[Format], command: s
     files are often named ``*.txt`` but need not be).
     """
     allowed = list(kinds)
+    if Path(path).is_dir():
+        raise FishgenError("expected a file, found a directory", path)
     found = candidates(path)
-    fmt = detect(path) if Path(path).is_file() else None
+    there = Path(path).is_file()
+    fmt = detect(path) if there else None
     if fmt is None:  # no content to tell by (or no sniff agreed): the one this command reads
         fmt = next((f for f in found if f in allowed), found[0] if found else None)
     if fmt in allowed:
         return fmt
     if fmt is not None:
         use = f"; use `fishgen {fmt.command}` for it" if fmt.command and fmt.command != command else ""
+        # a name alone (no such file yet) is judged by its extension, and said to be
+        what = fmt.description if there else f"{Path(path).suffix!r}, the extension of {fmt.description}"
         raise FishgenError(f"expected an input of `fishgen {command}` ({', '.join(extensions(allowed))}), "
-                           f"found {fmt.description}{use}", path)
+                           f"found {what}{use}", path)
     if default is not None:
         return default
     suffix = Path(path).suffix or "no extension"

@@ -51,11 +51,11 @@ def prepare_assets(inputs: Sequence[str | os.PathLike], *, mode: str | None = No
 
     paths = [Path(p) for p in inputs]
     for path in paths:
+        if path.is_dir():
+            raise FishgenError("expected a file, found a directory", path)
         if path.suffix.lower() not in CUBES + GLTF:
             raise FishgenError(f"expected a cube file (.awn, .awa) or a glTF asset (.glb, .gltf), found "
                                f"{path.suffix or 'no extension'!r}", path)
-        if path.is_dir():
-            raise FishgenError("expected a file, found a directory", path)
     cubes = [p for p in paths if p.suffix.lower() in CUBES]
     assets = [p for p in paths if p.suffix.lower() in GLTF]
     if mode is not None and assets:

@@ -141,3 +141,18 @@ def test_two_targets_share_a_file_when_their_names_or_side_files_meet(targets, s
 
     found = first_shared(targets)
     assert (found if found is None else (found[0], found[1], str(found[2]))) == shared
+
+
+def test_an_input_is_judged_by_its_content_a_name_alone_by_its_extension_and_said_so(tmp_path):
+    """`fishgen edit out/x.txt` (no such file) said it found a VRFish species file, and a folder
+    was 'no extension'."""
+    cubes = [registry.FORMATS["cubes"], registry.FORMATS["texture cubes"]]
+    with pytest.raises(FishgenError) as named:
+        registry.input_format(tmp_path / "x.txt", kinds=cubes, command="edit")
+    assert named.value.message == ("expected an input of `fishgen edit` (.awn, .awa), found '.txt', the "
+                                   "extension of a VRFish species file; use `fishgen build` for it")
+    with pytest.raises(FishgenError) as there:
+        registry.input_format(PARAMS / "bonybream.txt", kinds=cubes, command="edit")
+    assert "found a VRFish species file; use `fishgen build`" in there.value.message
+    with pytest.raises(FishgenError, match="expected a file, found a directory"):
+        registry.input_format(tmp_path, kinds=cubes, command="edit")
