@@ -84,6 +84,23 @@ def protecting(paths: Iterable[str | os.PathLike]) -> Iterator[None]:
         _inputs.set(outer)
 
 
+def check_writable(target: str | os.PathLike) -> None:
+    """Refuse now, as a write would later, a target whose folder the system will not write in: for
+    an output written only after long work (a fly-through's report). A folder still to be made is
+    left to the write."""
+    import tempfile
+
+    folder = Path(target).parent
+    if not folder.is_dir():
+        return
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".fishgen-probe-", dir=folder)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as err:
+        raise cannot("write", target, err) from None
+
+
 def protect(path: str | os.PathLike) -> None:
     """Protect ``path`` too inside the :func:`protecting` under way, if any: a file an input names
     (a glTF's image, an OBJ's material), found only as the input is read."""

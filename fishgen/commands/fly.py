@@ -122,6 +122,9 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
     if options.report is not None:
         suffix_of(options.report, SUFFIXES, "a report")
         check_targets([options.report], inputs)
+        from fishgen.atomic import check_writable
+
+        check_writable(options.report)  # before the flight, not after it
     timeout = options.timeout
     if timeout is None and options.headless:
         timeout = HEADLESS_TIMEOUT

@@ -203,3 +203,15 @@ def test_a_batch_out_folder_that_is_a_file_is_bad_input(tmp_path):
     error = one_error(result)
     assert result.returncode == 2 and error["kind"] == "input", result.stderr
     assert error["error"] == f"{tmp_path / 'taken' / 'all'}: expected an out folder, found a file in its path"
+
+
+def test_a_fly_report_the_system_refuses_is_said_before_the_flight(small_disk, tmp_path):
+    """`fly --report` into a folder the system will not write was found only after the whole
+    flight. It is checked first: here before the damaged cube file is even read."""
+    _, readonly = small_disk
+    cubes = tmp_path / "bad.awn"
+    cubes.write_text("5\n1\n5, 1, 1, x, 0, 0, 0, 1\n")
+    result = run_cli("fly", cubes, "--headless", "--timeout", "1", "--report", readonly / "r.json")
+    assert result.returncode == 1 and result.stderr.count("\n") == 1, result.stderr
+    assert result.stderr.startswith(f"fishgen: cannot write {readonly / 'r.json'}: Read-only file system")
+    assert list(readonly.iterdir()) == []
