@@ -88,6 +88,8 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
     from fishgen.preview.pipeline import PreviewOptions
     from fishgen.preview.pipeline import preview as render
 
+    if options.duration is not None and options.frames is None and output.suffix.lower() != ".gif":
+        events.note(f"{output}: a still; --duration makes a loop in a .gif, or in a .webp with --frames")
     beside = read_beside(inputs, check_inputs(inputs, "preview", input_formats()), options.textures)
     check_targets([output], [*inputs, *beside])
     width, height = options.size

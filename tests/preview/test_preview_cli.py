@@ -190,3 +190,14 @@ def test_a_cube_file_over_the_particle_limit_names_no_option_preview_lacks(tmp_p
     result = run_cli("preview", big, "-o", tmp_path / "p.png")
     assert result.returncode == 2 and "--max-particles" not in result.stderr, result.stderr
     assert result.stderr == f"{big}:1: expected at most 50,000,000 particles, found 2,000,000,000\n"
+
+
+@pytest.mark.parametrize("name, still", [("w.webp", True), ("w.png", True), ("w.gif", False)])
+def test_a_duration_that_makes_no_loop_is_said(tmp_path, name, still):
+    """`--fps 2 --duration 3 -o w.webp` wrote a still with no word: a .webp loops only with --frames."""
+    out = tmp_path / name
+    result = run_cli("preview", PARAMS / "bonybream.txt", "--size", "64x48", "--duration", "1", "-o", out)
+    assert result.returncode == 0, result.stderr
+    note = f"{out}: a still; --duration makes a loop in a .gif, or in a .webp with --frames\n"
+    assert result.stderr == (note if still else "")
+    assert (getattr(Image.open(out), "n_frames", 1) == 1) == still
