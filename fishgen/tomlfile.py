@@ -77,8 +77,15 @@ class Where:
 
     def fail(self, what: str, found: Any, key: str, table: str | None = None, nth: int = 0) -> FishgenError:
         plain = isinstance(found, str) and found.startswith(("a ", "an ", "no "))
-        shown = found if plain else describe(str(found))
+        shown = found if plain else describe(_as_toml(found))
         return FishgenError(f"expected {what}, found {shown}", self.file, self.line(key, table, nth))
+
+
+def _as_toml(value: Any) -> str:
+    """A value as TOML writes it (``true``, not Python's ``True``), for a message."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return str(value)
 
 
 def _top_keys(path: str | os.PathLike) -> set[str]:

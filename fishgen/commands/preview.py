@@ -88,8 +88,6 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
     from fishgen.preview.pipeline import PreviewOptions
     from fishgen.preview.pipeline import preview as render
 
-    if options.duration is not None and options.frames is None and output.suffix.lower() != ".gif":
-        events.note(f"{output}: a still; --duration makes a loop in a .gif, or in a .webp with --frames")
     beside = read_beside(inputs, check_inputs(inputs, "preview", input_formats()), options.textures)
     check_targets([output], [*inputs, *beside])
     width, height = options.size
@@ -108,4 +106,7 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
 
         out = render(inputs, output, settings, progress=lambda n: bar[0].update(n) if bar else None,
                      on_loaded=start, on_note=events.note)
+    if options.duration is not None and options.frames is None and output.suffix.lower() != ".gif":
+        # said once it is written: a failed run's one line stays its only one
+        events.note(f"{output}: a still; --duration makes a loop in a .gif, or in a .webp with --frames")
     return Made((out,), (*inputs, *beside), (f"wrote {out}",))
