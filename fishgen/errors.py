@@ -42,6 +42,10 @@ class FishgenError(Exception):
         clone.job = name
         if self.file is None:
             clone.message = f"{name}: {self.message}"
+        elif os.path.isabs(self.file):  # a job's inputs are resolved: shown from here, as a user names them
+            shown = os.path.relpath(self.file)
+            if not shown.startswith(".."):
+                clone.file = shown
         clone.args = (str(clone),)
         return clone
 

@@ -159,3 +159,13 @@ def test_a_manifest_named_as_another_format_still_runs(tmp_path):
     result = run_cli("batch", tmp_path / "jobs.txt", "--out", tmp_path / "out")
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "out" / "b.glb").is_file()
+
+
+def test_a_jobs_error_names_its_file_from_where_the_batch_was_run(tmp_path):
+    """A missing input read '/tmp/.../params/nope.txt: ...': the job's inputs are resolved, and their
+    errors showed the resolved path where every other message shows the path as a user names it."""
+    (tmp_path / "params").mkdir()
+    (tmp_path / "params" / "t.toml").write_text('[[school]]\ninput = "nope.txt"\noutput = "a.glb"\n')
+    result = run_cli("batch", "params/t.toml", "--out", "out", cwd=tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.splitlines()[0] == "params/nope.txt: expected a species file, found no such file"
