@@ -111,18 +111,14 @@ def test_a_couzin_school_pre_rolls_twenty_of_the_papers_seconds_at_its_own_speed
     scene.write_text('model = "couzin"\n[[species]]\nfile = "a.txt"\n\npreroll = -1\n')
     with pytest.raises(FishgenError, match="preroll"):
         load_scene_file(scene)
+    # a wrong value is shown as TOML writes it ('True', Python's spelling, before)
+    scene.write_text('preroll = true\n[[species]]\nfile = "a.txt"\n')
+    with pytest.raises(FishgenError, match=r"s.toml:1: expected preroll as a number from 0 to 600, "
+                                           r"found 'true'$"):
+        load_scene_file(scene)
     # the pre-roll's steps count towards the work refused before it starts
     big = with_options(couzin, count=1_000, frames=2, fps=1000.0, speed=0.1)    # 600 s at 1,000 frames/s
     check_size(with_options(big, preroll=0.0))
     with pytest.raises(UsageError, match="1,000 fish x 2 frames and 600,000 pre-roll steps"):
         check_size(big)
 
-
-def test_a_wrong_value_is_shown_as_toml_writes_it(tmp_path):
-    """`preroll = true` read "found 'True'", Python's spelling of a TOML boolean."""
-    (tmp_path / "a.txt").write_text("")
-    scene = tmp_path / "s.toml"
-    scene.write_text('preroll = true\n[[species]]\nfile = "a.txt"\n')
-    with pytest.raises(FishgenError, match=r"s.toml:1: expected preroll as a number from 0 to 600, "
-                                           r"found 'true'$"):
-        load_scene_file(scene)
