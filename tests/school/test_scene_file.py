@@ -122,3 +122,17 @@ def test_a_couzin_school_pre_rolls_twenty_of_the_papers_seconds_at_its_own_speed
     with pytest.raises(UsageError, match="1,000 fish x 2 frames and 600,000 pre-roll steps"):
         check_size(big)
 
+
+
+def test_every_scene_file_key_is_in_the_users_documentation():
+    """The [couzin], [pso], [target] and [variety] keys were listed only in error messages."""
+    from dataclasses import fields
+
+    from fishgen.school.model import CouzinParams, PsoParams, Variety
+
+    text = (PARAMS.parent / "docs" / "commands.md").read_text()
+    section = text[text.index("**Scene-file keys.**"):text.index("**Outputs besides the glb:**")]
+    keys = {f.name for record in (CouzinParams, PsoParams, Variety) for f in fields(record)}
+    keys |= {"model", "frames", "fps", "seed", "bounds", "layout", "warmup", "preroll", "length", "file",
+             "count", "speed", "preset", "path", "centre", "radius", "period"}
+    assert not {key for key in keys if f"`{key}`" not in section}
