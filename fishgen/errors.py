@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import copy
 import os
+from typing import Any
 
 
 class FishgenError(Exception):
@@ -38,22 +39,22 @@ class FishgenError(Exception):
     def of_job(self, name: str) -> FishgenError:
         """This error as batch job ``name``'s: the job is named in the message unless a
         ``FILE:LINE`` already says where."""
-        clone = copy.copy(self)
-        clone.job = name
         if self.file is None:
-            clone.message = f"{name}: {self.message}"
-        elif os.path.isabs(self.file):  # a job's inputs are resolved: shown from here, as a user names them
-            shown = os.path.relpath(self.file)
-            if not shown.startswith(".."):
-                clone.file = shown
-        clone.args = (str(clone),)
-        return clone
+            return self._with(job=name, message=f"{name}: {self.message}")
+        shown = os.path.relpath(self.file) if os.path.isabs(self.file) else self.file
+        # a job's inputs are resolved: shown from here, as a user names them, when they lie below
+        return self._with(job=name, file=self.file if shown.startswith("..") else shown)
 
     def naming(self, file: str | os.PathLike) -> FishgenError:
         """This error with its place named as ``file`` (the path as a user gave it, where a layer
         below read another spelling of it)."""
+        return self._with(file=os.fspath(file))
+
+    def _with(self, **changes: Any) -> FishgenError:
+        """A copy of this error (its class kept) with ``changes`` to its attributes."""
         clone = copy.copy(self)
-        clone.file = os.fspath(file)
+        for name, value in changes.items():
+            setattr(clone, name, value)
         clone.args = (str(clone),)
         return clone
 
@@ -79,14 +80,6 @@ class SystemFailure(FishgenError):
 
     status = 1
     kind = "os"
-
-    def naming(self, file: str | os.PathLike) -> FishgenError:
-        """This error with its place named as ``file`` (the path as a user gave it, where a layer
-        below read another spelling of it)."""
-        clone = copy.copy(self)
-        clone.file = os.fspath(file)
-        clone.args = (str(clone),)
-        return clone
 
     def __str__(self) -> str:  # the path is in the message ("cannot write PATH: reason")
         return self.message
