@@ -152,7 +152,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         check_size,
         check_species_files,
         load_scene_file,
-        preroll_seconds,
+        preroll_steps,
         with_options,
     )
 
@@ -188,7 +188,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
 
     from fishgen.school import run_school
 
-    steps = scene.frames + int(round(preroll_seconds(scene) * scene.fps))
+    steps = scene.frames + preroll_steps(scene)
     with events.progress("simulating", steps) as bar:
         run = run_school(scene, fins=options.fins, swim=options.swim, tolerance=options.tolerance,
                          textures_dir=options.textures, progress=bar.update, lods=options.lods,
@@ -198,9 +198,6 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
 
         compact_clips(run.scene)
     warmup = run.warmup_frames
-    if scene.warmup is not None and round(scene.warmup * scene.fps) > warmup:
-        events.note(f"{output}: a warm-up of {scene.warmup:g} s is as long as the run or longer "
-                    f"({scene.frames / scene.fps:.1f} s): the summary measures its last frame only")
     per_frame: dict = {}
     numbers: dict = {}
     table = ""
@@ -212,6 +209,10 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     if events.summary:  # else nobody reads the table: only what it prints is measured
         table = run.summary(per_frame or None)
     files, sizes = _write_all(output, run, sides, per_frame, numbers, warmup)
+    # said once written: a run that fails keeps its one line
+    if scene.warmup is not None and round(scene.warmup * scene.fps) > warmup:
+        events.note(f"{output}: a warm-up of {scene.warmup:g} s is as long as the run or longer "
+                    f"({scene.frames / scene.fps:.1f} s): the summary measures its last frame only")
     size = sum(n for p, n in sizes.items() if p not in sides.values())
     counted = tuple(zip(run.species_names, (e.count for e in scene.species), strict=True))
     kinds_line = ", ".join(f"{count} {name}" for name, count in counted)

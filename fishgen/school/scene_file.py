@@ -231,6 +231,11 @@ def preroll_seconds(scene: SceneFile) -> float:
     return min(MAX_PREROLL, PREROLL_PAPER_SECONDS * paper / min(e.speed for e in scene.species))
 
 
+def preroll_steps(scene: SceneFile) -> int:
+    """Steps simulated before the first frame (SchoolConfig.preroll_frames, known before planning)."""
+    return int(round(preroll_seconds(scene) * scene.fps))
+
+
 def check_size(scene: SceneFile, file: str | os.PathLike | None = None, line: int | None = None,
                tracks: bool = False) -> None:
     """Refuse absurd schools before anything is built: MAX_FISH fish, MAX_FISH_FRAMES fish x frames,
@@ -241,7 +246,7 @@ def check_size(scene: SceneFile, file: str | os.PathLike | None = None, line: in
     # without a scene file, the fish and frames came from the command line (--count, --frames)
     refused = FishgenError if file is not None else UsageError
     total = sum(e.count for e in scene.species)
-    pre = int(round(preroll_seconds(scene) * scene.fps))
+    pre = preroll_steps(scene)
     if total > MAX_FISH or total * (scene.frames + pre) > MAX_FISH_FRAMES:
         steps = f" and {pre:,} pre-roll steps" if pre else ""
         raise refused(f"expected at most {MAX_FISH:,} fish and {MAX_FISH_FRAMES:,} fish x frames, "
