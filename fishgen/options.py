@@ -48,6 +48,8 @@ class Numbers(click.ParamType):
         self.ordered, self.positive, self.nonzero = ordered, positive, nonzero
         float32 = (low, high) == (-FLOAT32_MAX, FLOAT32_MAX)
         within = "within float32 range" if float32 else f"from {low:g} to {high:g}"
+        # shown in --help as click shows a number range; float32's own bounds go unsaid
+        self.range_text = None if float32 else f"{_plain(low)}<=each<={_plain(high)}"
         self.what = (f"{name} with {self._WORDS.get(count, count)} finite numbers {within}"
                      + (", the first at most the second" if ordered else "")
                      + (", all above 0" if positive else "") + (", not all 0" if nonzero else ""))
@@ -68,6 +70,11 @@ class Numbers(click.ParamType):
         if not ok:
             self.fail(f"expected {self.what}, found {value!r}", param, ctx)
         return tuple(float(v) for v in numbers)
+
+
+def _plain(value: float) -> str:
+    """A bound as --help shows it: 1000000, not 1e+06."""
+    return str(int(value)) if float(value).is_integer() else f"{value:g}"
 
 
 class Triple(Numbers):
@@ -99,6 +106,7 @@ class Size(click.ParamType):
 
     def __init__(self, low: int = 16, high: int = 8192):
         self.low, self.high = low, high
+        self.range_text = f"{low}<=W,H<={high}"
         self.what = f"WxH with {low} to {high} pixels a side"
 
     def convert(self, value, param, ctx):
@@ -309,6 +317,8 @@ def click_params(record: type) -> list[click.Parameter]:
         switch = f"--{long_name(f)}" + (f"/{spec.off}" if spec.off else "")
         decls = [switch, *([spec.short] if spec.short else []), f.name]
         help_text = f"{spec.help}  [default: {spec.default_text()}]" if not spec.required else spec.help
+        if getattr(spec.type, "range_text", None):  # as click adds a FloatRange's bounds
+            help_text += f"  [{spec.type.range_text}]"
         # a required option gets no default at all: click 8.3 takes an explicit default=None as a value
         default = {} if spec.required else {"default": bool(spec.default) if spec.flag else spec.default}
         if spec.flag:

@@ -47,9 +47,9 @@ class Lighting:
 
     sun: Triple = option(Direction, "Direction towards the sun (+Y is up): where the light comes from; "
                          "its length does not matter.", SUN)
-    sun_color: Triple = option(Colour3, "Sunlight on a particle in full sun, linear RGB, each 0 to 10.",
+    sun_color: Triple = option(Colour3, "Sunlight on a particle in full sun, linear RGB.",
                                SUN_COLOR)
-    sky_color: Triple = option(Colour3, "Ambient sky light every particle gets, linear RGB, each 0 to 10: "
+    sky_color: Triple = option(Colour3, "Ambient sky light every particle gets, linear RGB: "
                                "the colour of shadowed undersides.", SKY_COLOR)
     albedo: float = option(FiniteRange(0, 1), "Fraction of the light a particle stops that it scatters "
                            "rather than absorbs.", ALBEDO)

@@ -62,6 +62,26 @@ def test_every_option_of_every_command_says_its_default(name):
 
 
 @pytest.mark.parametrize("name", sorted(MODULES))
+def test_every_bounded_option_of_every_command_says_its_bounds(name):
+    """click shows a number range's bounds in `--help`; a size (WxH) or a list of numbers with
+    bounds of its own shows them the same way (`fly --size` said nothing of its 16 to 8192)."""
+    import click
+
+    from fishgen.cli import cli
+    from fishgen.options import FLOAT32_MAX, Numbers, Size
+
+    click_command = cli.get_command(None, name)  # type: ignore[arg-type]
+    for param in click_command.params:
+        kind = param.type
+        bounded = isinstance(kind, Size) or (isinstance(kind, Numbers)
+                                             and (kind.low, kind.high) != (-FLOAT32_MAX, FLOAT32_MAX))
+        if isinstance(param, click.Option) and bounded:
+            text = " ".join((param.help or "").split())
+            low, high = (str(int(v)) if float(v).is_integer() else f"{v:g}" for v in (kind.low, kind.high))
+            assert f"[{low}<=" in text and f"<={high}]" in text, f"fishgen {name} {param.opts[0]}: {text!r}"
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
 def test_no_number_option_of_any_command_takes_nan_or_infinity(name):
     """click's FloatRange lets NaN through (every comparison with it is false): `texture
     --focal-length nan` got past it into a traceback. Every number option refuses both."""
