@@ -317,8 +317,9 @@ def click_params(record: type) -> list[click.Parameter]:
         switch = f"--{long_name(f)}" + (f"/{spec.off}" if spec.off else "")
         decls = [switch, *([spec.short] if spec.short else []), f.name]
         help_text = f"{spec.help}  [default: {spec.default_text()}]" if not spec.required else spec.help
-        if getattr(spec.type, "range_text", None):  # as click adds a FloatRange's bounds
-            help_text += f"  [{spec.type.range_text}]"
+        bounds = getattr(spec.type, "range_text", None)
+        if bounds:  # as click adds a FloatRange's bounds
+            help_text += f"  [{bounds}]"
         # a required option gets no default at all: click 8.3 takes an explicit default=None as a value
         default = {} if spec.required else {"default": bool(spec.default) if spec.flag else spec.default}
         if spec.flag:

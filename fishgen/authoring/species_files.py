@@ -116,11 +116,13 @@ def sample_files(seed: int, stem: str, textures: TextureNames | None = None) -> 
 
 
 def write_samples(seed: int, count: int, output: Path, folder: bool | None = None,
-                  note: Callable[[str], None] | None = None) -> list[Path]:
+                  note: Callable[[str], None] | None = None,
+                  progress: Callable[[int], None] | None = None) -> list[Path]:
     """Write ``count`` sampled species from ``seed`` on: into the folder ``output`` when ``folder``
     (default: when it has no extension), else as the one species file ``output``, exactly there.
     Every file of every species is one atomic set (:func:`fishgen.atomic.together`): an interrupt
-    or a failure leaves none of them. ``note`` is told when texture names had to be derived."""
+    or a failure leaves none of them. ``note`` is told when texture names had to be derived, and
+    ``progress`` gets 1 as each species is written."""
     from fishgen.atomic import together, write_files
 
     if folder is None:
@@ -144,6 +146,8 @@ def write_samples(seed: int, count: int, output: Path, folder: bool | None = Non
             files = sample_files(seed + k, stem, given)
             write_files({where / name: data for name, data in files.items()})
             written.append(where / next(iter(files)))
+            if progress is not None:
+                progress(1)
     return written
 
 

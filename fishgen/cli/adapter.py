@@ -81,9 +81,14 @@ class TerminalEvents:
         self.command = command
 
     def as_events(self) -> Events:
-        return Events(note=lambda text: click.echo(text, err=True), failed=self.failed,
+        return Events(note=self.note, failed=self.failed,
                       progress=self.progress,
                       line=self.line)
+
+    def note(self, text: str) -> None:
+        if self.bars:
+            click.echo("", err=True)  # off the bar's line; the bar draws again below at its next step
+        click.echo(text, err=True)
 
     def failed(self, err: Any) -> None:
         if self.bars:

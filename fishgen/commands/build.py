@@ -73,17 +73,20 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
     lines: list[str] = []
     facts = []
     errors: list = []
-    for source, target in zip(inputs, outputs, strict=True):
-        with each_input(events, errors, len(inputs) > 1):
-            species = load_species(source, options.textures)
-            check_targets([target], species.side_files)  # its textures are inputs, and the side files'
-            fish = fish_of(species, options)
-            with protecting(species.side_files):
-                files = export(fish.scene, target, require=[MESHES])
-            read += [source, *species.side_files]
-            written += files
-            facts.append(fish.facts)
-            lines.append(summary(fish, target, files))
+    # a bar for several inputs: `fishgen build params/*.txt` of hundreds of species takes minutes
+    with events.progress("building", len(inputs) if len(inputs) > 1 else 0) as progress:
+        for source, target in zip(inputs, outputs, strict=True):
+            with each_input(events, errors, len(inputs) > 1):
+                species = load_species(source, options.textures)
+                check_targets([target], species.side_files)  # its textures are inputs, and the side files'
+                fish = fish_of(species, options)
+                with protecting(species.side_files):
+                    files = export(fish.scene, target, require=[MESHES])
+                read += [source, *species.side_files]
+                written += files
+                facts.append(fish.facts)
+                lines.append(summary(fish, target, files))
+            progress.update(1)
     return Made(tuple(written), tuple(read), tuple(lines), tuple(facts), tuple(errors))
 
 

@@ -73,5 +73,8 @@ def species(inputs: Sequence[Path], output: str | os.PathLike, options: SpeciesO
         raise UsageError(f"expected seeds within 0..2^63-1 (--seed {MAX_SEED - options.count + 1} at most "
                          f"for --count {options.count}), found --seed {options.seed} --count {options.count} "
                          f"reaching {last}")
-    written = write_samples(options.seed, options.count, path, folder=folder, note=events.note)
+    # a bar for several: 2,000 species take about a minute
+    with events.progress("sampling", options.count if options.count > 1 else 0) as bar:
+        written = write_samples(options.seed, options.count, path, folder=folder, note=events.note,
+                                progress=bar.update)
     return Made(tuple(written), (), tuple(f"wrote {p}" for p in written))

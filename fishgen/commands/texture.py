@@ -77,7 +77,7 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     """Measure the photo and write the new species, its texture and mask (and the extras asked)."""
     inputs = tuple(Path(p) for p in inputs)
     output = Path(output)
-    from fishgen.authoring.photo.run import TextureOptions, make_texture
+    from fishgen.authoring.photo.run import FITS, TextureOptions, make_texture
     from fishgen.authoring.species_files import check_texture_names, texture_names
     from fishgen.commands.paths import check_targets
     from fishgen.errors import UsageError
@@ -101,7 +101,9 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
                               focal_length=options.focal_length)
     if names.note is not None:
         events.note(names.note)
-    result = make_texture(photo, species, output, settings, on_note=events.note)
+    # --fit-shape takes seconds, up to a minute on a photo that fits badly: a bar over its levels
+    with events.progress("fitting", FITS if options.fit_shape else 0) as bar:
+        result = make_texture(photo, species, output, settings, on_note=events.note, progress=bar.update)
     turned = (["head on the right"] if result.mirrored else []) + (
         [f"turned {result.angle:+.1f} degrees"] if result.angle else [])
     # the summary, on stdout (and silenced by --quiet); a warning about the fit stays a note

@@ -33,6 +33,8 @@ RENDERERS_DIFFER = 0.006
 #: it is tried again with the photo turned these degrees further, in order, until one matches that
 #: well; a level is kept only when its rebuilt fish matches at least TURN_GAIN better.
 TURNS = (4.0, -4.0, 2.0, -2.0)
+FITS = 1 + len(TURNS)
+"""Levels --fit-shape may try: side-on, then each of TURNS (a progress bar's length)."""
 TURN_GOOD = 0.87
 TURN_GAIN = 0.01
 
@@ -177,10 +179,12 @@ def texture_bytes(original: Photo, work: Photo, mask: np.ndarray) -> tuple[bytes
 
 def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.PathLike,
                  options: TextureOptions = TextureOptions(),
-                 on_note: Callable[[str], None] | None = None) -> TextureResult:
-    """Measure ``photo_path``, write the new species file beside its texture and mask, atomically."""
+                 on_note: Callable[[str], None] | None = None,
+                 progress: Callable[[int], None] | None = None) -> TextureResult:
+    """Measure ``photo_path``, write the new species file beside its texture and mask, atomically.
+    With ``fit_shape``, ``progress`` gets 1 as each of the FITS levels is fitted or skipped."""
     try:
-        return _make_texture(photo_path, base, out, options, on_note)
+        return _make_texture(photo_path, base, out, options, on_note, progress)
     except FishgenError as err:
         if err.file is None and not isinstance(err, UsageError):  # about what the photo shows: say which
             raise FishgenError(err.message, photo_path) from None
@@ -188,7 +192,8 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
 
 
 def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.PathLike,
-                  options: TextureOptions, on_note: Callable[[str], None] | None) -> TextureResult:
+                  options: TextureOptions, on_note: Callable[[str], None] | None,
+                  progress: Callable[[int], None] | None = None) -> TextureResult:
     from fishgen.atomic import write_files
     from fishgen.authoring.photo import fxl
 
@@ -238,9 +243,13 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         # without them was 0.85 in Blender where the command's own measure said 0.93: the fit
         # takes the faint edges too (an alpha channel keeps the tips; a mask file is the truth).
         target = sil.mask | faint if sil.source == "background model" and faint is not None else sil.mask
-        for turn in (0.0, *TURNS):
+        step = progress or (lambda _n: None)
+        for k, turn in enumerate((0.0, *TURNS)):
             if tried is not None and tried[1] >= TURN_GOOD:
+                step(FITS - k + 1)    # the level just fitted, and those left unneeded
                 break
+            if k:
+                step(1)           # the level before
             attempt = fit_species(base, target, sections_fixed=options.body_sections is not None, turn=turn)
             attempt = settled_tips(attempt, render_scale(attempt.species, *_render_size(photo)))
             if distance is not None:
@@ -256,6 +265,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
             # another level is kept only for a clear gain: the renders differ by a little anyway
             if tried is None or rendered[1] >= tried[1] + TURN_GAIN:
                 tried, chosen_fit, fit, problems = rendered, (candidate, attempt), attempt, []
+        else:
+            step(1)
         if chosen_fit is None:
             # A broken fish is never written: the base's geometry stays, and the command says why.
             note(f"fitted shape not kept: {problems[0]}")

@@ -1,0 +1,44 @@
+"""Long work shows a bar on a terminal: what each command counts, and that a note does not land
+on the bar's line (the school's and the preview's bars are tested with them)."""
+from __future__ import annotations
+
+from fishgen.commands import Events
+from fishgen.commands.build import build
+from fishgen.commands.species import SpeciesOptions, species
+from tests.conftest import PARAMS
+from tests.progress_bars import recorded_bars
+
+
+def test_species_counts_each_species_written(tmp_path):
+    """`species --count 2000` takes about a minute: one step a species."""
+    bars, progress = recorded_bars()
+    made = species([], f"{tmp_path}/out/", SpeciesOptions(random=True, seed=3, count=3),
+                   Events(progress=progress))
+    assert bars == [("sampling", 3, [1, 1, 1])] and len(made.written) == 3
+
+
+def test_one_species_draws_no_bar(tmp_path):
+    bars, progress = recorded_bars()
+    species([], tmp_path / "one.txt", SpeciesOptions(random=True), Events(progress=progress))
+    assert [(label, total) for label, total, _ in bars] == [("sampling", 0)]   # a total of 0 draws nothing
+
+
+def test_build_counts_each_input_the_bad_ones_too(tmp_path):
+    bad = tmp_path / "bad.txt"
+    bad.write_text("not a species\n")
+    failed: list = []
+    bars, progress = recorded_bars()
+    made = build([PARAMS / "bonybream.txt", bad, PARAMS / "centroberyx.txt"], f"{tmp_path}/out/",
+                 events=Events(progress=progress, failed=failed.append))
+    assert bars == [("building", 3, [1, 1, 1])]
+    assert len(failed) == 1 and len(made.lines) == 2
+
+
+def test_a_note_during_a_bar_starts_on_a_line_of_its_own(capsys):
+    from fishgen.cli.adapter import TerminalEvents
+
+    events = TerminalEvents("texture")
+    events.note("before")
+    events.bars = 1          # as while a bar is drawn
+    events.note("during")
+    assert capsys.readouterr().err == "before\n\nduring\n"
