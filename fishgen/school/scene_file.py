@@ -5,7 +5,7 @@
     fps = 30
     seed = 1
     bounds = [[-4, -1.5, -4], [4, 1.5, 4]]
-    layout = "sphere"          # sphere | box | line
+    layout = "sphere"          # sphere | box | line | ring
 
     [[species]]
     file = "bonybream.txt"     # relative to this file
@@ -40,7 +40,7 @@ and, among the first keys (before any [table], where TOML would put them inside 
 
 Every mistake is one ``FILE:LINE: expected ..., found ...`` line; absurd sizes are refused
 before anything is allocated. The keys that are also `fishgen school` options (frames, fps, seed,
-model, a species' count) are declared once, here, and checked exactly as the options are.
+model, layout, a species' count, ...) are declared once, here, and checked exactly as the options are.
 Leaf module (no numpy): `fishgen school --help` and batch manifests read the declarations.
 """
 from __future__ import annotations
@@ -144,6 +144,9 @@ PRESET = Option(click.Choice(tuple(COUZIN_PRESETS)),
                 + ". From a random start the torus rarely mills in the default region; "
                 "params/bait-ball.toml starts one as a ring.", None,
                 shown_default="the scene file's [couzin], else zones of 1, 1 and 15 body lengths (torus)")
+LAYOUT = Option(click.Choice(LAYOUTS), "How the fish start: a random ball (sphere), scattered through the "
+                "region (box), a line, or a horizontal ring heading round it (ring: a mill already).", None,
+                shown_default="sphere")
 SIZE_VARIETY = Option(FiniteRange(*VARIETY_RANGES["size"]), VARIETY_HELP["size"].capitalize() + ".",
                       Variety.size)
 TINTS = Option(click.IntRange(int(VARIETY_RANGES["tints"][0]), int(VARIETY_RANGES["tints"][1])),
@@ -199,7 +202,8 @@ def with_options(scene: SceneFile, *, count: int | None = None, frames: int | No
                  fps: float | None = None, seed: int | None = None, model: str | None = None,
                  speed: float | None = None, bounds: Any = None, length: float | None = None,
                  warmup: float | None = None, preset: str | None = None,
-                 variety: dict[str, Any] | None = None, preroll: float | None = None) -> SceneFile:
+                 variety: dict[str, Any] | None = None, preroll: float | None = None,
+                 layout: str | None = None) -> SceneFile:
     """``scene`` with the options given (not None) overriding it, as `fishgen school`'s flags do;
     ``count`` and ``speed`` set every species'; ``preset`` a Couzin preset (and the couzin model
     unless ``model`` says otherwise); ``variety`` the Variety fields given."""
@@ -214,7 +218,7 @@ def with_options(scene: SceneFile, *, count: int | None = None, frames: int | No
     given: dict[str, Any] = {name: value for name, value in
                              (("frames", frames), ("fps", fps), ("seed", seed), ("model", model),
                               ("bounds", bounds), ("length", length), ("warmup", warmup),
-                              ("preroll", preroll))
+                              ("preroll", preroll), ("layout", layout))
                              if value is not None}
     return replace(scene, **given)
 
@@ -414,13 +418,10 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
             raise where.fail(f"one of {', '.join(sorted(known))}", key, key)
     scene = SceneFile()
     for key, spec in (("model", MODEL), ("frames", FRAMES), ("fps", FPS), ("seed", SEED_KEY),
-                      ("warmup", WARMUP), ("preroll", PREROLL), ("length", LENGTH), ("bounds", BOUNDS)):
+                      ("warmup", WARMUP), ("preroll", PREROLL), ("length", LENGTH), ("bounds", BOUNDS),
+                      ("layout", LAYOUT)):
         if key in data:
             scene = replace(scene, **{key: _declared(where, spec, data[key], key)})
-    if "layout" in data:
-        if data["layout"] not in LAYOUTS:
-            raise where.fail(f"layout as one of {', '.join(LAYOUTS)}", data["layout"], "layout")
-        scene = replace(scene, layout=data["layout"])
     entries = data.get("species", [])
     if not isinstance(entries, list) or not entries or not all(isinstance(e, dict) for e in entries):
         raise where.fail("one or more [[species]] tables", "none" if not entries else entries, "species")

@@ -288,6 +288,23 @@ def test_the_readmes_preset_school_is_in_its_state_from_the_first_frame(tmp_path
     assert_valid_gltf(out)
 
 
+@pytest.mark.parametrize("args, milling", [
+    (("--preset", "torus", "--layout", "sphere"), False),
+    (("--preset", "swarm"), False),
+    (("--preset", "swarm", "--layout", "ring"), True),
+    (("--model", "boids", "--layout", "ring"), True),
+])
+def test_layout_sets_how_the_fish_start(tmp_path, args, milling):
+    """The first frame without a pre-roll is the start layout: a ring heads round itself (rotation
+    near 1), a random ball every way (rotation near 0)."""
+    metrics = tmp_path / "m.json"
+    result = run_cli("school", PARAMS / "bonybream.txt", *args, "--preroll", "0", "--frames", "2",
+                     "-o", tmp_path / "s.glb", "--metrics", metrics)
+    assert result.returncode == 0, result.stderr
+    rotation = json.loads(metrics.read_text())["per_frame"]["rotation"][0][0]
+    assert (rotation > 0.9) if milling else (rotation < 0.5), rotation
+
+
 def test_a_species_listed_twice_is_two_schools_told_apart(tmp_path):
     """Two [[species]] of one file: the summary's rows and the tracks' names read bonybream and
     bonybream (2); before, both rows read bonybream."""
