@@ -86,7 +86,7 @@ output = "torus.glb"
 preset = "torus"
 """))
     assert manifest.jobs[0].options.layout == "ring"
-    assert manifest.jobs[1].options.layout is None  # the scene file's, else a sphere
+    assert manifest.jobs[1].options.layout is None  # the scene file's, else the preset's: a ring
 
 
 @pytest.mark.parametrize("text,line,message", [
