@@ -27,6 +27,7 @@ from fishgen.school.scene_file import (
     COUNT,
     FPS,
     FRAMES,
+    LAYOUT,
     LENGTH,
     MODEL,
     PREROLL,
@@ -58,6 +59,7 @@ class SchoolOptions:
                                   shown_default=f"the scene file's, else {SPEED.default:g}")
     length: float | None = declare(LENGTH)
     bounds: Any = declare(BOUNDS, shown_default=f"the scene file's, else {BOUNDS.shown_default}")
+    layout: str | None = declare(LAYOUT, shown_default=f"the scene file's, else {LAYOUT.shown_default}")
     warmup: float | None = declare(WARMUP, shown_default=f"the scene file's, else {WARMUP.shown_default}")
     preroll: float | None = declare(PREROLL, shown_default=f"the scene file's, else {PREROLL.shown_default}")
     size_variety: float | None = declare(SIZE_VARIETY, default=None,
@@ -179,7 +181,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     scene = with_options(scene, count=options.count, frames=options.frames, fps=options.fps,
                          seed=options.seed, model=options.model, speed=options.speed, bounds=options.bounds,
                          length=options.length, warmup=options.warmup, preset=options.preset,
-                         variety=variety, preroll=options.preroll)
+                         variety=variety, preroll=options.preroll, layout=options.layout)
     # before anything is built
     check_size(scene, scene_files[0] if scene_files else None, tracks="tracks" in sides)
     species_files = [e.file for e in scene.species]

@@ -146,7 +146,7 @@ def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "
     """What run_school simulates, each species built once (as `fishgen build` builds it), and
     the files that took (species files and the textures they name)."""
     from fishgen.assembly.fish import make_fish
-    from fishgen.school.scene_file import preroll_seconds
+    from fishgen.school.scene_file import preroll_seconds, start_layout
     from fishgen.species.parser import load_species
 
     couzin = _given(couzin, scene_file, "couzin", CouzinParams())
@@ -174,7 +174,8 @@ def plan_school(scene_file: SceneFile, *, fins: str | None = None, swim: str = "
         region = ((-half, -half / 3, -half), (half, half / 3, half))
     config = SchoolConfig(groups=tuple(groups), model=scene_file.model,  # type: ignore[arg-type]
                           frames=scene_file.frames, fps=scene_file.fps, seed=scene_file.seed, bounds=region,
-                          layout=scene_file.layout, target=scene_file.target,  # type: ignore[arg-type]
+                          layout=start_layout(scene_file),  # type: ignore[arg-type]
+                          target=scene_file.target,
                           pso=scene_file.pso, predator=scene_file.predator, couzin=couzin,
                           size_jitter=variety.size,
                           preroll=preroll_seconds(replace(scene_file, couzin=couzin)))

@@ -5,7 +5,7 @@
     fps = 30
     seed = 1
     bounds = [[-4, -1.5, -4], [4, 1.5, 4]]
-    layout = "sphere"          # sphere | box | line
+    layout = "sphere"          # sphere | box | line | ring (default: ring for the torus preset)
 
     [[species]]
     file = "bonybream.txt"     # relative to this file
@@ -40,7 +40,7 @@ and, among the first keys (before any [table], where TOML would put them inside 
 
 Every mistake is one ``FILE:LINE: expected ..., found ...`` line; absurd sizes are refused
 before anything is allocated. The keys that are also `fishgen school` options (frames, fps, seed,
-model, a species' count) are declared once, here, and checked exactly as the options are.
+model, layout, a species' count, ...) are declared once, here, and checked exactly as the options are.
 Leaf module (no numpy): `fishgen school --help` and batch manifests read the declarations.
 """
 from __future__ import annotations
@@ -141,9 +141,12 @@ PRESET = Option(click.Choice(tuple(COUZIN_PRESETS)),
                 "Couzin et al. (2002)'s collective state for the couzin model (sets --model couzin): "
                 + ", ".join(f"{name} (orientation zone {p.orientation:g} body lengths)"
                             for name, p in COUZIN_PRESETS.items())
-                + ". From a random start the torus rarely mills in the default region; "
-                "params/bait-ball.toml starts one as a ring.", None,
+                + ". The torus starts as a ring already milling unless --layout says otherwise (from a "
+                "random ball it rarely mills).", None,
                 shown_default="the scene file's [couzin], else zones of 1, 1 and 15 body lengths (torus)")
+LAYOUT = Option(click.Choice(LAYOUTS), "How the fish start: a random ball (sphere), scattered through the "
+                "region (box), a line, or a horizontal ring heading round it (ring: a mill already).", None,
+                shown_default="ring for the torus preset, else sphere")
 SIZE_VARIETY = Option(FiniteRange(*VARIETY_RANGES["size"]), VARIETY_HELP["size"].capitalize() + ".",
                       Variety.size)
 TINTS = Option(click.IntRange(int(VARIETY_RANGES["tints"][0]), int(VARIETY_RANGES["tints"][1])),
@@ -183,11 +186,12 @@ class SceneFile:
     fps: float = FPS.default
     seed: int = SEED_KEY.default
     bounds: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
-    layout: str = "sphere"
+    layout: str | None = None            # None: start_layout's default
     target: TargetPath = TargetPath()
     predator: TargetPath | None = None
     pso: PsoParams = PsoParams()
     couzin: CouzinParams | None = None   # None: CouzinParams()
+    preset: str | None = None            # the Couzin preset `couzin` was named by, if any
     variety: Variety | None = None       # None: Variety()
     warmup: float | None = None          # seconds; None: WARMUP_SHARE of the run, at most WARMUP_SECONDS
     preroll: float | None = None         # seconds; None: preroll_seconds' default
@@ -199,7 +203,8 @@ def with_options(scene: SceneFile, *, count: int | None = None, frames: int | No
                  fps: float | None = None, seed: int | None = None, model: str | None = None,
                  speed: float | None = None, bounds: Any = None, length: float | None = None,
                  warmup: float | None = None, preset: str | None = None,
-                 variety: dict[str, Any] | None = None, preroll: float | None = None) -> SceneFile:
+                 variety: dict[str, Any] | None = None, preroll: float | None = None,
+                 layout: str | None = None) -> SceneFile:
     """``scene`` with the options given (not None) overriding it, as `fishgen school`'s flags do;
     ``count`` and ``speed`` set every species'; ``preset`` a Couzin preset (and the couzin model
     unless ``model`` says otherwise); ``variety`` the Variety fields given."""
@@ -208,15 +213,24 @@ def with_options(scene: SceneFile, *, count: int | None = None, frames: int | No
     if speed is not None:
         scene = replace(scene, species=tuple(replace(e, speed=speed) for e in scene.species))
     if preset is not None:
-        scene = replace(scene, couzin=COUZIN_PRESETS[preset], model=model or "couzin")
+        scene = replace(scene, couzin=COUZIN_PRESETS[preset], preset=preset, model=model or "couzin")
     if variety:
         scene = replace(scene, variety=replace(scene.variety or Variety(), **variety))
     given: dict[str, Any] = {name: value for name, value in
                              (("frames", frames), ("fps", fps), ("seed", seed), ("model", model),
                               ("bounds", bounds), ("length", length), ("warmup", warmup),
-                              ("preroll", preroll))
+                              ("preroll", preroll), ("layout", layout))
                              if value is not None}
     return replace(scene, **given)
+
+
+def start_layout(scene: SceneFile) -> str:
+    """How the fish start: the scene's layout, else a ring for the couzin model's torus preset
+    (from a random ball in the default region it milled for 1 seed of 8: docs/decisions.md), else
+    a sphere."""
+    if scene.layout is not None:
+        return scene.layout
+    return "ring" if scene.model == "couzin" and scene.preset == "torus" else "sphere"
 
 
 def preroll_seconds(scene: SceneFile) -> float:
@@ -359,8 +373,9 @@ def _csv_points(where: _Where, path: Path, table: str) -> tuple[tuple[float, flo
     return tuple((r[0], r[1], r[2], r[3]) for r in rows)
 
 
-def _couzin(where: _Where, table: Any) -> CouzinParams:
-    """[couzin]: ``preset`` (one of COUZIN_PRESETS) and any CouzinParams field overriding it."""
+def _couzin(where: _Where, table: Any) -> tuple[CouzinParams, str | None]:
+    """[couzin]: ``preset`` (one of COUZIN_PRESETS) and any CouzinParams field overriding it; and
+    the preset's name."""
     if not isinstance(table, dict):
         raise where.fail("a [couzin] table", table, "couzin")
     keys = ("preset", *COUZIN_RANGES)
@@ -377,7 +392,7 @@ def _couzin(where: _Where, table: Any) -> CouzinParams:
             whole = key in ("neighbours", "sampled")
             number = _number(where, value, key, *COUZIN_RANGES[key], "couzin", whole=whole)
             values[key] = int(number) if whole else float(number)
-    return couzin_params(preset, **values)
+    return couzin_params(preset, **values), preset
 
 
 def _variety(where: _Where, table: Any) -> Variety:
@@ -414,13 +429,10 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
             raise where.fail(f"one of {', '.join(sorted(known))}", key, key)
     scene = SceneFile()
     for key, spec in (("model", MODEL), ("frames", FRAMES), ("fps", FPS), ("seed", SEED_KEY),
-                      ("warmup", WARMUP), ("preroll", PREROLL), ("length", LENGTH), ("bounds", BOUNDS)):
+                      ("warmup", WARMUP), ("preroll", PREROLL), ("length", LENGTH), ("bounds", BOUNDS),
+                      ("layout", LAYOUT)):
         if key in data:
             scene = replace(scene, **{key: _declared(where, spec, data[key], key)})
-    if "layout" in data:
-        if data["layout"] not in LAYOUTS:
-            raise where.fail(f"layout as one of {', '.join(LAYOUTS)}", data["layout"], "layout")
-        scene = replace(scene, layout=data["layout"])
     entries = data.get("species", [])
     if not isinstance(entries, list) or not entries or not all(isinstance(e, dict) for e in entries):
         raise where.fail("one or more [[species]] tables", "none" if not entries else entries, "species")
@@ -456,7 +468,8 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
             values[key] = float(_number(where, value, key, 0, 1e3, "pso"))
         scene = replace(scene, pso=replace(PsoParams(), **values))
     if "couzin" in data:
-        scene = replace(scene, couzin=_couzin(where, data["couzin"]))
+        couzin, preset = _couzin(where, data["couzin"])
+        scene = replace(scene, couzin=couzin, preset=preset)
     if "variety" in data:
         scene = replace(scene, variety=_variety(where, data["variety"]))
     total = sum(e.count for e in scene.species)

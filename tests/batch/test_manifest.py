@@ -74,6 +74,21 @@ output = "ab.glb"
     assert manifest.jobs[1].options.seed == derived_seed("ab.glb")
 
 
+def test_a_school_job_takes_a_layout(tmp_path):
+    manifest = load_manifest(write(tmp_path, """
+[[school]]
+input = "a.txt"
+output = "ring.glb"
+layout = "ring"
+[[school]]
+input = "a.txt"
+output = "torus.glb"
+preset = "torus"
+"""))
+    assert manifest.jobs[0].options.layout == "ring"
+    assert manifest.jobs[1].options.layout is None  # the scene file's, else the preset's: a ring
+
+
 @pytest.mark.parametrize("text,line,message", [
     ('[[build]]\ninput = "a.txt"\noutput = "a.glb"\nfins = "sparkly"\n', 4,
      "expected fins as one of blend, mask, opaque, found 'sparkly'"),
@@ -100,6 +115,8 @@ output = "ab.glb"
     # options that cannot go together, as `fishgen school` refuses them, at the job's output line
     ('[[school]]\ninput = "a.txt"\noutput = "s.glb"\npreset = "torus"\nmodel = "boids"\n', 3,
      "expected preset with the couzin model, found model boids"),
+    ('[[school]]\ninput = "a.txt"\noutput = "s.glb"\nlayout = "donut"\n', 4,
+     "expected layout as one of sphere, box, line, ring, found 'donut'"),
     ('[[school]]\ninput = "a.txt"\noutput = "s.glb"\ntints = 3\nmerge = true\n', 3,
      "expected tints 1 with lods or merge"),
     ('[[build]\ninput = "a.txt"\n', 1, "expected TOML"),

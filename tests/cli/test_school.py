@@ -288,6 +288,35 @@ def test_the_readmes_preset_school_is_in_its_state_from_the_first_frame(tmp_path
     assert_valid_gltf(out)
 
 
+def test_the_torus_preset_mills_at_the_commands_defaults(tmp_path):
+    """`fishgen school params/bonybream.txt --preset torus`: from a random ball in the default region
+    it milled for 1 seed of 8 (seed 3: rotation 0.33, 6 groups); it starts as a ring now, and the
+    torus rules keep the mill through the pre-roll."""
+    result = run_cli("school", PARAMS / "bonybream.txt", "--preset", "torus", "--seed", "3", "--frames", "60",
+                     "-o", tmp_path / "torus.glb")
+    assert result.returncode == 0, result.stderr
+    assert summary_row(result.stdout, "rotation")[0] > 0.8
+    assert summary_row(result.stdout, "polarization")[0] < 0.35
+
+
+@pytest.mark.parametrize("args, milling", [
+    (("--preset", "torus"), True),                         # the torus's default: a ring
+    (("--preset", "torus", "--layout", "sphere"), False),  # a layout given wins
+    (("--preset", "swarm"), False),
+    (("--preset", "swarm", "--layout", "ring"), True),
+    (("--model", "boids", "--layout", "ring"), True),
+])
+def test_layout_sets_how_the_fish_start(tmp_path, args, milling):
+    """The first frame without a pre-roll is the start layout: a ring heads round itself (rotation
+    near 1), a random ball every way (rotation near 0)."""
+    metrics = tmp_path / "m.json"
+    result = run_cli("school", PARAMS / "bonybream.txt", *args, "--preroll", "0", "--frames", "2",
+                     "-o", tmp_path / "s.glb", "--metrics", metrics)
+    assert result.returncode == 0, result.stderr
+    rotation = json.loads(metrics.read_text())["per_frame"]["rotation"][0][0]
+    assert (rotation > 0.9) if milling else (rotation < 0.5), rotation
+
+
 def test_a_species_listed_twice_is_two_schools_told_apart(tmp_path):
     """Two [[species]] of one file: the summary's rows and the tracks' names read bonybream and
     bonybream (2); before, both rows read bonybream."""

@@ -88,6 +88,37 @@ def test_options_override_the_scene_file_as_the_command_line_does():
     assert with_options(scene, preset="torus", model="couzin").model == "couzin"
 
 
+def test_the_torus_preset_starts_as_a_ring_unless_a_layout_is_given(tmp_path):
+    """From a random ball in the default region the torus milled for 1 seed of 8 (docs/decisions.md):
+    named as a preset (--preset or the scene file's [couzin] preset), it starts as a milling ring; a
+    layout given (--layout or the scene file's `layout`) wins, and other presets start as a ball."""
+    from fishgen.school.scene_file import start_layout
+
+    bream = SceneFile(species=(SpeciesEntry(Path("a.txt")),))
+    assert start_layout(bream) == "sphere"
+    assert start_layout(with_options(bream, preset="torus")) == "ring"
+    assert start_layout(with_options(bream, preset="torus", layout="sphere")) == "sphere"
+    assert start_layout(with_options(bream, layout="line")) == "line"
+    assert {start_layout(with_options(bream, preset=p)) for p in COUZIN_PRESETS if p != "torus"} == {"sphere"}
+    (tmp_path / "a.txt").write_text("")
+    file = tmp_path / "s.toml"
+    file.write_text('model = "couzin"\n[[species]]\nfile = "a.txt"\n'
+                    '[couzin]\npreset = "torus"\nrepulsion = 0.75\n')
+    torus = load_scene_file(file)
+    assert torus.layout is None and start_layout(torus) == "ring"
+    assert start_layout(with_options(torus, preset="swarm")) == "sphere"   # the command line's preset wins
+    assert start_layout(with_options(torus, model="boids")) == "sphere"    # [couzin] is the couzin model's
+    assert start_layout(with_options(torus, layout="box")) == "box"
+    file.write_text('layout = "box"\nmodel = "couzin"\n[[species]]\nfile = "a.txt"\n'
+                    '[couzin]\npreset = "torus"\n')
+    assert start_layout(load_scene_file(file)) == "box"
+    # the key is checked by the --layout option's declaration, at its line
+    file.write_text('layout = "donut"\n[[species]]\nfile = "a.txt"\n')
+    with pytest.raises(FishgenError, match=r"s.toml:1: expected layout as one of sphere, box, line, ring, "
+                                           r"found 'donut'$"):
+        load_scene_file(file)
+
+
 def test_a_couzin_school_pre_rolls_twenty_of_the_papers_seconds_at_its_own_speed(tmp_path):
     """The paper's clock runs at its speed (3 body lengths/s) over the fish's: 20 of its seconds are
     60 s at 1 body length/s, 20 s at 3; the slowest species sets it. Other models start at once, and
