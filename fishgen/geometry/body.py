@@ -23,11 +23,29 @@ class Body:
     ring_index: np.ndarray   # (BodySections, CircleSections) vertex index of each ring point
 
 
+def ring_offset(circles: int) -> float:
+    """Where ring point 0 stands, in steps of the ring, from the fish's left (+z).
+
+    0 for an even count (the thesis' angle_i = 2 pi i / C). An odd ring from there is not a mirror
+    image of itself across the fish's mid-plane, so the mirrored right fins stood off the body by up
+    to 15 % of its length; turned a quarter step (the way that puts a point straight above the
+    axis), it is, and every point moves by at most a quarter step.
+    """
+    if circles % 2 == 0:
+        return 0.0
+    return 0.25 if circles % 4 == 1 else -0.25
+
+
+def ring_angles(circles: int) -> np.ndarray:
+    """Angle of each ring point from the fish's left (+z) towards its back (+y)."""
+    return 2.0 * np.pi * (np.arange(circles, dtype=np.float64) + ring_offset(circles)) / circles
+
+
 def ring_positions(profile: Profile, bodies: int, circles: int, scale) -> tuple[np.ndarray, np.ndarray]:
-    """Ring points: x_j = j/(B-1), r_j = profile(x_j), angle_i = 2 pi i / C."""
+    """Ring points: x_j = j/(B-1), r_j = profile(x_j), angle_i = 2 pi i / C (:func:`ring_angles`)."""
     x = np.arange(bodies, dtype=np.float64) / (bodies - 1)
     r = np.maximum(profile(x), 0.0)
-    theta = 2.0 * np.pi * np.arange(circles, dtype=np.float64) / circles
+    theta = ring_angles(circles)
     rings = np.empty((bodies, circles, 3))
     rings[:, :, 0] = x[:, None]
     rings[:, :, 1] = r[:, None] * np.sin(theta)[None, :]

@@ -64,3 +64,19 @@ def test_midline_point_lies_on_the_faceted_surface(circles):
     pts = np.array([midline_point(body.rings, j, s) for j in range(1, 7) for s in (1, -1)])
     _, dist, _ = trimesh.proximity.closest_point(mesh, pts)
     assert dist.max() < 1e-9
+
+
+@pytest.mark.parametrize("circles", range(3, 14))
+def test_every_ring_is_its_own_mirror_image_across_the_mid_plane(circles):
+    """Left and right of the fish are alike at any CircleSections: an odd ring is turned a quarter
+    step so a point stands straight above the axis (an even one keeps the thesis' angles)."""
+    from fishgen.geometry.body import ring_angles
+
+    angles = ring_angles(circles)
+    points = np.stack([np.sin(angles), np.cos(angles)], axis=1)          # (y, z)
+    mirrored = points * [1, -1]
+    assert np.abs(points[:, None] - mirrored[None]).max(axis=2).min(axis=1).max() < 1e-12
+    if circles % 2:
+        assert np.isclose(np.sin(angles).max(), 1.0)
+    else:
+        assert np.allclose(angles, 2 * np.pi * np.arange(circles) / circles)

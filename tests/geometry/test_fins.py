@@ -63,6 +63,21 @@ def test_no_gap_under_the_dorsal_fin_at_any_level_of_detail(bodies, circles):
 
 
 @pytest.mark.parametrize("sp", SPECIES, ids=lambda s: s.name)
+@pytest.mark.parametrize("circles", [3, 5, 7, 9])
+def test_paired_fins_touch_the_body_at_an_odd_number_of_circle_sections(sp, circles):
+    """An odd ring was no mirror image of itself, so the right fins (mirror images of the left)
+    stood off the body by up to 15 % of its length (PineappleFish at 16x3)."""
+    from fishgen.assembly.levels import at_level
+
+    body, fins = body_and_fins(at_level(sp, 16, circles))
+    mesh = trimesh.Trimesh(body.mesh.positions, body.mesh.faces, process=False)
+    scale = np.ptp(body.mesh.positions[:, 0])
+    for name in ("pectoral_fin_left", "pectoral_fin_right", "pelvic_fin_left", "pelvic_fin_right"):
+        _, dist, _ = trimesh.proximity.closest_point(mesh, fins[name].mesh.positions)
+        assert np.sort(dist)[1] < 1e-6 * scale, f"{name}: {np.sort(dist)[1] / scale:.3f} of the length off"
+
+
+@pytest.mark.parametrize("sp", SPECIES, ids=lambda s: s.name)
 def test_right_fins_mirror_the_left(sp):
     _, fins = body_and_fins(sp)
     for kind in ("pectoral", "pelvic"):

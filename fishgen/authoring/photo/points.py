@@ -31,7 +31,9 @@ def circle_heights(circles: int, spacing: str) -> np.ndarray:
     the points in BonyBream's Appendix A listing are spaced.
     """
     if spacing == "even":
-        q = 4.0 * np.arange(circles) / circles
+        from fishgen.geometry.body import ring_offset
+
+        q = (4.0 * (np.arange(circles) + ring_offset(circles)) / circles) % 4.0   # quarter turns from +z
         return np.where(q <= 1, q, np.where(q <= 3, 2 - q, q - 4))
     s = circle_sines(circles)
     up, down = s.max(), -s.min()

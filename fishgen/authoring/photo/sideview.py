@@ -50,7 +50,9 @@ class SideView:
 
 def circle_sines(circles: int) -> np.ndarray:
     """sin of each CircleSection's angle: how high ring point i stands, as a share of the radius."""
-    return np.sin(2.0 * np.pi * np.arange(circles) / circles)
+    from fishgen.geometry.body import ring_angles
+
+    return np.sin(ring_angles(circles))
 
 
 def side_view(species: Species) -> SideView:
