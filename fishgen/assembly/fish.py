@@ -76,6 +76,7 @@ class LevelFacts:
     triangles: int
     vertices: int
     coverage: float              # screen coverage (fish length / screen height) down to which it shows
+    missing: tuple[str, ...] = ()  # fins the file's own level has and this one lost (too few sections)
 
 
 @dataclass(frozen=True)
@@ -174,6 +175,9 @@ def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None
         raise FishgenError(str(err)) from None
 
     built = [_level_geometry(species, b, c) for b, c in levels]
+    own = (species.body_sections, species.circle_sections)
+    file_fins = [f.name for f in (built[levels.index(own)] if own in levels
+                                  else _level_geometry(species, *own))[2]]
     body0, fins0 = built[0][1], built[0][2]
     # Scaled thesis space -> glTF axes in metres, centred on the body's middle, set by the finest level.
     xs = [body0.mesh.positions[:, 0], *(f.mesh.positions[:, 0] for f in fins0)]
@@ -217,8 +221,10 @@ def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None
     swim_clip = scene.clip("swim")
     has_swim = swim_plan_ is not None and swim_clip is not None
     level_facts = tuple(LevelFacts(b, c, sum(len(p.faces) for p in level_parts),
-                                   sum(len(p.positions) for p in level_parts), cov)
-                        for (b, c), level_parts, cov in zip(levels, parts, coverage, strict=True))
+                                   sum(len(p.positions) for p in level_parts), cov,
+                                   tuple(n for n in file_fins if n not in {f.name for f in fins}))
+                        for (b, c), level_parts, cov, (_, _, fins)
+                        in zip(levels, parts, coverage, built, strict=True))
     clip_facts = tuple(ClipFacts(p.name, clip.duration, p.loop, p.tail_beat_hz, p.bend_degrees)
                        for p in plans if (clip := scene.clip(p.name)) is not None)
     draw_calls = (len({m for m in (False, True) if any(p.fin == m for p in first)}) if merge

@@ -90,6 +90,16 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
     return Made(tuple(written), tuple(read), tuple(lines), tuple(facts), tuple(errors))
 
 
+def _lost(fins: tuple[str, ...]) -> str:
+    """``; no anal or adipose fin``: the fins a level is too coarse to hold, said where it is listed."""
+    if not fins:
+        return ""
+    names = [name.removesuffix("_fin").replace("_fin_", " ").replace("_", " ") for name in fins]
+    kinds = list(dict.fromkeys(n.split(" ")[0] for n in names))     # a pair is named once
+    return "; no " + (" or ".join([", ".join(kinds[:-1]), kinds[-1]]) if len(kinds) > 1 else kinds[0]) + \
+        (" fins" if len(kinds) > 1 or len(names) > 1 else " fin")
+
+
 def summary(fish, target: Path, written: list[Path]) -> str:
     """One line: what was built, and what the format could not keep (said once)."""
     from fishgen.exchange.registry import by_extension, lost
@@ -106,7 +116,8 @@ def summary(fish, target: Path, written: list[Path]) -> str:
     if animated and others and "more than one clip" not in dropped:
         motion += ", clips " + ", ".join(f"{c.name} {c.seconds:.2f} s" for c in others)
     if len(facts.levels) > 1 and fmt is not None and fmt.name in ("glb", "gltf"):
-        motion += ", levels " + ", ".join(f"{lv.bodies}x{lv.circles} ({lv.triangles})" for lv in facts.levels)
+        motion += ", levels " + ", ".join(f"{lv.bodies}x{lv.circles} ({lv.triangles}{_lost(lv.missing)})"
+                                          for lv in facts.levels)
     if facts.merged:
         motion += f", merged ({facts.draw_calls} draw calls)"
     listed = ", ".join(dropped[:-1]) + (" or " if len(dropped) > 1 else "") + dropped[-1] if dropped else ""

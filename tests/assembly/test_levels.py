@@ -56,6 +56,44 @@ def test_fins_move_to_the_nearest_section_of_each_level(bony):
     assert coarse.texture_points is not None and len(coarse.texture_points.body) == 8 * 6
 
 
+def _fin_areas(species) -> dict[str, float]:
+    from fishgen.assembly.fins import build_fins
+    from fishgen.geometry.body import build_body
+    from fishgen.geometry.shapes import profile_for
+
+    body = build_body(profile_for(species.shape_class, species.shape_params), species.body_sections,
+                      species.circle_sections, species.scale)
+    out = {}
+    for fin in build_fins(species, body.rings):
+        tri = fin.mesh.positions[fin.mesh.faces]
+        out[fin.name] = float(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
+                                             axis=1).sum() / 2)
+    return out
+
+
+@pytest.mark.parametrize("name,finer", [("bonybream", [(32, 24), (64, 48)]),
+                                        ("centroberyx", [(64, 48)]), ("threadfingoldie", [(32, 24), (64, 48)])])
+def test_a_finer_level_keeps_the_files_fin_sizes(name, finer):
+    """Each top point of a fin lies `proportion` of the way up the triangle before it, so over twice
+    the sections the edge fell twice as fast: BonyBream's pectoral fin at 32x24 had 68 % of its
+    file's area, at 64x48 39 %. The proportion per step now keeps the fall over the fin's span."""
+    species = load_species(PARAMS / f"{name}.txt")
+    own = _fin_areas(species)
+    for level in finer:
+        got = _fin_areas(at_level(species, *level))
+        for fin in ("dorsal_fin", "anal_fin", "pectoral_fin_left"):
+            if fin in own:
+                assert 0.85 <= got[fin] / own[fin] <= 1.15, f"{name} {level} {fin}: {got[fin] / own[fin]:.2f}"
+
+
+def test_the_summary_says_which_fins_a_coarse_level_cannot_hold(bony):
+    from fishgen.assembly.fish import fish_of
+    from fishgen.assembly.fish_options import FishOptions
+
+    fish = fish_of(bony, FishOptions(lods=((32, 24), (16, 12), (8, 6))))
+    assert [lv.missing for lv in fish.facts.levels] == [(), (), ("adipose_fin", "anal_fin")]
+
+
 def test_one_glb_holds_every_level_and_names_them_for_msft_lod_and_unity(levels):
     fish, path = levels
     doc = pygltflib.GLTF2().load(str(path))

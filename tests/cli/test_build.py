@@ -232,3 +232,14 @@ def test_with_several_inputs_one_refused_output_is_a_usage_line_naming_the_comma
                                     "inputs, found 'bonybream.gltf'") and result.stderr.count("\n") == 1
     assert (tmp_path / "pineapplefish.gltf").is_file() and not (tmp_path / "bonybream.gltf").exists()
     assert {p: p.read_bytes() for p in inputs} == inputs
+
+
+def test_the_summary_names_the_fins_a_coarse_level_drops(tmp_path):
+    from click.testing import CliRunner
+
+    from fishgen.cli import cli
+
+    ran = CliRunner().invoke(cli, ["build", str(PARAMS / "bonybream.txt"), "--lods", "32x24,16x12,8x6",
+                                   "-o", str(tmp_path / "b.glb")])
+    assert ran.exit_code == 0
+    assert "levels 32x24 (1518), 16x12 (376), 8x6 (92; no adipose or anal fins)" in ran.output
