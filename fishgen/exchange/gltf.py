@@ -284,7 +284,7 @@ def write_glb(scene: Scene, path: Path) -> list[Path]:
 
 def write_gltf(scene: Scene, path: Path) -> list[Path]:
     """``.gltf`` JSON with the buffer and images as files beside it (URIs percent-encoded)."""
-    from fishgen.exchange.sidefiles import image_side_stems
+    from fishgen.exchange.sidefiles import check_shared, image_side_stems
 
     stem = path.stem
     stems = image_side_stems(stem, [image.name for image in scene.images])
@@ -296,5 +296,6 @@ def write_gltf(scene: Scene, path: Path) -> list[Path]:
                                 path.with_name(f"{stem}.bin"): _blob(buf)}
     for name, image in zip(names, scene.images, strict=True):
         files[path.with_name(name)] = image.encoded()
+    check_shared(path, files)
     write_files(files)
     return list(files)

@@ -7,7 +7,7 @@ import numpy as np
 
 from fishgen.atomic import write_files
 from fishgen.exchange.rest import rest_meshes
-from fishgen.exchange.sidefiles import image_side_stems
+from fishgen.exchange.sidefiles import check_shared, image_side_stems
 from fishgen.scene.model import Scene
 
 
@@ -72,5 +72,6 @@ def write_obj(scene: Scene, path: Path) -> list[Path]:
         files[path.with_name(name)] = scene.images[k].encoded()
     for k, name in masks.items():
         files[path.with_name(name)] = _alpha_png(scene.images[k].rgba())
+    check_shared(path, files)
     write_files(files)
     return list(files)

@@ -16,7 +16,7 @@ from fishgen.atomic import atomic_open, write_files
 from fishgen.errors import FishgenError
 from fishgen.exchange.particles import only_points, particle_chunks, particle_columns
 from fishgen.exchange.rest import rest_meshes
-from fishgen.exchange.sidefiles import image_side_stems
+from fishgen.exchange.sidefiles import check_shared, image_side_stems
 from fishgen.scene.model import Scene
 
 VERTEX = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("nx", "<f4"), ("ny", "<f4"),
@@ -69,6 +69,7 @@ def _write_mesh(scene: Scene, path: Path) -> list[Path]:
     files = {path: "\n".join(header).encode("ascii") + vertices.tobytes() + faces.tobytes()}
     if texture and image is not None:
         files[path.with_name(texture)] = image.encoded()
+    check_shared(path, files)
     write_files(files)
     return list(files)
 

@@ -8,9 +8,11 @@ file someone sent you cannot read (or embed in a page) anything else on disk.
 """
 from __future__ import annotations
 
+import os
 import re
+from collections.abc import Mapping
 from pathlib import Path
-from urllib.parse import unquote
+from urllib.parse import quote, unquote
 
 from fishgen.errors import describe, expected
 from fishgen.file_names import NAME_MAX, too_long
@@ -77,3 +79,53 @@ def image_side_stems(asset_stem: str, image_names: list[str]) -> list[str]:
             unique = f"{stem}_{n}"
         stems.append(unique)
     return stems
+
+
+NAMING = (".gltf", ".mtl", ".usda", ".usdc", ".usd", ".ply")
+"""Formats whose files name side files beside them (a glTF's images and buffer, an OBJ's material
+file's textures, USD's textures, a textured PLY's TextureFile). A .usdc's names may be compressed,
+so it is taken to name every side file of its stem."""
+_READ_MOST = 1 << 26
+
+
+def check_shared(asset: str | os.PathLike, files: Mapping[Path, bytes]) -> None:
+    """Refuse to change a side file that another asset beside ``asset`` names.
+
+    ``files`` is everything one write puts down (``asset`` and its side files). ``fish.gltf`` and
+    ``fish.obj`` both name ``fish_skin.png``: built with other ``--fins``, the second rewrote the
+    first's texture without its mask. The same bytes again (the same fish) are no change.
+    """
+    from fishgen.errors import UsageError
+
+    asset = Path(asset)
+    writing = {Path(os.path.abspath(p)) for p in files}
+    siblings = [p for ext in NAMING for p in [asset.with_name(asset.stem + ext)]
+                if Path(os.path.abspath(p)) not in writing and p.is_file()]
+    if not siblings:
+        return
+    for side, data in files.items():
+        if Path(os.path.abspath(side)) == Path(os.path.abspath(asset)) or not side.is_file():
+            continue
+        try:
+            if side.stat().st_size == len(data) and side.read_bytes() == data:
+                continue
+        except OSError:
+            continue
+        for other in siblings:
+            if _names(other, side.name):
+                obj = other.with_suffix(".obj")      # an OBJ names its textures in its .mtl
+                other = obj if other.suffix.lower() == ".mtl" and obj.is_file() else other
+                raise UsageError(f"expected side files no other asset names, found {side.name!r}, named by "
+                                 f"{other.name!r} beside it, with other content; choose another -o")
+
+
+def _names(asset: Path, name: str) -> bool:
+    """Whether ``asset`` names the side file ``name`` (a .usdc is taken to name all of its stem's)."""
+    if asset.suffix.lower() in (".usdc", ".usd"):
+        return name.startswith(asset.stem)
+    try:
+        with asset.open("rb") as handle:
+            data = handle.read(_READ_MOST)
+    except OSError:
+        return False
+    return any(form.encode("utf-8", "surrogateescape") in data for form in (name, quote(name)))

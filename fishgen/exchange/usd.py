@@ -35,6 +35,7 @@ DEFAULT_FPS = 30.0
 def write_usd(scene: Scene, path: str | os.PathLike) -> list[Path]:
     """Write ``scene`` as USD in the encoding its extension names; returns the files written."""
     from fishgen.atomic import write_files
+    from fishgen.exchange.sidefiles import check_shared
 
     path = Path(path)
     suffix = path.suffix.lower()
@@ -61,6 +62,7 @@ def write_usd(scene: Scene, path: str | os.PathLike) -> list[Path]:
         else:
             files = {path: inner.read_bytes(),
                      **{path.parent / name: data for name, data in pictures.files.items()}}
+    check_shared(path, files)
     write_files(files)
     return list(files)
 

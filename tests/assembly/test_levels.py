@@ -71,8 +71,8 @@ def _fin_areas(species) -> dict[str, float]:
     return out
 
 
-@pytest.mark.parametrize("name,finer", [("bonybream", [(32, 24), (64, 48)]),
-                                        ("centroberyx", [(64, 48)]), ("threadfingoldie", [(32, 24), (64, 48)])])
+@pytest.mark.parametrize("name,finer", [("bonybream", [(32, 24), (64, 48)]), ("centroberyx", [(64, 48)]),
+                                        ("threadfingoldie", [(32, 24), (64, 48)])])
 def test_a_finer_level_keeps_the_files_fin_sizes(name, finer):
     """Each top point of a fin lies `proportion` of the way up the triangle before it, so over twice
     the sections the edge fell twice as fast: BonyBream's pectoral fin at 32x24 had 68 % of its

@@ -36,7 +36,7 @@ def test_the_issues_command_line(tmp_path):
     run = run_cli("build", PARAMS / "bonybream.txt", "--lods", "32x24,16x12,8x6", "--merge",
                   "--clips", "swim,idle,turn_left,turn_right,burst", "-o", out)
     assert run.returncode == 0, run.stderr
-    assert ("levels 32x24 (1518), 16x12 (376), 8x6 (92)" in run.stdout
+    assert ("levels 32x24 (1518), 16x12 (376), 8x6 (92; no adipose or anal fins)" in run.stdout
             and "merged (2 draw calls)" in run.stdout)
     assert "clips idle 2.00 s, turn_left 3.20 s, turn_right 3.20 s, burst 0.60 s" in run.stdout
     assert_valid_gltf(out)

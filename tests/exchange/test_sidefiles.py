@@ -34,3 +34,33 @@ def test_a_page_never_replaces_a_file_its_asset_names(tmp_path):
     result = run_cli("view", "--no-serve", tmp_path / "bb.gltf", "-o", tmp_path / "page.html")
     assert result.returncode == 2 and "not one of the command's inputs" in result.stderr, result.stderr
     assert (tmp_path / "page.html").read_bytes() == image
+
+
+@pytest.mark.parametrize("first, second", [("foo.gltf", "foo.obj"), ("foo.obj", "foo.usda"),
+                                           ("foo.usda", "foo.ply"), ("foo.ply", "foo.gltf")])
+def test_a_build_never_changes_a_texture_another_asset_beside_it_names(tmp_path, first, second):
+    """foo.gltf and foo.obj both name foo_skin.png: `-o foo.obj --fins opaque` after `-o foo.gltf
+    --fins mask` wrote the skin without its mask, and the glTF's fins lost their cut-out, exit 0."""
+    from fishgen.commands import run
+    from fishgen.commands.build import COMMAND
+    from fishgen.errors import UsageError
+
+    bream = PARAMS / "bonybream.txt"
+    fins = {"mask": COMMAND.options(fins="mask"), "opaque": COMMAND.options(fins="opaque")}
+    run(COMMAND, (bream,), tmp_path / first, fins["mask"])
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    with pytest.raises(UsageError, match=f"found 'foo_skin.png', named by '{first}' beside it"):
+        run(COMMAND, (bream,), tmp_path / second, fins["opaque"])
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    run(COMMAND, (bream,), tmp_path / second, fins["mask"])           # the same texture: no change
+    assert (tmp_path / "foo_skin.png").read_bytes() == before["foo_skin.png"]
+
+
+def test_an_asset_may_replace_its_own_texture(tmp_path):
+    from fishgen.commands import run
+    from fishgen.commands.build import COMMAND
+
+    bream = PARAMS / "bonybream.txt"
+    run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="mask"))
+    run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="opaque"))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["foo.bin", "foo.gltf", "foo_skin.png"]
