@@ -158,6 +158,10 @@ def run(cmd: Command, inputs: tuple[Path, ...], output: str | os.PathLike | None
 
         if names_folder(output):
             raise UsageError(f"expected -o to name an output file, found the folder {os.fspath(output)!r}")
+        from fishgen.atomic import check_target
+
+        # before the format's check: `-o /dev/null` is a device, not a name with no extension
+        check_target(Path(output))
     with protecting(inputs):
         return cmd.function()(inputs, output, options, events)
 

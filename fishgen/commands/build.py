@@ -113,4 +113,4 @@ def summary(fish, target: Path, written: list[Path]) -> str:
     note = f" ({fmt.extensions[0][1:].upper()} holds no {listed})" if dropped and fmt else ""
     return (f"{target}: {scene.name}, {scene.counts()['triangles']} triangles, "
             f"{facts.body_length:.3f} m long, fins {facts.fin_mode}, {motion}{note}"
-            + (f" (+{len(written) - 1} files)" if len(written) > 1 else ""))
+            + (f" (+{len(written) - 1} file{'s' * (len(written) > 2)})" if len(written) > 1 else ""))
