@@ -160,7 +160,8 @@ def make_fish(species: Species, *, fins: str | None = None, length: float | None
 def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None) -> Fish:
     """The fish of ``species`` built as ``options`` (checked when they were made) say: what
     `fishgen build` runs for each species file."""
-    length, fps, swim, speed = options.length, options.fps, options.swim, options.speed
+    length, fps, swim = options.length, options.fps, options.swim
+    speed = options.speed if options.speed is not None else DEFAULT_SPEED
     merge, clips, compact = options.merge, options.clips, options.compact
     mode = options.fins or default_fin_mode(species)
     if mode == "mask" and not species.textured:

@@ -43,9 +43,11 @@ class FishOptions:
                         30.0)
     swim: str = swim_option("body: a travelling body wave (carangiform, tail-beat frequency from --speed) "
                             "under the fin swings; fins: a rigid body, only the fins move (VRFish's fish).")
-    speed: float = option(FiniteRange(0.01, 100), "Cruising speed of the swim loop in body lengths per "
-                          "second; the tail beats at Strouhal number 0.3, rounded to a whole number of beats "
-                          "in the loop.", DEFAULT_SPEED, metavar="BL/S")
+    # None: not given, so that one given with --swim fins (no body wave to set) can be refused
+    speed: float | None = option(FiniteRange(0.01, 100), "Cruising speed of the swim loop in body lengths "
+                                 "per second; the tail beats at Strouhal number 0.3, rounded to a whole "
+                                 "number of beats in the loop. --swim body only.",
+                                 shown_default=f"{DEFAULT_SPEED:g}", metavar="BL/S")
     lods: tuple[tuple[int, int], ...] | None = lods_option()
     merge: bool = merge_option()
     clips: tuple[str, ...] = option(Names(CLIP_NAMES), "Clips to write, each looping but burst: "

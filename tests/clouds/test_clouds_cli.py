@@ -114,6 +114,8 @@ def test_total_mismatch_is_a_warning_on_stderr(cli, write_awn, tmp_path):
                               "finite numbers within float32 range, found '0,0,inf'"),
     (["--offset", "nan,0,0"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z"),
     (["--billboards"], "out.ply: expected a .glb or .gltf output with --billboards"),
+    # was ignored without a word, as --billboards is not
+    (["--voxel-size", "0.5"], "out.ply: expected a .nvdb or .vdb output with --voxel-size, found '.ply'"),
     (["--voxel-size", "0"], "fishgen clouds: Invalid value for '--voxel-size': 0.0 is not in the range "
                             "0<x<="),
     (["--voxel-size", "nan"], "fishgen clouds: Invalid value for '--voxel-size': 'nan' is not a finite "
