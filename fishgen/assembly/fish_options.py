@@ -16,7 +16,7 @@ import click
 
 from fishgen.assembly.clip_names import BENDING_CLIPS, CLIP_NAMES, DEFAULT_CLIPS
 from fishgen.errors import FishgenError
-from fishgen.fish_modes import DEFAULT_SPEED
+from fishgen.fish_modes import DEFAULT_SPEED, MAX_TAIL_BEAT_HZ
 from fishgen.options import (
     FiniteRange,
     Names,
@@ -45,8 +45,10 @@ class FishOptions:
                             "under the fin swings; fins: a rigid body, only the fins move (VRFish's fish).")
     # None: not given, so that one given with --swim fins (no body wave to set) can be refused
     speed: float | None = option(FiniteRange(0.01, 100), "Cruising speed of the swim loop in body lengths "
-                                 "per second; the tail beats at Strouhal number 0.3, rounded to a whole "
-                                 "number of beats in the loop. --swim body only.",
+                                 "per second; the tail beats at Strouhal number 0.3 (1.5 Hz per BL/s), "
+                                 f"at most {MAX_TAIL_BEAT_HZ:g} Hz (from {MAX_TAIL_BEAT_HZ / 1.5:.2f} BL/s "
+                                 "up: the same fish), a whole number of beats in the loop (rounded down "
+                                 f"where up would pass {MAX_TAIL_BEAT_HZ:g} Hz). --swim body only.",
                                  shown_default=f"{DEFAULT_SPEED:g}", metavar="BL/S")
     lods: tuple[tuple[int, int], ...] | None = lods_option()
     merge: bool = merge_option()

@@ -122,6 +122,8 @@ def summary(fish, target: Path, written: list[Path]) -> str:
               else "rest pose only" if facts.clips else "no animation")
     if animated and facts.tail_beat_hz is not None:
         motion += f", body wave {facts.tail_beat_hz:.2f} Hz"
+        if facts.capped_hz is not None:   # a faster --speed would give the same file
+            motion += f" (--speed {facts.speed:g} capped at {facts.capped_hz:g} Hz)"
     others = [c for c in facts.clips if c.name != "swim"]
     if animated and others and "more than one clip" not in dropped:
         motion += ", clips " + ", ".join(f"{c.name} {c.seconds:.2f} s" for c in others)

@@ -45,3 +45,19 @@ def test_an_option_that_would_be_ignored_is_refused_before_any_work(tmp_path, ou
 def test_an_option_that_applies_is_taken(tmp_path, output, options):
     made = _build(tmp_path, f"{tmp_path}/{output}", **options)
     assert made.written and not made.failed
+
+
+def test_the_summary_says_when_the_tail_beat_cap_binds():
+    species = load_species(PARAMS / "bonybream.txt")
+    fast = summary(fish_of(species, BuildOptions(speed=7.0)), Path("x.glb"), [Path("x.glb")])
+    cruising = summary(fish_of(species, BuildOptions()), Path("x.glb"), [Path("x.glb")])
+    assert "body wave 7.81 Hz (--speed 7 capped at 8 Hz)" in fast      # was 8.12 Hz, said nothing
+    assert "body wave 1.56 Hz" in cruising and "capped" not in cruising
+
+
+def test_the_speed_help_states_the_cap():
+    from fishgen.commands.build import COMMAND
+    from fishgen.options import declared
+
+    speed = next(spec for f, spec in declared(COMMAND.options) if f.name == "speed")
+    assert "at most 8 Hz (from 5.33 BL/s up" in speed.help
