@@ -78,7 +78,8 @@ COMMAND = Command(
     \b
     Examples:
       fishgen clouds params/clouds/table_4_3.awn -o out/cloud.ply
-      fishgen clouds a.awn b.awn --offset 0,0,0 --offset 25,3,-10 -o out/sky.glb --billboards
+      fishgen clouds params/clouds/table_4_3.awn params/clouds/table_4_4.awn \\
+          --offset 0,0,0 --offset 25,3,-10 -o out/sky.glb --billboards
       fishgen clouds params/clouds/table_4_4.awn -o out/cloud.glb --billboards --sun 1,0.3,0
       fishgen clouds params/clouds/sky.awa -o out/texture-sky.glb
       fishgen clouds params/clouds/table_4_4.awn -o out/cloud.vdb --voxel-size 0.1
