@@ -10,3 +10,5 @@ SWIM_MODES = ("body", "fins")
 """``body``: a travelling body wave under the fin swings; ``fins``: a rigid body, only the fins move."""
 DEFAULT_SPEED = 1.0
 """Cruising speed of a built fish's swim loop, body lengths per second."""
+MAX_TAIL_BEAT_HZ = 8.0
+"""The body wave's tail-beat frequency cap (docs/decisions.md), reached at 16/3 body lengths a second."""

@@ -482,7 +482,9 @@ def seed_option(help_text: str, default: int | None = 0, shown_default: str | No
 
 def voxel_size_option(default: float) -> Any:
     """--voxel-size of a command writing volumes (.vdb, .nvdb). ``default``: the cloud model's own
-    (options sit below the models)."""
+    (options sit below the models), shown in --help; the field's own is None, so that one given with
+    another output can be refused."""
     return option(FiniteRange(0, FLOAT32_MAX, min_open=True),
                   ".vdb and .nvdb only: the side of a voxel, in the cube files' units; a box of more "
-                  "than 2^25 voxels around the cloud is refused before filling.", default, metavar="SIZE")
+                  "than 2^25 voxels around the cloud is refused before filling.",
+                  shown_default=f"{default:g}", metavar="SIZE")

@@ -8,6 +8,8 @@ parts (docs/decisions.md: morph targets chosen over a skin).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from fishgen.geometry.body_wave import BodyWave, wave_targets, wave_weights
@@ -79,20 +81,28 @@ def wave_channels(scene: Scene, sampler: Sampler, nodes: list[int] | None = None
 
 def loop_beats(wave: BodyWave, speed: float, clip_seconds: float) -> tuple[int, float]:
     """(beats, frequency in Hz): the whole number of tail beats closest to ``speed``'s frequency
-    that fits the clip exactly, so the wave closes with the fin swings (at least one beat)."""
+    that fits the clip exactly, so the wave closes with the fin swings (at least one beat), and
+    never more than the wave's cap allows."""
     target = float(wave.frequency(speed))
     beats = max(1, round(target * clip_seconds))
+    if beats > wave.max_frequency * clip_seconds * (1 + 1e-12):
+        # rounded up past the cap (8.12 Hz "capped at 8"): round down instead; a loop too short
+        # for one beat under the cap keeps its one
+        beats = max(1, math.floor(wave.max_frequency * clip_seconds * (1 + 1e-12)))
     return beats, beats / clip_seconds
 
 
 def loop_laps(wave: BodyWave, speed: float, fin_loop_seconds: float, most: int) -> int:
     """How many fin loops the clip spans (1..most): the fewest whose whole number of beats is within
-    LOOP_FREQUENCY_SLACK of the frequency ``speed`` asks for, else the closest of them."""
+    LOOP_FREQUENCY_SLACK of the frequency ``speed`` asks for, else the closest of them, never one
+    beating faster than the wave's cap (unless none can: then 1)."""
     target = float(wave.frequency(speed))
     best, best_error = 1, np.inf
     for laps in range(1, max(1, most) + 1):
         _, frequency = loop_beats(wave, speed, laps * fin_loop_seconds)
         error = abs(frequency - target) / target
+        if frequency > wave.max_frequency * (1 + 1e-12):  # a loop too short for one beat under the cap
+            error = np.inf
         if error <= LOOP_FREQUENCY_SLACK:
             return laps
         if error < best_error:

@@ -105,6 +105,7 @@ class FishFacts:
     merged: bool = False
     targets: tuple[str, ...] = ()
     draw_calls: int = 0          # primitives a client draws for one fish at its finest level
+    capped_hz: float | None = None  # the tail-beat cap, when the speed asked for a faster wave
 
 
 @dataclass(frozen=True)
@@ -161,7 +162,8 @@ def make_fish(species: Species, *, fins: str | None = None, length: float | None
 def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None) -> Fish:
     """The fish of ``species`` built as ``options`` (checked when they were made) say: what
     `fishgen build` runs for each species file."""
-    length, fps, swim, speed = options.length, options.fps, options.swim, options.speed
+    length, fps, swim = options.length, options.fps, options.swim
+    speed = options.speed if options.speed is not None else DEFAULT_SPEED
     merge, clips, compact = options.merge, options.clips, options.compact
     mode = options.fins or default_fin_mode(species)
     if mode == "mask" and not species.textured:
@@ -232,8 +234,14 @@ def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None
     facts = FishFacts(species.name, (nose_to_tail - foremost) * metres, mode, swim, float(fps), float(speed),
                       swim_plan_.tail_beat_hz if has_swim and swim_plan_ is not None else None,
                       swim_clip.duration if has_swim and swim_clip is not None else None,
-                      level_facts, clip_facts, merge, targets, draw_calls)
+                      level_facts, clip_facts, merge, targets, draw_calls,
+                      wave.max_frequency if has_swim and waving and _capped(wave, speed) else None)
     return Fish(scene, facts)
+
+
+def _capped(wave: BodyWave, speed: float) -> bool:
+    """Whether ``speed`` asks for a faster tail beat than the wave's cap."""
+    return wave.strouhal * abs(speed) / wave.tail_peak_to_peak > wave.max_frequency
 
 
 def _fin_loop_frames(species: Species, swings: list[FinSwing]) -> int:

@@ -16,7 +16,7 @@ import click
 
 from fishgen.assembly.clip_names import BENDING_CLIPS, CLIP_NAMES, DEFAULT_CLIPS
 from fishgen.errors import FishgenError
-from fishgen.fish_modes import DEFAULT_SPEED
+from fishgen.fish_modes import DEFAULT_SPEED, MAX_TAIL_BEAT_HZ
 from fishgen.options import (
     FiniteRange,
     Names,
@@ -43,9 +43,13 @@ class FishOptions:
                         30.0)
     swim: str = swim_option("body: a travelling body wave (carangiform, tail-beat frequency from --speed) "
                             "under the fin swings; fins: a rigid body, only the fins move (VRFish's fish).")
-    speed: float = option(FiniteRange(0.01, 100), "Cruising speed of the swim loop in body lengths per "
-                          "second; the tail beats at Strouhal number 0.3, rounded to a whole number of beats "
-                          "in the loop.", DEFAULT_SPEED, metavar="BL/S")
+    # None: not given, so that one given with --swim fins (no body wave to set) can be refused
+    speed: float | None = option(FiniteRange(0.01, 100), "Cruising speed of the swim loop in body lengths "
+                                 "per second; the tail beats at Strouhal number 0.3 (1.5 Hz per BL/s), "
+                                 f"at most {MAX_TAIL_BEAT_HZ:g} Hz (from {MAX_TAIL_BEAT_HZ / 1.5:.2f} BL/s "
+                                 "up: the same fish), a whole number of beats in the loop (rounded down "
+                                 f"where up would pass {MAX_TAIL_BEAT_HZ:g} Hz). --swim body only.",
+                                 shown_default=f"{DEFAULT_SPEED:g}", metavar="BL/S")
     lods: tuple[tuple[int, int], ...] | None = lods_option()
     merge: bool = merge_option()
     clips: tuple[str, ...] = option(Names(CLIP_NAMES), "Clips to write, each looping but burst: "

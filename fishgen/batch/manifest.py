@@ -45,7 +45,8 @@ class Kind:
     name: str                        # its [[table]] in a manifest, and Job.kind
     options: type                    # its frozen options record, whose manifest keys a job may set
     holds: tuple[str, ...] = ()      # what its output's format must hold
-    check: Callable[[Any], None] | None = None  # refuses options that cannot go together (UsageError)
+    check: Callable[[Any, str | os.PathLike | None], None] | None = None  # refuses options that cannot
+                                                    # go together, or with the output (UsageError)
 
 
 @dataclass(frozen=True)
@@ -183,7 +184,7 @@ def _job(where: Where, of: Kind, nth: int, entry: dict[str, Any], folder: Path, 
         raise fail_at("offset")(f"one [x, y, z] per input ({len(inputs)})")
     if of.check is not None:
         try:
-            of.check(options)
+            of.check(options, relative)
         except UsageError as err:  # said at the job's line, before any job runs
             line = where.line("output", kind, nth)
             raise FishgenError(err.message.replace("--", ""), where.file, line) from None

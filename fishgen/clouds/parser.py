@@ -179,11 +179,11 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
     cube_rows = rows[2:]
     if len(cube_rows) > declared_cubes:
         extra = cube_rows[declared_cubes][0]
-        raise expected(f"the end of the file after the {declared_cubes:,} cubes declared on line "
+        raise expected(f"the end of the file after the {_plural(declared_cubes, 'cube')} declared on line "
                        f"{rows[1][0]}", "another cube line", name, extra)
     if len(cube_rows) < declared_cubes:
         last = cube_rows[-1][0] if cube_rows else rows[1][0]
-        raise expected(f"{declared_cubes} cube lines (declared on line {rows[1][0]})",
+        raise expected(f"{_plural(declared_cubes, 'cube line')} (declared on line {rows[1][0]})",
                        f"{len(cube_rows)}", name, last + 1)
 
     cubes: list[Cube] = []
@@ -196,8 +196,9 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
         cubes.append(cube)
 
     total = sum(cube.particles for cube in cubes)
-    if total == 0:
-        raise expected(f"at least 1 {noun} in the cubes", "0", name, cube_rows[0][0])
+    if total == 0:  # a total of 0 is where it starts; else the cubes' counts, which are used, are wrong
+        raise expected(f"at least 1 {noun} in the cubes", "0", name,
+                       rows[0][0] if declared_total == 0 else cube_rows[0][0])
     notes: list[str] = []
     if total != declared_total:
         notes.append(f"{name}:{rows[0][0]}: warning: declared total {declared_total} {noun}s, "
@@ -205,6 +206,10 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
         warnings.warn(notes[-1], CubeFileWarning, stacklevel=3)
     return CubeFile(path=name, declared_total=declared_total, cubes=tuple(cubes),
                     warnings=tuple(notes))
+
+
+def _plural(count: int, noun: str) -> str:
+    return f"{count:,} {noun}{'s' * (count != 1)}"
 
 
 def _decode(data: bytes, name: str) -> str:

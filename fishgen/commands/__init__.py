@@ -78,8 +78,9 @@ class Command:
     batch: bool = False                 # a batch manifest may list jobs of this command
     cli: str | None = None              # "module:function" of a command-specific CLI adapter
     together: bool = False              # the CLI lands every output only once the summary is printed
-    check: Callable[[Any], None] | None = None  # options that cannot go together: a UsageError, for the
-                                                # use case and for a manifest's job before any job runs
+    check: Callable[[Any, str | os.PathLike | None], None] | None = None
+    # options that cannot go together, or with the output (-o): a UsageError, for the use case and
+    # for a manifest's job before any job runs
 
     @property
     def holds(self) -> tuple[str, ...]:
@@ -158,6 +159,10 @@ def run(cmd: Command, inputs: tuple[Path, ...], output: str | os.PathLike | None
 
         if names_folder(output):
             raise UsageError(f"expected -o to name an output file, found the folder {os.fspath(output)!r}")
+        from fishgen.atomic import check_target
+
+        # before the format's check: `-o /dev/null` is a device, not a name with no extension
+        check_target(Path(output))
     with protecting(inputs):
         return cmd.function()(inputs, output, options, events)
 

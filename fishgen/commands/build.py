@@ -20,9 +20,27 @@ FISH_FORMATS = formats(writable=True, holding=[MESHES])
 class BuildOptions(FishOptions):
     """How each fish is built (:class:`FishOptions`, checked when made), and where its files go."""
 
-    format: str = option(click.Choice([f.name for f in FISH_FORMATS]), "Format of each file written into "
-                         "a folder (-o FOLDER/).", "glb", manifest=False)
+    # None: not given, so that one given with -o naming a file of another format can be refused
+    format: str | None = option(click.Choice([f.name for f in FISH_FORMATS]), "Format of each file written "
+                                "into a folder (-o FOLDER/).", shown_default="glb", manifest=False)
     textures: Path | None = textures_option("the species file's folder, then the textures/ folder beside it")
+
+
+def check_options(options: BuildOptions, output: str | os.PathLike | None = None) -> None:
+    """Options that would be ignored, refused before any work (and at a manifest job's line)."""
+    from fishgen.errors import UsageError
+
+    if options.speed is not None and options.swim == "fins":
+        raise UsageError(f"expected --swim body with --speed (it sets the body wave's tail beat, which "
+                         f"--swim fins does not have), found --swim fins with --speed {options.speed:g}")
+    if options.format is not None and output is not None:
+        from fishgen.commands.paths import names_folder
+        from fishgen.exchange.registry import FORMATS
+
+        suffix = Path(output).suffix.lower()
+        if not names_folder(output) and suffix not in FORMATS[options.format].extensions:
+            raise UsageError(f"expected --format only with -o naming a folder (the file's extension picks "
+                             f"its format), found -o {os.fspath(output)!r} with --format {options.format}")
 
 
 COMMAND = Command(
@@ -49,6 +67,7 @@ COMMAND = Command(
                   "ending in /.", required=False, shown_default="out/<species file stem>.<format>",
                   holds=(MESHES,), folder=True),
     batch=True,
+    check=check_options,
 )
 
 
@@ -65,8 +84,9 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
     from fishgen.exchange.registry import FORMATS
     from fishgen.species.parser import load_species
 
+    check_options(options, output)
     check_inputs(inputs, "build", [FORMATS["species"]], default=FORMATS["species"])
-    outputs = targets(inputs, output, fmt=options.format, holding=[MESHES], noun="species file")
+    outputs = targets(inputs, output, fmt=options.format or "glb", holding=[MESHES], noun="species file")
     check_targets(outputs, inputs)
     written: list[Path] = []
     read: list[Path] = []
@@ -112,6 +132,8 @@ def summary(fish, target: Path, written: list[Path]) -> str:
               else "rest pose only" if facts.clips else "no animation")
     if animated and facts.tail_beat_hz is not None:
         motion += f", body wave {facts.tail_beat_hz:.2f} Hz"
+        if facts.capped_hz is not None:   # a faster --speed would give the same file
+            motion += f" (--speed {facts.speed:g} capped at {facts.capped_hz:g} Hz)"
     others = [c for c in facts.clips if c.name != "swim"]
     if animated and others and "more than one clip" not in dropped:
         motion += ", clips " + ", ".join(f"{c.name} {c.seconds:.2f} s" for c in others)
@@ -124,4 +146,4 @@ def summary(fish, target: Path, written: list[Path]) -> str:
     note = f" ({fmt.extensions[0][1:].upper()} holds no {listed})" if dropped and fmt else ""
     return (f"{target}: {scene.name}, {scene.counts()['triangles']} triangles, "
             f"{facts.body_length:.3f} m long, fins {facts.fin_mode}, {motion}{note}"
-            + (f" (+{len(written) - 1} files)" if len(written) > 1 else ""))
+            + (f" (+{len(written) - 1} file{'s' * (len(written) > 2)})" if len(written) > 1 else ""))

@@ -39,12 +39,25 @@ class CloudsOptions:
                               "triangles, 12 vertices), an alpha-blended Gaussian sprite, instead of points; "
                               "a texture cloud (.awa) is always billboards, with its PNGs.", False, flag=True)
     max_particles: int = max_particles_option(DEFAULT_MAX_PARTICLES)
-    voxel_size: float = voxel_size_option(DEFAULT_VOXEL_SIZE)
+    voxel_size: float | None = voxel_size_option(DEFAULT_VOXEL_SIZE)
     textures: Path | None = cloud_textures_option()
     lighting: Lighting = group(Lighting)
     light: bool = option(click.BOOL, "Bake the sunlight into each particle's colour (and its _LIGHT "
                          "attribute); off skips the lighting and writes the particles white, for "
                          "positions, radii and density only.", True, flag=True, off="--no-light")
+
+
+def check_options(options: CloudsOptions, output: str | os.PathLike | None = None) -> None:
+    """Options that would be ignored, refused before any work (and at a manifest job's line)."""
+    from fishgen.errors import UsageError
+
+    if options.voxel_size is not None and output is not None:
+        from fishgen.exchange.clouds import VOLUME_FORMATS
+
+        suffix = Path(output).suffix.lower()
+        if suffix not in VOLUME_FORMATS:
+            raise UsageError(f"expected a {' or '.join(sorted(VOLUME_FORMATS))} output with --voxel-size, "
+                             f"found {suffix or 'no extension'!r}", output)
 
 
 COMMAND = Command(
@@ -65,7 +78,8 @@ COMMAND = Command(
     \b
     Examples:
       fishgen clouds params/clouds/table_4_3.awn -o out/cloud.ply
-      fishgen clouds a.awn b.awn --offset 0,0,0 --offset 25,3,-10 -o out/sky.glb --billboards
+      fishgen clouds params/clouds/table_4_3.awn params/clouds/table_4_4.awn \\
+          --offset 0,0,0 --offset 25,3,-10 -o out/sky.glb --billboards
       fishgen clouds params/clouds/table_4_4.awn -o out/cloud.glb --billboards --sun 1,0.3,0
       fishgen clouds params/clouds/sky.awa -o out/texture-sky.glb
       fishgen clouds params/clouds/table_4_4.awn -o out/cloud.vdb --voxel-size 0.1
@@ -76,6 +90,7 @@ COMMAND = Command(
     output=Output(f"Output file; the extension picks the format: "
                   f"{', '.join(extensions(formats(writable=True, holding=[POINTS])))}.", holds=(POINTS,)),
     batch=True,
+    check=check_options,
 )
 
 
@@ -105,6 +120,7 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     textured = any(kind is FORMATS["texture cubes"] for kind in kinds)
     billboards = options.billboards or (textured and output.suffix.lower() in (".glb", ".gltf"))
     check_output(output, billboards)
+    check_options(options, output)
     check_targets([output], inputs)
     if not options.light and options.lighting != Lighting():
         from dataclasses import fields
@@ -126,10 +142,11 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     check_targets([output], textures)
     check_output(output, billboards, particles=sum(f.total for f in files))  # a glTF buffer holds 4 GiB
     volume = output.suffix.lower() in VOLUME_FORMATS
+    voxel_size = options.voxel_size if options.voxel_size is not None else DEFAULT_VOXEL_SIZE
     if volume:
         from fishgen.clouds.volume import check_cube_files
 
-        check_cube_files(files, options.offset, options.voxel_size, output)
+        check_cube_files(files, options.offset, voxel_size, output)
     seed = options.seed or 0
     made = cube_clouds(files, seed=seed, method=options.method, offsets=options.offset,
                        lighting=options.lighting, light=options.light, max_particles=options.max_particles)
@@ -140,10 +157,10 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
         from fishgen.clouds.fill import merge_clouds
 
         cloud, sun = merge_clouds(made.clouds), "unlit"
-    written = export_cloud(cloud, output, billboards=billboards, voxel_size=options.voxel_size)
+    written = export_cloud(cloud, output, billboards=billboards, voxel_size=voxel_size)
     line = (f"{output}: {_plural(len(cloud), made.noun)} in {_plural(len(cloud.cube_bounds), 'cube')} "
             f"from {_plural(len(files), 'file')} ({options.method} fill, seed {seed}, {sun}"
-            f"{f', voxels of {options.voxel_size:g}' * volume})")
+            f"{f', voxels of {voxel_size:g}' * volume})")
     facts = CloudFacts(len(cloud), len(cloud.cube_bounds), len(files), billboards, options.lighting)
     return Made(tuple(written), (*inputs, *textures), (line,), facts)
 

@@ -58,7 +58,8 @@ COMMAND = Command(
     summary="Render inputs or assets to PNG, contact sheets or swim loops.",
     help="""Render INPUT... to an image, as a game engine would show it.
 
-    INPUT is a species file (.txt), a cloud cube file (.awn) or an asset
+    INPUT is a species file (.txt), a cloud cube file (.awn), a texture
+    cloud (.awa) or an asset
     (.glb, .gltf, .obj, .ply) written by fishgen or anything else. Several
     inputs make a labelled contact sheet; a .gif or .webp with --frames makes
     an animated swim loop (a turntable for assets without animation).

@@ -88,7 +88,7 @@ class SchoolOptions:
     prototypes: int = prototypes_option()
 
 
-def check_options(options: SchoolOptions) -> None:
+def check_options(options: SchoolOptions, output: str | os.PathLike | None = None) -> None:
     """Options that cannot go together, refused before any work (and at a manifest job's line)."""
     from fishgen.errors import UsageError
 

@@ -179,8 +179,11 @@ def input_format(path: str | os.PathLike, *, kinds: Iterable[Format], command: s
         return fmt
     if fmt is not None:
         use = f"; use `fishgen {fmt.command}` for it" if fmt.command and fmt.command != command else ""
-        # a name alone (no such file yet) is judged by its extension, and said to be
-        what = fmt.description if there else f"{Path(path).suffix!r}, the extension of {fmt.description}"
+        # only a sniff reads the content: a format judged by its extension alone is said to be
+        suffix = Path(path).suffix
+        what = (fmt.description if there and len(found) > 1
+                else f"a {suffix} file ({fmt.description.removeprefix('a ')}, by its extension)" if there
+                else f"{suffix!r}, the extension of {fmt.description}")
         raise FishgenError(f"expected an input of `fishgen {command}` ({', '.join(extensions(allowed))}), "
                            f"found {what}{use}", path)
     if default is not None:

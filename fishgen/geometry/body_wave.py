@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fishgen.fish_modes import MAX_TAIL_BEAT_HZ
+
 
 @dataclass(frozen=True)
 class BodyWave:
@@ -27,7 +29,7 @@ class BodyWave:
     envelope: tuple[float, float, float] = (0.02, -0.0825, 0.1625)  # a(x) = c0 + c1 x + c2 x^2
     wavelength: float = 0.95          # body lengths
     strouhal: float = 0.3             # St = f A / U, A = peak-to-peak tail-tip amplitude
-    max_frequency: float = 8.0        # Hz: a cap for absurd speeds
+    max_frequency: float = MAX_TAIL_BEAT_HZ  # Hz: a cap for absurd speeds
 
     def amplitude(self, x: np.ndarray | float) -> np.ndarray:
         """a(x): the wave's amplitude (half the peak-to-peak excursion) in body lengths."""

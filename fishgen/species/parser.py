@@ -157,13 +157,15 @@ class _Fields:
         return value
 
     def whole(self, i: int, low: int = 0, high: int | None = None, what: str = "a whole number") -> int:
+        # the range is said either way: "16.5" for BodySections needs it as much as "2" does
+        rng = f"from {low} to {high}" if high is not None else f"of {low} or more"
+        expected = f"{what} {rng}" if what == "a whole number" else f"{what}, {rng}"
         value = _real(self.tokens[i])
         if value is None or not math.isfinite(value) or value != int(value):
-            raise self._fail(i, what)
+            raise self._fail(i, expected)
         value = int(value)
         if value < low or (high is not None and value > high):
-            rng = f"{low}..{high}" if high is not None else f">= {low}"
-            raise self._fail(i, f"{what} in {rng}")
+            raise self._fail(i, expected)
         return value
 
     def flag(self, i: int) -> bool:
@@ -314,8 +316,8 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     if shape_class not in SHAPE_NAMES:
         raise reader.error(line, "a shape class (one of " + ", ".join(sorted(SHAPE_NAMES)) + ")",
                            f"{shape_class!r}")
-    bodies = f.whole(1, 3, MAX_SECTIONS, "BodySections")
-    circles = f.whole(2, 3, MAX_SECTIONS, "CircleSections")
+    bodies = f.whole(1, 3, MAX_SECTIONS)
+    circles = f.whole(2, 3, MAX_SECTIONS)
     textured, masked, turn, catch = (f.flag(k) for k in range(3, 7))
     shape_params = tuple(f.number(k) for k in range(7, len(line.tokens)))
     problem = check_shape_params(shape_class, shape_params)

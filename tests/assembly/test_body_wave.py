@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from fishgen.assembly.fish import build_fish
+from fishgen.assembly.fish import build_fish, make_fish
 from fishgen.exchange import export
 from fishgen.geometry.body_wave import BodyWave
 from fishgen.scene.pose import deformed, pose
@@ -221,3 +221,26 @@ def test_the_bent_body_never_intersects_itself(sections, circles):
             segments = trimesh.intersections.mesh_plane(mesh3d, [0, 0, 1], [0, 0, z])
             if len(segments) > 2:
                 assert _slice_is_simple(segments[:, :, :2]), (sections, phase, z)
+
+
+@pytest.mark.parametrize("speed, fps", [(7, 30), (100, 30), (10, 240), (5.3, 30)])
+def test_the_loop_never_beats_faster_than_the_cap(speed, fps):
+    """Whole beats per loop were rounded to the nearest, up past the cap: 8.12 Hz at --speed 7,
+    8.33 Hz at --fps 240, 'capped at 8 Hz'."""
+    fish = make_fish(load_species(PARAMS / "bonybream.txt"), speed=speed, fps=fps)
+    assert fish.facts.tail_beat_hz <= BodyWave().max_frequency
+
+
+def test_a_loop_below_the_cap_keeps_its_nearest_whole_beats():
+    from fishgen.assembly.body_wave import loop_beats, loop_laps
+
+    wave = BodyWave()
+    for seconds in (0.1, 0.5, 1.6, 3.2, 7.3):
+        for speed in np.arange(0.05, 6.0, 0.05):
+            beats, hz = loop_beats(wave, speed, seconds)
+            nearest = max(1, round(float(wave.frequency(speed)) * seconds))
+            if nearest / seconds <= wave.max_frequency:
+                assert beats == nearest
+            else:   # rounded down, but a loop too short for one beat under the cap keeps its one
+                assert hz <= wave.max_frequency or beats == 1
+    assert loop_laps(wave, 1.0, 1.6, 100) == 2   # the shipped bream's loop: 3.2 s at 1.56 Hz

@@ -44,7 +44,7 @@ def test_the_report_has_each_jobs_inputs_options_output_hashes_time_status_and_e
     fish = jobs["fish/bonybream.glb"]
     assert fish["status"] == "built" and fish["kind"] == "build" and fish["seconds"] > 0
     assert fish["output_sha256"] == hashes(out)["fish/bonybream.glb"]
-    assert fish["options"] == {"fins": None, "fps": 30.0, "length": None, "speed": 1.0, "swim": "body",
+    assert fish["options"] == {"fins": None, "fps": 30.0, "length": None, "speed": None, "swim": "body",
                                "textures": None, "lods": None, "merge": False, "clips": ["swim"],
                                "compact": False}
     assert set(fish["inputs"]) == {"../../params/bonybream.txt", "../../textures/bonybream.png",

@@ -119,6 +119,11 @@ preset = "torus"
      "expected layout as one of sphere, box, line, ring, found 'donut'"),
     ('[[school]]\ninput = "a.txt"\noutput = "s.glb"\ntints = 3\nmerge = true\n', 3,
      "expected tints 1 with lods or merge"),
+    # options the job would ignore: speed without a body wave, voxel-size without voxels
+    ('[[build]]\ninput = "a.txt"\noutput = "a.glb"\nswim = "fins"\nspeed = 3\n', 3,
+     "expected swim body with speed (it sets the body wave's tail beat, which swim fins does not have)"),
+    ('[[clouds]]\ninput = "a.awn"\noutput = "a.glb"\nvoxel-size = 0.5\n', 3,
+     "expected a .nvdb or .vdb output with voxel-size, found '.glb'"),
     ('[[build]\ninput = "a.txt"\n', 1, "expected TOML"),
     ('out = "o"\n', None, "expected at least one job ([[build]], [[clouds]], [[school]])"),
 ])

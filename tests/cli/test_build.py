@@ -28,7 +28,8 @@ def test_obj_summary_says_the_animation_is_not_kept(tmp_path):
 def test_a_cube_file_says_which_command_builds_it(tmp_path):
     result = run_cli("build", PARAMS / "clouds" / "table_4_3.awn", "-o", tmp_path / "x.glb")
     assert result.returncode == 2 and result.stderr.count("\n") == 1
-    assert "found a RekAwan cloud cube file; use `fishgen clouds` for it" in result.stderr
+    assert ("found a .awn file (RekAwan cloud cube file, by its extension); use `fishgen clouds` for it"
+            in result.stderr)
 
 
 def test_help_documents_every_option():

@@ -125,6 +125,19 @@ def test_a_required_option_left_out_is_a_usage_error_in_one_line(tmp_path, name)
 
 
 @pytest.mark.parametrize("args", [
+    ["sky", "--mode", "thin", "--particles", "500"], ["school", "{fish}", "--count", "3", "--frames", "5"],
+    ["clouds", "{cubes}"],
+])
+def test_a_device_as_the_output_is_said_to_be_one(args):
+    """`-o /dev/null` read "found 'no extension'" where the format was checked first."""
+    fill = {"fish": PARAMS / "bonybream.txt", "cubes": PARAMS / "clouds" / "table_4_3.awn"}
+    result = run_cli(*[str(fill[a[1:-1]]) if a.startswith("{") else a for a in args], "-o", "/dev/null")
+    assert result.returncode == 2 and result.stderr == (
+        "/dev/null: expected a regular file or no file as the output, found a device, pipe or other "
+        "special file\n")
+
+
+@pytest.mark.parametrize("args", [
     ["sky", "--mode", "thin", "--particles", "500"], ["preview", "{fish}"], ["view", "--no-serve", "{glb}"],
     ["school", "{fish}", "--count", "3", "--frames", "5"], ["clouds", "{cubes}"],
     ["texture", "{photo}", "-s", "{fish}"],

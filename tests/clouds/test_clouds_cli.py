@@ -114,6 +114,8 @@ def test_total_mismatch_is_a_warning_on_stderr(cli, write_awn, tmp_path):
                               "finite numbers within float32 range, found '0,0,inf'"),
     (["--offset", "nan,0,0"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z"),
     (["--billboards"], "out.ply: expected a .glb or .gltf output with --billboards"),
+    # was ignored without a word, as --billboards is not
+    (["--voxel-size", "0.5"], "out.ply: expected a .nvdb or .vdb output with --voxel-size, found '.ply'"),
     (["--voxel-size", "0"], "fishgen clouds: Invalid value for '--voxel-size': 0.0 is not in the range "
                             "0<x<="),
     (["--voxel-size", "nan"], "fishgen clouds: Invalid value for '--voxel-size': 'nan' is not a finite "
@@ -322,3 +324,16 @@ def test_a_texture_cloud_to_gltf_names_its_textures_with_one_extension(cli, tmp_
 
     uris = [image["uri"] for image in json.loads((tmp_path / "x.gltf").read_text())["images"]]
     assert sorted(uris) == ["x_billow.png", "x_cumulus.png", "x_wisp.png"]
+
+
+def test_every_help_example_runs_as_written(cli, tmp_path):
+    """The two-cloud example named a.awn and b.awn, which no one has: it failed as written."""
+    import shlex
+
+    text = cli("clouds", "--help").stdout.replace("\\\n", " ")
+    examples = [shlex.split(line) for line in text.splitlines() if line.strip().startswith("fishgen clouds ")]
+    assert len(examples) == 5
+    for words in examples:
+        args = [str(tmp_path / word[len("out/"):]) if word.startswith("out/") else word for word in words[2:]]
+        result = cli("clouds", *args)
+        assert result.returncode == 0, (args, result.stderr)

@@ -116,7 +116,10 @@ FAULTS = [
     ("zero radius", "1\n1\n1, 1, 1, 1, 0, 0, 0, 0.0\n", 3, "maximum radius greater than 0"),
     ("negative radius", "1\n1\n1, 1, 1, 1, 0, 0, 0, -1\n", 3, "maximum radius greater than 0"),
     ("float32 underflow", "1\n1\n1, 1, 1, 1, 0, 0, 0, 1e-50\n", 3, "within float32 range"),
-    ("no particles at all", "0\n1\n0, 1, 1, 1, 0, 0, 0, 1\n", 3, "at least 1 particle"),
+    ("no particles at all", "0\n1\n0, 1, 1, 1, 0, 0, 0, 1\n", 1, "at least 1 particle"),
+    ("cubes of none under a total", "5\n1\n0, 1, 1, 1, 0, 0, 0, 1\n", 3, "at least 1 particle"),
+    ("one cube line missing", "1\n1\n", 3, "expected 1 cube line (declared on line 2), found 0"),
+    ("one cube too many", f"1\n1\n{GOOD}\n{GOOD}\n", 4, "after the 1 cube declared on line 2"),
 ]
 
 

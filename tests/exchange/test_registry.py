@@ -153,6 +153,20 @@ def test_an_input_is_judged_by_its_content_a_name_alone_by_its_extension_and_sai
                                    "extension of a VRFish species file; use `fishgen build` for it")
     with pytest.raises(FishgenError) as there:
         registry.input_format(PARAMS / "bonybream.txt", kinds=cubes, command="edit")
-    assert "found a VRFish species file; use `fishgen build`" in there.value.message
+    assert ("found a .txt file (VRFish species file, by its extension); use `fishgen build`"
+            in there.value.message)
     with pytest.raises(FishgenError, match="expected a file, found a directory"):
         registry.input_format(tmp_path, kinds=cubes, command="edit")
+
+
+def test_an_input_judged_by_its_extension_alone_is_not_said_to_hold_that_content(tmp_path):
+    """A species file named fish.glb read 'found binary glTF 2.0', though no byte was read; a
+    school scene (.toml, which several formats share) is told by its content, and said so."""
+    species = tmp_path / "fish.glb"
+    species.write_text((PARAMS / "bonybream.txt").read_text())
+    with pytest.raises(FishgenError) as named:
+        registry.input_format(species, kinds=[registry.FORMATS["species"]], command="build")
+    assert named.value.message.endswith("found a .glb file (binary glTF 2.0, by its extension)")
+    with pytest.raises(FishgenError) as sniffed:
+        registry.input_format(PARAMS / "reef.toml", kinds=[registry.FORMATS["species"]], command="build")
+    assert sniffed.value.message.endswith("found a school scene file; use `fishgen school` for it")

@@ -201,3 +201,8 @@ def test_a_duration_that_makes_no_loop_is_said(tmp_path, name, still):
     note = f"{out}: a still; --duration makes a loop in a .gif, or in a .webp with --frames\n"
     assert result.stderr == (note if still else "")
     assert (getattr(Image.open(out), "n_frames", 1) == 1) == still
+
+
+def test_help_names_every_input_kind():
+    text = " ".join(run_cli("preview", "--help").stdout.split())
+    assert "a cloud cube file (.awn), a texture cloud (.awa) or an asset" in text   # .awa went unsaid

@@ -128,7 +128,7 @@ def test_fin_point_count_must_follow_fin_structure(tmp_path):
 def test_fin_section_outside_the_body(tmp_path):
     err = error_of(tmp_path, replace_record(BONY, "7.0 10.0 0.6 0.05 70.0 0.98",
                                             "7.0 16.0 0.6 0.05 70.0 0.98"))
-    assert ("dorsal fin endBodySection as a BodySection number after startBodySection 7 in 8..15, "
+    assert ("dorsal fin endBodySection as a BodySection number after startBodySection 7, from 8 to 15, "
             "found '16.0'" in str(err))
 
 
@@ -145,7 +145,7 @@ def test_a_fin_on_one_body_section_is_refused_at_its_line(tmp_path, fin, record,
 
 def test_pectoral_triangles_may_not_wrap_the_body(tmp_path):
     err = error_of(tmp_path, replace_record(BONY, "6.0 2.0 3.0 0.95", "6.0 2.0 12.0 0.95"))
-    assert "pectoral no_of_triangles" in str(err) and "1..11" in str(err)
+    assert "pectoral no_of_triangles" in str(err) and "from 1 to 11" in str(err)
 
 
 def test_unknown_shape_class(tmp_path):
@@ -212,7 +212,19 @@ def test_binary_file(tmp_path):
 
 def test_absurd_level_of_detail_is_refused_before_allocating(tmp_path):
     err = error_of(tmp_path, replace_record(BONY, "FishShapeSin 16 12", "FishShapeSin 100000000 12"))
-    assert "BodySections in 3..1024" in str(err) and "'100000000'" in str(err)
+    assert "BodySections as a whole number from 3 to 1024, found '100000000'" in str(err)
+
+
+@pytest.mark.parametrize("old, new, message", [
+    # said "BodySections as BodySections": the expectation named the field again
+    ("FishShapeSin 16 12", "FishShapeSin 16.5 12",
+     "BodySections as a whole number from 3 to 1024, found '16.5'"),
+    # said "a whole number in >= 0"
+    ("//number_of_ points_body_points\n192", "//number_of_ points_body_points\n-5",
+     "number_of_points_body_points as a whole number of 0 or more, found '-5'"),
+])
+def test_a_whole_number_says_its_range_in_words(tmp_path, old, new, message):
+    assert message in str(error_of(tmp_path, replace_record(BONY, old, new)))
 
 
 def test_step_size_required_for_a_moving_fin(tmp_path):
