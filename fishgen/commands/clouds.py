@@ -141,6 +141,9 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
                     "written as particles")
     check_targets([output], textures)
     check_output(output, billboards, particles=sum(f.total for f in files))  # a glTF buffer holds 4 GiB
+    from fishgen.clouds.memory import check_fits
+
+    check_fits(sum(f.total for f in files), output.suffix, billboards)    # before anything is filled
     volume = output.suffix.lower() in VOLUME_FORMATS
     voxel_size = options.voxel_size if options.voxel_size is not None else DEFAULT_VOXEL_SIZE
     if volume:

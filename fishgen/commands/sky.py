@@ -117,6 +117,9 @@ def sky(inputs: Sequence[Path], output: str | os.PathLike, options: SkyOptions =
     check_targets([output], [*models, *read_beside(models, kinds, options.textures)])
     total = options.particles if options.particles is not None else MODES[options.mode].particles
     check_output(output, options.billboards, particles=total)
+    from fishgen.clouds.memory import check_fits
+
+    check_fits(total, output.suffix, options.billboards, sky=True)    # before anything is filled
     from fishgen.sky.build import build_sky
 
     built = build_sky(options.mode, seed=options.seed, area=options.area, altitude=options.altitude,

@@ -337,3 +337,39 @@ def test_every_help_example_runs_as_written(cli, tmp_path):
         args = [str(tmp_path / word[len("out/"):]) if word.startswith("out/") else word for word in words[2:]]
         result = cli("clouds", *args)
         assert result.returncode == 0, (args, result.stderr)
+
+
+def test_the_memory_estimate_is_above_what_a_run_peaks_at():
+    """The estimate errs high: measured peaks (VmPeak, kB; Table 4.4 scaled, lit) stay below it, by
+    less than 40 %."""
+    from fishgen.clouds.memory import estimate
+
+    measured = {(1_000_000, ".glb", False, False): 413_568, (3_000_000, ".glb", False, False): 499_452,
+                (1_000_000, ".gltf", False, False): 453_520, (3_000_000, ".gltf", False, False): 621_484,
+                (1_000_000, ".glb", True, False): 1_067_820, (3_000_000, ".glb", True, False): 2_563_920,
+                (1_000_000, ".gltf", True, False): 1_255_364, (3_000_000, ".gltf", True, False): 3_091_284,
+                (1_000_000, ".glb", False, True): 745_768, (3_000_000, ".glb", False, True): 972_672,
+                (1_000_000, ".glb", True, True): 1_176_108}
+    for (particles, suffix, billboards, sky), kib in measured.items():
+        need = estimate(particles, suffix, billboards, sky)
+        assert kib * 1024 < need < 1.4 * kib * 1024, (particles, suffix, billboards, sky)
+
+
+@pytest.mark.parametrize("command", ["clouds", "sky"])
+def test_a_cloud_that_would_not_fit_in_memory_is_refused_before_it_is_filled(tmp_path, monkeypatch, command):
+    """6 million billboards took 5 GB before ending in an out-of-memory error; a limit known up front
+    refuses them in one line, as a school too big is refused."""
+    import fishgen.clouds.memory as memory
+    from fishgen.commands import command as named
+    from fishgen.commands import run
+    from fishgen.errors import UsageError
+
+    monkeypatch.setattr(memory, "allowed", lambda: (600 * 2**20, "this process's address-space limit"))
+    cmd = named(command)
+    options = cmd.options(billboards=True, **({"particles": 2_000_000} if command == "sky" else {}))
+    big = tmp_path / "big.awn"
+    big.write_text("2000000\n1\n2000000, 10, 10, 10, 0, 0, 0, 1\n")
+    inputs = (big,) if command == "clouds" else ()
+    with pytest.raises(UsageError, match=r"fits in 600 MiB .* found 2,000,000 billboards for \.glb"):
+        run(cmd, inputs, tmp_path / "out.glb", options)
+    assert not (tmp_path / "out.glb").exists()

@@ -1,0 +1,32 @@
+"""How much memory this process may use, to refuse a run that would not fit before allocating.
+
+A leaf module (no numpy): `fishgen school` (:mod:`fishgen.school.memory`) and the cloud commands
+(:mod:`fishgen.clouds.memory`) estimate their peaks from their sizes and compare them with this.
+"""
+from __future__ import annotations
+
+import os
+import resource
+
+
+def allowed() -> tuple[int, str] | None:
+    """The memory this process may use and what sets it: the address-space limit if one is set,
+    else the machine's available memory; None if neither is known."""
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft != resource.RLIM_INFINITY:
+        return soft, "this process's address-space limit"
+    try:
+        with open("/proc/meminfo", encoding="ascii") as info:
+            for line in info:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024, "the memory this machine has available"
+    except OSError:
+        pass
+    pages = os.sysconf("SC_AVPHYS_PAGES") if hasattr(os, "sysconf") else -1
+    if pages <= 0:
+        return None
+    return pages * os.sysconf("SC_PAGE_SIZE"), "the memory this machine has available"
+
+
+def size_text(n: int) -> str:
+    return f"{n / 2**30:.1f} GiB" if n >= 2**30 else f"{n / 2**20:.0f} MiB"
