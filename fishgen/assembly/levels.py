@@ -33,10 +33,8 @@ def at_level(species: Species, bodies: int, circles: int) -> Species:
     def sec(k: int) -> int:
         return min(max(_nearest(k * (bodies - 1) / (b0 - 1)), 0), bodies - 1)
 
-    o0, o1 = ring_offset(c0), ring_offset(circles)
-
-    def circ(k: int) -> int:  # the new point nearest the same angle (an odd ring is turned)
-        return _nearest((k + o0) * circles / c0 - o1) % circles
+    def circ(k: int) -> int:
+        return circle_at(k, c0, circles)
 
     def vertical(f: VerticalFin) -> VerticalFin:  # a fin spans at least one section's length
         start = min(sec(f.start_section), bodies - 2)
@@ -67,6 +65,13 @@ def at_level(species: Species, bodies: int, circles: int) -> Species:
         anal=_vertical_points(tp.anal, out.anal),
         pectoral=_pectoral_points(tp.pectoral, pectoral.triangles),
         pelvic=_pelvic_points(tp.pelvic, pelvic.end_section - pelvic.start_section + 1)))
+
+
+def circle_at(k: int, circles: int, new_circles: int) -> int:
+    """The point of a ring of ``new_circles`` nearest the angle of point ``k`` of one of ``circles``
+    (an odd ring is turned a quarter step: :func:`~fishgen.geometry.body.ring_offset`)."""
+    at = (k + ring_offset(circles)) * new_circles / circles - ring_offset(new_circles)
+    return _nearest(at) % new_circles
 
 
 def _per_step(proportion: float, steps: int, new_steps: int) -> float:

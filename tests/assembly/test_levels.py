@@ -151,3 +151,14 @@ def test_every_level_keeps_its_fins_on_over_every_clip(levels):
 def test_levels_must_go_from_finest_to_coarsest(bony, lods):
     with pytest.raises(FishgenError, match="--lods"):
         make_fish(bony, lods=lods)
+
+
+@pytest.mark.parametrize("circles", [5, 7, 9, 10])
+def test_texture_at_other_circle_sections_puts_the_paired_fins_where_a_level_does(bony, circles):
+    """`texture --circle-sections 5` moved BonyBream's pelvic fin from below the flank (330 degrees)
+    to above it (+18): its own copy of the level mapping was not taught the odd ring's turn."""
+    from fishgen.authoring.photo.sideview import with_counts
+
+    texture, level = with_counts(bony, None, circles), at_level(bony, bony.body_sections, circles)
+    assert texture.pelvic.start_circle == level.pelvic.start_circle
+    assert texture.pectoral.start_circle == level.pectoral.start_circle

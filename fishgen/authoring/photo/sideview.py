@@ -113,8 +113,10 @@ def with_counts(base: Species, sections: int | None, circles: int | None) -> Spe
     def sec(k: int) -> int:
         return int(np.clip(round(k * (b - 1) / (b0 - 1)), 0, b - 1))
 
-    def circ(k: int) -> int:
-        return int(round(k * c / c0)) % c
+    def circ(k: int) -> int:  # by angle, as a level of detail maps it (an odd ring is turned)
+        from fishgen.assembly.levels import circle_at
+
+        return circle_at(k, c0, c)
 
     def vertical(f: VerticalFin) -> VerticalFin:  # a fin spans at least one section's length
         start = min(sec(f.start_section), b - 2)
