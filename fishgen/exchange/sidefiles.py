@@ -83,8 +83,7 @@ def image_side_stems(asset_stem: str, image_names: list[str]) -> list[str]:
 
 NAMING = (".gltf", ".mtl", ".usda", ".usdc", ".usd", ".ply")
 """Formats whose files name side files beside them (a glTF's images and buffer, an OBJ's material
-file's textures, USD's textures, a textured PLY's TextureFile). A .usdc's names may be compressed,
-so it is taken to name every side file of its stem."""
+file's textures, USD's textures, a textured PLY's TextureFile); each holds the names as bytes."""
 _READ_MOST = 1 << 26
 
 
@@ -98,13 +97,12 @@ def check_shared(asset: str | os.PathLike, files: Mapping[Path, bytes]) -> None:
     from fishgen.errors import UsageError
 
     asset = Path(asset)
-    writing = {Path(os.path.abspath(p)) for p in files}
-    siblings = [p for ext in NAMING for p in [asset.with_name(asset.stem + ext)]
-                if Path(os.path.abspath(p)) not in writing and p.is_file()]
+    writing = [Path(p) for p in files]
+    siblings = [p for p in _same_stem(asset) if not any(_same(p, w) for w in writing)]
     if not siblings:
         return
     for side, data in files.items():
-        if Path(os.path.abspath(side)) == Path(os.path.abspath(asset)) or not side.is_file():
+        if _same(side, asset) or not side.is_file():
             continue
         try:
             if side.stat().st_size == len(data) and side.read_bytes() == data:
@@ -119,10 +117,29 @@ def check_shared(asset: str | os.PathLike, files: Mapping[Path, bytes]) -> None:
                                  f"{other.name!r} beside it, with other content; choose another -o")
 
 
+def _same_stem(asset: Path) -> list[Path]:
+    """The files beside ``asset`` of its stem in a format that names side files, any case."""
+    try:
+        entries = list(os.scandir(asset.parent if str(asset.parent) else "."))
+    except OSError:
+        return []
+    return sorted(asset.with_name(e.name) for e in entries
+                  if Path(e.name).stem == asset.stem and Path(e.name).suffix.lower() in NAMING
+                  and e.is_file())
+
+
+def _same(a: Path, b: Path) -> bool:
+    """One file, however spelt (a case-insensitive file system, a link)."""
+    if os.path.abspath(a) == os.path.abspath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
 def _names(asset: Path, name: str) -> bool:
-    """Whether ``asset`` names the side file ``name`` (a .usdc is taken to name all of its stem's)."""
-    if asset.suffix.lower() in (".usdc", ".usd"):
-        return name.startswith(asset.stem)
+    """Whether ``asset`` names the side file ``name``."""
     try:
         with asset.open("rb") as handle:
             data = handle.read(_READ_MOST)

@@ -64,3 +64,30 @@ def test_an_asset_may_replace_its_own_texture(tmp_path):
     run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="mask"))
     run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="opaque"))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["foo.bin", "foo.gltf", "foo_skin.png"]
+
+
+def test_a_usdc_beside_it_blocks_only_the_side_files_it_names(tmp_path):
+    """A .usdc was taken to name every file of its stem: rebuilding foo.gltf with another --length
+    was refused for foo.bin, which no USD names."""
+    from fishgen.commands import run
+    from fishgen.commands.build import COMMAND
+    from fishgen.errors import UsageError
+
+    bream = PARAMS / "bonybream.txt"
+    run(COMMAND, (bream,), tmp_path / "foo.usdc", COMMAND.options(fins="mask"))
+    run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="mask"))
+    run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="mask", length=0.5))   # foo.bin changes
+    with pytest.raises(UsageError, match="named by 'foo.usdc'"):
+        run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="opaque"))
+
+
+def test_an_asset_of_another_case_names_its_side_files_too(tmp_path):
+    from fishgen.commands import run
+    from fishgen.commands.build import COMMAND
+    from fishgen.errors import UsageError
+
+    bream = PARAMS / "bonybream.txt"
+    run(COMMAND, (bream,), tmp_path / "foo.GLTF", COMMAND.options(fins="mask"))
+    with pytest.raises(UsageError, match="named by 'foo.GLTF'"):
+        run(COMMAND, (bream,), tmp_path / "foo.obj", COMMAND.options(fins="opaque"))
+    run(COMMAND, (bream,), tmp_path / "foo.GLTF", COMMAND.options(fins="opaque"))              # its own
