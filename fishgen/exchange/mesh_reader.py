@@ -275,7 +275,8 @@ def _check_ply_header(path: Path) -> None:
     for number, line in enumerate(lines, 1):
         words = line.split()
         if len(words) >= 3 and words[:2] == ["comment", "TextureFile"]:
-            _named_texture(path, line.split(None, 2)[2].strip(), number)
+            # its bytes as trimesh reads them: UTF-8 (a name like pòisson_skin.png), else Latin-1
+            _named_texture(path, _decode(line.encode("latin-1")).split(None, 2)[2].strip(), number)
         if not words or words[0] in ("ply", "comment", "obj_info", "end_header"):
             continue
         if words[0] == "format":

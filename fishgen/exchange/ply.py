@@ -66,7 +66,9 @@ def _write_mesh(scene: Scene, path: Path) -> list[Path]:
         header.append(f"comment TextureFile {texture}")
     header += [f"element vertex {len(vertices)}"] + [f"property float {n}" for n in VERTEX.names or ()]
     header += [f"element face {len(faces)}", "property list uchar int vertex_indices", "end_header", ""]
-    files = {path: "\n".join(header).encode("ascii") + vertices.tobytes() + faces.tobytes()}
+    # The header is ASCII but for a texture's file name, which must be the file's own: UTF-8, as
+    # trimesh (and so fishgen's reader) reads it; "pòisson.ply" was a traceback.
+    files = {path: "\n".join(header).encode("utf-8") + vertices.tobytes() + faces.tobytes()}
     if texture and image is not None:
         files[path.with_name(texture)] = image.encoded()
     check_shared(path, files)

@@ -151,6 +151,18 @@ def test_output_names_that_need_percent_encoding(tmp_path):
     assert_valid_gltf(out)
 
 
+@pytest.mark.parametrize("name", ["pòisson.ply", "my fish.ply", "pòisson.obj"])
+def test_a_textured_mesh_of_any_name_reads_back_with_its_texture(tmp_path, name):
+    """`build -o pòisson.ply` was a traceback: the PLY's header named its texture in ASCII."""
+    from fishgen.exchange.mesh_reader import read_mesh_file
+
+    out = tmp_path / name
+    result = run_cli("build", PARAMS / "bonybream.txt", "-o", out)
+    assert result.returncode == 0, result.stderr
+    scene = read_mesh_file(out)
+    assert scene.images and scene.images[0].rgba().shape[2] == 4
+
+
 def test_an_existing_folder_is_a_folder_whatever_its_name(tmp_path):
     (tmp_path / "x.glb").mkdir()
     result = run_cli("build", PARAMS / "bonybream.txt", "-o", tmp_path / "x.glb")
