@@ -153,16 +153,16 @@ def run(cmd: Command, inputs: tuple[Path, ...], output: str | os.PathLike | None
     a command that writes one file is given a file, not a folder."""
     from fishgen.atomic import protecting
 
-    if output is not None and cmd.output is not None and not cmd.output.folder:
+    if output is not None and cmd.output is not None:
+        from fishgen.atomic import check_target
         from fishgen.commands.paths import names_folder
         from fishgen.errors import UsageError
 
-        if names_folder(output):
+        folder = names_folder(output)
+        if folder and not cmd.output.folder:
             raise UsageError(f"expected -o to name an output file, found the folder {os.fspath(output)!r}")
-        from fishgen.atomic import check_target
-
-        # before the format's check: `-o /dev/null` is a device, not a name with no extension
-        check_target(Path(output))
+        if not folder:  # before the format's check: `-o /dev/null` is a device, not a name with no extension
+            check_target(Path(output))
     with protecting(inputs):
         return cmd.function()(inputs, output, options, events)
 

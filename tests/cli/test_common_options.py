@@ -126,7 +126,7 @@ def test_a_required_option_left_out_is_a_usage_error_in_one_line(tmp_path, name)
 
 @pytest.mark.parametrize("args", [
     ["sky", "--mode", "thin", "--particles", "500"], ["school", "{fish}", "--count", "3", "--frames", "5"],
-    ["clouds", "{cubes}"],
+    ["clouds", "{cubes}"], ["species", "--random"], ["build", "{fish}"],
 ])
 def test_a_device_as_the_output_is_said_to_be_one(args):
     """`-o /dev/null` read "found 'no extension'" where the format was checked first."""
