@@ -173,15 +173,20 @@ def input_format(path: str | os.PathLike, *, kinds: Iterable[Format], command: s
     found = candidates(path)
     there = Path(path).is_file()
     fmt = detect(path) if there else None
+    sniffed = fmt is not None and len(found) > 1    # read and recognised, not named by its extension
     if fmt is None:  # no content to tell by (or no sniff agreed): the one this command reads
         fmt = next((f for f in found if f in allowed), found[0] if found else None)
     if fmt in allowed:
         return fmt
+    if fmt is not None and there and len(found) > 1 and not sniffed:  # no sharing format knew it
+        names = " nor ".join(f.description for f in found)
+        raise FishgenError(f"expected an input of `fishgen {command}` ({', '.join(extensions(allowed))}), "
+                           f"found a {Path(path).suffix} file that is neither {names}", path)
     if fmt is not None:
         use = f"; use `fishgen {fmt.command}` for it" if fmt.command and fmt.command != command else ""
         # only a sniff reads the content: a format judged by its extension alone is said to be
         suffix = Path(path).suffix
-        what = (fmt.description if there and len(found) > 1
+        what = (fmt.description if sniffed
                 else f"a {suffix} file ({fmt.description.removeprefix('a ')}, by its extension)" if there
                 else f"{suffix!r}, the extension of {fmt.description}")
         raise FishgenError(f"expected an input of `fishgen {command}` ({', '.join(extensions(allowed))}), "

@@ -170,3 +170,9 @@ def test_an_input_judged_by_its_extension_alone_is_not_said_to_hold_that_content
     with pytest.raises(FishgenError) as sniffed:
         registry.input_format(PARAMS / "reef.toml", kinds=[registry.FORMATS["species"]], command="build")
     assert sniffed.value.message.endswith("found a school scene file; use `fishgen school` for it")
+    junk = tmp_path / "junk.toml"
+    junk.write_bytes(bytes(range(256)))
+    with pytest.raises(FishgenError) as neither:          # no sharing format knew it: none is claimed
+        registry.input_format(junk, kinds=[registry.FORMATS["species"]], command="build")
+    assert neither.value.message.endswith("found a .toml file that is neither a school scene file nor a "
+                                          "batch manifest")
