@@ -117,6 +117,16 @@ def cannot(action: str, path: str | os.PathLike, err: OSError) -> SystemFailure:
     return SystemFailure(f"cannot {action} {os.fspath(path)}: {err.strerror or err}", path)
 
 
+def plural(count: int, noun: str) -> str:
+    """``1 cube``, ``2 cubes``, ``1,000 files``: a count and its noun, as messages and summaries say it."""
+    return f"{count:,} {noun}{'s' * (count != 1)}"
+
+
+def either(words: list[str] | tuple[str, ...], conjunction: str = "or") -> str:
+    """``a``, ``a or b``, ``a, b or c``: words as a sentence lists them."""
+    return ", ".join(words[:-1]) + f" {conjunction} " + words[-1] if len(words) > 1 else "".join(words)
+
+
 def describe(token: str, limit: int = 40) -> str:
     """Quote a piece of input for an error message, shortened and made printable."""
     text = token if len(token) <= limit else token[: limit - 1] + "…"

@@ -235,13 +235,8 @@ def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None
                       swim_plan_.tail_beat_hz if has_swim and swim_plan_ is not None else None,
                       swim_clip.duration if has_swim and swim_clip is not None else None,
                       level_facts, clip_facts, merge, targets, draw_calls,
-                      wave.max_frequency if has_swim and waving and _capped(wave, speed) else None)
+                      wave.max_frequency if has_swim and waving and wave.capped(speed) else None)
     return Fish(scene, facts)
-
-
-def _capped(wave: BodyWave, speed: float) -> bool:
-    """Whether ``speed`` asks for a faster tail beat than the wave's cap."""
-    return wave.strouhal * abs(speed) / wave.tail_peak_to_peak > wave.max_frequency
 
 
 def _fin_loop_frames(species: Species, swings: list[FinSwing]) -> int:

@@ -21,7 +21,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, Cube, CubeFile
-from fishgen.errors import FishgenError, describe, expected
+from fishgen.errors import FishgenError, describe, expected, plural
 
 # ASCII-only patterns: "１２" (full-width digits) or "1_000" are not numbers in this format.
 _SEPARATOR = re.compile(r"[ \t]*,[ \t]*|[ \t]+")
@@ -179,11 +179,11 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
     cube_rows = rows[2:]
     if len(cube_rows) > declared_cubes:
         extra = cube_rows[declared_cubes][0]
-        raise expected(f"the end of the file after the {_plural(declared_cubes, 'cube')} declared on line "
+        raise expected(f"the end of the file after the {plural(declared_cubes, 'cube')} declared on line "
                        f"{rows[1][0]}", "another cube line", name, extra)
     if len(cube_rows) < declared_cubes:
         last = cube_rows[-1][0] if cube_rows else rows[1][0]
-        raise expected(f"{_plural(declared_cubes, 'cube line')} (declared on line {rows[1][0]})",
+        raise expected(f"{plural(declared_cubes, 'cube line')} (declared on line {rows[1][0]})",
                        f"{len(cube_rows)}", name, last + 1)
 
     cubes: list[Cube] = []
@@ -207,9 +207,6 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
     return CubeFile(path=name, declared_total=declared_total, cubes=tuple(cubes),
                     warnings=tuple(notes))
 
-
-def _plural(count: int, noun: str) -> str:
-    return f"{count:,} {noun}{'s' * (count != 1)}"
 
 
 def _decode(data: bytes, name: str) -> str:

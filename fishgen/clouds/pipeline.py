@@ -126,14 +126,14 @@ def cube_clouds(models: Sequence[CubeFile], *, seed: int = 0, method: str = "pap
     """
     from fishgen.clouds.fill import fill_cloud, merge_clouds
     from fishgen.clouds.light import light_cloud
-    from fishgen.errors import UsageError
+    from fishgen.errors import UsageError, plural
 
     models = tuple(models)
     places = tuple(offsets) or ((0.0, 0.0, 0.0),) * len(models)
     filled = tuple(scaled(m, most) if most is not None and m.total > most else m for m in models)
     total = sum(m.total for m in filled)
     if total > max_particles:
-        files = f"{len(models):,} file{'s' * (len(models) != 1)}"
+        files = plural(len(models), "file")
         raise UsageError(f"expected at most {max_particles:,} particles in the scene (raise the limit with "
                          f"--max-particles), found {total:,} in {files}")
     fills = (fill_cloud(m, seed=seed + i, method=method, offset=place)

@@ -10,6 +10,7 @@ import click
 
 from fishgen.assembly.fish_options import FishOptions
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output, each_input
+from fishgen.errors import either, plural
 from fishgen.exchange.registry import MESHES, extensions, formats
 from fishgen.options import option, textures_option
 
@@ -116,8 +117,7 @@ def _lost(fins: tuple[str, ...]) -> str:
         return ""
     names = [name.removesuffix("_fin").replace("_fin_", " ").replace("_", " ") for name in fins]
     kinds = list(dict.fromkeys(n.split(" ")[0] for n in names))     # a pair is named once
-    return "; no " + (" or ".join([", ".join(kinds[:-1]), kinds[-1]]) if len(kinds) > 1 else kinds[0]) + \
-        (" fins" if len(kinds) > 1 or len(names) > 1 else " fin")
+    return f"; no {either(kinds)} fin" + "s" * (len(names) > 1)
 
 
 def summary(fish, target: Path, written: list[Path]) -> str:
@@ -142,8 +142,7 @@ def summary(fish, target: Path, written: list[Path]) -> str:
                                           for lv in facts.levels)
     if facts.merged:
         motion += f", merged ({facts.draw_calls} draw calls)"
-    listed = ", ".join(dropped[:-1]) + (" or " if len(dropped) > 1 else "") + dropped[-1] if dropped else ""
-    note = f" ({fmt.extensions[0][1:].upper()} holds no {listed})" if dropped and fmt else ""
+    note = f" ({fmt.extensions[0][1:].upper()} holds no {either(dropped)})" if dropped and fmt else ""
     return (f"{target}: {scene.name}, {scene.counts()['triangles']} triangles, "
             f"{facts.body_length:.3f} m long, fins {facts.fin_mode}, {motion}{note}"
-            + (f" (+{len(written) - 1} file{'s' * (len(written) > 2)})" if len(written) > 1 else ""))
+            + (f" (+{plural(len(written) - 1, 'file')})" if len(written) > 1 else ""))

@@ -109,7 +109,7 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     scene; input i is filled with seed + i. A texture cloud (.awa) becomes textured billboards."""
     from fishgen.clouds.pipeline import cloud_textures, cube_clouds, read_cube_files
     from fishgen.commands.paths import check_inputs, check_targets
-    from fishgen.errors import UsageError
+    from fishgen.errors import UsageError, plural
     from fishgen.exchange.clouds import VOLUME_FORMATS, check_output, export_cloud
     from fishgen.exchange.registry import FORMATS
 
@@ -161,12 +161,9 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
 
         cloud, sun = merge_clouds(made.clouds), "unlit"
     written = export_cloud(cloud, output, billboards=billboards, voxel_size=voxel_size)
-    line = (f"{output}: {_plural(len(cloud), made.noun)} in {_plural(len(cloud.cube_bounds), 'cube')} "
-            f"from {_plural(len(files), 'file')} ({options.method} fill, seed {seed}, {sun}"
+    line = (f"{output}: {plural(len(cloud), made.noun)} in {plural(len(cloud.cube_bounds), 'cube')} "
+            f"from {plural(len(files), 'file')} ({options.method} fill, seed {seed}, {sun}"
             f"{f', voxels of {voxel_size:g}' * volume})")
     facts = CloudFacts(len(cloud), len(cloud.cube_bounds), len(files), billboards, options.lighting)
     return Made(tuple(written), (*inputs, *textures), (line,), facts)
 
-
-def _plural(count: int, noun: str) -> str:
-    return f"{count:,} {noun}{'s' * (count != 1)}"

@@ -43,9 +43,16 @@ class BodyWave:
         return 2.0 * float(self.amplitude(1.0))
 
     def frequency(self, speed: np.ndarray | float) -> np.ndarray:
-        """Tail-beat frequency (Hz) at swimming speed U (body lengths per second): f = St U / A."""
-        f = self.strouhal * np.abs(np.asarray(speed, dtype=np.float64)) / self.tail_peak_to_peak
-        return np.minimum(f, self.max_frequency)
+        """Tail-beat frequency (Hz) at swimming speed U (body lengths per second): f = St U / A,
+        at most ``max_frequency``."""
+        return np.minimum(self._strouhal_frequency(speed), self.max_frequency)
+
+    def capped(self, speed: float) -> bool:
+        """Whether ``speed`` asks for a faster tail beat than ``max_frequency``."""
+        return bool(self._strouhal_frequency(speed) > self.max_frequency)
+
+    def _strouhal_frequency(self, speed: np.ndarray | float) -> np.ndarray:
+        return self.strouhal * np.abs(np.asarray(speed, dtype=np.float64)) / self.tail_peak_to_peak
 
     def shapes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The two standing waves S(x), C(x) (body lengths) at positions x along the body."""

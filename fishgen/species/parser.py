@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, plural
 from fishgen.file_names import resolve_texture
 from fishgen.reading import read_capped
 from fishgen.shape_names import SHAPE_NAMES, check_shape_params
@@ -114,7 +114,7 @@ def _found_values(line: _Line) -> str:
         shown = shown[:47] + "…"
     non_numeric = next((t for t in tokens if not _is_number(t)), None)
     hint = _hint(non_numeric) if non_numeric is not None else ""
-    return f"{len(tokens)} value{'s' if len(tokens) != 1 else ''} {shown!r}{hint}"
+    return f"{plural(len(tokens), 'value')} {shown!r}{hint}"
 
 
 # The number forms the thesis' files use, ASCII only: Python's float() also takes "1_0.0",

@@ -61,3 +61,13 @@ def test_the_speed_help_states_the_cap():
 
     speed = next(spec for f, spec in declared(COMMAND.options) if f.name == "speed")
     assert "at most 8 Hz (from 5.33 BL/s up" in speed.help
+
+
+@pytest.mark.parametrize("fins, said", [
+    (("anal_fin",), "; no anal fin"), (("pectoral_fin_left", "pectoral_fin_right"), "; no pectoral fins"),
+    (("adipose_fin", "anal_fin"), "; no adipose or anal fins"),
+    (("dorsal_fin", "adipose_fin", "anal_fin"), "; no dorsal, adipose or anal fins"), ((), "")])
+def test_a_levels_lost_fins_are_said_as_a_sentence_says_them(fins, said):
+    from fishgen.commands.build import _lost
+
+    assert _lost(fins) == said

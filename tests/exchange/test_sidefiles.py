@@ -76,7 +76,7 @@ def test_a_usdc_beside_it_blocks_only_the_side_files_it_names(tmp_path):
     bream = PARAMS / "bonybream.txt"
     run(COMMAND, (bream,), tmp_path / "foo.usdc", COMMAND.options(fins="mask"))
     run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="mask"))
-    run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="mask", length=0.5))   # foo.bin changes
+    run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="mask", length=0.5))  # a new foo.bin
     with pytest.raises(UsageError, match="named by 'foo.usdc'"):
         run(COMMAND, (bream,), tmp_path / "foo.gltf", COMMAND.options(fins="opaque"))
 
