@@ -42,10 +42,15 @@ _TINY = np.finfo(np.float32).smallest_subnormal
 def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
                offset: Sequence[float] = (0.0, 0.0, 0.0), workers: int | None = None) -> Cloud:
     """Fill every cube with its particles; ``offset`` moves the whole cloud in the scene."""
+    # a library caller's arguments get the command line's kind of error, not numpy's
     if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, not {method!r}")
+        raise FishgenError(f"expected a fill method of {' or '.join(METHODS)}, found {method!r}")
     if int(seed) < 0:
-        raise ValueError("seed must be 0 or more")
+        raise FishgenError(f"expected a seed of 0 or more, found {seed}")
+    if np.shape(offset) != (3,):
+        shown = ", ".join(f"{v:g}" if isinstance(v, (int, float)) else repr(v)
+                          for v in np.ravel(offset).tolist())
+        raise FishgenError(f"expected an offset of three numbers (x, y, z), found ({shown})")
     cubes = cube_file.cubes
     counts = np.array([c.particles for c in cubes], np.int64)
     size = np.array([c.size for c in cubes], np.float64).reshape(-1, 3)
@@ -118,7 +123,7 @@ def merge_clouds(clouds: Sequence[Cloud]) -> Cloud:
     their light; otherwise the merged cloud is unlit (its colours kept).
     """
     if not clouds:
-        raise ValueError("merge_clouds needs at least one cloud")
+        raise FishgenError("expected at least one cloud to merge, found none")
     if len(clouds) == 1:
         return clouds[0]
     shifts = np.cumsum([0] + [len(c.cube_bounds) for c in clouds[:-1]])

@@ -447,9 +447,10 @@ def load_species(path: str | os.PathLike, textures_dir: str | os.PathLike | None
     path = Path(path)
     file = os.fspath(path)
     try:
-        if not stat.S_ISREG(path.stat().st_mode):
-            raise FishgenError("expected a regular species file, found a device, pipe or other special file",
-                               file)
+        mode = path.stat().st_mode
+        if not stat.S_ISREG(mode):
+            kind = "a directory" if stat.S_ISDIR(mode) else "a device, pipe or other special file"
+            raise FishgenError(f"expected a regular species file, found {kind}", file)
         with path.open("rb") as handle:
             data = read_capped(handle, MAX_SPECIES_FILE_BYTES)
         if len(data) > MAX_SPECIES_FILE_BYTES:

@@ -9,6 +9,7 @@ from cloud_tables import TABLES
 from scipy import stats
 
 from fishgen.clouds import Cube, CubeFile, Lighting, fill_cloud, light_cloud, load_cubes, merge_clouds
+from fishgen.errors import FishgenError
 
 METHODS = ("paper", "uniform")
 
@@ -145,15 +146,18 @@ def test_merge_renumbers_cubes_and_keeps_everything():
     lo, hi = scene.cube_bounds[scene.cube_index, 0], scene.cube_bounds[scene.cube_index, 1]
     assert np.all((scene.centers >= lo) & (scene.centers <= hi))
     assert merge_clouds([a]) is a
-    with pytest.raises(ValueError):
+    with pytest.raises(FishgenError, match="expected at least one cloud to merge, found none"):
         merge_clouds([])
 
 
-def test_bad_method_and_seed():
-    with pytest.raises(ValueError, match="method"):
+def test_bad_method_seed_and_offset_are_said_as_the_command_line_says_them():
+    """A library caller's offset of two numbers was numpy's "cannot reshape array of size 2"."""
+    with pytest.raises(FishgenError, match="expected a fill method of paper or uniform, found 'gaussian'"):
         fill_cloud(one_cube(10), method="gaussian")
-    with pytest.raises(ValueError, match="seed"):
+    with pytest.raises(FishgenError, match="expected a seed of 0 or more, found -1"):
         fill_cloud(one_cube(10), seed=-1)
+    with pytest.raises(FishgenError, match=r"an offset of three numbers \(x, y, z\), found \(1, 2\)"):
+        fill_cloud(one_cube(10), offset=(1, 2))
 
 
 def test_phase_shift_is_eq_4_5_to_4_7_as_decided():
