@@ -18,3 +18,13 @@ def test_readme_example(tmp_path):
     fishgen.export_cloud(cloud, tmp_path / "cloud.glb")
     assert len(cloud.centers) == 615
     assert_valid_gltf(tmp_path / "bonybream.glb", tmp_path / "cloud.glb")
+
+
+def test_clips_and_levels_may_be_given_as_the_command_line_gives_them():
+    """`build_fish(species, clips="swim")` split the name into its letters ('s,w,i,m')."""
+    from fishgen.assembly.fish import make_fish
+    from fishgen.species.parser import load_species
+
+    fish = make_fish(load_species(PARAMS / "bonybream.txt"), clips="swim,idle", lods="32x24,16x12")
+    assert [c.name for c in fish.facts.clips] == ["swim", "idle"]
+    assert [(lv.bodies, lv.circles) for lv in fish.facts.levels] == [(32, 24), (16, 12)]

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
 
@@ -130,8 +131,9 @@ class Part:
 
 def build_fish(species: Species, *, fins: str | None = None, length: float | None = None,
                fps: float = 30.0, swim: str = "body", speed: float = DEFAULT_SPEED,
-               wave: BodyWave | None = None, lods: Sequence[tuple[int, int]] | None = None,
-               merge: bool = False, clips: Sequence[str] = DEFAULT_CLIPS, compact: bool = False) -> Scene:
+               wave: BodyWave | None = None, lods: str | Sequence[tuple[int, int]] | None = None,
+               merge: bool = False, clips: str | Sequence[str] = DEFAULT_CLIPS,
+               compact: bool = False) -> Scene:
     """The scene of :func:`make_fish` (the library's one-line way to a fish)."""
     return make_fish(species, fins=fins, length=length, fps=fps, swim=swim, speed=speed, wave=wave,
                      lods=lods, merge=merge, clips=clips, compact=compact).scene
@@ -139,8 +141,8 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
 
 def make_fish(species: Species, *, fins: str | None = None, length: float | None = None,
               fps: float = 30.0, swim: str = "body", speed: float = DEFAULT_SPEED,
-              wave: BodyWave | None = None, lods: Sequence[tuple[int, int]] | None = None,
-              merge: bool = False, clips: Sequence[str] = DEFAULT_CLIPS, compact: bool = False) -> Fish:
+              wave: BodyWave | None = None, lods: str | Sequence[tuple[int, int]] | None = None,
+              merge: bool = False, clips: str | Sequence[str] = DEFAULT_CLIPS, compact: bool = False) -> Fish:
     """Build the fish of ``species``, and say what was built.
 
     ``fins``: ``blend``, ``mask`` or ``opaque`` (default: ``mask`` when the file
@@ -154,8 +156,11 @@ def make_fish(species: Species, *, fins: str | None = None, length: float | None
     CLIP_NAMES. ``compact``: rotation and weight keys as normalized 16-bit integers. Each is
     checked as `fishgen build` checks its option (:class:`FishOptions`).
     """
+    # a string is the command line's "swim,idle" or "32x24,16x12" (FishOptions converts it as the
+    # option does), not its letters
     options = FishOptions(fins=fins, length=length, fps=fps, swim=swim, speed=speed, merge=merge,
-                          lods=tuple(lods) if lods else None, clips=tuple(clips), compact=compact)
+                          lods=cast(Any, lods if isinstance(lods, str) else tuple(lods)) if lods else None,
+                          clips=cast(Any, clips if isinstance(clips, str) else tuple(clips)), compact=compact)
     return fish_of(species, options, wave)
 
 
