@@ -146,7 +146,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     inputs = tuple(Path(p) for p in inputs)
     output = Path(output)
     from fishgen.commands.paths import check_inputs, check_targets, needs, read_beside, suffix_of
-    from fishgen.errors import UsageError
+    from fishgen.errors import UsageError, either, plural
     from fishgen.exchange.registry import FORMATS, INSTANCES, MESHES, NODE_ANIMATION, output_format
     from fishgen.school.scene_file import (
         SceneFile,
@@ -221,9 +221,12 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     # an instancer's prototypes keep the finest level and their own keys: said, as `build` says it
     dropped = [what for what, given in (("levels of detail", options.lods), ("compact keys", options.compact))
                if instanced and given]
-    note = f" ({output.suffix[1:].upper()} holds no {' or '.join(dropped)})" if dropped else ""
+    note = f" ({output.suffix[1:].upper()} holds no {either(dropped)})" if dropped else ""
+    # a .gltf's buffer and images, a USD's textures: counted in the size, and said, as `build` says them
+    beside = [p for p in sizes if Path(p) != Path(output) and p not in sides.values()]
     line = (f"{output}: {kinds_line}; {scene.frames} frames ({scene.frames / scene.fps:.1f} s), "
-            f"{scene.model}, {size / 1e6:.2f} MB{note}")
+            f"{scene.model}, {size / 1e6:.2f} MB{note}"
+            + (f" (+{plural(len(beside), 'file')})" if beside else ""))
     facts = SchoolFacts(counted, scene.frames, scene.fps,
                         scene.model, size, warmup, table)
     read = tuple(dict.fromkeys([*inputs, *scene.read, *run.read]))

@@ -344,3 +344,13 @@ def test_a_warm_up_as_long_as_the_run_is_said_in_a_note(tmp_path):
     short = run_cli("school", PARAMS / "bonybream.txt", "--count", "3", "--frames", "10", "--warmup", "0.2",
                     "-o", out)
     assert short.returncode == 0 and short.stderr == ""
+
+
+@pytest.mark.parametrize("name, beside", [("s.glb", ""), ("s.gltf", " (+2 files)"), ("s.usda", " (+1 file)")])
+def test_the_summary_counts_the_files_written_beside_the_school(tmp_path, name, beside):
+    """A USD school wrote its fish's texture beside it and did not say so, as `build` does."""
+    result = run_cli("school", PARAMS / "bonybream.txt", "--count", "3", "--frames", "5",
+                     "-o", tmp_path / name, "--metrics", tmp_path / "m.json")
+    assert result.returncode == 0, result.stderr
+    first = result.stdout.splitlines()[0]
+    assert first.endswith(" MB" + beside), first
