@@ -142,7 +142,9 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
     assets, read = prepare_assets(inputs, mode=options.mode, seed=options.seed, lighting=options.lighting,
                                   textures_dir=options.textures, max_particles=options.max_particles)
     title = ", ".join(a.name for a in assets)
-    run = {"inputs": [str(p) for p in inputs], "mode": options.mode, "timeout": timeout}
+    # how the page drew: a report of --no-instancing is told from an instanced one
+    run = {"inputs": [str(p) for p in inputs], "mode": options.mode, "timeout": timeout,
+           "instancing": options.instancing}
     config = FlyConfig(size=options.size, timeout=timeout, warmup=options.warmup,
                        path="fly" if options.headless else None, seed=options.seed,
                        report=timeout is not None, cloud_scale=options.cloud_resolution,

@@ -17,7 +17,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, plural
 
 SUFFIXES = (".json", ".csv")
 MAX_SECONDS = 86_400
@@ -143,14 +143,18 @@ def summary(report: dict[str, Any]) -> list[str]:
     things = f"{scene['particles']:,} particles"
     if scene["billboards"]:
         things += f", {scene['billboards']:,} billboards"
+    clouds = [f"{things} in {plural(scene['clouds'], 'cloud')}; drawn on average "
+              f"{drawn['particles']:,.0f} particles"
+              + (f", {drawn['billboards']:,.0f} billboards" if scene["billboards"] else "")
+              + f" in {drawn['clouds']:.1f} clouds"] if scene["clouds"] else []
+    # a school flown alone said only "0 particles in 0 clouds"
+    meshes = [f"{scene['meshes']:,} mesh{'es' * (scene['meshes'] != 1)} (fish and other solids), schools "
+              + ("instanced" if report.get("instancing", True) else "drawn fish by fish (--no-instancing)")
+              ] if scene["meshes"] else []
     return [f"flew {report['seconds']:.1f} s at {w['width']}x{w['height']}: {report['frames']:,} frames, "
             f"{fps['median']:.1f} FPS median (5th percentile {fps['p5']:.1f}, min {fps['min']:.1f}, "
             f"max {fps['max']:.1f})",
-            f"{things} in {scene['clouds']:,} cloud{'' if scene['clouds'] == 1 else 's'}; drawn on average "
-            f"{drawn['particles']:,.0f} particles"
-            + (f", {drawn['billboards']:,.0f} billboards" if scene["billboards"] else "")
-            + f" in {drawn['clouds']:.1f} clouds",
-            *impostor_lines(report["impostors"]),
+            *clouds, *meshes, *impostor_lines(report["impostors"]),
             f"renderer: {report['renderer']}"]
 
 

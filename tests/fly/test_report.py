@@ -54,3 +54,17 @@ def test_the_summary_says_size_frames_fps_particles_and_renderer():
     text = "\n".join(summary(full_report(check_report(page_report()), {})))
     for words in ("800x600", "40 frames", "20.0 FPS median", "615 particles", "SwiftShader"):
         assert words in text
+
+
+@pytest.mark.parametrize("instancing, said", [(True, "schools instanced"),
+                                              (False, "schools drawn fish by fish (--no-instancing)")])
+def test_a_school_flown_alone_is_summed_up_as_meshes_and_how_they_were_drawn(instancing, said):
+    """Flying a school printed only "0 particles in 0 clouds", and a --no-instancing report looked
+    like an instanced one."""
+    scene = {"particles": 0, "billboards": 0, "distant_particles": 0, "distant_billboards": 0,
+             "clouds": 0, "meshes": 1000}
+    report = full_report(check_report(page_report(scene=scene)), {"instancing": instancing})
+    lines = summary(report)
+    assert report["instancing"] is instancing
+    assert not any(line.startswith("0 particles") for line in lines)
+    assert f"1,000 meshes (fish and other solids), {said}" in lines
