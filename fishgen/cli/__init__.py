@@ -14,7 +14,7 @@ import threading
 
 import click
 
-from fishgen import interrupts
+from fishgen import __version__, interrupts
 from fishgen.cli.common import add_common_options, error_line, json_errors, reset
 from fishgen.commands import MODULES, command
 
@@ -38,7 +38,7 @@ class LazyGroup(click.Group):
 
 
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(package_name="fishgen")
+@click.version_option(__version__, package_name="fishgen")  # the version the files record, not pip's metadata
 def cli() -> None:
     """fishgen: procedural fish and cloud assets for games and pipelines.
 
