@@ -5,8 +5,10 @@
     python docs/make_renders.py --list   # what would be rendered
 
 One still per shipped species (params/*.txt) and per report cloud
-(params/clouds/*.awn), a side-view contact sheet of the species, and a swim
-loop. Run it (and look at the images) whenever a change is meant to alter how
+(params/clouds/*.awn), a side-view contact sheet of the species, a swim loop,
+the engine fish's clips, the reef and a small school (and the reef's measures,
+by `fishgen school --plot`). The README's other pictures come from other
+scripts or by hand (docs/preview.md lists each). Run it (and look at the images) whenever a change is meant to alter how
 an asset looks. The tests do not diff against these files; they measure each
 part instead (tests/preview/test_reference.py).
 """
