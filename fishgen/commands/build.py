@@ -24,7 +24,7 @@ class BuildOptions(FishOptions):
     # None: not given, so that one given with -o naming a file of another format can be refused
     format: str | None = option(click.Choice([f.name for f in FISH_FORMATS]), "Format of each file written "
                                 "into a folder (-o FOLDER/).", shown_default="glb", manifest=False)
-    textures: Path | None = textures_option("the species file's folder, then the textures/ folder beside it")
+    textures: Path | None = textures_option("the species file's folder, then the textures/ folder beside that folder")
 
 
 def check_options(options: BuildOptions, output: str | os.PathLike | None = None) -> None:
@@ -40,8 +40,9 @@ def check_options(options: BuildOptions, output: str | os.PathLike | None = None
 
         suffix = Path(output).suffix.lower()
         if not names_folder(output) and suffix not in FORMATS[options.format].extensions:
-            raise UsageError(f"expected --format only with -o naming a folder (the file's extension picks "
-                             f"its format), found -o {os.fspath(output)!r} with --format {options.format}")
+            raise UsageError(f"expected --format with -o naming a folder, or a file of that format's "
+                             f"extension (a file's extension picks its format), found -o "
+                             f"{os.fspath(output)!r} with --format {options.format}")
 
 
 COMMAND = Command(

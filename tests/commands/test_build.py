@@ -29,7 +29,7 @@ def _build(tmp_path, output, **options):
     # --speed sets the body wave; a rigid body swims the same at any speed (the files were identical)
     ("x.glb", {"swim": "fins", "speed": 3.0}, "expected --swim body with --speed"),
     # --format is the format inside a folder: -o x.glb --format obj wrote a glb without a word
-    ("x.glb", {"format": "obj"}, "expected --format only with -o naming a folder"),
+    ("x.glb", {"format": "obj"}, "expected --format with -o naming a folder, or a file of that format"),
 ])
 def test_an_option_that_would_be_ignored_is_refused_before_any_work(tmp_path, output, options, message):
     with pytest.raises(UsageError, match=message):

@@ -17,7 +17,7 @@ The second half proves the checks catch an upside-down fish, a lost texture and 
 dropped fin; `test_checks_hold_under_softpipe` runs this module again under softpipe.
 Recorded sizes live in reference_measures.json; when a change is meant to alter the
 look, rewrite it with `PYTHONPATH=. python -m tests.preview.test_reference --update`
-(the README pictures come from `python docs/make_renders.py`, separately).
+(the README's pictures are made separately: docs/preview.md lists where each comes from).
 
 Every use of fishgen's preview internals is in tests/preview/partrender.py.
 """
