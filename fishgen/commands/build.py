@@ -24,7 +24,8 @@ class BuildOptions(FishOptions):
     # None: not given, so that one given with -o naming a file of another format can be refused
     format: str | None = option(click.Choice([f.name for f in FISH_FORMATS]), "Format of each file written "
                                 "into a folder (-o FOLDER/).", shown_default="glb", manifest=False)
-    textures: Path | None = textures_option("the species file's folder, then the textures/ folder beside that folder")
+    textures: Path | None = textures_option("the species file's folder, then the textures/ folder beside "
+                                            "that folder")
 
 
 def check_options(options: BuildOptions, output: str | os.PathLike | None = None) -> None:
