@@ -90,7 +90,8 @@ PRELOAD = {"build": _FISH,
                       "fishgen.school.scene_file", "fishgen.school.memory", "fishgen.school.behaviour.boids",
                       "fishgen.school.behaviour.pso", "fishgen.school.behaviour.couzin",
                       "fishgen.exchange.sidefiles"],
-           "clouds": ["fishgen.clouds.parser", "fishgen.clouds.fill", "fishgen.exchange.clouds",
+           "clouds": ["fishgen.clouds.parser", "fishgen.clouds.memory", "fishgen.clouds.fill",
+                      "fishgen.exchange.clouds",
                       "fishgen.clouds.scene", "fishgen.clouds.light", "fishgen.exchange.sidefiles",
                       # np.median reaches for numpy.ma on first use
                       "numpy.random", "numpy.fft", "numpy.ma"]}

@@ -361,6 +361,6 @@ def test_a_school_to_usd_says_what_its_prototypes_leave_out(tmp_path):
     args = ("school", PARAMS / "bonybream.txt", "--count", "3", "--frames", "10", "--lods", "16x12,8x6")
     usd = run_cli(*args, "--compact", "-o", tmp_path / "s.usdc")
     assert usd.returncode == 0, usd.stderr
-    assert usd.stdout.splitlines()[0].endswith("(USDC holds no levels of detail or compact keys)")
+    assert usd.stdout.splitlines()[0].endswith("(USDC holds no levels of detail or compact keys) (+1 file)")
     glb = run_cli(*args, "-o", tmp_path / "s.glb")
     assert glb.returncode == 0 and "holds no" not in glb.stdout
