@@ -231,6 +231,8 @@ class Option:
     required: bool = False            # on the command line
     off: str | None = None            # a flag's switch-off name (--no-scattering)
     path: bool = False                # a file or folder: relative to the manifest in a manifest
+    exists: bool = False              # a folder read from: it must be there (commands.run checks it once a
+                                      # manifest has resolved it; click would check it against the cwd)
 
     def default_text(self) -> str:
         if self.shown_default is not None:
@@ -460,7 +462,7 @@ def swim_option(help_text: str) -> Any:
 
 def textures_option(shown_default: str) -> Any:
     return option(FOLDER, "Folder texture names resolve in (and may not leave).", shown_default=shown_default,
-                  metavar="DIR", path=True)
+                  metavar="DIR", path=True, exists=True)
 
 
 def cloud_textures_option() -> Any:

@@ -178,6 +178,8 @@ def _job(where: Where, of: Kind, nth: int, entry: dict[str, Any], folder: Path, 
         if key in entry:
             value = check_value(spec, entry[key], fail_at(key))
             values[f.name] = Path(os.path.abspath(folder / value)) if spec.path else value
+            if spec.exists and not values[f.name].is_dir():   # said at its line, before any job runs
+                raise fail_at(key)("an existing folder (relative to the manifest)")
     options: Any = build(record, values)
     offsets = getattr(options, "offset", None)
     if offsets and len(offsets) != len(inputs):

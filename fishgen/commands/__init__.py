@@ -163,8 +163,28 @@ def run(cmd: Command, inputs: tuple[Path, ...], output: str | os.PathLike | None
             raise UsageError(f"expected -o to name an output file, found the folder {os.fspath(output)!r}")
         if not folder:  # before the format's check: `-o /dev/null` is a device, not a name with no extension
             check_target(Path(output))
+    _folders_there(options)
     with protecting(inputs):
         return cmd.function()(inputs, output, options, events)
+
+
+def _folders_there(options: Any) -> None:
+    """A folder an option reads from must be there: `sky --textures typo/` with no texture cloud
+    was taken without a word (a manifest's folders are resolved by now)."""
+    from dataclasses import fields, is_dataclass
+
+    from fishgen.errors import UsageError
+    from fishgen.options import OPTION, long_name
+
+    if not is_dataclass(options):
+        return
+    for f in fields(options):       # a group's options (a cloud's lighting) name no folders
+        spec = f.metadata.get(OPTION)
+        value = getattr(options, f.name)
+        if spec is not None and spec.exists and value is not None and not Path(value).is_dir():
+            kind = "a file" if Path(value).exists() else "nothing"
+            raise UsageError(f"expected --{long_name(f)} to name an existing folder, found {kind} at "
+                             f"{os.fspath(value)!r}")
 
 
 @contextmanager

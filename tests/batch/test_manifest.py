@@ -170,3 +170,16 @@ def test_a_seed_the_command_line_takes_a_manifest_takes_too(tmp_path):
     manifest = load_manifest(write(tmp_path, '[[clouds]]\ninput = "a.awn"\noutput = "a.ply"\n'
                                              'seed = 1099511627776\n'))
     assert manifest.jobs[0].options.seed == 1099511627776
+
+
+def test_a_textures_folder_that_is_not_there_is_refused_at_its_line(tmp_path):
+    """`--textures typo/` was taken without a word where no texture was looked up (a sky of .awn
+    clouds); a manifest's folder is checked relative to the manifest, at its line."""
+    (tmp_path / "tex").mkdir()
+    good = load_manifest(write(tmp_path, '[[build]]\ninput = "a.txt"\noutput = "a.glb"\ntextures = "tex"\n'))
+    assert good.jobs[0].options.textures == tmp_path / "tex"
+    path = write(tmp_path, '[[build]]\ninput = "a.txt"\noutput = "a.glb"\ntextures = "text"\n')
+    with pytest.raises(FishgenError) as caught:
+        load_manifest(path)
+    assert str(caught.value) == (f"{path}:4: expected textures as an existing folder (relative to the "
+                                 "manifest), found 'text'")

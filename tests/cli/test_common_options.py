@@ -159,3 +159,14 @@ def test_a_folder_as_the_one_output_file_is_a_usage_error(tmp_path, args):
     assert result.returncode == 2 and result.stderr == (
         f"fishgen {args[0]}: expected -o to name an output file, found the folder {str(folder)!r}\n")
     assert list(folder.iterdir()) == []
+
+
+@pytest.mark.parametrize("args", [["sky", "--mode", "thin"], ["build", "{fish}"], ["clouds", "{cubes}"]])
+def test_a_textures_folder_that_is_not_there_is_a_usage_error(tmp_path, args):
+    fill = {"fish": PARAMS / "bonybream.txt", "cubes": PARAMS / "clouds" / "table_4_3.awn"}
+    argv = [str(fill[a[1:-1]]) if a.startswith("{") else a for a in args]
+    result = run_cli(*argv, "--textures", tmp_path / "typo", "-o", tmp_path / "x.glb")
+    assert result.returncode == 2 and result.stderr == (
+        f"fishgen {args[0]}: expected --textures to name an existing folder, found nothing at "
+        f"'{tmp_path / 'typo'}'\n")
+    assert not (tmp_path / "x.glb").exists()
