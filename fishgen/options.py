@@ -435,10 +435,16 @@ def merge_option() -> Any:
                   "instead of one per part; fins swing on joints.", False, flag=True)
 
 
+PROTOTYPES = 4
+"""A USD school's prototypes a species when --prototypes is not given."""
+
+
 def prototypes_option() -> Any:
+    # None when not given: a glb has no prototypes, and a --prototypes given with one is refused
     return option(click.IntRange(1, 64), "In a USD file (.usdc, .usda, .usdz), each species as this many "
                   "prototypes of a PointInstancer, their swim clips phase-shifted by an equal share of a "
-                  "loop; each fish wears one, seeded (more: fewer fish swim in step, a larger file).", 4)
+                  "loop; each fish wears one, seeded (more: fewer fish swim in step, a larger file).", None,
+                  shown_default=str(PROTOTYPES))
 
 
 def compact_option() -> Any:

@@ -11,6 +11,7 @@ from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
 from fishgen.exchange.registry import MESHES, NODE_ANIMATION
 from fishgen.options import (
     FILE,
+    PROTOTYPES,
     FiniteRange,
     compact_option,
     declare,
@@ -85,7 +86,7 @@ class SchoolOptions:
     compact: bool = compact_option()
     lods: tuple[tuple[int, int], ...] | None = lods_option()
     merge: bool = merge_option()
-    prototypes: int = prototypes_option()
+    prototypes: int | None = prototypes_option()
 
 
 def check_options(options: SchoolOptions, output: str | os.PathLike | None = None) -> None:
@@ -97,6 +98,13 @@ def check_options(options: SchoolOptions, output: str | os.PathLike | None = Non
                          f"found --tints {options.tints}")
     if options.preset is not None and options.model not in (None, "couzin"):
         raise UsageError(f"expected --preset with the couzin model, found --model {options.model}")
+    if options.prototypes is not None and output is not None:
+        from fishgen.exchange.registry import INSTANCES, by_extension
+
+        fmt = by_extension(output)
+        if fmt is not None and INSTANCES not in fmt.holds:   # a glb's fish share meshes, not prototypes
+            raise UsageError(f"expected --prototypes with a USD output (.usdc, .usda, .usdz), found -o "
+                             f"{os.fspath(output)!r}")
 
 
 COMMAND = Command(
@@ -175,7 +183,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         check_species_files(scene, scene_files[0])
     else:
         scene = SceneFile(species=tuple(SpeciesEntry(p) for p in inputs))
-    check_options(options)
+    check_options(options, output)
     variety = {key: value for key, value in (("size", options.size_variety), ("tints", options.tints),
                                              ("tint", options.tint)) if value is not None}
     scene = with_options(scene, count=options.count, frames=options.frames, fps=options.fps,
@@ -194,7 +202,8 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     with events.progress("simulating", steps) as bar:
         run = run_school(scene, fins=options.fins, swim=options.swim, tolerance=options.tolerance,
                          textures_dir=options.textures, progress=bar.update, lods=options.lods,
-                         merge=options.merge, prototypes=options.prototypes if instanced else None)
+                         merge=options.merge,
+                         prototypes=(options.prototypes or PROTOTYPES) if instanced else None)
     if options.compact:
         from fishgen.assembly.compact import compact_clips
 

@@ -183,3 +183,10 @@ def test_a_textures_folder_that_is_not_there_is_refused_at_its_line(tmp_path):
         load_manifest(path)
     assert str(caught.value) == (f"{path}:4: expected textures as an existing folder (relative to the "
                                  "manifest), found 'text'")
+
+
+def test_a_school_job_with_prototypes_and_a_glb_is_refused_at_its_line(tmp_path):
+    path = write(tmp_path, '[[school]]\ninput = "a.txt"\noutput = "s.glb"\nprototypes = 2\n')
+    with pytest.raises(FishgenError, match="expected prototypes with a USD output"):
+        load_manifest(path)
+    assert load_manifest(write(tmp_path, '[[school]]\ninput = "a.txt"\noutput = "s.usdc"\nprototypes = 2\n'))

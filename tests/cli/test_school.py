@@ -354,3 +354,13 @@ def test_the_summary_counts_the_files_written_beside_the_school(tmp_path, name, 
     assert result.returncode == 0, result.stderr
     first = result.stdout.splitlines()[0]
     assert first.endswith(" MB" + beside), first
+
+
+def test_prototypes_are_refused_for_an_output_without_them(tmp_path):
+    """`--prototypes` was taken and ignored for a .glb, whose fish share meshes, not prototypes."""
+    result = run_cli("school", PARAMS / "bonybream.txt", "--count", "3", "--frames", "5", "--prototypes", "2",
+                     "-o", tmp_path / "s.glb")
+    assert result.returncode == 2 and result.stderr == (
+        f"fishgen school: expected --prototypes with a USD output (.usdc, .usda, .usdz), found -o "
+        f"'{tmp_path / 's.glb'}'\n")
+    assert not (tmp_path / "s.glb").exists()
