@@ -33,8 +33,10 @@ RENDERERS_DIFFER = 0.006
 #: it is tried again with the photo turned these degrees further, in order, until one matches that
 #: well; a level is kept only when its rebuilt fish matches at least TURN_GAIN better.
 TURNS = (4.0, -4.0, 2.0, -2.0)
-FITS = 1 + len(TURNS)
-"""Levels --fit-shape may try: side-on, then each of TURNS (a progress bar's length)."""
+LEVELS = 1 + len(TURNS)
+"""Levels --fit-shape may try: side-on, then each of TURNS."""
+FITS = LEVELS + 1
+"""A --fit-shape's steps for a progress bar: each level, then the rebuilt fish measured."""
 TURN_GOOD = 0.87
 TURN_GAIN = 0.01
 
@@ -182,7 +184,8 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
                  on_note: Callable[[str], None] | None = None,
                  progress: Callable[[int], None] | None = None) -> TextureResult:
     """Measure ``photo_path``, write the new species file beside its texture and mask, atomically.
-    With ``fit_shape``, ``progress`` gets 1 as each of the FITS levels is fitted or skipped."""
+    With ``fit_shape``, ``progress`` gets 1 as each level is fitted or skipped and as the rebuilt
+    fish is measured: FITS in all."""
     try:
         return _make_texture(photo_path, base, out, options, on_note, progress)
     except FishgenError as err:
@@ -232,6 +235,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     chosen = _candidate(photo, sil.mask, base, out, options, imported, textures)
     shown: tuple[np.ndarray, float] | None = None   # the chosen fish rendered, and its IoU
     fitted, problems, fit = False, [], None
+    step = progress if progress is not None and options.fit_shape else (lambda _n: None)
     if options.fit_shape:
         from fishgen.authoring.photo.checks import fit_problems
         from fishgen.authoring.photo.compare import render_scale
@@ -243,10 +247,9 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         # without them was 0.85 in Blender where the command's own measure said 0.93: the fit
         # takes the faint edges too (an alpha channel keeps the tips; a mask file is the truth).
         target = sil.mask | faint if sil.source == "background model" and faint is not None else sil.mask
-        step = progress or (lambda _n: None)
         for k, turn in enumerate((0.0, *TURNS)):
             if tried is not None and tried[1] >= TURN_GOOD:
-                step(FITS - k + 1)    # the level just fitted, and those left unneeded
+                step(LEVELS - k + 1)  # the level just fitted, and those left unneeded
                 break
             if k:
                 step(1)           # the level before
@@ -303,6 +306,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         from fishgen.authoring.photo.compare import HALF_ALPHA, silhouette_iou
 
         faded = silhouette_iou(chosen.measured.frame_mask, shown[0][:, :, 3] >= HALF_ALPHA)
+    step(1)    # the bar's last step: the rebuilt fish measured (the slowest render of a fit)
     if shown is not None and unsure is not None and unsure < ADVICE_IOU:
         note(f"silhouette IoU {shown[1]:.3f}, but {unsure:.3f} if the faint pixels round the photo's "
              "outline are fish (thin translucent fin tips over the backdrop): the rebuilt fish may be "
