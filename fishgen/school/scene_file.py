@@ -5,7 +5,7 @@
     fps = 30
     seed = 1
     bounds = [[-4, -1.5, -4], [4, 1.5, 4]]
-    layout = "sphere"          # sphere | box | line | ring (default: ring for the torus preset)
+    layout = "sphere"          # sphere | box | line | ring (default: ring for the couzin torus)
 
     [[species]]
     file = "bonybream.txt"     # relative to this file
@@ -146,7 +146,8 @@ PRESET = Option(click.Choice(tuple(COUZIN_PRESETS)),
                 shown_default="the scene file's [couzin], else zones of 1, 1 and 15 body lengths (torus)")
 LAYOUT = Option(click.Choice(LAYOUTS), "How the fish start: a random ball (sphere), scattered through the "
                 "region (box), a line, or a horizontal ring heading round it (ring: a mill already).", None,
-                shown_default="ring for the torus preset, else sphere")
+                shown_default="ring for the couzin model's torus (its preset, or its default zones), "
+                              "else sphere")
 SIZE_VARIETY = Option(FiniteRange(*VARIETY_RANGES["size"]), VARIETY_HELP["size"].capitalize() + ".",
                       Variety.size)
 TINTS = Option(click.IntRange(int(VARIETY_RANGES["tints"][0]), int(VARIETY_RANGES["tints"][1])),
@@ -225,12 +226,16 @@ def with_options(scene: SceneFile, *, count: int | None = None, frames: int | No
 
 
 def start_layout(scene: SceneFile) -> str:
-    """How the fish start: the scene's layout, else a ring for the couzin model's torus preset
-    (from a random ball in the default region it milled for 1 seed of 8: docs/decisions.md), else
-    a sphere."""
+    """How the fish start: the scene's layout, else a ring for the couzin model's torus (its preset
+    named, or its zones as they stand, which the model's defaults are: from a random ball in the
+    default region it milled for 1 seed of 8, docs/decisions.md), else a sphere."""
     if scene.layout is not None:
         return scene.layout
-    return "ring" if scene.model == "couzin" and scene.preset == "torus" else "sphere"
+    if scene.model != "couzin":
+        return "sphere"
+    torus = scene.preset == "torus" or (scene.preset is None
+                                         and (scene.couzin or CouzinParams()) == COUZIN_PRESETS["torus"])
+    return "ring" if torus else "sphere"
 
 
 def preroll_seconds(scene: SceneFile) -> float:

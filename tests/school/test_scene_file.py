@@ -1,6 +1,7 @@
 """School scene files: every mistake is one FILE:LINE line; absurd sizes refused before allocating."""
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -99,6 +100,10 @@ def test_the_torus_preset_starts_as_a_ring_unless_a_layout_is_given(tmp_path):
     assert start_layout(with_options(bream, preset="torus")) == "ring"
     assert start_layout(with_options(bream, preset="torus", layout="sphere")) == "sphere"
     assert start_layout(with_options(bream, layout="line")) == "line"
+    # the model's own zones are the torus's, named or not; other zones with no preset start as a ball
+    assert start_layout(with_options(bream, model="couzin")) == "ring"
+    assert start_layout(replace(bream, model="couzin", couzin=COUZIN_PRESETS["torus"])) == "ring"
+    assert start_layout(replace(bream, model="couzin", couzin=COUZIN_PRESETS["swarm"])) == "sphere"
     assert {start_layout(with_options(bream, preset=p)) for p in COUZIN_PRESETS if p != "torus"} == {"sphere"}
     (tmp_path / "a.txt").write_text("")
     file = tmp_path / "s.toml"
