@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 from collections.abc import Mapping
 from pathlib import Path
 from urllib.parse import quote, unquote
@@ -101,6 +102,7 @@ def check_shared(asset: str | os.PathLike, files: Mapping[Path, bytes]) -> None:
     siblings = [p for p in _same_stem(asset) if not any(_same(p, w) for w in writing)]
     if not siblings:
         return
+    texts: dict[Path, bytes] = {}      # each sibling read once, however many side files
     for side, data in files.items():
         if _same(side, asset) or not side.is_file():
             continue
@@ -110,7 +112,10 @@ def check_shared(asset: str | os.PathLike, files: Mapping[Path, bytes]) -> None:
         except OSError:
             continue
         for other in siblings:
-            if _names(other, side.name):
+            if other not in texts:
+                texts[other] = _head(other)
+            if any(form.encode("utf-8", "surrogateescape") in texts[other]
+                   for form in (side.name, quote(side.name))):
                 obj = other.with_suffix(".obj")      # an OBJ names its textures in its .mtl
                 other = obj if other.suffix.lower() == ".mtl" and obj.is_file() else other
                 raise UsageError(f"expected side files no other asset names, found {side.name!r}, named by "
@@ -118,14 +123,20 @@ def check_shared(asset: str | os.PathLike, files: Mapping[Path, bytes]) -> None:
 
 
 def _same_stem(asset: Path) -> list[Path]:
-    """The files beside ``asset`` of its stem in a format that names side files, any case."""
-    try:
-        entries = list(os.scandir(asset.parent if str(asset.parent) else "."))
-    except OSError:
-        return []
-    return sorted(asset.with_name(e.name) for e in entries
-                  if Path(e.name).stem == asset.stem and Path(e.name).suffix.lower() in NAMING
-                  and e.is_file())
+    """The files beside ``asset`` of its stem in a format that names side files, its extension in
+    lower or upper case. Looked up by name, not by listing the folder: a batch writes thousands of
+    files into one, and a listing for each write was quadratic."""
+    found: dict[tuple[int, int], Path] = {}    # one file once (a case-insensitive file system)
+    for ext in NAMING:
+        for spelt in (ext, ext.upper()):
+            path = asset.with_name(asset.stem + spelt)
+            try:
+                st = path.stat()
+            except OSError:
+                continue
+            if stat.S_ISREG(st.st_mode):
+                found.setdefault((st.st_dev, st.st_ino), path)
+    return list(found.values())
 
 
 def _same(a: Path, b: Path) -> bool:
@@ -138,11 +149,10 @@ def _same(a: Path, b: Path) -> bool:
         return False
 
 
-def _names(asset: Path, name: str) -> bool:
-    """Whether ``asset`` names the side file ``name``."""
+def _head(asset: Path) -> bytes:
+    """The first _READ_MOST bytes of ``asset`` (b"" when it cannot be read): where it names its files."""
     try:
         with asset.open("rb") as handle:
-            data = handle.read(_READ_MOST)
+            return handle.read(_READ_MOST)
     except OSError:
-        return False
-    return any(form.encode("utf-8", "surrogateescape") in data for form in (name, quote(name)))
+        return b""
