@@ -11,7 +11,8 @@ Here the recurrence is taken along each ray: optical depth d on the way passes o
 ``e^-d`` of the light straight through and ``F (1 - e^-d)`` of it scattered forward, F
 being the lighting's forward fraction (SkyWorks: albedo x extinction x p(0) x solid angle
 / 4 pi). So the light never exceeds the sun, scattering only adds to it, and with
-scattering off a particle's light is ``exp(-tau)`` of the optical depth towards the sun. A
+scattering off a particle's light is ``exp(-tau)`` of the optical depth towards the sun, with a
+faint share of light scattered many times that keeps it above 0 (``light_of_depth``). A
 particle's optical depth across the rays is a Gaussian of width ``sigma = SIGMA x radius``
 (the billboard sprite's), whose total equals the shadow of SkyWorks' splat
 (``peak_optical_depth``).
@@ -169,7 +170,7 @@ def _pairs(centers, radii, density, frame, middle, extinction: float, forward: f
     Table 4.2, scattering off). With scattering on, j's depth d on the ray passes on ``e^-d + F (1 -
     e^-d)`` of the light, F the forward fraction, as it does in the recurrence: an effective
     depth e(d), of which the same share Phi counts (as the slabs take half their own slab's).
-    So with scattering off the light is exactly ``exp(-tau)``.
+    So with scattering off the light is exactly ``light_of_depth(tau)``.
 
     No grid: the particles sorted across the rays, each block of them weighed against those
     within REACH of the widest sigma across the rays; every sum runs in that order, so the
@@ -211,7 +212,7 @@ def _pairs(centers, radii, density, frame, middle, extinction: float, forward: f
             shade = -np.log1p((1 - forward) * np.expm1(-shade))
         shade *= _normal_cdf(along[i, j])
         tau[start:stop] = np.bincount(i, shade, minlength=stop - start)
-    light[order] = np.exp(-tau)
+    light[order] = light_of_depth(tau.astype(_F32))
 
 
 def _normal_cdf(z: np.ndarray) -> np.ndarray:
@@ -253,8 +254,8 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     order cost more than all the arithmetic). Three passes in memory order, each chunk on
     its own thread: one numbers the slabs; one splats every particle into its slab's maps
     (summed in chunk order, so threads do not change a bit); then the maps go down the slabs
-    in order, keeping the light each slab received and the depth it holds; and the last
-    pass reads each particle's light from its slab's maps, clipped to [0, 1], into ``light``,
+    in order, keeping the optical depth each slab's light came through and the depth it holds;
+    and the last pass reads each particle's light from its slab's maps into ``light``,
     or, when one group holds every slab, over the across-ray coordinate it has just read (and
     returns that array): fresh pages cost more than the arithmetic on them.
     """
@@ -288,10 +289,12 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
                                                               for k in range(0, last - first, BLUR_SLABS)))))
             del layers
             before = np.empty_like(depths)
-            direct = grid.direct.ravel()                        # a view: the grid's map
+            # depths, not light, down the slabs: a product of light factors reaches 0 in float32
+            # after an optical depth of ~100, where a dense cloud's order would be lost
+            reached = grid.reached.ravel()                      # a view: the grid's map
             for k in range(last - first):
-                before[k] = direct
-                direct *= np.exp(-depths[k])
+                before[k] = reached
+                reached += depths[k]
             read = functools.partial(_read_chunk, grid, place, own, before, depths, light)
             list(pool.map(read, spans))
     return light
@@ -382,8 +385,8 @@ def _splat_share(grid: _Grid, place, radii, density, table, size: int, own: np.n
 
 def _read_chunk(grid: _Grid, place, own: np.ndarray, before: np.ndarray, depths: np.ndarray,
                 light: np.ndarray, span: tuple[int, int]) -> None:
-    """Each particle's light: what reached its slab, at its centre, less about half of what the
-    rest of its own slab holds there, clipped to [0, 1]."""
+    """Each particle's light: behind the depth before its slab, at its centre, and about half of
+    what the rest of its own slab holds there."""
     pick, number, (flat, fx, fy), near = place(span)
     start, stop = span
     number *= np.int32(grid.shape[0] * grid.shape[1])
@@ -393,13 +396,40 @@ def _read_chunk(grid: _Grid, place, own: np.ndarray, before: np.ndarray, depths:
     half = np.take(depths.ravel(), near)
     half -= own[start:stop] if pick is None else own[start:stop][pick]          # less its own
     np.maximum(half, 0, out=half)
-    half *= _F32(-0.5)
-    got *= np.exp(half, out=half)
-    np.clip(got, 0, 1, out=got)
+    half *= _F32(0.5)
+    got += half
+    np.maximum(got, 0, out=got)
+    got = light_of_depth(got)
     if pick is None:
         light[start:stop] = got
     else:
         light[start:stop][pick] = got
+
+
+DIFFUSE = 2.0 ** -10
+"""The share of sunlight that reaches deep into a cloud by scattering many times (see
+``light_of_depth``): a power of two, so full sun stays exactly 1."""
+
+
+def light_of_depth(depth: np.ndarray) -> np.ndarray:
+    """The light (float32, 1 in full sun) behind an effective optical ``depth`` towards the sun:
+    ``e^-depth`` as Harris's first pass lets it through, and DIFFUSE of the sun falling as
+    ``1 / (1 + depth)`` instead, as light scattered many times does through a thick cloud.
+
+    Harris's pass keeps only the light scattered forward; with it alone a particle behind an
+    optical depth of ~100 gets exactly 0 in float32, and a dense cloud's inside (depths in the
+    thousands) is one black, its order towards the sun lost (issue 32). DIFFUSE moves no
+    colour by more than a quarter of a byte, and the light still falls strictly with depth.
+    """
+    depth = np.asarray(depth, _F32)
+    light = np.negative(depth)
+    np.exp(light, out=light)
+    light *= _F32(1 - DIFFUSE)
+    tail = depth + _F32(1)
+    np.reciprocal(tail, out=tail)
+    tail *= _F32(DIFFUSE)
+    light += tail
+    return light
 
 
 def peak_optical_depth(density, extinction: float) -> np.ndarray:
@@ -555,7 +585,7 @@ def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None
 
 
 class _Grid:
-    """The deep shadow map: the ``direct`` light on cells across the sun's rays (a big cloud)."""
+    """The deep shadow map: the optical depth ``reached`` on cells across the sun's rays (a big cloud)."""
 
     def __init__(self, lo: np.ndarray, hi: np.ndarray, radii: np.ndarray, most: int | None = None):
         step = max(1, len(radii) // CHUNK)
@@ -577,7 +607,7 @@ class _Grid:
         rows, cols = (_fast_size(int(math.ceil((hi[k] - lo[k] + 2 * margin) / cell)) + 6) for k in range(2))
         self.shape = (rows, cols)
         self.corner = lo - margin - 3 * cell      # world (a, b) of cell (0, 0)'s lower corner
-        self.direct = np.ones(self.shape, _F32)
+        self.reached = np.zeros(self.shape, _F32)
         self.kernels = _class_kernels(sigma_max / cell)
         widths = [w for w, _ in self.kernels]
         # a particle's class: the nearest width in log scale

@@ -114,6 +114,8 @@ class Lighting:
                 "sky_color": list(self.sky_color), "albedo": self.albedo, "extinction": self.extinction,
                 "solid_angle": self.solid_angle, "anisotropy": self.anisotropy,
                 "scattering": self.scattering,
+                "light": "_LIGHT = e^-E + 2^-10 (1 / (1 + E) - e^-E), E the effective optical depth "
+                         "towards the sun (Harris's first pass, and light scattered many times)",
                 "colour": "COLOR_0 = albedo * (sky_color + sun_color * _LIGHT), clamped to 0..1",
                 "second_pass": "albedo * (sky_color + sun_color * _LIGHT * phase(dot(view, sun)))"}
 

@@ -5,10 +5,12 @@ rays is a Gaussian of width sigma_j = 0.4 radius_j with peak Li2(1 - exp(-extinc
 density_j)) (the shadow of SkyWorks' splat), and it shades particle i as far as it lies nearer
 the sun than i's sunward face, FRONT sigma_i before its centre: Phi((t - FRONT sigma_i) / sigma_j)
 of it, t how much nearer j's centre is. With
-scattering off a particle's light is exp(-tau), tau summed over those shares; with scattering
+scattering off a particle's effective depth is tau, summed over those shares; with scattering
 on, depth d passes on e^-d + F (1 - e^-d) of the light (Harris's recurrence, report eq. 3.12,
-along the ray), to the same share. A small cloud is lit so pair by pair; a big one through slabs of a grid,
-checked against the small one's light.
+along the ray), to the same share. The light behind effective depth E is e^-E, and a share
+DIFFUSE of the sun falling as 1 / (1 + E) (light scattered many times), so that it never
+reaches 0. A small cloud is lit so pair by pair; a big one through slabs of a grid, checked
+against the small one's light.
 """
 from __future__ import annotations
 
@@ -22,7 +24,7 @@ from scipy import special, stats
 
 import fishgen.clouds.light as light_module
 from fishgen.clouds import Cloud, Lighting, export_cloud, fill_cloud, light_cloud, load_cubes, merge_clouds
-from fishgen.clouds.light import incident_light, lit_colors, peak_optical_depth
+from fishgen.clouds.light import DIFFUSE, incident_light, light_of_depth, lit_colors, peak_optical_depth
 from fishgen.clouds.lighting import EXTRAS_KEY, from_extras
 from fishgen.errors import FishgenError
 
@@ -59,6 +61,12 @@ def brute_force(centers, radii, density, lighting):
     return light, tau
 
 
+def behind(depth):
+    """The light behind an effective optical depth: e^-E, and DIFFUSE falling as 1 / (1 + E)."""
+    depth = np.asarray(depth, np.float64)
+    return np.exp(-depth) + DIFFUSE * (1 / (1 + depth) - np.exp(-depth))
+
+
 def luminance(colors: np.ndarray) -> np.ndarray:
     from fishgen.numeric import srgb_to_linear
 
@@ -76,12 +84,12 @@ def test_peak_depth_is_the_shadow_of_skyworks_splat():
 
 @pytest.mark.parametrize("sun", sorted(SUNS))
 @pytest.mark.parametrize("extinction", [80.0, 2.0])
-def test_scattering_off_gives_exp_minus_tau_exactly(sun, extinction):
+def test_scattering_off_gives_the_light_behind_tau_exactly(sun, extinction):
     centers, radii, density = random_cloud()
     lighting = Lighting(sun=SUNS[sun], extinction=extinction, scattering=False)
     got = incident_light(centers, radii, density, lighting)
     _, tau = brute_force(centers, radii, density, lighting)
-    np.testing.assert_allclose(got, np.exp(-tau), rtol=1e-5, atol=1e-6)     # float32 and the CDF's table
+    np.testing.assert_allclose(got, behind(tau), rtol=1e-5, atol=1e-6)     # float32 and the CDF's table
 
 
 def test_a_neighbour_shades_as_far_as_it_lies_nearer_the_sun():
@@ -93,8 +101,8 @@ def test_a_neighbour_shades_as_far_as_it_lies_nearer_the_sun():
     for ahead in (0.0, 0.4, 1.2):           # how much nearer the sun the second one is, sigma = 0.4
         centers = np.array([[0, 0, 0], [ahead, 0, 0]], np.float32)
         light = incident_light(centers, np.ones(2, np.float32), np.ones(2, np.float32), lighting)
-        behind, front = special.ndtr((ahead - 0.4) / 0.4), special.ndtr((-ahead - 0.4) / 0.4)
-        np.testing.assert_allclose(light, np.exp(-peak * np.array([behind, front])), rtol=1e-6)
+        back, front = special.ndtr((ahead - 0.4) / 0.4), special.ndtr((-ahead - 0.4) / 0.4)
+        np.testing.assert_allclose(light, behind(peak * np.array([back, front])), rtol=1e-6)
 
 
 @pytest.mark.parametrize("sun", sorted(SUNS))
@@ -103,7 +111,19 @@ def test_scattering_on_follows_harris_recurrence_along_the_ray(sun):
     lighting = Lighting(sun=SUNS[sun])
     got = incident_light(centers, radii, density, lighting)
     want, _ = brute_force(centers, radii, density, lighting)
-    np.testing.assert_allclose(got, want, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(got, behind(-np.log(want)), rtol=1e-5, atol=1e-6)
+
+
+def test_light_behind_a_depth_is_the_sun_at_none_and_never_reaches_zero():
+    """Full sun is exactly 1; the light falls strictly with depth, within DIFFUSE of e^-E, and stays
+    above 0 in float32 to depths of 10^6, where e^-E is 0 below a depth of ~100."""
+    depth = np.concatenate([np.linspace(0, 30, 30_001), np.geomspace(30.01, 1e6, 10_000)])
+    light = light_of_depth(depth)
+    assert light.dtype == np.float32 and light[0] == 1.0
+    assert (np.diff(light) < 0).all() and light[-1] > 0
+    np.testing.assert_allclose(light, behind(depth), rtol=1e-5)
+    assert np.abs(light - np.exp(-depth)).max() <= DIFFUSE
+    assert np.exp(-depth.astype(np.float32))[depth > 110].max() == 0     # what e^-E alone would bake
 
 
 # -- invariants -------------------------------------------------------------------------------
