@@ -399,7 +399,7 @@ def _read_chunk(grid: _Grid, place, own: np.ndarray, before: np.ndarray, depths:
     half *= _F32(0.5)
     got += half
     np.maximum(got, 0, out=got)
-    got = light_of_depth(got)
+    got = _light_into(got, half)
     if pick is None:
         light[start:stop] = got
     else:
@@ -419,17 +419,23 @@ def light_of_depth(depth: np.ndarray) -> np.ndarray:
     Harris's pass keeps only the light scattered forward; with it alone a particle behind an
     optical depth of ~100 gets exactly 0 in float32, and a dense cloud's inside (depths in the
     thousands) is one black, its order towards the sun lost (issue 32). DIFFUSE moves no
-    colour by more than a quarter of a byte, and the light still falls strictly with depth.
+    colour by more than one sRGB byte, and the light still falls strictly with depth.
     """
-    depth = np.asarray(depth, _F32)
-    light = np.negative(depth)
-    np.exp(light, out=light)
-    light *= _F32(1 - DIFFUSE)
-    tail = depth + _F32(1)
-    np.reciprocal(tail, out=tail)
-    tail *= _F32(DIFFUSE)
-    light += tail
-    return light
+    depth = np.array(depth, _F32)
+    return _light_into(depth, np.empty_like(depth))
+
+
+def _light_into(depth: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """``light_of_depth`` into ``out``, using ``depth`` (float32, overwritten) as scratch: a big
+    cloud's read allocates nothing more a chunk (fresh pages cost more than the arithmetic)."""
+    np.negative(depth, out=out)
+    np.exp(out, out=out)
+    out *= _F32(1 - DIFFUSE)
+    depth += _F32(1)
+    np.reciprocal(depth, out=depth)
+    depth *= _F32(DIFFUSE)
+    out += depth
+    return out
 
 
 def peak_optical_depth(density, extinction: float) -> np.ndarray:
