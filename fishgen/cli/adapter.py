@@ -77,7 +77,7 @@ class TerminalEvents:
     not --quiet), else one plain line per step on stdout, with the reason under --verbose."""
 
     def __init__(self, command: str = "") -> None:
-        self.bars = 0
+        self.bars: list[Any] = []     # the bars drawn, innermost last
         self.command = command
 
     def as_events(self) -> Events:
@@ -86,23 +86,29 @@ class TerminalEvents:
                       line=self.line)
 
     def note(self, text: str) -> None:
+        self._above_bar(text)
+
+    def _above_bar(self, text: str) -> None:
+        """``text`` on stderr; while a bar is drawn, in the bar's place, and the bar again below it
+        (as tqdm's write): no line of the bar left half drawn, no blank line when it ends."""
         if self.bars:
-            click.echo("", err=True)  # off the bar's line; the bar draws again below at its next step
+            sys.stderr.write("\r\x1b[K")
         click.echo(text, err=True)
+        if self.bars:
+            bar = self.bars[-1]
+            bar._last_line = None       # click skips drawing the line it drew last: it was cleared
+            bar.render_progress()
 
     def failed(self, err: Any) -> None:
-        if self.bars:
-            click.echo("", err=True)  # off the bar's line
         from fishgen.errors import UsageError
 
         message = str(err)
         if isinstance(err, UsageError) and err.file is None and self.command:
             message = f"fishgen {self.command}: {message}"     # as a usage error that stops the command
-        click.echo(error_line(message, err.status, file=err.file, line=err.line, kind=err.kind,
-                              **({"job": err.job} if err.job else {})), err=True)
         detail = getattr(err, "detail", "")
-        if detail and verbosity() >= VERBOSE:
-            click.echo(detail, err=True)
+        self._above_bar(error_line(message, err.status, file=err.file, line=err.line, kind=err.kind,
+                                   **({"job": err.job} if err.job else {}))
+                        + (f"\n{detail}" if detail and verbosity() >= VERBOSE else ""))
 
     def line(self, text: str, detail: str | None) -> None:
         if self.bars or verbosity() <= QUIET:
@@ -115,12 +121,12 @@ class TerminalEvents:
             yield Progress()
             return
         bar = click.progressbar(length=total, label=label, file=sys.stderr)
-        self.bars += 1
+        self.bars.append(bar)
         try:
             with bar:
                 yield _Bar(bar)
         finally:
-            self.bars -= 1
+            self.bars.pop()
 
 
 class _Bar(Progress):

@@ -34,11 +34,31 @@ def test_build_counts_each_input_the_bad_ones_too(tmp_path):
     assert len(failed) == 1 and len(made.lines) == 2
 
 
-def test_a_note_during_a_bar_starts_on_a_line_of_its_own(capsys):
+class _DrawnBar:
+    """A bar as click draws one: it skips a redraw of the line it drew last."""
+
+    def __init__(self) -> None:
+        self._last_line: str | None = "[###---]"
+        self.drawn = 0
+
+    def render_progress(self) -> None:
+        if self._last_line != "[###---]":
+            self._last_line = "[###---]"
+            self.drawn += 1
+
+
+def test_a_note_during_a_bar_takes_the_bar_s_line_and_the_bar_is_drawn_again_below(capsys):
+    """No half-drawn bar before the note, and no blank line when the bar ends (its line is the
+    bar's, ended by click)."""
     from fishgen.cli.adapter import TerminalEvents
+    from fishgen.errors import FishgenError
 
     events = TerminalEvents("texture")
     events.note("before")
-    events.bars = 1          # as while a bar is drawn
+    bar = _DrawnBar()
+    events.bars.append(bar)          # as while a bar is drawn
     events.note("during")
-    assert capsys.readouterr().err == "before\n\nduring\n"
+    events.failed(FishgenError("expected a fish, found none", "p.png"))
+    err = capsys.readouterr().err
+    assert err.startswith("before\n\r\x1b[Kduring\n\r\x1b[Kp.png: ") and err.count("\n") == 3
+    assert bar.drawn == 2
