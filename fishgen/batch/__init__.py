@@ -121,8 +121,9 @@ def _locked(out: Path) -> Iterator[None]:
     try:
         out.mkdir(parents=True, exist_ok=True)
         handle = open(out / LOCK_NAME, "a+b")  # held open for the whole batch
-    except (NotADirectoryError, FileExistsError):  # a file where --out names a folder: the command line's
-        raise FishgenError("expected an out folder, found a file in its path", out) from None
+    except (NotADirectoryError, FileExistsError):  # a file where --out names a folder: as every command says it
+        blocker = next((folder for folder in (out, *out.parents) if folder.is_file()), out)
+        raise SystemFailure(f"cannot write {out}: expected a folder at {blocker}, found a file", out) from None
     except OSError as err:  # the system refused (read-only, permissions, full): not the input
         raise cannot("write", out, err) from None
     try:
@@ -134,8 +135,9 @@ def _locked(out: Path) -> Iterator[None]:
         try:
             fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
-            raise FishgenError("expected no other `fishgen batch` writing this out folder, found one running",
-                               out) from None
+            # the system's refusal, as a port in use is: the same batch may be run again later
+            raise SystemFailure(f"cannot write {out}: expected no other `fishgen batch` writing this out "
+                                "folder, found one running", out) from None
         yield
     finally:
         handle.close()

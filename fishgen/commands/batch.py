@@ -210,6 +210,13 @@ def _check_report(report: Path, manifest: Manifest) -> None:
     from fishgen.errors import UsageError
     from fishgen.exchange.registry import FORMATS, first_shared
 
+    from fishgen.batch import LOCK_NAME
+    from fishgen.batch.record import RECORD_NAME
+
+    own = {name for name in (RECORD_NAME, LOCK_NAME) if report.resolve() == (manifest.out / name).resolve()}
+    if own:  # the record says which jobs may be skipped next time; the lock keeps one batch a folder
+        raise UsageError(f"expected a report that is not the batch's own {own.pop()}, found "
+                         f"{os.fspath(report)!r}")
     recorded = Record(manifest.out).jobs  # first: a file named again below is then named as given
     read = [Path(os.path.normpath(manifest.out / name)) for job in manifest.jobs
             if isinstance(inputs := recorded.get(job.name, {}).get("inputs"), dict) for name in inputs]

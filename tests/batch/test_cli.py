@@ -96,7 +96,8 @@ def test_two_batches_may_not_write_one_out_folder_at_once(shipped):
     with open(out / ".fishgen-batch.lock", "a+b") as lock:
         fcntl.flock(lock.fileno(), fcntl.LOCK_EX)
         run = batch(shipped / "params" / "assets.toml", "--out", out)
-    assert run.returncode == 2 and "found one running" in run.stderr and not (out / "fish").exists()
+    # the system's refusal (exit 1, as a port in use): nothing wrong with the input, run it again later
+    assert run.returncode == 1 and "found one running" in run.stderr and not (out / "fish").exists()
 
 
 def test_a_full_disk_says_one_line_per_failed_job_and_one_summary(shipped, monkeypatch):
@@ -169,3 +170,13 @@ def test_a_jobs_error_names_its_file_from_where_the_batch_was_run(tmp_path):
     result = run_cli("batch", "params/t.toml", "--out", "out", cwd=tmp_path)
     assert result.returncode == 2, result.stderr
     assert result.stderr.splitlines()[0] == "params/nope.txt: expected a species file, found no such file"
+
+
+@pytest.mark.parametrize("name", [".fishgen-batch.json", ".fishgen-batch.lock"])
+def test_the_report_may_not_be_the_batch_s_own_record_or_lock(shipped, name):
+    """The record was replaced by the report (every job rebuilt on the next run), or the lock by a
+    new file while the batch held the old one."""
+    out = shipped / "o"
+    run = batch(shipped / "params" / "assets.toml", "--out", out, "--report", out / name)
+    assert run.returncode == 2 and f"expected a report that is not the batch's own {name}" in run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1 and not (out / "fish").exists()

@@ -201,12 +201,18 @@ def test_a_batch_into_a_read_only_folder_exits_1_with_the_path(small_disk):
     assert error["file"] == str(readonly / "all")
 
 
-def test_a_batch_out_folder_that_is_a_file_is_bad_input(tmp_path):
+def test_a_batch_out_folder_under_a_file_is_said_as_every_command_says_it(tmp_path):
+    """Exit 1, kind `os`, as `school`, `sky`, `species` and `preview` say a file in an output's
+    path (it was exit 2 in `batch` alone)."""
     (tmp_path / "taken").write_text("")
-    result = run(["batch", str(PARAMS / "clouds"), "--out", str(tmp_path / "taken" / "all")])
+    out = tmp_path / "taken" / "all"
+    result = run(["batch", str(PARAMS / "clouds"), "--out", str(out)])
     error = one_error(result)
-    assert result.returncode == 2 and error["kind"] == "input", result.stderr
-    assert error["error"] == f"{tmp_path / 'taken' / 'all'}: expected an out folder, found a file in its path"
+    assert result.returncode == 1 and error["kind"] == "os", result.stderr
+    assert error["error"] == f"fishgen: cannot write {out}: expected a folder at {tmp_path / 'taken'}, found a file"
+    school = one_error(run(["school", str(PARAMS / "bonybream.txt"), "--count", "2", "--frames", "2",
+                            "-o", str(out / "s.glb")]))
+    assert (school["exit"], school["kind"]) == (1, "os") and "expected a folder at" in school["error"]
 
 
 def test_a_fly_report_the_system_refuses_is_said_before_the_flight(small_disk, tmp_path):
