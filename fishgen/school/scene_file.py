@@ -378,6 +378,22 @@ def _csv_points(where: _Where, path: Path, table: str) -> tuple[tuple[float, flo
     return tuple((r[0], r[1], r[2], r[3]) for r in rows)
 
 
+def _model_of_tables(where: _Where, data: dict, scene: SceneFile) -> SceneFile:
+    """A [pso] or [couzin] table picks its model when the file names none (as ``--preset`` sets
+    ``--model couzin``); under another model, or beside the other table, it would be read and then
+    ignored, so it is refused at its header."""
+    tables = [name for name in ("pso", "couzin") if name in data]
+    if len(tables) > 1:
+        raise where.fail("one model's table, [pso] or [couzin]", "a [pso] and a [couzin] table", "couzin",
+                         "couzin")
+    for name in tables:
+        if "model" not in data:
+            return replace(scene, model=name)
+        if scene.model != name:
+            raise where.fail(f'model = "{name}" (or no model) with a [{name}] table', scene.model, name, name)
+    return scene
+
+
 def _couzin(where: _Where, table: Any) -> tuple[CouzinParams, str | None]:
     """[couzin]: ``preset`` (one of COUZIN_PRESETS) and any CouzinParams field overriding it; and
     the preset's name."""
@@ -475,6 +491,7 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
     if "couzin" in data:
         couzin, preset = _couzin(where, data["couzin"])
         scene = replace(scene, couzin=couzin, preset=preset)
+    scene = _model_of_tables(where, data, scene)
     if "variety" in data:
         scene = replace(scene, variety=_variety(where, data["variety"]))
     total = sum(e.count for e in scene.species)

@@ -59,6 +59,31 @@ def test_a_csv_target_path(tmp_path):
         load_scene_file(path)
 
 
+@pytest.mark.parametrize("head,table,model", [("", '[couzin]\npreset = "torus"', "couzin"),
+                                              ("", "[pso]\ninertia = 0.1", "pso"),
+                                              ('model = "couzin"\n', '[couzin]\npreset = "swarm"', "couzin")])
+def test_a_model_s_table_picks_its_model_when_the_file_names_none(tmp_path, head, table, model):
+    """As --preset sets --model couzin: a [couzin] table alone ran boids, read and then ignored."""
+    (tmp_path / "a.txt").write_text("")
+    (tmp_path / "s.toml").write_text(f'{head}[[species]]\nfile = "a.txt"\n{table}\n')
+    assert load_scene_file(tmp_path / "s.toml").model == model
+
+
+@pytest.mark.parametrize("head,tables,message", [
+    ('model = "boids"\n', '[couzin]\npreset = "torus"', 'model = "couzin" \\(or no model\\) with a \\[couzin\\] table, found \'boids\''),
+    ('model = "couzin"\n', "[pso]\ninertia = 0.1", 'model = "pso" \\(or no model\\) with a \\[pso\\] table, found \'couzin\''),
+    ("", '[pso]\ninertia = 0.1\n[couzin]\npreset = "swarm"', r"one model's table, \[pso\] or \[couzin\], found a \[pso\] and"),
+])
+def test_a_model_s_table_under_another_model_is_refused_at_its_header(tmp_path, head, tables, message):
+    (tmp_path / "a.txt").write_text("")
+    text = f'{head}[[species]]\nfile = "a.txt"\n{tables}\n'
+    (tmp_path / "s.toml").write_text(text)
+    with pytest.raises(FishgenError, match=message) as err:
+        load_scene_file(tmp_path / "s.toml")
+    header = "[couzin]" if "couzin]" in tables else "[pso]"
+    assert err.value.line == text.splitlines().index(header) + 1
+
+
 def test_couzin_variety_warmup_and_length_keys_are_read_and_checked(tmp_path):
     (tmp_path / "a.txt").write_text("")
     scene = tmp_path / "ball.toml"
