@@ -76,7 +76,8 @@ def build_page(asset: str | Path, background: str = "#8cadcc", *, instancing: bo
     asset = Path(asset)
     kind = KINDS.get(asset.suffix.lower())
     if kind is None:
-        raise FishgenError(f"expected an asset ending in {', '.join(KINDS)}, found {asset.name!r}")
+        found = asset.suffix or "no extension"       # named: the page's one input is the file at fault
+        raise FishgenError(f"expected an asset ending in {', '.join(KINDS)}, found {found!r}", asset)
     if asset.is_dir():
         raise FishgenError("expected a file, found a directory", asset)
     if not asset.is_file():
