@@ -62,7 +62,9 @@ def texture_names(species_file: str | os.PathLike) -> TextureNames:
 def check_texture_names(names: TextureNames, others: Iterable[str | os.PathLike | None] = ()) -> None:
     """Derived texture names may be neither another output of the run (``others``) nor a file that
     is already there and that the species file at ``names.species_file`` does not name (a rerun
-    replaces its own textures). Names kept as ``-o`` gave them are the documented pair."""
+    replaces its own textures). Names kept as ``-o`` gave them are the documented pair, but neither
+    may be a texture another species file beside it names (see :func:`_named_by_another`)."""
+    _named_by_another(names)
     if names.why is None:
         return
     taken = {os.path.abspath(p) for p in others if p is not None}
@@ -76,6 +78,26 @@ def check_texture_names(names: TextureNames, others: Iterable[str | os.PathLike 
             raise UsageError(f"expected texture names that are no file already there, found "
                              f"{os.fspath(path)!r} (derived from -o {os.fspath(names.species_file)!r}, "
                              f"which does not name it); choose another -o")
+
+
+def _named_by_another(names: TextureNames) -> None:
+    """Refuse textures another species file beside names them: ``fish7_mask.txt``'s colour texture
+    is ``fish7_mask.png``, ``fish7.txt``'s fin mask, which it silently replaced with a colour
+    picture. The other owners are looked up by the documented pair (``T.png`` is ``T.txt``'s
+    colour, ``T_mask.png`` also ``T.txt``'s mask), not by reading the folder: ``species`` may
+    write thousands of files into one."""
+    own = os.path.abspath(names.species_file)
+    for path in names.paths:
+        if not os.path.lexists(path):
+            continue
+        stem = path.name[:-len(".png")]
+        owners = [stem + ".txt"] + ([stem[:-len("_mask")] + ".txt"] if stem.endswith("_mask") else [])
+        for owner in (path.with_name(name) for name in owners):
+            if os.path.abspath(owner) == own or not owner.is_file():
+                continue
+            if path.name in (_named_textures(owner) or ()):
+                raise UsageError(f"expected textures no other species file names, found {path.name!r}, "
+                                 f"named by {owner.name!r} beside it; choose another -o")
 
 
 def _named_textures(species_file: Path) -> tuple[str, str] | None:

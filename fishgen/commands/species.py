@@ -45,7 +45,8 @@ COMMAND = Command(
                   "OUT.png (texture) and OUT_mask.png (fin mask); where a species file cannot name those "
                   "(whitespace, / or \\, not UTF-8, over 255 bytes), each such run becomes _ and a note "
                   "says so, and a derived name that is a file already there, not named by OUT.txt, is "
-                  "refused. Every file lands, or none.",
+                  "refused; so is a texture another species file beside it names (X.txt's X_mask.png). "
+                  "Every file lands, or none.",
                   metavar="OUT", folder=True),
     together=True,
 )

@@ -66,7 +66,8 @@ COMMAND = Command(
     output=Output("New species file, written exactly there; NEW.png (texture) and NEW_mask.png (fin mask) "
                   "go beside it. Where a species file cannot name those (whitespace, / or \\, not UTF-8, "
                   "over 255 bytes), each such run becomes _ and a note says so, and a derived name that is "
-                  "another output or a file already there, not named by NEW.txt, is refused. The species "
+                  "another output or a file already there, not named by NEW.txt, is refused; so is a "
+                  "texture another species file beside it names (X.txt's X_mask.png). The species "
                   "file, its textures and --compare/--fxl-out land together, or none.",
                   metavar="NEW.txt"),
 )

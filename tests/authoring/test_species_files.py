@@ -51,9 +51,24 @@ def test_a_rerun_gives_the_same_bytes_and_replaces_its_own_derived_textures(tmp_
 def test_derived_names_never_take_another_file(tmp_path):
     write_samples(3, 1, tmp_path / "my_fish.txt")
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
-    with pytest.raises(UsageError, match="no file already there"):
+    with pytest.raises(UsageError, match="named by 'my_fish.txt' beside it"):
         write_samples(4, 1, tmp_path / "my fish.txt")
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    (tmp_path / "my_fish.txt").unlink()             # a picture no species file names: still not ours
+    with pytest.raises(UsageError, match="no file already there"):
+        write_samples(4, 1, tmp_path / "my fish.txt")
+
+
+@pytest.mark.parametrize("first,second", [("fish7.txt", "fish7_mask.txt"), ("fish7_mask.txt", "fish7.txt")])
+def test_a_texture_another_species_file_names_is_never_replaced(tmp_path, first, second):
+    """fish7_mask.txt's colour texture is fish7_mask.png, fish7.txt's fin mask: it was replaced by a
+    colour picture, and fish7 built with it as its mask, exit 0."""
+    write_samples(7, 1, tmp_path / first)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    with pytest.raises(UsageError, match=f"'fish7_mask.png', named by '{first}' beside it"):
+        write_samples(7, 1, tmp_path / second)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    write_samples(7, 1, tmp_path / first)           # a rerun still replaces its own textures
 
 
 def test_derived_names_never_take_another_output(tmp_path):
