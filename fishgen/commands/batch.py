@@ -205,13 +205,11 @@ def _check_report(report: Path, manifest: Manifest) -> None:
     """``--report`` is none of the files the jobs read or write, checked before any job runs: the
     manifest, each job's inputs and the files they name (a species' textures, a texture cloud's
     pictures, what the record says a job read last time), and each job's output and side files."""
-    from fishgen.batch.record import Record
+    from fishgen.batch import LOCK_NAME
+    from fishgen.batch.record import RECORD_NAME, Record
     from fishgen.commands.paths import check_inputs, check_targets, read_beside
     from fishgen.errors import UsageError
     from fishgen.exchange.registry import FORMATS, first_shared
-
-    from fishgen.batch import LOCK_NAME
-    from fishgen.batch.record import RECORD_NAME
 
     own = {name for name in (RECORD_NAME, LOCK_NAME) if report.resolve() == (manifest.out / name).resolve()}
     if own:  # the record says which jobs may be skipped next time; the lock keeps one batch a folder

@@ -209,7 +209,8 @@ def test_a_batch_out_folder_under_a_file_is_said_as_every_command_says_it(tmp_pa
     result = run(["batch", str(PARAMS / "clouds"), "--out", str(out)])
     error = one_error(result)
     assert result.returncode == 1 and error["kind"] == "os", result.stderr
-    assert error["error"] == f"fishgen: cannot write {out}: expected a folder at {tmp_path / 'taken'}, found a file"
+    blocker = tmp_path / "taken"
+    assert error["error"] == f"fishgen: cannot write {out}: expected a folder at {blocker}, found a file"
     school = one_error(run(["school", str(PARAMS / "bonybream.txt"), "--count", "2", "--frames", "2",
                             "-o", str(out / "s.glb")]))
     assert (school["exit"], school["kind"]) == (1, "os") and "expected a folder at" in school["error"]

@@ -69,10 +69,14 @@ def test_a_model_s_table_picks_its_model_when_the_file_names_none(tmp_path, head
     assert load_scene_file(tmp_path / "s.toml").model == model
 
 
+_PICKS = r'model = "{}" \(or no model\) with a \[{}\] table, found '
+
+
 @pytest.mark.parametrize("head,tables,message", [
-    ('model = "boids"\n', '[couzin]\npreset = "torus"', 'model = "couzin" \\(or no model\\) with a \\[couzin\\] table, found \'boids\''),
-    ('model = "couzin"\n', "[pso]\ninertia = 0.1", 'model = "pso" \\(or no model\\) with a \\[pso\\] table, found \'couzin\''),
-    ("", '[pso]\ninertia = 0.1\n[couzin]\npreset = "swarm"', r"one model's table, \[pso\] or \[couzin\], found a \[pso\] and"),
+    ('model = "boids"\n', '[couzin]\npreset = "torus"', _PICKS.format("couzin", "couzin") + "'boids'"),
+    ('model = "couzin"\n', "[pso]\ninertia = 0.1", _PICKS.format("pso", "pso") + "'couzin'"),
+    ("", '[pso]\ninertia = 0.1\n[couzin]\npreset = "swarm"',
+     r"one model's table, \[pso\] or \[couzin\], found a \[pso\] and"),
 ])
 def test_a_model_s_table_under_another_model_is_refused_at_its_header(tmp_path, head, tables, message):
     (tmp_path / "a.txt").write_text("")

@@ -81,7 +81,8 @@ def test_missing_side_file_is_a_one_line_error(viewer_assets, tmp_path):
 
 def test_unsupported_asset_is_refused(tmp_path):
     (tmp_path / "fish.txt").write_text("x")
-    with pytest.raises(FishgenError, match="expected an asset ending in .glb, .gltf, .obj, .ply, found '.txt'") as err:
+    wrong = "expected an asset ending in .glb, .gltf, .obj, .ply, found '.txt'"
+    with pytest.raises(FishgenError, match=wrong) as err:
         build_page(tmp_path / "fish.txt")
     assert err.value.file == str(tmp_path / "fish.txt")      # it was named by no file: `fishgen: expected …`
 
