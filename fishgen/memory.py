@@ -1,12 +1,15 @@
 """How much memory this process may use, to refuse a run that would not fit before allocating.
 
-A leaf module (no numpy): `fishgen school` (:mod:`fishgen.school.memory`) and the cloud commands
-(:mod:`fishgen.clouds.memory`) estimate their peaks from their sizes and compare them with this.
+A leaf module (no numpy): `fishgen school` (:mod:`fishgen.school.memory`), the cloud commands
+(:mod:`fishgen.clouds.memory`) and `fishgen preview` (:mod:`fishgen.preview.memory`) estimate their
+peaks from their sizes and compare them with this.
 """
 from __future__ import annotations
 
 import os
 import resource
+
+ADDRESS_SPACE = "this process's address-space limit"
 
 
 def allowed() -> tuple[int, str] | None:
@@ -14,7 +17,7 @@ def allowed() -> tuple[int, str] | None:
     else the machine's available memory; None if neither is known."""
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft != resource.RLIM_INFINITY:
-        return soft, "this process's address-space limit"
+        return soft, ADDRESS_SPACE
     try:
         with open("/proc/meminfo", encoding="ascii") as info:
             for line in info:

@@ -118,6 +118,9 @@ def check_output(out: Path, options: PreviewOptions, inputs: int = 1) -> int:
         raise UsageError(f"expected at most {MAX_TOTAL_PIXELS} pixels (2^30) in all frames and "
                            f"contact sheets, found {total} for {inputs} input(s) x {frames} frame(s) "
                            f"at {options.width}x{options.height}; use a smaller --size or fewer --frames")
+    from fishgen.preview.memory import check_fits
+
+    check_fits(options.width, options.height, total if frames > 1 or inputs > 1 else 0)
     return frames
 
 

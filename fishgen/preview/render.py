@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from fishgen.clouds.lighting import Lighting, from_extras
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, SystemFailure
 from fishgen.geometry.mesh import vertex_normals
 from fishgen.numeric import to_linear_float
 from fishgen.preview.camera import Camera
@@ -208,9 +208,10 @@ class Renderer:
         except moderngl.Error as err:  # out of memory: the driver leaves the framebuffer incomplete
             self.ctx.release()
             need = width * height * (4 + 4) * samples + width * height * 4
-            raise FishgenError(f"expected memory for a {width}x{height} framebuffer ({need / 2**20:,.0f} MiB "
-                               f"with {samples}x anti-aliasing), found the driver unable to make one "
-                               f"({err}); use a smaller --size") from None
+            # past the estimate (preview.memory): the system's refusal, as an out-of-memory error is
+            raise SystemFailure(f"out of memory for a {width}x{height} framebuffer ({need / 2**20:,.0f} MiB "
+                                f"with {samples}x anti-aliasing): the driver could not make one ({err}); "
+                                "use a smaller --size") from None
         self.mesh_prog: Any = self.ctx.program(vertex_shader=MESH_VS, fragment_shader=MESH_FS)
         self.point_prog: Any = self.ctx.program(vertex_shader=POINT_VS, fragment_shader=POINT_FS)
         corners = np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32)
