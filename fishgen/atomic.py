@@ -137,14 +137,17 @@ def _land(staged: list[tuple[str, Path]]) -> None:
     pending.extend(staged)
 
 
-def _fail(target: Path, err: OSError) -> SystemFailure:
+def write_failure(target: Path, err: OSError, folder: bool = False) -> SystemFailure:
     """An OS error about a temp file or rename, reported against the user's target (a full disk's
-    error names no file, so the target is always named here)."""
-    if target.is_dir():
+    error names no file, so the target is always named here). ``folder``: the target is to be a
+    folder (a batch's out folder), so a file there is in the way too."""
+    if target.is_dir() and not folder:
         return SystemFailure(f"cannot write {target}: a folder is in the way", target)
-    blocker = next((folder for folder in target.parents if folder.is_file()), None)
+    blocker = next((f for f in ((target,) if folder else ()) + tuple(target.parents)
+                    if f.is_file() or (f.is_symlink() and not f.exists())), None)
     if blocker is not None:  # mkdir's error says only "File exists"
-        return SystemFailure(f"cannot write {target}: expected a folder at {blocker}, found a file", target)
+        found = "a file" if blocker.is_file() else "a broken symbolic link"
+        return SystemFailure(f"cannot write {target}: expected a folder at {blocker}, found {found}", target)
     return cannot("write", target, err)
 
 
@@ -365,7 +368,7 @@ def _stage(path: Path, data: bytes, into: list[tuple[str, Path]]) -> None:
     try:
         fd, tmp = _temporary(path, into)
     except OSError as err:
-        raise _fail(path, err) from None
+        raise write_failure(path, err) from None
     try:
         with _writer(tmp, fd) as handle:
             handle.write(data)
@@ -375,7 +378,7 @@ def _stage(path: Path, data: bytes, into: list[tuple[str, Path]]) -> None:
     except BaseException as err:
         _discard(tmp)
         if isinstance(err, OSError):
-            raise _fail(path, err) from None
+            raise write_failure(path, err) from None
         raise
 
 
@@ -420,7 +423,7 @@ def _commit(staged: list[tuple[str, Path]]) -> None:
                 try:
                     os.replace(tmp, target)
                 except OSError as err:
-                    raise _fail(target, err) from None
+                    raise write_failure(target, err) from None
                 _release(tmp)
         except BaseException as err:
             stranded: list[tuple[str, Path]] = []
@@ -477,7 +480,7 @@ class atomic_open:
             for tmp, _ in named:
                 _discard(tmp)
             if isinstance(err, OSError):
-                raise _fail(self.path, err) from None
+                raise write_failure(self.path, err) from None
             raise
         return self._handle
 
@@ -501,12 +504,12 @@ class atomic_open:
             _discard(self._tmp)
         except OSError as err:
             _discard(self._tmp)
-            raise _fail(self.path, err) from None
+            raise write_failure(self.path, err) from None
         except BaseException:
             _discard(self._tmp)
             raise
         if isinstance(exc, OSError) and exc.filename is None:
             # A write to the handle failed (a full disk, a file size limit): its error names no
             # file, so say which output it was.
-            raise _fail(self.path, exc) from None
+            raise write_failure(self.path, exc) from None
         return False

@@ -87,15 +87,14 @@ def _named_by_another(names: TextureNames) -> None:
     colour, ``T_mask.png`` also ``T.txt``'s mask), not by reading the folder: ``species`` may
     write thousands of files into one."""
     own = os.path.abspath(names.species_file)
-    for path in names.paths:
-        if not os.path.lexists(path):
-            continue
+    for path in names.paths:   # there or not: a missing mask written as a colour picture is as wrong
         stem = path.name[:-len(".png")]
         owners = [stem + ".txt"] + ([stem[:-len("_mask")] + ".txt"] if stem.endswith("_mask") else [])
         for owner in (path.with_name(name) for name in owners):
             if os.path.abspath(owner) == own or not owner.is_file():
                 continue
-            if path.name in (_named_textures(owner) or ()):
+            # casefolded: on a case-insensitive disk Fish7_mask.png is fish7_mask.png
+            if path.name.casefold() in (name.casefold() for name in _named_textures(owner) or ()):
                 raise UsageError(f"expected textures no other species file names, found {path.name!r}, "
                                  f"named by {owner.name!r} beside it; choose another -o")
 

@@ -121,10 +121,10 @@ def _locked(out: Path) -> Iterator[None]:
     try:
         out.mkdir(parents=True, exist_ok=True)
         handle = open(out / LOCK_NAME, "a+b")  # held open for the whole batch
-    except (NotADirectoryError, FileExistsError):  # a file where --out names a folder: as every command says
-        blocker = next((folder for folder in (out, *out.parents) if folder.is_file()), out)
-        raise SystemFailure(f"cannot write {out}: expected a folder at {blocker}, found a file",
-                            out) from None
+    except (NotADirectoryError, FileExistsError) as err:  # a file where --out names a folder
+        from fishgen.atomic import write_failure
+
+        raise write_failure(out, err, folder=True) from None
     except OSError as err:  # the system refused (read-only, permissions, full): not the input
         raise cannot("write", out, err) from None
     try:

@@ -35,7 +35,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from fishgen.clouds.lighting import Lighting
+from fishgen.clouds.lighting import DIFFUSE, Lighting
 from fishgen.clouds.model import Cloud
 from fishgen.clouds.sprite import SIGMA
 
@@ -406,11 +406,6 @@ def _read_chunk(grid: _Grid, place, own: np.ndarray, before: np.ndarray, depths:
         light[start:stop][pick] = got
 
 
-DIFFUSE = 2.0 ** -10
-"""The share of sunlight that reaches deep into a cloud by scattering many times (see
-``light_of_depth``): a power of two, so full sun stays exactly 1."""
-
-
 def light_of_depth(depth: np.ndarray) -> np.ndarray:
     """The light (float32, 1 in full sun) behind an effective optical ``depth`` towards the sun:
     ``e^-depth`` as Harris's first pass lets it through, and DIFFUSE of the sun falling as
@@ -418,8 +413,9 @@ def light_of_depth(depth: np.ndarray) -> np.ndarray:
 
     Harris's pass keeps only the light scattered forward; with it alone a particle behind an
     optical depth of ~100 gets exactly 0 in float32, and a dense cloud's inside (depths in the
-    thousands) is one black, its order towards the sun lost (issue 32). DIFFUSE moves no
-    colour by more than one sRGB byte, and the light still falls strictly with depth.
+    thousands) is one black, its order towards the sun lost (issue 32). With the default sky,
+    DIFFUSE moves no colour by more than one sRGB byte (under a black sky and a bright sun, the
+    darkest by a few); the light still falls with depth, to float32's rounding of ``exp``.
     """
     depth = np.array(depth, _F32)
     return _light_into(depth, np.empty_like(depth))

@@ -34,6 +34,9 @@ ALBEDO = 0.9           # SkyWorks: SkyCloud::s_rAlbedo
 EXTINCTION = 80.0      # SkyWorks: SkyCloud::s_rExtinction (a particle's centre passes e^-80)
 SOLID_ANGLE = 0.09     # SkyWorks: rSolidAngle in SkyCloud::Illuminate, steradians
 ANISOTROPY = 0.0       # Cornette-Shanks g (report eq. 3.14); 0 is Rayleigh scattering, as SkyWorks uses
+DIFFUSE = 2.0 ** -10
+"""The share of sunlight that reaches deep into a cloud by scattering many times
+(``fishgen.clouds.light.light_of_depth``): a power of two, so full sun stays exactly 1."""
 
 
 @dataclass(frozen=True)
@@ -63,7 +66,8 @@ class Lighting:
                                "Cornette-Shanks); 0 is Rayleigh, positive scatters more light forward.",
                                ANISOTROPY, metavar="G")
     scattering: bool = option(click.BOOL, "Multiple forward scattering (Harris); off leaves only the "
-                              "sunlight that passes straight through.", True, flag=True,
+                              "sunlight that passes straight through (and the faint diffuse share "
+                              "of docs/clouds.md).", True, flag=True,
                               off="--no-scattering")
 
     def __post_init__(self) -> None:
@@ -114,8 +118,9 @@ class Lighting:
                 "sky_color": list(self.sky_color), "albedo": self.albedo, "extinction": self.extinction,
                 "solid_angle": self.solid_angle, "anisotropy": self.anisotropy,
                 "scattering": self.scattering,
-                "light": "_LIGHT = e^-E + 2^-10 (1 / (1 + E) - e^-E), E the effective optical depth "
-                         "towards the sun (Harris's first pass, and light scattered many times)",
+                "light": f"_LIGHT = e^-E + 2^{round(math.log2(DIFFUSE))} (1 / (1 + E) - e^-E), E the "
+                         "effective optical depth towards the sun (Harris's first pass, and light "
+                         "scattered many times)",
                 "colour": "COLOR_0 = albedo * (sky_color + sun_color * _LIGHT), clamped to 0..1",
                 "second_pass": "albedo * (sky_color + sun_color * _LIGHT * phase(dot(view, sun)))"}
 

@@ -211,7 +211,9 @@ def _check_report(report: Path, manifest: Manifest) -> None:
     from fishgen.errors import UsageError
     from fishgen.exchange.registry import FORMATS, first_shared
 
-    own = {name for name in (RECORD_NAME, LOCK_NAME) if report.resolve() == (manifest.out / name).resolve()}
+    # realpath, not resolve(): a symlink loop is no error here, as the checks below find it
+    own = {name for name in (RECORD_NAME, LOCK_NAME)
+           if os.path.realpath(report) == os.path.realpath(manifest.out / name)}
     if own:  # the record says which jobs may be skipped next time; the lock keeps one batch a folder
         raise UsageError(f"expected a report that is not the batch's own {own.pop()}, found "
                          f"{os.fspath(report)!r}")

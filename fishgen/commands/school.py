@@ -161,6 +161,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         SpeciesEntry,
         check_size,
         check_species_files,
+        check_table,
         load_scene_file,
         preroll_steps,
         with_options,
@@ -191,6 +192,8 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
                          length=options.length, warmup=options.warmup, preset=options.preset,
                          variety=variety, preroll=options.preroll, layout=options.layout)
     # before anything is built
+    if scene_files:
+        check_table(scene, scene_files[0])
     check_size(scene, scene_files[0] if scene_files else None, tracks="tracks" in sides)
     species_files = [e.file for e in scene.species]
     textures = read_beside(species_files, [FORMATS["species"]] * len(species_files), options.textures)

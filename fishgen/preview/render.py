@@ -210,8 +210,8 @@ class Renderer:
             need = width * height * (4 + 4) * samples + width * height * 4
             # past the estimate (preview.memory): the system's refusal, as an out-of-memory error is
             raise SystemFailure(f"out of memory for a {width}x{height} framebuffer ({need / 2**20:,.0f} MiB "
-                                f"with {samples}x anti-aliasing): the driver could not make one ({err}); "
-                                "use a smaller --size") from None
+                                f"with {samples}x anti-aliasing): the driver could not make one ({err})"
+                                ) from None
         self.mesh_prog: Any = self.ctx.program(vertex_shader=MESH_VS, fragment_shader=MESH_FS)
         self.point_prog: Any = self.ctx.program(vertex_shader=POINT_VS, fragment_shader=POINT_FS)
         corners = np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32)

@@ -198,6 +198,8 @@ class SceneFile:
     preroll: float | None = None         # seconds; None: preroll_seconds' default
     length: float | None = None          # metres, every species; None: each species file's own
     read: tuple[Path, ...] = ()      # the files it named and were read: path CSVs
+    table: tuple[str, int | None] | None = None   # the model's table the file gave ("pso" or "couzin"),
+                                                  # and its header's line: the model must stay that
 
 
 def with_options(scene: SceneFile, *, count: int | None = None, frames: int | None = None,
@@ -387,11 +389,19 @@ def _model_of_tables(where: _Where, data: dict, scene: SceneFile) -> SceneFile:
         raise where.fail("one model's table, [pso] or [couzin]", "a [pso] and a [couzin] table", "couzin",
                          "couzin")
     for name in tables:
-        if "model" not in data:
-            return replace(scene, model=name)
-        if scene.model != name:
+        if "model" in data and scene.model != name:
             raise where.fail(f'model = "{name}" (or no model) with a [{name}] table', scene.model, name, name)
+        return replace(scene, model=name, table=(name, where.line(name, name)))
     return scene
+
+
+def check_table(scene: SceneFile, file: str | os.PathLike) -> None:
+    """Refuse a scene whose model, after the command line's ``--model`` or ``--preset``, is not the
+    one its [pso] or [couzin] table is for: the table would be ignored."""
+    if scene.table is not None and scene.table[0] != scene.model:
+        name, line = scene.table
+        raise FishgenError(f"expected the {name} model with a [{name}] table, found the {scene.model} "
+                           "model from the command line", file, line)
 
 
 def _couzin(where: _Where, table: Any) -> tuple[CouzinParams, str | None]:

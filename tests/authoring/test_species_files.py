@@ -69,6 +69,9 @@ def test_a_texture_another_species_file_names_is_never_replaced(tmp_path, first,
         write_samples(7, 1, tmp_path / second)
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
     write_samples(7, 1, tmp_path / first)           # a rerun still replaces its own textures
+    (tmp_path / "fish7_mask.png").unlink()          # missing, it would be written as the wrong picture
+    with pytest.raises(UsageError, match=f"'fish7_mask.png', named by '{first}' beside it"):
+        write_samples(7, 1, tmp_path / second)
 
 
 def test_derived_names_never_take_another_output(tmp_path):

@@ -180,3 +180,14 @@ def test_the_report_may_not_be_the_batch_s_own_record_or_lock(shipped, name):
     run = batch(shipped / "params" / "assets.toml", "--out", out, "--report", out / name)
     assert run.returncode == 2 and f"expected a report that is not the batch's own {name}" in run.stderr
     assert len(run.stderr.strip().splitlines()) == 1 and not (out / "fish").exists()
+
+
+def test_a_report_through_a_symlink_loop_is_a_line_not_a_traceback(shipped):
+    """Path.resolve() raises RuntimeError on a loop (Python 3.11): the record-or-lock check used it."""
+    loop = shipped / "self"
+    loop.symlink_to(loop)
+    run = batch(shipped / "params" / "clouds", "--out", shipped / "o", "--report", loop / "r.json")
+    assert "Traceback" not in run.stderr and run.returncode == 1
+    said = f"fishgen: cannot write {loop / 'r.json'}: expected a folder at {loop}, found a broken symbolic " \
+           "link"
+    assert run.stderr.strip().splitlines() == [said]

@@ -62,3 +62,25 @@ def test_a_note_during_a_bar_takes_the_bar_s_line_and_the_bar_is_drawn_again_bel
     err = capsys.readouterr().err
     assert err.startswith("before\n\r\x1b[Kduring\n\r\x1b[Kp.png: ") and err.count("\n") == 3
     assert bar.drawn == 2
+
+
+def test_click_s_own_bar_is_drawn_again_at_once_below_a_note(monkeypatch):
+    """With click's progress bar itself (the redraw clears what click remembers it drew last)."""
+    import io
+    import sys
+
+    from fishgen.cli.adapter import TerminalEvents
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    err = Terminal()
+    monkeypatch.setattr(sys, "stderr", err)
+    events = TerminalEvents("texture")
+    with events.progress("fitting", 4) as bar:
+        bar.update(1)
+        events.note("hello")
+        assert "fitting" in err.getvalue().split("hello\n", 1)[1]     # before the next step
+        bar.update(3)
+    assert "\n\n" not in err.getvalue() and err.getvalue().count("hello") == 1

@@ -88,6 +88,26 @@ def test_a_model_s_table_under_another_model_is_refused_at_its_header(tmp_path, 
     assert err.value.line == text.splitlines().index(header) + 1
 
 
+@pytest.mark.parametrize("table,override", [('[couzin]\npreset = "torus"', {"model": "boids"}),
+                                            ("[pso]\ninertia = 0.1", {"preset": "torus"}),
+                                            ("[pso]\ninertia = 0.1", {"model": "couzin"})])
+def test_a_model_s_table_is_refused_when_the_command_line_picks_another_model(tmp_path, table, override):
+    """`school s.toml --model boids` with a [couzin] table ran boids, the table ignored."""
+    import shutil
+
+    from fishgen.commands import command, run
+
+    for name in ("bonybream.txt", "bonybream.png", "bonybream_mask.png"):
+        shutil.copy(PARAMS.parent / ("params" if name.endswith(".txt") else "textures") / name, tmp_path)
+    (tmp_path / "s.toml").write_text(f'[[species]]\nfile = "bonybream.txt"\ncount = 3\n{table}\n')
+    school = command("school")
+    name = table[1:table.index("]")]
+    with pytest.raises(FishgenError, match=f"expected the {name} model with a \\[{name}\\] table, found the "
+                                           "(boids|couzin) model from the command line") as err:
+        run(school, (tmp_path / "s.toml",), tmp_path / "s.glb", school.options(frames=3, **override))
+    assert err.value.line == 4 and not (tmp_path / "s.glb").exists()
+
+
 def test_couzin_variety_warmup_and_length_keys_are_read_and_checked(tmp_path):
     (tmp_path / "a.txt").write_text("")
     scene = tmp_path / "ball.toml"
