@@ -31,5 +31,16 @@ def allowed() -> tuple[int, str] | None:
     return pages * os.sysconf("SC_PAGE_SIZE"), "the memory this machine has available"
 
 
+def over(limit: tuple[int, str] | None, need: int) -> tuple[str, str] | None:
+    """(what may be used, what ``need`` is) as a message says them, when ``need`` bytes are more than
+    ``limit`` (:func:`allowed`'s) allows; else None. Near the line, with places enough to differ."""
+    if limit is None or need <= limit[0]:
+        return None
+    have, want = size_text(limit[0]), size_text(need)
+    if have == want:
+        have, want = f"{limit[0] / 2**30:.2f} GiB", f"{need / 2**30:.2f} GiB"
+    return have, want
+
+
 def size_text(n: int) -> str:
     return f"{n / 2**30:.1f} GiB" if n >= 2**30 else f"{n / 2**20:.0f} MiB"

@@ -10,7 +10,7 @@ and 3 x 10^6 particles) peaked at 750 MiB, 113 bytes a point with its levels of 
 """
 from __future__ import annotations
 
-from fishgen.memory import allowed, size_text
+from fishgen.memory import allowed, over
 
 BASE = 400 * 2**20
 SKY_BASE = 800 * 2**20
@@ -32,12 +32,11 @@ def check_fits(particles: int, suffix: str, billboards: bool = False, sky: bool 
     may use (a usage error: the output's kind and the counts are the command line's)."""
     from fishgen.errors import UsageError
 
-    need, limit = estimate(particles, suffix, billboards, sky), allowed()
-    if limit is not None and need > limit[0]:
+    limit = allowed()
+    texts = over(limit, estimate(particles, suffix, billboards, sky))
+    if limit is not None and texts is not None:
         noun = "billboards" if billboards else "particles"
-        have, want = size_text(limit[0]), size_text(need)
-        if have == want:  # near the line: enough places to tell them apart
-            have, want = f"{limit[0] / 2**30:.2f} GiB", f"{need / 2**30:.2f} GiB"
+        have, want = texts
         raise UsageError(f"expected a {'sky' if sky else 'cloud'} that fits in {have} ({limit[1]}), found "
                          f"{particles:,} {noun} for {suffix}, which need about {want}: use fewer "
                          f"particles{' or points' if billboards else ''}")

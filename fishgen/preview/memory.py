@@ -8,7 +8,7 @@ about 10 bytes a pixel in a GIF (RGBA, then a palette) and 4 in a WebP. Rounded 
 """
 from __future__ import annotations
 
-from fishgen.memory import ADDRESS_SPACE, allowed, size_text
+from fishgen.memory import ADDRESS_SPACE, allowed, over
 
 RESIDENT_BASE = 160 * 2**20
 ADDRESS_BASE = 900 * 2**20
@@ -32,11 +32,9 @@ def check_fits(width: int, height: int, held: int) -> None:
     if limit is None:
         return
     resident, address = estimate(width, height, held)
-    need = address if limit[1] == ADDRESS_SPACE else resident
-    if need > limit[0]:
-        have, want = size_text(limit[0]), size_text(need)
-        if have == want:  # near the line: enough places to tell them apart
-            have, want = f"{limit[0] / 2**30:.2f} GiB", f"{need / 2**30:.2f} GiB"
+    texts = over(limit, address if limit[1] == ADDRESS_SPACE else resident)
+    if texts is not None:
+        have, want = texts
         raise UsageError(f"expected a preview that fits in {have} ({limit[1]}), found {width}x{height}"
                          f"{f' holding {held:,} pixels of frames' if held else ''}, which needs about "
                          f"{want}: use a smaller --size or fewer --frames")
