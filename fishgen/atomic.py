@@ -15,6 +15,7 @@ the renames that land a set of files run to their end first (:mod:`fishgen.inter
 """
 from __future__ import annotations
 
+import errno
 import logging
 import os
 import re
@@ -92,6 +93,8 @@ def check_writable(target: str | os.PathLike) -> None:
 
     folder = Path(target).parent
     if not folder.is_dir():
+        if any(f.is_file() or (f.is_symlink() and not f.exists()) for f in (folder, *folder.parents)):
+            raise write_failure(Path(target), FileExistsError(errno.EEXIST, "File exists"))
         return
     try:
         fd, probe = tempfile.mkstemp(prefix=".fishgen-probe-", dir=folder)

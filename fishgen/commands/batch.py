@@ -205,6 +205,7 @@ def _check_report(report: Path, manifest: Manifest) -> None:
     """``--report`` is none of the files the jobs read or write, checked before any job runs: the
     manifest, each job's inputs and the files they name (a species' textures, a texture cloud's
     pictures, what the record says a job read last time), and each job's output and side files."""
+    from fishgen.atomic import check_writable
     from fishgen.batch import LOCK_NAME
     from fishgen.batch.record import RECORD_NAME, Record
     from fishgen.commands.paths import check_inputs, check_targets, read_beside
@@ -228,6 +229,7 @@ def _check_report(report: Path, manifest: Manifest) -> None:
         except FishgenError:
             pass
     check_targets([report], read)
+    check_writable(report)   # before the jobs, not after them
     clash = first_shared([report, *(job.output for job in manifest.jobs)])
     if clash is not None and clash[0] == 0:
         job = manifest.jobs[clash[1] - 1]
