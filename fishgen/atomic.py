@@ -85,6 +85,29 @@ def protecting(paths: Iterable[str | os.PathLike]) -> Iterator[None]:
         _inputs.set(outer)
 
 
+def _umask() -> int:
+    """This process's umask: read from /proc where Linux says it, else set and restored at once."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _mode_for(path: str | os.PathLike) -> int:
+    """The permissions a written file gets: a replaced file keeps its own (a 0600 file stays
+    private), a new one what the umask allows of 0666, as ``open`` would have given it."""
+    try:
+        return stat.S_IMODE(os.stat(path).st_mode)
+    except OSError:
+        return 0o666 & ~_umask()
+
+
 def check_writable(target: str | os.PathLike) -> None:
     """Refuse now, as a write would later, a target whose folder the system will not write in: for
     an output written only after long work (a fly-through's report). A folder still to be made is
@@ -158,7 +181,8 @@ def check_target(target: Path) -> None:
     """Only a missing file or a regular file may be replaced: renaming over a FIFO or a device
     node (``-o /dev/null`` run as root) would replace the special file itself."""
     if target.is_dir():
-        raise FishgenError(f"expected an output file, found a folder at {target}")
+        # named as its FILE: without one, a command blamed its input (`photo.png: …, found a folder at d.png`)
+        raise FishgenError("expected an output file, found a folder", target)
     try:
         info = target.stat()
     except OSError:
@@ -377,7 +401,7 @@ def _stage(path: Path, data: bytes, into: list[tuple[str, Path]]) -> None:
             handle.write(data)
             handle.flush()
             os.fsync(handle.fileno())
-        os.chmod(tmp, 0o644)
+        os.chmod(tmp, _mode_for(path))
     except BaseException as err:
         _discard(tmp)
         if isinstance(err, OSError):
@@ -496,7 +520,7 @@ class atomic_open:
                 os.fsync(self._handle.fileno())
             self._handle.close()
             if exc_type is None:
-                os.chmod(self._tmp, 0o644)
+                os.chmod(self._tmp, _mode_for(self.path))
                 if _staging.get() is None:
                     os.replace(self._tmp, self.path)
                     _release(self._tmp)

@@ -25,7 +25,7 @@ def test_replaces_a_file(tmp_path):
 
 def test_folder_in_the_way_is_refused_before_writing(tmp_path):
     (tmp_path / "x.glb").mkdir()
-    with pytest.raises(FishgenError, match=r"expected an output file, found a folder at .*x\.glb"):
+    with pytest.raises(FishgenError, match=r"expected an output file, found a folder$"):
         write_bytes(tmp_path / "x.glb", b"data")
     assert leftovers(tmp_path) == []
 
@@ -350,3 +350,23 @@ def test_an_interrupt_at_any_step_leaves_no_temporary_file_and_no_half_set(tmp_p
             assert target.read_bytes() == b"new"
         step += 1
     assert step > 10 and target.read_bytes() == b"new"
+
+
+def test_a_new_file_gets_what_the_umask_allows_and_a_replaced_one_keeps_its_mode(tmp_path):
+    """Every write was chmod 0644: a 0600 file turned world-readable when replaced."""
+    import os
+    import stat
+
+    old = os.umask(0o077)
+    try:
+        write_files({tmp_path / "new.txt": b"a"})
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE((tmp_path / "new.txt").stat().st_mode) == 0o600
+    (tmp_path / "private.txt").write_bytes(b"x")
+    (tmp_path / "private.txt").chmod(0o640)
+    write_files({tmp_path / "private.txt": b"y"})
+    assert stat.S_IMODE((tmp_path / "private.txt").stat().st_mode) == 0o640
+    with atomic_open(tmp_path / "private.txt") as handle:
+        handle.write(b"z")
+    assert stat.S_IMODE((tmp_path / "private.txt").stat().st_mode) == 0o640

@@ -114,7 +114,8 @@ def _wrapped(callback, name: str):
 def _devnull():
     import os
 
-    return open(os.devnull, "w", encoding="utf-8")
+    # surrogateescape: a summary naming a file whose name is not UTF-8 is discarded, not an error
+    return open(os.devnull, "w", encoding="utf-8", errors="surrogateescape")
 
 
 def _log_to_stderr() -> None:

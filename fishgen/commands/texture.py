@@ -80,11 +80,16 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     output = Path(output)
     from fishgen.authoring.photo.run import FITS, TextureOptions, make_texture
     from fishgen.authoring.species_files import check_texture_names, texture_names
-    from fishgen.commands.paths import check_targets
+    from fishgen.commands.paths import check_targets, suffix_of
     from fishgen.errors import UsageError
     from fishgen.species.parser import load_species
 
     (photo,) = inputs
+    # the comparison is a PNG and the points Fixel text, whatever the name: refused, not mislabelled
+    if options.compare is not None:
+        suffix_of(options.compare, [".png"], "--compare")
+    if options.fxl_out is not None:
+        suffix_of(options.fxl_out, [".fxl"], "--fxl-out")
     if options.species is None:
         raise UsageError("expected -s/--species BASE.txt, the species to start from, found none")
     sides = [options.mask, options.fxl_in]
@@ -95,6 +100,7 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     check_targets(outputs, species.side_files)  # the textures it names are inputs too
     names = texture_names(output)
     check_texture_names(names, [options.compare, options.fxl_out, photo, options.species, *sides])
+    check_targets(names.paths, [photo, options.species, *given, *species.side_files])  # before the fit
     settings = TextureOptions(mask=options.mask, fit_shape=options.fit_shape,
                               body_sections=options.body_sections,
                               circle_sections=options.circle_sections, spacing=options.spacing,

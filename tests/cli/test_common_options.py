@@ -26,6 +26,15 @@ def test_quiet_drops_the_summary_and_verbose_lists_each_file_written(tmp_path):
     assert "fishgen clouds: done in" in verbose.stderr
 
 
+def test_quiet_discards_a_summary_naming_a_file_whose_name_is_not_utf8(tmp_path):
+    """-q wrote the summary to a strict UTF-8 sink: `wrote bad\\udcff.glb` raised after the write."""
+    import os
+
+    out = os.fsdecode(os.fsencode(str(tmp_path)) + b"/bad\xff.glb")
+    result = run_cli("build", PARAMS / "bonybream.txt", "-o", out, "-q")
+    assert (result.returncode, result.stdout, result.stderr) == (0, "", "") and os.path.isfile(out)
+
+
 @pytest.mark.parametrize("args", [["-q", "-v", "build"], ["-v", "build", "-q"], ["build", "-q", "-v"]])
 def test_quiet_wins_over_verbose_wherever_each_is_given(tmp_path, args):
     out = tmp_path / "b.glb"

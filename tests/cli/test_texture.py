@@ -110,7 +110,11 @@ def _photos(tmp_path, bream_photo):
     _png_header_only(tmp_path / "big.png", 9000, 9000)      # PIL would decode it; fishgen does not
     (tmp_path / "notes.png").write_text("not a picture\n")
     Image.fromarray(photo.rgba[:40, :40]).save(tmp_path / "tiny.png")
-    return {"blank.png": "expected a fish in the photo, found none",
+    frames = [Image.fromarray(np.ascontiguousarray(rgba)).convert("RGB")
+              for rgba in (photo.rgba, photo.rgba[:, ::-1])]
+    frames[0].save(tmp_path / "swim.gif", save_all=True, append_images=frames[1:])  # 1st frame was used
+    return {"swim.gif": "expected a still photo, found an animation of 2 frames",
+            "blank.png": "expected a fish in the photo, found none",
             "two.png": "expected one fish, found 2 objects",
             "cut.png": "cut off at the left edge",
             "huge.png": "at most 64 megapixels, found 900 megapixels",
@@ -129,6 +133,19 @@ def test_bad_photos_get_one_line_errors_and_nothing_is_written(tmp_path, cli, br
         assert words in r.stderr, (name, r.stderr)
         assert str(tmp_path / name) in r.stderr, (name, r.stderr)
         assert not out.parent.exists() or not any(out.parent.iterdir()), name
+
+
+def test_a_16_bit_grey_photo_is_scaled_to_8_bits_not_clipped_white(tmp_path, bream_photo):
+    """Pillow converts I;16 to RGBA by clipping at 255: the photo read as all white ("no fish",
+    or with --mask an all-white texture)."""
+    from fishgen.authoring.photo.image import load_photo
+
+    path, _ = bream_photo
+    grey = np.asarray(Image.open(path).convert("L"))
+    Image.fromarray(grey.astype(np.uint16) * 257).save(tmp_path / "grey16.png")
+    assert Image.open(tmp_path / "grey16.png").mode == "I;16"
+    photo = load_photo(tmp_path / "grey16.png")
+    assert np.array_equal(photo.rgb[:, :, 0], grey) and np.array_equal(photo.rgb[:, :, 2], grey)
 
 
 def test_failure_after_measuring_leaves_no_file(tmp_path, cli, bream_photo):
@@ -234,11 +251,9 @@ def test_focal_length_measures_the_rebuilt_fish_in_that_perspective(tmp_path, cl
     assert "--focal-length" in bad.stderr
 
 
-@pytest.mark.parametrize("args,twice", [
-    (["-o", "out/d.txt", "--compare", "out/d.txt"], "out/d.txt"),
+@pytest.mark.parametrize("args,twice", [   # (--compare or --fxl-out over -o: refused by their extensions)
     (["-o", "out/c.txt", "--compare", "out/c.png"], "out/c.png"),        # the new species' texture
     (["-o", "out/h.txt", "--compare", "out/h_mask.png"], "out/h_mask.png"),  # and its mask
-    (["-o", "out/e.txt", "--fxl-out", "out/e.png"], "out/e.png"),
 ])
 def test_outputs_that_name_one_file_are_refused_before_fitting(tmp_path, args, twice):
     """The comparison picture or the .FXL file over the species file, its texture or its mask:
@@ -293,3 +308,25 @@ def test_a_derived_texture_name_that_is_another_output_is_refused_before_any_wor
             "-o", tmp_path / "a b.txt", "--compare", tmp_path / "a_b.png")
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "a_b.png" in r.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("option,name,said", [
+    ("--compare", "cmp.jpg", "--compare ending in .png, found '.jpg'"),
+    ("--compare", "cmp", "--compare ending in .png, found 'no extension'"),
+    ("--fxl-out", "pts.png", "--fxl-out ending in .fxl, found '.png'")])
+def test_a_side_output_named_for_another_format_is_refused(tmp_path, cli, bream_photo, option, name, said):
+    """--compare wrote PNG bytes into cmp.jpg, and --fxl-out Fixel text into pts.png."""
+    photo, _ = bream_photo
+    r = cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "n.txt", option,
+            tmp_path / name)
+    assert r.returncode == 2 and said in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    assert not any(tmp_path.iterdir())
+
+
+def test_a_folder_where_a_texture_goes_is_named_and_refused_before_the_work(tmp_path, cli, bream_photo):
+    """It was said after the measuring, as the photo's fault: `photo.png: …, found a folder at d.png`."""
+    photo, _ = bream_photo
+    (tmp_path / "d.png").mkdir()
+    r = cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "d.txt")
+    said = f"{tmp_path / 'd.png'}: expected an output file, found a folder\n"
+    assert r.returncode == 2 and r.stderr == said

@@ -73,9 +73,12 @@ def load_photo(path: str | os.PathLike) -> Photo:
                 if max(w, h) > MAX_ASPECT * min(w, h):
                     raise FishgenError(f"expected a photo at most {MAX_ASPECT} times as long as it is tall "
                                        f"(it is measured {MEASURE_SIDE} pixels long), found {w} x {h}", path)
+                if getattr(img, "n_frames", 1) > 1:   # a GIF's or WebP's first frame is no choice
+                    raise FishgenError(f"expected a still photo, found an animation of {img.n_frames} "
+                                       "frames", path)
                 img = ImageOps.exif_transpose(img)  # phones store portrait shots sideways
                 has_alpha = img.mode in ("RGBA", "LA", "PA") or "transparency" in img.info
-                rgba = np.asarray(img.convert("RGBA"))
+                rgba = np.asarray(_eight_bit(img).convert("RGBA"))
     except FishgenError:
         raise
     except (Image.DecompressionBombError, Image.DecompressionBombWarning) as err:
@@ -92,6 +95,20 @@ def load_photo(path: str | os.PathLike) -> Photo:
     # An alpha channel that is opaque everywhere says nothing about the background.
     usable = has_alpha and bool((alpha < 128).any())
     return Photo(np.ascontiguousarray(rgba[:, :, :3]), alpha.copy() if usable else None, path)
+
+
+def _eight_bit(img):
+    """``img`` with 8-bit channels. Pillow converts a 16-bit or 32-bit grey image (``I;16``, ``I``,
+    ``F``) to RGBA by clipping at 255, not scaling: a 16-bit photo turned all white."""
+    if img.mode not in ("I;16", "I;16B", "I;16L", "I", "F"):
+        return img
+    from PIL import Image
+
+    grey = np.asarray(img, dtype=np.float64)
+    top = 65535.0 if img.mode.startswith("I;16") or grey.max(initial=0) > 255 else 255.0
+    if img.mode == "F":
+        top = 1.0 if grey.max(initial=0) <= 1.0 else top
+    return Image.fromarray(np.clip(np.round(grey / top * 255), 0, 255).astype(np.uint8), "L")
 
 
 def _why(err: Exception) -> str:
