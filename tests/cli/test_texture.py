@@ -330,3 +330,17 @@ def test_a_folder_where_a_texture_goes_is_named_and_refused_before_the_work(tmp_
     r = cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "d.txt")
     said = f"{tmp_path / 'd.png'}: expected an output file, found a folder\n"
     assert r.returncode == 2 and r.stderr == said
+
+
+def test_a_photo_in_perspective_is_told_to_give_its_focal_length(tmp_path, cli):
+    """fishgen preview's own side view is a 50 mm one: ThreadfinGoldie on its own geometry read 0.730
+    and was told only to try --fit-shape; told the lens it reads 0.868."""
+    photo = tmp_path / "goldie.png"
+    assert cli("preview", PARAMS / "threadfingoldie.txt", "--view", "side", "-o", photo).returncode == 0
+    plain = cli("texture", photo, "-s", PARAMS / "threadfingoldie.txt", "-o", tmp_path / "a.txt")
+    assert plain.returncode == 0
+    assert "try --fit-shape; if it was taken close up, give --focal-length" in plain.stderr
+    told = cli("texture", photo, "-s", PARAMS / "threadfingoldie.txt", "-o", tmp_path / "b.txt",
+               "--focal-length", "50")
+    figure = float(re.search(r"silhouette IoU of the rebuilt fish: ([0-9.]+)", told.stdout).group(1))
+    assert figure >= 0.85 and "--focal-length" not in told.stderr

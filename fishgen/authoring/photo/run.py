@@ -318,12 +318,17 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
              f"rebuilt fish covers at least half (thin or translucent fin parts fade out there){margin}: it "
              "may look unlike the photographed fish in another renderer; see --compare")
     elif shown is not None and shown[1] < ADVICE_IOU:
+        # a photo in perspective (fishgen preview's own side view is a 50 mm one) reads as a misfit
+        # side-on: BonyBream on its own geometry 0.875, 0.976 told the lens
+        lens = ("" if options.focal_length is not None else
+                "; if it was taken close up, give --focal-length (fishgen preview draws at about 50 mm, "
+                "or none with --ortho)")
         if options.fit_shape:
             note(f"silhouette IoU {shown[1]:.3f}: the rebuilt fish is still unlike the photo's; if the "
-                 "silhouette is wrong (a busy background), give --mask")
+                 f"silhouette is wrong (a busy background), give --mask{lens}")
         else:
             note(f"silhouette IoU {shown[1]:.3f}: the base's geometry does not match the photographed "
-                 "fish; try --fit-shape")
+                 f"fish; try --fit-shape{lens}")
     files = dict(chosen.files)
     if options.fxl_out is not None:
         tp = chosen.species.texture_points
