@@ -78,13 +78,14 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     """Measure the photo and write the new species, its texture and mask (and the extras asked)."""
     inputs = tuple(Path(p) for p in inputs)
     output = Path(output)
-    from fishgen.authoring.photo.run import FITS, TextureOptions, make_texture
+    from fishgen.authoring.photo.run import FITS, TextureOptions, check_out, make_texture
     from fishgen.authoring.species_files import check_texture_names, texture_names
     from fishgen.commands.paths import check_targets, suffix_of
     from fishgen.errors import UsageError
     from fishgen.species.parser import load_species
 
     (photo,) = inputs
+    check_out(output)   # first: no other refusal about derived names hides it
     # the comparison is a PNG and the points Fixel text, whatever the name: refused, not mislabelled
     if options.compare is not None:
         suffix_of(options.compare, [".png"], "--compare")
@@ -96,7 +97,7 @@ def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureC
     outputs = [output, options.compare, options.fxl_out]  # and NEW.png, NEW_mask.png beside NEW.txt
     given = [p for p in sides if p is not None]
     check_targets(outputs, [photo, options.species, *given])  # before the base species is even read
-    species = load_species(options.species)
+    species = load_species(options.species, textures_needed=False)   # its geometry is all it gives
     check_targets(outputs, species.side_files)  # the textures it names are inputs too
     names = texture_names(output)
     check_texture_names(names, [options.compare, options.fxl_out, photo, options.species, *sides])

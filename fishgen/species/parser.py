@@ -442,8 +442,11 @@ def texture_roots(species_path: Path, textures_dir: str | os.PathLike | None) ->
     return [here]
 
 
-def load_species(path: str | os.PathLike, textures_dir: str | os.PathLike | None = None) -> Species:
-    """Read and check a species file; texture files are resolved and must exist."""
+def load_species(path: str | os.PathLike, textures_dir: str | os.PathLike | None = None, *,
+                 textures_needed: bool = True) -> Species:
+    """Read and check a species file; texture files are resolved and must exist, unless
+    ``textures_needed`` is false (only the geometry is wanted: a missing texture is then named
+    where the species file's folder would hold it)."""
     path = Path(path)
     file = os.fspath(path)
     try:
@@ -469,5 +472,13 @@ def load_species(path: str | os.PathLike, textures_dir: str | os.PathLike | None
         raise FishgenError("expected a UTF-8 text species file, found binary data", file,
                            data[: err.start].count(b"\n") + 1) from None
     roots = texture_roots(path, textures_dir)
-    return parse_species(text, file,
-                         lambda name, line: resolve_texture(name, roots, file, line.number))
+
+    def resolve(name: str, line: _Line) -> Path:
+        try:
+            return resolve_texture(name, roots, file, line.number)
+        except FishgenError:
+            if textures_needed:
+                raise
+            return path.parent / name
+
+    return parse_species(text, file, resolve)

@@ -344,3 +344,15 @@ def test_a_photo_in_perspective_is_told_to_give_its_focal_length(tmp_path, cli):
                "--focal-length", "50")
     figure = float(re.search(r"silhouette IoU of the rebuilt fish: ([0-9.]+)", told.stdout).group(1))
     assert figure >= 0.85 and "--focal-length" not in told.stderr
+
+
+def test_a_base_species_is_read_for_its_geometry_alone(tmp_path, cli, bream_photo):
+    """A base copied without its textures failed every run (`base.txt:32: expected an existing
+    texture file`), though texture never reads them."""
+    import shutil
+
+    photo, _ = bream_photo
+    shutil.copy(PARAMS / "bonybream.txt", tmp_path / "base.txt")
+    r = cli("texture", photo, "-s", tmp_path / "base.txt", "-o", tmp_path / "new.txt")
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["base.txt", "new.png", "new.txt", "new_mask.png"]

@@ -194,15 +194,21 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
         raise
 
 
+def check_out(out: str | os.PathLike) -> Path:
+    """``out`` as the new species file's path, when it names one (.txt)."""
+    out = Path(out)
+    if out.suffix.lower() != ".txt":
+        raise UsageError(f"expected -o to name a species file (.txt), found {out.name!r}")
+    return out
+
+
 def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.PathLike,
                   options: TextureOptions, on_note: Callable[[str], None] | None,
                   progress: Callable[[int], None] | None = None) -> TextureResult:
     from fishgen.atomic import write_files
     from fishgen.authoring.photo import fxl
 
-    out = Path(out)
-    if out.suffix.lower() != ".txt":
-        raise UsageError(f"expected -o to name a species file (.txt), found {out.name!r}")
+    out = check_out(out)
     if options.spacing not in fixel.SPACINGS:
         raise UsageError(f"expected --spacing {'|'.join(fixel.SPACINGS)}, found {options.spacing!r}")
     note = on_note or (lambda _text: None)
