@@ -72,7 +72,8 @@ def load_photo(path: str | os.PathLike) -> Photo:
                                        f"found {w} x {h}", path)
                 if max(w, h) > MAX_ASPECT * min(w, h):
                     raise FishgenError(f"expected a photo at most {MAX_ASPECT} times as long as it is tall "
-                                       f"(measured on a copy {MEASURE_SIDE} pixels long), found {w} x {h}", path)
+                                       f"(measured on a copy {MEASURE_SIDE} pixels long), found {w} x {h}",
+                                       path)
                 if getattr(img, "n_frames", 1) > 1:   # a GIF's or WebP's first frame is no choice
                     raise FishgenError(f"expected a still photo, found an animation of {img.n_frames} "
                                        "frames", path)
