@@ -21,7 +21,7 @@ import os
 import re
 import stat
 import time
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from pathlib import Path
@@ -116,7 +116,7 @@ def check_writable(target: str | os.PathLike) -> None:
 
     folder = Path(target).parent
     if not folder.is_dir():
-        if any(f.is_file() or (f.is_symlink() and not f.exists()) for f in (folder, *folder.parents)):
+        if _in_the_way((folder, *folder.parents)) is not None:
             raise write_failure(Path(target), FileExistsError(errno.EEXIST, "File exists"))
         return
     try:
@@ -163,14 +163,18 @@ def _land(staged: list[tuple[str, Path]]) -> None:
     pending.extend(staged)
 
 
+def _in_the_way(folders: Sequence[Path]) -> Path | None:
+    """The first of ``folders`` that cannot be one: a file, or a broken (or looping) link."""
+    return next((f for f in folders if f.is_file() or (f.is_symlink() and not f.exists())), None)
+
+
 def write_failure(target: Path, err: OSError, folder: bool = False) -> SystemFailure:
     """An OS error about a temp file or rename, reported against the user's target (a full disk's
     error names no file, so the target is always named here). ``folder``: the target is to be a
     folder (a batch's out folder), so a file there is in the way too."""
     if target.is_dir() and not folder:
         return SystemFailure(f"cannot write {target}: a folder is in the way", target)
-    blocker = next((f for f in ((target,) if folder else ()) + tuple(target.parents)
-                    if f.is_file() or (f.is_symlink() and not f.exists())), None)
+    blocker = _in_the_way(((target,) if folder else ()) + tuple(target.parents))
     if blocker is not None:  # mkdir's error says only "File exists"
         found = "a file" if blocker.is_file() else "a broken symbolic link"
         return SystemFailure(f"cannot write {target}: expected a folder at {blocker}, found {found}", target)
