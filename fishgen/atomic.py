@@ -26,11 +26,12 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from pathlib import Path
 from types import TracebackType
-from typing import BinaryIO, Literal, TypeVar
+from typing import BinaryIO, Literal, TypeVar, cast
 
 from fishgen import interrupts
 from fishgen.errors import FishgenError, SystemFailure, UsageError, cannot
 from fishgen.file_names import NAME_MAX
+from fishgen.uncached import UncachedWriter
 
 #: A path type: any one of them per call (a Mapping's key type cannot widen).
 _PathT = TypeVar("_PathT", bound="str | os.PathLike[str]")
@@ -380,8 +381,8 @@ def _stale_names(folder: str, fresh: bool) -> dict[str, list[str]]:
 def _writer(tmp: str, fd: int) -> BinaryIO:
     """A handle that writes ``tmp``. Where ``fd`` holds its lock, the lock stays with ``fd`` until
     the rename; where there are no locks (Windows) the handle takes ``fd``, since a file still open
-    there cannot be renamed."""
-    return os.fdopen(os.dup(fd) if tmp in _held else fd, "wb")
+    there cannot be renamed. Big files go past the page cache (:mod:`fishgen.uncached`)."""
+    return cast(BinaryIO, UncachedWriter(os.fdopen(os.dup(fd) if tmp in _held else fd, "wb", buffering=0)))
 
 
 def _release(tmp: str) -> None:
