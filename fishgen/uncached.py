@@ -1,28 +1,32 @@
 """A file writer that sends big outputs past the page cache (``O_DIRECT`` where the system has it).
 
-Why: on the virtual machines CI and users run on, the first touch of a page the host has not
-backed costs about 3 ns a byte, and a buffered write of a fresh file fills the page cache with
-such pages. Writing 230 MB (a 10^7-particle PLY) took 0.6-0.9 s buffered plus its fsync, and
-0.1 s straight from one reused, page-aligned buffer (docs/decisions.md, "Writing past the page
-cache"). The bytes written are the same either way.
+Why: on the virtual machine fishgen is developed and tested on, the first touch of a page the
+host has not backed costs about 3 ns a byte, and a buffered write of a fresh file fills the page
+cache with such pages. Writing 230 MB (a 10^7-particle PLY) took 0.6-0.9 s buffered plus its fsync
+when its pages were fresh, and 0.1 s straight from one page-aligned buffer (docs/decisions.md,
+"Third round: writing past the page cache"). The bytes written are the same either way.
 
-Everything written is staged in one page-aligned buffer of :data:`BLOCK` bytes. A file that never
-fills it (almost every output) is written in one ordinary write at :meth:`UncachedWriter.flush`. Each
-full buffer is written with ``O_DIRECT``; the tail, which is not a whole number of blocks, goes
-through the page cache, as does everything where ``O_DIRECT`` is missing or refused (another
-system, a file system without it, an odd block size).
+What is written is staged in a page-aligned buffer of :data:`BLOCK` bytes, reused from file to
+file. A file that never fills it (almost every output) is written in one ordinary write when
+flushed. Each full buffer is written with ``O_DIRECT``; what is left at the end (under a buffer's
+worth, so not a whole number of blocks) goes through the page cache, as does everything where
+``O_DIRECT`` is missing or refused (another system, a file system without it, an odd block size, a
+short write).
 """
 from __future__ import annotations
 
 import errno
+import io
 import mmap
 import os
-from typing import Any, BinaryIO, cast
+from typing import Any
 
 BLOCK = 8 << 20
 """Bytes staged before a direct write: a whole number of blocks on any device (4096 divides it)."""
 
 _O_DIRECT: int = getattr(os, "O_DIRECT", 0)
+_spare: list[mmap.mmap] = []
+"""Buffers no writer holds: the next file reuses one, so a small file's bytes land in warm pages."""
 
 
 def _set_direct(fd: int, on: bool) -> bool:
@@ -39,49 +43,65 @@ def _set_direct(fd: int, on: bool) -> bool:
     return True
 
 
-class UncachedWriter:
+def _take_buffer() -> mmap.mmap:
+    while _spare:
+        try:
+            buffer = _spare.pop()      # atomic under the GIL: two threads never get the same one
+        except IndexError:
+            break
+        if len(buffer) == BLOCK:       # else BLOCK changed (a test): dropped
+            return buffer
+    private = {"flags": mmap.MAP_PRIVATE} if hasattr(mmap, "MAP_PRIVATE") else {}
+    return mmap.mmap(-1, BLOCK, **private)   # page-aligned, as O_DIRECT needs; never shared with a child
+
+
+SPARES = 2
+"""Most buffers kept for the next writers (one a thread that writes at once)."""
+
+
+class UncachedWriter(io.RawIOBase):
     """A binary handle over ``raw`` (an unbuffered file) for :mod:`fishgen.atomic`'s writers."""
 
     def __init__(self, raw: Any):
+        super().__init__()
         self._raw = raw
-        self._buffer: mmap.mmap | None = None   # made at the first write: an unused handle needs none
+        self._buffer: mmap.mmap | None = None   # taken at the first write: an unused handle needs none
         self._used = 0
         self._direct: bool | None = None       # None: untried; False once the offset is unaligned
 
+    def writable(self) -> bool:
+        return True
+
     def write(self, data: Any) -> int:
-        piece = memoryview(data).cast("B")
+        self._checkClosed()
         if self._buffer is None:
-            self._buffer = mmap.mmap(-1, BLOCK)   # page-aligned, as O_DIRECT needs
-        view = memoryview(self._buffer)
-        done = 0
-        while done < len(piece):
-            take = min(len(piece) - done, BLOCK - self._used)
-            view[self._used:self._used + take] = piece[done:done + take]
-            self._used += take
-            done += take
-            if self._used == BLOCK:
-                self._write_block()
+            self._buffer = _take_buffer()
+        with memoryview(data) as given, given.cast("B") as piece, memoryview(self._buffer) as view:
+            done = 0
+            while done < len(piece):
+                take = min(len(piece) - done, BLOCK - self._used)
+                view[self._used:self._used + take] = piece[done:done + take]
+                self._used += take
+                done += take
+                if self._used == BLOCK:
+                    self._write_block(view)
         return done
 
-    def _write_block(self) -> None:
-        assert self._buffer is not None
+    def _write_block(self, view: memoryview) -> None:
         fd = self._raw.fileno()
         if self._direct is None:
             self._direct = _set_direct(fd, True)
+        written = 0
         if self._direct:
             try:
-                written = os.write(fd, memoryview(self._buffer))
+                written = os.write(fd, view)
             except OSError as err:
                 if err.errno != errno.EINVAL:   # alignment the device refuses: go on through the cache
                     raise
-                written = 0
-            if written == BLOCK:
-                self._used = 0
-                return
-            self._stop_direct()
-            self._drain(memoryview(self._buffer)[written:BLOCK])
-        else:
-            self._drain(memoryview(self._buffer)[:self._used])
+            if written != BLOCK:
+                self._stop_direct()
+        if written < self._used:
+            self._drain(view[written:self._used])
         self._used = 0
 
     def _stop_direct(self) -> None:
@@ -90,33 +110,33 @@ class UncachedWriter:
         self._direct = False
 
     def _drain(self, data: memoryview) -> None:
+        """Write ``data`` through the page cache."""
         while len(data):
-            written = self._raw.write(data)
-            data = data[written:]
+            data = data[self._raw.write(data):]
 
     def flush(self) -> None:
-        """Write what is staged: the file's tail, a partial block, through the page cache."""
-        if self._used:
-            assert self._buffer is not None
+        """Write what is staged (a file's end: under a buffer's worth) through the page cache."""
+        if self._used and self._buffer is not None:
             self._stop_direct()
-            self._drain(memoryview(self._buffer)[:self._used])
+            with memoryview(self._buffer) as view:
+                self._drain(view[:self._used])
             self._used = 0
+
+    def tell(self) -> int:
+        return int(self._raw.tell()) + self._used
 
     def fileno(self) -> int:
         return int(self._raw.fileno())
 
-    @property
-    def closed(self) -> bool:
-        return bool(self._raw.closed)
-
     def close(self) -> None:
-        """Close without writing what is staged: :mod:`fishgen.atomic` flushes and syncs first, and a
-        failed write is discarded anyway."""
-        self._buffer = None   # unmapped once no view of it is left (a failed write's traceback may hold one)
-        self._raw.close()
-
-    def __enter__(self) -> BinaryIO:
-        return cast(BinaryIO, self)
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+        """Flush, close the file and hand the buffer to the next writer."""
+        if self.closed:
+            return
+        try:
+            super().close()        # flushes
+        finally:
+            if self._buffer is not None and len(_spare) < SPARES:
+                _spare.append(self._buffer)
+                self._buffer = None
+            self._used = 0
+            self._raw.close()
