@@ -19,7 +19,10 @@ import errno
 import io
 import mmap
 import os
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from concurrent.futures import Future, ThreadPoolExecutor
 
 BLOCK = 8 << 20
 """Bytes staged before a direct write: a whole number of blocks on any device (4096 divides it)."""
@@ -56,53 +59,87 @@ def _take_buffer() -> mmap.mmap:
 
 
 SPARES = 2
-"""Most buffers kept for the next writers (one a thread that writes at once)."""
+"""Most buffers kept for the next writers: a big file's two (one filled while one is written)."""
+
+
+def _give_back(buffer: mmap.mmap) -> None:
+    if len(_spare) < SPARES:
+        _spare.append(buffer)
 
 
 class UncachedWriter(io.RawIOBase):
-    """A binary handle over ``raw`` (an unbuffered file) for :mod:`fishgen.atomic`'s writers."""
+    """A binary handle over ``raw`` (an unbuffered file) for :mod:`fishgen.atomic`'s writers.
+
+    A full buffer is written on a thread of its own while the caller fills the next one, so the
+    disk's time and the caller's packing overlap, as the page cache's writeback let them before.
+    One block at a time is in flight, so the file's bytes stay in order; its error is raised at
+    the next write, flush or close."""
 
     def __init__(self, raw: Any):
         super().__init__()
         self._raw = raw
         self._buffer: mmap.mmap | None = None   # taken at the first write: an unused handle needs none
         self._used = 0
+        self._accepted = int(raw.tell())
         self._direct: bool | None = None       # None: untried; False once the offset is unaligned
+        self._worker: ThreadPoolExecutor | None = None
+        self._writing: Future[None] | None = None
 
     def writable(self) -> bool:
         return True
 
     def write(self, data: Any) -> int:
         self._checkClosed()
-        if self._buffer is None:
-            self._buffer = _take_buffer()
-        with memoryview(data) as given, given.cast("B") as piece, memoryview(self._buffer) as view:
+        with memoryview(data) as given, given.cast("B") as piece:
             done = 0
             while done < len(piece):
+                if self._buffer is None:
+                    self._buffer = _take_buffer()
                 take = min(len(piece) - done, BLOCK - self._used)
-                view[self._used:self._used + take] = piece[done:done + take]
+                with memoryview(self._buffer) as view:
+                    view[self._used:self._used + take] = piece[done:done + take]
                 self._used += take
                 done += take
                 if self._used == BLOCK:
-                    self._write_block(view)
+                    self._send()
+        self._accepted += done
         return done
 
-    def _write_block(self, view: memoryview) -> None:
-        fd = self._raw.fileno()
-        if self._direct is None:
-            self._direct = _set_direct(fd, True)
-        written = 0
-        if self._direct:
-            try:
-                written = os.write(fd, view)
-            except OSError as err:
-                if err.errno != errno.EINVAL:   # alignment the device refuses: go on through the cache
-                    raise
-            if written != BLOCK:
-                self._stop_direct()
-        if written < self._used:
-            self._drain(view[written:self._used])
-        self._used = 0
+    def _send(self) -> None:
+        """Hand the full buffer to the writing thread, once the block before it is written."""
+        self._wait()
+        full, self._buffer, self._used = self._buffer, None, 0
+        assert full is not None
+        if self._worker is None:
+            from concurrent.futures import ThreadPoolExecutor
+
+            self._worker = ThreadPoolExecutor(1, thread_name_prefix="fishgen-write")
+        self._writing = self._worker.submit(self._write_block, full)
+
+    def _wait(self) -> None:
+        writing, self._writing = self._writing, None
+        if writing is not None:
+            writing.result()
+
+    def _write_block(self, full: mmap.mmap) -> None:
+        try:
+            fd = self._raw.fileno()
+            if self._direct is None:
+                self._direct = _set_direct(fd, True)
+            with memoryview(full) as view:
+                written = 0
+                if self._direct:
+                    try:
+                        written = os.write(fd, view)
+                    except OSError as err:
+                        if err.errno != errno.EINVAL:   # alignment the device refuses: on through the cache
+                            raise
+                    if written != BLOCK:
+                        self._stop_direct()
+                if written < BLOCK:
+                    self._drain(view[written:])
+        finally:
+            _give_back(full)
 
     def _stop_direct(self) -> None:
         if self._direct:
@@ -115,7 +152,9 @@ class UncachedWriter(io.RawIOBase):
             data = data[self._raw.write(data):]
 
     def flush(self) -> None:
-        """Write what is staged (a file's end: under a buffer's worth) through the page cache."""
+        """Write everything given: the block in flight, then what is staged (a file's end, under a
+        buffer's worth) through the page cache."""
+        self._wait()
         if self._used and self._buffer is not None:
             self._stop_direct()
             with memoryview(self._buffer) as view:
@@ -123,7 +162,7 @@ class UncachedWriter(io.RawIOBase):
             self._used = 0
 
     def tell(self) -> int:
-        return int(self._raw.tell()) + self._used
+        return self._accepted
 
     def fileno(self) -> int:
         return int(self._raw.fileno())
@@ -135,8 +174,11 @@ class UncachedWriter(io.RawIOBase):
         try:
             super().close()        # flushes
         finally:
-            if self._buffer is not None and len(_spare) < SPARES:
-                _spare.append(self._buffer)
+            if self._worker is not None:     # never close the file under a write in flight
+                self._worker.shutdown(wait=True)
+                self._writing = None
+            if self._buffer is not None:
+                _give_back(self._buffer)
                 self._buffer = None
             self._used = 0
             self._raw.close()

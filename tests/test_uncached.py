@@ -158,3 +158,56 @@ def test_a_full_disk_is_said_and_nothing_is_left(tmp_path, monkeypatch, size):
     with pytest.raises(SystemFailure, match="No space left on device"):
         write_bytes(target, b"y" * size)
     assert target.read_bytes() == b"earlier" and os.listdir(tmp_path) == ["cloud.ply"]
+
+
+def test_a_full_block_is_written_on_its_own_thread_while_the_next_fills_and_in_order(tmp_path, monkeypatch):
+    """The disk's time overlaps the caller's packing, as the page cache's writeback did."""
+    import threading
+    import time
+
+    threads = []
+    write, drain = os.write, uncached.UncachedWriter._drain
+
+    def slow_direct(fd, data):
+        threads.append(threading.current_thread().name)
+        time.sleep(0.01)
+        return write(fd, data)
+
+    def slow_cached(self, data):
+        threads.append(threading.current_thread().name)
+        time.sleep(0.01)
+        return drain(self, data)
+
+    monkeypatch.setattr(os, "write", slow_direct)
+    monkeypatch.setattr(uncached.UncachedWriter, "_drain", slow_cached)
+    parts = pieces(6 * BLOCK + 5, seed=3)
+    with atomic_open(tmp_path / "cloud.ply") as handle:
+        for part in parts:
+            handle.write(part)
+    assert (tmp_path / "cloud.ply").read_bytes() == b"".join(parts)
+    assert threads[:6] == [threads[0]] * 6 and threads[0].startswith("fishgen-write")
+    assert threads[6:] == [threading.current_thread().name], "the file's end, from the caller's thread"
+
+
+def test_an_error_in_the_body_waits_for_the_block_in_flight_and_leaves_nothing(tmp_path, monkeypatch):
+    import time
+
+    import fishgen.atomic as atomic
+
+    events = []
+    write, discard = os.write, atomic._discard
+
+    def slow(fd, data):
+        time.sleep(0.05)
+        written = write(fd, data)
+        events.append("written")
+        return written
+
+    monkeypatch.setattr(os, "write", slow)
+    monkeypatch.setattr(uncached.UncachedWriter, "_drain", lambda self, data: slow(self.fileno(), data))
+    monkeypatch.setattr(atomic, "_discard", lambda tmp: (events.append("discarded"), discard(tmp)))
+    with pytest.raises(RuntimeError, match="stopped"):
+        with atomic_open(tmp_path / "cloud.ply") as handle:
+            handle.write(b"z" * (BLOCK + 10))     # a block now in flight
+            raise RuntimeError("stopped")
+    assert events[0] == "written" and events[-1] == "discarded" and os.listdir(tmp_path) == []
