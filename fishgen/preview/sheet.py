@@ -28,13 +28,25 @@ def contact_sheet(tiles: list[Image.Image], labels: list[str], columns: int | No
     # Text colour picked against the background so labels stay readable on any --background.
     r, g, b, a = background
     ink = (20, 24, 28, 255) if a < 128 or (0.299 * r + 0.587 * g + 0.114 * b) > 140 else (245, 245, 245, 255)
-    for k, (tile, label) in enumerate(zip(tiles, labels, strict=True)):
+    for k, (tile, shown) in enumerate(zip(tiles, labels, strict=True)):
+        label = drawable(shown)
         x, y = (k % columns) * w, (k // columns) * (h + strip)
         sheet.paste(tile, (x, y))
         box = draw.textbbox((0, 0), label, font=font)
         draw.text((x + (w - (box[2] - box[0])) / 2, y + h + (strip - (box[3] - box[1])) / 2 - box[1]),
                   label, fill=ink, font=font)
     return sheet
+
+
+def drawable(label: str) -> str:
+    """``label`` in the characters Pillow's default font draws (ASCII): accents dropped
+    (``pòisson`` is ``poisson``), anything else ``?``, where the font drew an empty box."""
+    import unicodedata
+
+    if label.isascii():
+        return label
+    bare = "".join(c for c in unicodedata.normalize("NFKD", label) if not unicodedata.combining(c))
+    return "".join(c if c.isascii() and c.isprintable() else "?" for c in bare)
 
 
 def _font(size: int):
