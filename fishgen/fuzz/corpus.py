@@ -21,6 +21,31 @@ from fishgen.fuzz.mutate import png_bytes
 PARAMS = Path(__file__).resolve().parents[2] / "params"
 SMALL_CLOUD = b"60\n3\n20, 4.0, 3.0, 2.0, 0.0, 0.0, 0.0, 1.0\n20, 2.0, 2.0, 2.0, 5.0, 1.0, -2.0, 0.8\n" \
               b"20 3.0, 1.0, 1.0, -4.0, 0.5, 1.0, 0.5\n"
+#: The thesis' Appendix B.10 sample as printed (the first line runs header, count and points together).
+APPENDIX_B_FXL = """//dorsal 14 0.228515625 0.00390625 0.13671875 0.31640625
+0.396484375 0.328125
+0.439453125 0.1796875
+0.181640625 0.29296875
+0.22265625 0.2890625
+0.263671875 0.29296875
+0.3125 0.30078125
+0.353515625 0.30859375
+0.2265625 0.01953125
+0.23046875 0.02734375
+0.234375 0.0390625
+0.244140625 0.046875
+0.25 0.05859375
+//anal
+8
+0.40625 0.875
+0.37890625 0.71875
+0.5390625 0.65625
+0.59765625 0.76171875
+0.431640625 0.69921875
+0.486328125 0.6796875
+0.41015625 0.84765625
+0.41796875 0.83203125
+"""
 ASCII_PLY_CLOUD = """ply
 format ascii 1.0
 comment particles: position, radius, density, sRGB colour
@@ -210,6 +235,7 @@ def add_new_inputs(dest: Path) -> None:
         sp = parse_species(p.read_text(), str(p))
         if sp.texture_points is not None:
             (dest / "fxl" / f"{p.stem}.fxl").write_text(format_fxl(sp.texture_points, sp.circle_sections))
+    (dest / "fxl" / "appendix_b.fxl").write_text(APPENDIX_B_FXL)
     with Image.open(PARAMS / "photos" / "bonybream-side.png") as im:
         small = im.resize((160, 80), Image.Resampling.LANCZOS)
         small.save(dest / "photo" / "bonybream-side.png", optimize=True)

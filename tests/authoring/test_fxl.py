@@ -5,34 +5,9 @@ import pytest
 
 from fishgen.authoring.photo.fxl import format_fxl, parse_fxl, read_fxl
 from fishgen.errors import FishgenError
+from fishgen.fuzz.corpus import APPENDIX_B_FXL as APPENDIX_B  # Appendix B.10 as printed
 from fishgen.species.parser import load_species
 from tests.conftest import PARAMS
-
-# Appendix B.10 as printed (the first line runs header, count and points together).
-APPENDIX_B = """//dorsal 14 0.228515625 0.00390625 0.13671875 0.31640625
-0.396484375 0.328125
-0.439453125 0.1796875
-0.181640625 0.29296875
-0.22265625 0.2890625
-0.263671875 0.29296875
-0.3125 0.30078125
-0.353515625 0.30859375
-0.2265625 0.01953125
-0.23046875 0.02734375
-0.234375 0.0390625
-0.244140625 0.046875
-0.25 0.05859375
-//anal
-8
-0.40625 0.875
-0.37890625 0.71875
-0.5390625 0.65625
-0.59765625 0.76171875
-0.431640625 0.69921875
-0.486328125 0.6796875
-0.41015625 0.84765625
-0.41796875 0.83203125
-"""
 
 
 def test_appendix_b_sample_reads():
