@@ -74,7 +74,11 @@ def replay(spec: str, corpus: Path) -> int:
     case = make_case(load_seeds(corpus), target, int(seed), int(index))
     with tempfile.TemporaryDirectory() as tmp:
         outcome = run_case(case, Path(tmp))
-    print(f"{outcome.status}: {outcome.key}\n{outcome.detail}")
+    said = {"ok": "accepted", "error": f"refused in one line: {outcome.detail}"}
+    print(f"{case.target} case {index} of seed {seed}: "
+          f"{said.get(outcome.status, f'finding: {outcome.key}')}")
+    if outcome.status == "finding":
+        print(outcome.detail)
     return 1 if outcome.status == "finding" else 0
 
 

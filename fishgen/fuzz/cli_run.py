@@ -52,7 +52,7 @@ def run_cli(case: Case, workdir: Path) -> Outcome:
             many = f"{min(len(lines), 2)}{'+' if len(lines) > 1 else ''}"
             return Outcome("finding", f"cli {command}: exit 2 with {many} error lines on stderr",
                            stderr[-3000:])
-        return Outcome("error")
+        return Outcome("error", detail=lines[0])
     return Outcome("finding", f"cli {command}: exit status {code} ({_shape(lines[-1] if lines else '')})",
                    stderr[-3000:])
 

@@ -25,7 +25,7 @@ class CaseTimeout(BaseException):
 class Outcome:
     status: str                 # "ok", "error" (a FishgenError / clean CLI error) or "finding"
     key: str = ""
-    detail: str = ""
+    detail: str = ""            # a finding's traceback or input; an error's one-line message
 
 
 def innermost_fishgen_frame(tb) -> str:
@@ -68,7 +68,7 @@ def classify(err: BaseException) -> Outcome:
         if "\n" in text.strip() or "Traceback" in text:
             return Outcome("finding", f"FishgenError with a multi-line message at "
                                       f"{innermost_fishgen_frame(err.__traceback__)}", text[:2000])
-        return Outcome("error")
+        return Outcome("error", detail=text)
     return Outcome("finding", f"{type(err).__name__} at {innermost_fishgen_frame(err.__traceback__)}",
                    formatted(err))
 

@@ -213,3 +213,13 @@ def test_a_case_is_timed_by_its_cpu_not_by_the_machines_load():
         pass
     after = _clock()
     assert before is not None and after is not None and after[0] - before[0] >= 0.2
+
+
+def test_a_replayed_case_shows_what_the_input_got(capsys):
+    """It printed "error: " and a blank line: the refusal's own message is what one replays for."""
+    from fishgen.fuzz.__main__ import replay
+    from fishgen.fuzz.inputs import DEFAULT_CORPUS
+
+    assert replay("species:1:5", DEFAULT_CORPUS) == 0
+    shown = capsys.readouterr().out
+    assert shown.startswith("species case 5 of seed 1: refused in one line: <fuzz>:") and "expected" in shown
