@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import click
 
 from fishgen.commands import MODULES, QUIET, Command, Events, Inputs, Made, Progress, command, run
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, plural
 from fishgen.options import FILE, FOLDER, option
 
 if TYPE_CHECKING:
@@ -183,7 +183,7 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
             unwritten.append(err)
     counts = {s: sum(o.status == s for o in outcomes) for s in ("built", "skipped", "failed", "not run")}
     where = options.scheduler or f"-j {workers}"
-    line = (f"{_shown(manifest.out)}: {len(outcomes)} jobs, {counts['built']} built, "
+    line = (f"{_shown(manifest.out)}: {plural(len(outcomes), 'job')}, {counts['built']} built, "
             f"{counts['skipped']} skipped, {counts['failed']} failed"
             + (f", {counts['not run']} not run" if counts["not run"] else "")
             + f" in {seconds:.2f} s ({where})")

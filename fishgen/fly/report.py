@@ -154,7 +154,7 @@ def summary(report: dict[str, Any]) -> list[str]:
     return [f"flew {report['seconds']:.1f} s at {w['width']}x{w['height']}: {report['frames']:,} frames, "
             f"{fps['median']:.1f} FPS median (5th percentile {fps['p5']:.1f}, min {fps['min']:.1f}, "
             f"max {fps['max']:.1f})",
-            *clouds, *meshes, *impostor_lines(report["impostors"]),
+            *clouds, *meshes, *(impostor_lines(report["impostors"]) if scene["clouds"] else []),
             f"renderer: {report['renderer']}"]
 
 

@@ -151,7 +151,7 @@ def test_a_batch_whose_record_cannot_be_saved_still_says_what_it_built_and_exits
     (full / "filler").write_bytes(b"x" * (48 * 1024))
     result = run(["batch", str(manifest), "-j", "1"])
     lines = result.stdout.strip().splitlines()
-    assert result.returncode == 1 and lines and lines[-1].startswith(f"{full}: 1 jobs, 1 built"), result
+    assert result.returncode == 1 and lines and lines[-1].startswith(f"{full}: 1 job, 1 built"), result
     assert "Traceback" not in result.stderr and ".fishgen-batch.json" in result.stderr
 
 

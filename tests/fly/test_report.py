@@ -67,4 +67,5 @@ def test_a_school_flown_alone_is_summed_up_as_meshes_and_how_they_were_drawn(ins
     lines = summary(report)
     assert report["instancing"] is instancing
     assert not any(line.startswith("0 particles") for line in lines)
+    assert not any(line.startswith("impostors:") for line in lines), "no clouds, no impostor line"
     assert f"1,000 meshes (fish and other solids), {said}" in lines
