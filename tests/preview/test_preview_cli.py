@@ -206,3 +206,17 @@ def test_a_duration_that_makes_no_loop_is_said(tmp_path, name, still):
 def test_help_names_every_input_kind():
     text = " ".join(run_cli("preview", "--help").stdout.split())
     assert "a cloud cube file (.awn), a texture cloud (.awa) or an asset" in text   # .awa went unsaid
+
+
+@pytest.mark.parametrize("name", ["swim.gif", "swim.webp"])
+def test_a_loop_lasts_its_duration_though_a_gif_counts_in_hundredths(tmp_path, name):
+    """38 frames over 3.2 s were stored as 38 x 80 ms: the loop played 5 % fast."""
+    out = tmp_path / name
+    _ok(BREAM, "--size", "32x24", "--frames", "7", "--duration", "0.6", "-o", out)
+    with Image.open(out) as loop:
+        times = []
+        for k in range(loop.n_frames):
+            loop.seek(k)
+            loop.load()       # a WebP frame's duration is known once it is read
+            times.append(loop.info["duration"])
+    assert len(times) == 7 and sum(times) == 600 and max(times) - min(times) <= 10
