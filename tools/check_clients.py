@@ -86,8 +86,8 @@ def _judge_blender(asset: Asset, r: dict) -> str:
         images = sorted({i["name"] for o in meshes for m in o["materials"] for i in m["images"]})
         notes.append("images " + ", ".join(images))
         if asset.fmt.ext == "obj":
-            alpha = [i for o in meshes for m in o["materials"] if m["name"].endswith("fins") for i in m["images"]
-                     if "Principled BSDF.Alpha" in i["to"]]
+            alpha = [i for o in meshes for m in o["materials"] if m["name"].endswith("fins")
+                     for i in m["images"] if "Principled BSDF.Alpha" in i["to"]]
             expect(bool(alpha), "fins: map_d mask not wired to Alpha")
             notes.append("mask → Alpha")
     else:
