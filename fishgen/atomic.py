@@ -378,11 +378,11 @@ def _stale_names(folder: str, fresh: bool) -> dict[str, list[str]]:
     return index
 
 
-def _writer(tmp: str, fd: int) -> BinaryIO:
+def _writer(tmp: str, fd: int) -> UncachedWriter:
     """A handle that writes ``tmp``. Where ``fd`` holds its lock, the lock stays with ``fd`` until
     the rename; where there are no locks (Windows) the handle takes ``fd``, since a file still open
     there cannot be renamed. Big files go past the page cache (:mod:`fishgen.uncached`)."""
-    return cast(BinaryIO, UncachedWriter(os.fdopen(os.dup(fd) if tmp in _held else fd, "wb", buffering=0)))
+    return UncachedWriter(os.fdopen(os.dup(fd) if tmp in _held else fd, "wb", buffering=0))
 
 
 def _release(tmp: str) -> None:
@@ -401,13 +401,17 @@ def _stage(path: Path, data: bytes, into: list[tuple[str, Path]]) -> None:
         fd, tmp = _temporary(path, into)
     except OSError as err:
         raise write_failure(path, err) from None
+    handle = None
     try:
-        with _writer(tmp, fd) as handle:
-            handle.write(data)
-            handle.flush()
-            os.fsync(handle.fileno())
+        handle = _writer(tmp, fd)
+        handle.write(data)
+        handle.flush()
+        os.fsync(handle.fileno())
+        handle.close()
         os.chmod(tmp, _mode_for(path))
     except BaseException as err:
+        if handle is not None:
+            handle.abort()
         _discard(tmp)
         if isinstance(err, OSError):
             raise write_failure(path, err) from None
@@ -500,7 +504,7 @@ class atomic_open:
     def __init__(self, path: str | os.PathLike):
         self.path = Path(path)
         self._tmp: str | None = None
-        self._handle: BinaryIO | None = None
+        self._handle: UncachedWriter | None = None
 
     def __enter__(self) -> BinaryIO:
         check_target(self.path)
@@ -514,17 +518,19 @@ class atomic_open:
             if isinstance(err, OSError):
                 raise write_failure(self.path, err) from None
             raise
-        return self._handle
+        return cast(BinaryIO, self._handle)
 
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> Literal[False]:
         assert self._handle is not None and self._tmp is not None
         try:
-            if exc_type is None:
+            if exc_type is not None:     # the output is dropped: nothing more written, the first error kept
+                self._handle.abort()
+                _discard(self._tmp)
+            else:
                 self._handle.flush()
                 os.fsync(self._handle.fileno())
-            self._handle.close()
-            if exc_type is None:
+                self._handle.close()
                 os.chmod(self._tmp, _mode_for(self.path))
                 if _staging.get() is None:
                     os.replace(self._tmp, self.path)
@@ -533,11 +539,12 @@ class atomic_open:
                 else:
                     _land([(self._tmp, self.path)])
                 return False
-            _discard(self._tmp)
         except OSError as err:
+            self._handle.abort()         # a full disk's temporary file is closed, so its space is freed
             _discard(self._tmp)
             raise write_failure(self.path, err) from None
         except BaseException:
+            self._handle.abort()
             _discard(self._tmp)
             raise
         if isinstance(exc, OSError) and exc.filename is None:

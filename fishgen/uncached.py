@@ -55,7 +55,12 @@ def _take_buffer() -> mmap.mmap:
         if len(buffer) == BLOCK:       # else BLOCK changed (a test): dropped
             return buffer
     private = {"flags": mmap.MAP_PRIVATE} if hasattr(mmap, "MAP_PRIVATE") else {}
-    return mmap.mmap(-1, BLOCK, **private)   # page-aligned, as O_DIRECT needs; never shared with a child
+    try:
+        return mmap.mmap(-1, BLOCK, **private)   # page-aligned, as O_DIRECT needs; never shared with a child
+    except OSError as err:
+        if err.errno == errno.ENOMEM:  # an address-space limit: out of memory, not a write that failed
+            raise MemoryError(f"cannot map a {BLOCK >> 20} MiB write buffer") from None
+        raise
 
 
 SPARES = 2
@@ -84,12 +89,19 @@ class UncachedWriter(io.RawIOBase):
         self._direct: bool | None = None       # None: untried; False once the offset is unaligned
         self._worker: ThreadPoolExecutor | None = None
         self._writing: Future[None] | None = None
+        self._failed: BaseException | None = None   # a block's write that failed: the file is short
+
+    def _check_failed(self) -> None:
+        if self._failed is not None:
+            raise OSError(getattr(self._failed, "errno", None) or errno.EIO,
+                          f"an earlier block was not written ({self._failed})")
 
     def writable(self) -> bool:
         return True
 
     def write(self, data: Any) -> int:
         self._checkClosed()
+        self._check_failed()
         with memoryview(data) as given, given.cast("B") as piece:
             done = 0
             while done < len(piece):
@@ -118,8 +130,15 @@ class UncachedWriter(io.RawIOBase):
 
     def _wait(self) -> None:
         writing, self._writing = self._writing, None
-        if writing is not None:
+        if writing is None:
+            return
+        try:
             writing.result()
+        except BaseException as err:
+            self._failed = err           # every later write, flush or close says so too
+            raise
+        finally:
+            writing = None               # else frame -> future -> error -> frame keeps the file open
 
     def _write_block(self, full: mmap.mmap) -> None:
         try:
@@ -155,6 +174,7 @@ class UncachedWriter(io.RawIOBase):
         """Write everything given: the block in flight, then what is staged (a file's end, under a
         buffer's worth) through the page cache."""
         self._wait()
+        self._check_failed()
         if self._used and self._buffer is not None:
             self._stop_direct()
             with memoryview(self._buffer) as view:
@@ -166,6 +186,22 @@ class UncachedWriter(io.RawIOBase):
 
     def fileno(self) -> int:
         return int(self._raw.fileno())
+
+    def abort(self) -> None:
+        """Close without writing what is staged, once the block in flight is done, and without
+        raising its error: the file is being discarded, and the error that discards it is the one
+        to report (an interrupt stays an interrupt)."""
+        if self.closed:
+            return
+        self._used = 0
+        writing, self._writing = self._writing, None
+        try:
+            if writing is not None:
+                writing.exception()      # waits for it, raising nothing
+        finally:
+            writing = None
+            self._failed = None
+            self.close()
 
     def close(self) -> None:
         """Flush, close the file and hand the buffer to the next writer."""

@@ -189,7 +189,9 @@ def test_a_full_block_is_written_on_its_own_thread_while_the_next_fills_and_in_o
     assert threads[6:] == [threading.current_thread().name], "the file's end, from the caller's thread"
 
 
-def test_an_error_in_the_body_waits_for_the_block_in_flight_and_leaves_nothing(tmp_path, monkeypatch):
+def test_an_error_in_the_body_waits_for_the_block_in_flight_writes_nothing_more_and_leaves_nothing(
+        tmp_path, monkeypatch):
+    import threading
     import time
 
     import fishgen.atomic as atomic
@@ -197,17 +199,124 @@ def test_an_error_in_the_body_waits_for_the_block_in_flight_and_leaves_nothing(t
     events = []
     write, discard = os.write, atomic._discard
 
-    def slow(fd, data):
+    def slow_block(fd, data):
         time.sleep(0.05)
         written = write(fd, data)
-        events.append("written")
+        events.append("block written")
         return written
 
-    monkeypatch.setattr(os, "write", slow)
-    monkeypatch.setattr(uncached.UncachedWriter, "_drain", lambda self, data: slow(self.fileno(), data))
+    monkeypatch.setattr(os, "write", slow_block)
+    def drained(self, data):
+        events.append(f"{threading.current_thread().name} wrote {len(data)}")
+        return slow_block(self.fileno(), data)
+
+    monkeypatch.setattr(uncached.UncachedWriter, "_drain", drained)
     monkeypatch.setattr(atomic, "_discard", lambda tmp: (events.append("discarded"), discard(tmp)))
     with pytest.raises(RuntimeError, match="stopped"):
         with atomic_open(tmp_path / "cloud.ply") as handle:
-            handle.write(b"z" * (BLOCK + 10))     # a block now in flight
+            handle.write(b"z" * (BLOCK + 10))     # a block now in flight, 10 bytes staged
             raise RuntimeError("stopped")
-    assert events[0] == "written" and events[-1] == "discarded" and os.listdir(tmp_path) == []
+    assert "block written" in events and events.index("block written") < events.index("discarded")
+    assert not any(e.startswith("MainThread") for e in events), "a dropped file's staged end is not written"
+    assert os.listdir(tmp_path) == []
+
+
+def test_the_next_block_fills_while_one_is_written(tmp_path, monkeypatch):
+    """A block's write that waited for nothing would be a synchronous write in another thread."""
+    import threading
+
+    filled = threading.Event()
+    write, drain = os.write, uncached.UncachedWriter._drain
+
+    def held(fd, data):
+        assert filled.wait(10), "the caller did not go on filling while a block was written"
+        return write(fd, data)
+
+    monkeypatch.setattr(os, "write", held)
+    monkeypatch.setattr(uncached.UncachedWriter, "_drain",
+                        lambda self, data: held(self.fileno(), data) if threading.current_thread().name
+                        .startswith("fishgen-write") else drain(self, data))
+    with atomic_open(tmp_path / "cloud.ply") as handle:
+        handle.write(b"a" * BLOCK)       # handed to the writing thread, which waits for the next write
+        handle.write(b"b" * (BLOCK // 2))
+        filled.set()
+    assert (tmp_path / "cloud.ply").read_bytes() == b"a" * BLOCK + b"b" * (BLOCK // 2)
+
+
+@pytest.mark.parametrize("interrupt", [KeyboardInterrupt, RuntimeError])
+def test_an_interrupt_stays_an_interrupt_though_the_block_in_flight_fails(tmp_path, monkeypatch, interrupt):
+    """The block's error replaced it, so a batch worker stopped by SIGTERM went on to its next job."""
+    import time
+
+    def failing(*args):
+        time.sleep(0.05)
+        raise OSError(errno.EIO, os.strerror(errno.EIO))
+
+    monkeypatch.setattr(os, "write", failing)
+    monkeypatch.setattr(uncached.UncachedWriter, "_drain", failing)
+    with pytest.raises(interrupt):
+        with atomic_open(tmp_path / "cloud.ply") as handle:
+            handle.write(b"z" * BLOCK)
+            raise interrupt("stopped")
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_failed_write_closes_its_file_at_once_so_a_full_disk_gets_its_space_back(tmp_path, monkeypatch):
+    """The error's traceback held the writer, its thread and the open (deleted) temporary file."""
+    import gc
+
+    if not os.path.isdir("/proc/self/fd"):
+        pytest.skip("needs /proc to list open files")
+
+    def full(*args):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "write", full)
+    monkeypatch.setattr(uncached.UncachedWriter, "_drain", full)
+    gc.disable()
+    try:
+        kept = []
+        for k in range(3):
+            try:
+                with atomic_open(tmp_path / f"c{k}.ply") as handle:
+                    handle.write(b"y" * (BLOCK + 1))
+            except SystemFailure as err:
+                kept.append(err)          # as a batch keeps each job's error
+        held = [os.readlink(f"/proc/self/fd/{fd}") for fd in os.listdir("/proc/self/fd")
+                if os.path.exists(f"/proc/self/fd/{fd}")]
+    finally:
+        gc.enable()
+    assert len(kept) == 3 and not [h for h in held if str(tmp_path) in h]
+
+
+def test_after_a_block_fails_every_later_call_says_so(tmp_path, monkeypatch):
+    write = os.write
+    calls = []
+
+    def first_fails(fd, data):
+        calls.append(len(data))
+        if len(calls) == 1:
+            raise OSError(errno.EIO, os.strerror(errno.EIO))
+        return write(fd, data)
+
+    monkeypatch.setattr(os, "write", first_fails)
+    monkeypatch.setattr(uncached, "_set_direct", lambda fd, on: True)
+    fd = os.open(tmp_path / "a.bin", os.O_WRONLY | os.O_CREAT, 0o600)
+    writer = uncached.UncachedWriter(os.fdopen(fd, "wb", buffering=0))
+    writer.write(b"x" * BLOCK)
+    with pytest.raises(OSError):
+        writer.write(b"x" * BLOCK)      # the first block's error, at the next hand-over
+    for later in (lambda: writer.write(b"x"), writer.flush):
+        with pytest.raises(OSError, match="an earlier block was not written"):
+            later()
+    writer.abort()
+    assert writer.closed
+
+
+def test_a_buffer_that_cannot_be_mapped_is_out_of_memory_not_a_failed_write(monkeypatch):
+    def refused(*args, **kwargs):
+        raise OSError(errno.ENOMEM, os.strerror(errno.ENOMEM))
+
+    monkeypatch.setattr(uncached.mmap, "mmap", refused)
+    with pytest.raises(MemoryError):
+        uncached._take_buffer()
