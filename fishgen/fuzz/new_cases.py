@@ -247,7 +247,8 @@ def _run_editor(case: Case, workdir: Path) -> Outcome:
                     if judged.key.startswith(("budget", "RecursionError"))
                     else f"editor: {type(err).__name__} escaped the handler at {where}"
                 )
-                return Outcome("finding", key, f"request {k}: {data[:300]!r}\n{judged.detail or err!r}")
+                return Outcome("finding", key, f"request {k}: {data[:300]!r}\n"
+                               f"{judged.detail if judged.status == 'finding' else repr(err)}")
             status = _status(answer)
             if status >= 500 and not _protocol_answer(status, data):
                 return Outcome(
