@@ -116,3 +116,30 @@ def test_focal_length_fits_for_the_photo_s_perspective_and_repeats_byte_for_byte
     assert told.raster >= blind.raster - 0.005, (told, blind)
     for name in ("threadfingoldie.txt", "threadfingoldie.png", "threadfingoldie_mask.png"):
         assert (tmp_path / "a" / "long" / name).read_bytes() == (tmp_path / "b" / "long" / name).read_bytes()
+
+
+def test_told_the_lens_a_fit_over_water_keeps_the_faint_fin_tips_in_its_mask(tmp_path, gl_available):
+    """Over a backdrop the fit reaches the silhouette's faint edges (a translucent fin's last
+    pixels), and told the lens its fins take their texture where the render from the photo's camera
+    shows them, out to those edges: its mask texture is cut with them, or it trims the very tips
+    the fish was fitted to (issue 32: 703 on BonyBream, 0.885 -> 0.777 in Blender). Without the lens
+    the mask stays the bare silhouette, as before."""
+    from PIL import Image, ImageOps
+
+    from fishgen.authoring.photo.image import MEASURE_SIDE, load_photo, working_copy
+    from fishgen.authoring.photo.run import TextureOptions, make_texture
+    from fishgen.authoring.photo.silhouette import faint_edges, silhouette
+
+    rec = bp.fixture_records()["long"]
+    photo = working_copy(load_photo(rec["photo"]), MEASURE_SIDE)
+    sil = silhouette(photo)
+    faint = faint_edges(photo, sil.mask)
+    assert sil.source == "background model" and faint.sum() > 20
+    base = _bases(["bonybream"])["bonybream"]
+    for lens in (rec["shot"]["lens"], None):
+        out = tmp_path / f"lens-{lens}" / "fish.txt"
+        result = make_texture(rec["photo"], base, out, TextureOptions(fit_shape=True, focal_length=lens))
+        assert result.fitted
+        mask = np.asarray(ImageOps.flip(Image.open(out.with_name("fish_mask.png")))) >= 128
+        assert mask.shape == sil.mask.shape and mask[sil.mask].all()
+        assert np.array_equal(mask, sil.mask | faint if lens else sil.mask), lens

@@ -1,6 +1,7 @@
 """Render a species side-on as the photo shows a fish, and measure how alike two silhouettes are."""
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -20,15 +21,10 @@ def render_side(species: Species, width: int, height: int, distance: float | Non
     in the perspective of a camera ``distance`` fish lengths away. ``renderer``: one to reuse (a
     new one costs about 0.4 s). ``coverage``: only the (H, W) alpha, the silhouette's measure."""
     from fishgen.assembly.fish import build_fish
-    from fishgen.preview.camera import frame
-    from fishgen.preview.pipeline import subject_points
     from fishgen.preview.render import Renderer
 
     scene = build_fish(species)
-    points, _ = subject_points(scene, [None], None)   # a fish: vertices, which reach no farther
-    camera = frame(points, "side", width / height, ortho=distance is None)
-    if distance is not None:
-        camera = _from_afar(camera, points, distance)
+    camera = side_camera(scene, width, height, distance)
     own = renderer is None
     renderer = Renderer(width, height) if own else renderer
     try:
@@ -38,6 +34,63 @@ def render_side(species: Species, width: int, height: int, distance: float | Non
     finally:
         if own:
             renderer.release()
+
+
+def side_camera(scene: Any, width: int, height: int, distance: float | None = None) -> Any:
+    """The camera :func:`render_side` draws ``scene`` (a fish) with."""
+    from fishgen.preview.camera import frame
+    from fishgen.preview.pipeline import subject_points
+
+    points, _ = subject_points(scene, [None], None)   # a fish: vertices, which reach no farther
+    camera = frame(points, "side", width / height, ortho=distance is None)
+    return camera if distance is None else _from_afar(camera, points, distance)
+
+
+def seen_fins(species: Species, width: int, height: int, distance: float,
+              target: np.ndarray) -> dict[str, np.ndarray]:
+    """Where :func:`render_side`'s picture of ``species`` from ``distance`` fish lengths shows each
+    fin's vertices (one per texture point, as :func:`.sideview.side_view` lists them), in the
+    pixels of the silhouette ``target``: the picture's box laid on the target's, as
+    :func:`silhouette_iou` lays them. Fin name -> (N, 2). A fin standing out towards the camera (a
+    paired fin) is seen larger and lower than side-on, and the fins are fitted as so seen: a fin's
+    texture (and the mask cutting it) is then taken from where the photo shows it."""
+    from fishgen.assembly.fins import build_fins
+    from fishgen.assembly.fish import METRES_PER_WORLD_UNIT, THESIS_TO_GLTF, build_fish
+    from fishgen.authoring.photo.sideview import FIN_PARTS
+    from fishgen.geometry.body import ring_positions
+    from fishgen.geometry.shapes import profile_for
+    from fishgen.preview.render import Renderer
+
+    bare = replace(species, texture_points=None, colour_texture=None, mask_texture=None)
+    scene = build_fish(bare)
+    camera = side_camera(scene, width, height, distance)
+    renderer = Renderer(width, height)
+    try:
+        drawn = renderer.coverage(scene, camera) >= DRAWN_ALPHA
+    finally:
+        renderer.release()
+    rings, _ = ring_positions(profile_for(bare.shape_class, bare.shape_params), bare.body_sections,
+                              bare.circle_sections, bare.scale)
+    built = {f.name: f for f in build_fins(bare, rings, clear_of_caudal=False)}
+    # as fish_of places the thesis' scaled geometry: glTF axes in metres, centred on the body
+    centre = np.array([0.5 * bare.scale[0], 0.0, 0.0])
+    metres = bare.world_scale * METRES_PER_WORLD_UNIT
+    viewproj = camera.projection() @ camera.view()
+    d_rows, d_cols = np.flatnonzero(drawn.any(axis=1)), np.flatnonzero(drawn.any(axis=0))
+    t_rows, t_cols = np.flatnonzero(target.any(axis=1)), np.flatnonzero(target.any(axis=0))
+    kx = (t_cols[-1] + 1 - t_cols[0]) / (d_cols[-1] + 1 - d_cols[0])
+    ky = (t_rows[-1] + 1 - t_rows[0]) / (d_rows[-1] + 1 - d_rows[0])
+    out = {}
+    for name, part in FIN_PARTS.items():
+        if part not in built:
+            continue
+        world = (built[part].mesh.positions - centre) @ THESIS_TO_GLTF.T * metres
+        clip = np.c_[world, np.ones(len(world))] @ viewproj.T
+        ndc = clip[:, :2] / clip[:, 3:4]
+        px = np.stack([(ndc[:, 0] + 1) / 2 * width, (1 - ndc[:, 1]) / 2 * height], axis=1)
+        out[name] = np.stack([t_cols[0] + (px[:, 0] - d_cols[0]) * kx,
+                              t_rows[0] + (px[:, 1] - d_rows[0]) * ky], axis=1)
+    return out
 
 
 def camera_distance(focal_length: float, photo_width: int, mask: np.ndarray) -> float:
@@ -52,8 +105,6 @@ def camera_distance(focal_length: float, photo_width: int, mask: np.ndarray) -> 
 def _from_afar(camera: Any, points: np.ndarray, distance: float) -> Any:
     """``camera``'s side view of ``points`` taken from ``distance`` times their length, its field of
     view narrowed to frame them as before."""
-    from dataclasses import replace
-
     back = (camera.eye - camera.target) / np.linalg.norm(camera.eye - camera.target)
     right = np.cross(-back, camera.up)
     right /= np.linalg.norm(right)

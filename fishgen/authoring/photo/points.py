@@ -81,10 +81,13 @@ def _rows(name: str, count: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def fin_points(name: str, fin_xy: np.ndarray, faces: np.ndarray, outline: BodyOutline, view: SideView,
-               mask: np.ndarray, body: np.ndarray, search: float = 1 / 3) -> FinResult:
+               mask: np.ndarray, body: np.ndarray, search: float = 1 / 3,
+               seen: np.ndarray | None = None) -> FinResult:
     """One fin's texture points; ``body`` is the body's region in the frame (bool mask). Fin
-    pixels count up to ``search`` x the fin's size beyond where the base species puts it."""
-    pts = thesis_to_frame(outline, view, fin_xy)
+    pixels count up to ``search`` x the fin's size beyond where the base species puts it.
+    ``seen``: the fin's vertices in the frame where a render in perspective shows them, when the
+    photo was taken so (else they are carried in by the body's outline)."""
+    pts = thesis_to_frame(outline, view, fin_xy) if seen is None else np.asarray(seen, float)
     if not np.isfinite(pts).all():  # an outline too thin to measure (a 2000 x 64 photo at 3 sections)
         raise FishgenError(f"expected a fish whose outline places its {name} fin, found an outline too "
                            "thin to measure (a taller photo, or more --body-sections)")

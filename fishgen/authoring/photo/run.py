@@ -28,6 +28,12 @@ ADVICE_IOU = 0.85
 #: command's half-coverage figure and Blender's over 27 fits (issue 32; docs/blender-photos.md). A
 #: fish that clears ADVICE_IOU at half coverage by less is said to be near the line.
 RENDERERS_DIFFER = 0.006
+#: --focal-length: how far the camera's distance, estimated from the fish's length in the photo
+#: (:func:`.compare.camera_distance`), may be off: a turned fish's length is not its side-on one, and
+#: another camera framing the rebuilt fish by its own extents stands elsewhere (issue 32: 2-6 % on
+#: most Blender photos). A fit that matches from the estimate but not from this share nearer or
+#: farther says so.
+DISTANCE_UNSURE = 0.05
 #: --fit-shape: a fish photographed turned off side-on has no one true level (its nose-to-tail line
 #: is foreshortened, its far fins show): when the fit at the measured level matches under TURN_GOOD,
 #: it is tried again with the photo turned these degrees further, in order, until one matches that
@@ -92,17 +98,27 @@ class Analysis:
 
 
 def analyse(mask: np.ndarray, base: Species, spacing: str = "projected", search: float = 1 / 3,
-            fit: Any = None, level_by: Species | None = None) -> Analysis:
+            fit: Any = None, level_by: Species | None = None,
+            seen_from: tuple[float, tuple[int, int]] | None = None) -> Analysis:
     """``fit``: a :class:`.fit.ShapeFit` of ``base`` to ``mask``; its frame and placement are used
     rather than measured again, so the points land on the fish where the fit put it. ``level_by``:
     the species whose tail calibrates how the photo is levelled (the base as its file gives it,
-    when ``base`` is at another level of detail)."""
+    when ``base`` is at another level of detail). ``seen_from``: (camera distance in fish lengths,
+    render size) when the photo was taken in perspective (``--focal-length``): a fitted fish's fins
+    then take their texture from where its render from there shows them (:func:`.compare.seen_fins`),
+    as it was fitted; side-on, a paired fin standing out towards the camera lies elsewhere, and the
+    fin mask cut the fin's parts there away (a fin tip, and with it the box the overlap crops to)."""
     view = side_view(base)
+    seen: dict[str, np.ndarray] = {}
     if fit is not None:
         from fishgen.authoring.photo.fit import body_outline as fitted_outline
 
         fr = fit.frame
         outline = fitted_outline(fit, fr.mask.shape[1])
+        if seen_from is not None:
+            from fishgen.authoring.photo.compare import seen_fins
+
+            seen = seen_fins(base, *seen_from[1], seen_from[0], fr.mask)
     else:
         ys, xs = np.nonzero(mask)
         length = float(max(np.ptp(xs), np.ptp(ys)))
@@ -115,7 +131,8 @@ def analyse(mask: np.ndarray, base: Species, spacing: str = "projected", search:
         outline = body_outline(fr.mask, view, cal)
     body = fixel.body_points(outline, base.body_sections, base.circle_sections, spacing)
     region = body_region(outline, fr.mask.shape)
-    fins = {name: fixel.fin_points(name, xy, view.fin_faces[name], outline, view, fr.mask, region, search)
+    fins = {name: fixel.fin_points(name, xy, view.fin_faces[name], outline, view, fr.mask, region, search,
+                                   seen.get(name))
             for name, xy in view.fins.items()}
     if fit is not None:
         fins = {name: replace(res, points=_on_fish(res.points, fr.mask)) for name, res in fins.items()}
@@ -138,9 +155,11 @@ def _on_fish(points: np.ndarray, mask: np.ndarray) -> np.ndarray:
 
 
 def measure(photo: Photo, base: Species, mask: np.ndarray, spacing: str = "projected",
-            fit: Any = None, level_by: Species | None = None) -> Measured:
-    """Fixel's points for ``base``'s geometry, measured on ``photo`` (where ``fit`` put it)."""
-    a = analyse(mask, base, spacing, fit=fit, level_by=level_by)
+            fit: Any = None, level_by: Species | None = None,
+            seen_from: tuple[float, tuple[int, int]] | None = None) -> Measured:
+    """Fixel's points for ``base``'s geometry, measured on ``photo`` (where ``fit`` put it; see
+    :func:`analyse` for ``seen_from``)."""
+    a = analyse(mask, base, spacing, fit=fit, level_by=level_by, seen_from=seen_from)
     size = np.array(photo.size, float)
 
     def uv(frame_pts: np.ndarray) -> tuple[tuple[float, float], ...]:
@@ -261,6 +280,14 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         # without them was 0.85 in Blender where the command's own measure said 0.93: the fit
         # takes the faint edges too (an alpha channel keeps the tips; a mask file is the truth).
         target = sil.mask | faint if sil.source == "background model" and faint is not None else sil.mask
+        # Told the lens, a fitted fin takes its texture where the render from there shows it
+        # (compare.seen_fins), out to the faint edges it was fitted to; a mask texture cut from the
+        # bare silhouette is transparent there and trims the tip (703 on BonyBream in Blender: 0.885
+        # -> 0.777; its points moved onto the bare silhouette: 0.838, the tip's 1 px thread too thin
+        # to hold). So that fit's mask is cut from its own target. Without the lens it stays bare:
+        # three.js's water fits lost up to 0.03 with faint edges (docs/blender-photos.md).
+        seen_textures = texture_bytes(original, photo, target) \
+            if distance is not None and target is not sil.mask else None
         for k, turn in enumerate((0.0, *TURNS)):
             if tried is not None and tried[1] >= TURN_GOOD:
                 step(LEVELS - k + 1)  # the level just fitted, and those left unneeded
@@ -276,8 +303,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
                 fit, problems = attempt, found
             if found:
                 continue
-            candidate = _candidate(photo, sil.mask, attempt.species, out, options, imported, textures,
-                                   attempt)
+            candidate = _candidate(photo, sil.mask, attempt.species, out, options, imported,
+                                   seen_textures or textures, attempt, distance=distance)
             rendered = _rendered(photo, candidate, out, distance)
             # another level is kept only for a clear gain: the renders differ by a little anyway
             if tried is None or rendered[1] >= tried[1] + TURN_GAIN:
@@ -320,6 +347,11 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         from fishgen.authoring.photo.compare import HALF_ALPHA, silhouette_iou
 
         faded = silhouette_iou(chosen.measured.frame_mask, shown[0][:, :, 3] >= HALF_ALPHA)
+    apart = None    # (share, IoU): the rebuilt fish seen from another distance, the worse of two
+    if shown is not None and distance is not None and faded is not None \
+            and faded >= ADVICE_IOU + RENDERERS_DIFFER:
+        apart = min(((k, _rendered(photo, chosen, out, distance * (1 + k))[1])
+                     for k in (-DISTANCE_UNSURE, DISTANCE_UNSURE)), key=lambda v: v[1])
     step(1)    # the bar's last step: the rebuilt fish measured (the slowest render of a fit)
     if shown is not None and unsure is not None and unsure < ADVICE_IOU:
         note(f"silhouette IoU {shown[1]:.3f}, but {unsure:.3f} if the faint pixels round the photo's "
@@ -331,6 +363,10 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         note(f"silhouette IoU {shown[1]:.3f}, but {faded:.{4 if near else 3}f} counting only the pixels the "
              f"rebuilt fish covers at least half (thin or translucent fin parts fade out there){margin}: it "
              "may look unlike the photographed fish in another renderer; see --compare")
+    elif shown is not None and apart is not None and apart[1] < ADVICE_IOU:
+        note(f"silhouette IoU {shown[1]:.3f}, but {apart[1]:.3f} seen from {abs(apart[0]):.0%} "
+             f"{'nearer' if apart[0] < 0 else 'farther'} (the camera's distance is estimated from the "
+             "fish's length in the photo): it may look unlike the photographed fish; see --compare")
     elif shown is not None and shown[1] < ADVICE_IOU:
         # a photo in perspective (fishgen preview's own side view is a 50 mm one) reads as a misfit
         # side-on: BonyBream on its own geometry 0.875, 0.976 told the lens
@@ -371,12 +407,15 @@ class _Candidate:
 
 def _candidate(photo: Photo, mask: np.ndarray, base: Species, out: Path, options: TextureOptions,
                imported: dict[str, list[tuple[float, float]]], textures: tuple[bytes, bytes],
-               fit: Any = None, level_by: Species | None = None) -> _Candidate:
-    """The species file (and its texture files) ``base``'s geometry gives with this photo."""
+               fit: Any = None, level_by: Species | None = None,
+               distance: float | None = None) -> _Candidate:
+    """The species file (and its texture files) ``base``'s geometry gives with this photo (seen from
+    ``distance`` fish lengths, when the lens is known)."""
     from fishgen.species.parser import parse_species
     from fishgen.species.writer import format_species
 
-    measured = measure(photo, base, mask, options.spacing, fit, level_by)
+    seen_from = None if fit is None or distance is None else (distance, _render_size(photo))
+    measured = measure(photo, base, mask, options.spacing, fit, level_by, seen_from)
     pts = measured.points
     for part, values in imported.items():
         want = len(getattr(pts, part))
