@@ -78,6 +78,8 @@ def seen_fins(species: Species, width: int, height: int, distance: float,
     viewproj = camera.projection() @ camera.view()
     d_rows, d_cols = np.flatnonzero(drawn.any(axis=1)), np.flatnonzero(drawn.any(axis=0))
     t_rows, t_cols = np.flatnonzero(target.any(axis=1)), np.flatnonzero(target.any(axis=0))
+    if not (len(d_rows) and len(t_rows)):   # nothing to lay on: the fins stay where side-on puts them
+        return {}
     kx = (t_cols[-1] + 1 - t_cols[0]) / (d_cols[-1] + 1 - d_cols[0])
     ky = (t_rows[-1] + 1 - t_rows[0]) / (d_rows[-1] + 1 - d_rows[0])
     out = {}
