@@ -385,6 +385,22 @@ def _writer(tmp: str, fd: int) -> UncachedWriter:
     return UncachedWriter(os.fdopen(os.dup(fd) if tmp in _held else fd, "wb", buffering=0))
 
 
+def _finish(handle: UncachedWriter, tmp: str, path: Path) -> None:
+    """Make ``tmp`` durable and close it, with the permissions ``path`` is to have."""
+    handle.flush()
+    os.fsync(handle.fileno())
+    handle.close()
+    os.chmod(tmp, _mode_for(path))
+
+
+def _drop(handle: UncachedWriter | None, tmp: str) -> None:
+    """Abandon ``tmp``: nothing more written, its file closed at once (a full disk gets its space
+    back), then removed."""
+    if handle is not None:
+        handle.abort()
+    _discard(tmp)
+
+
 def _release(tmp: str) -> None:
     _live.pop(tmp, None)
     _folders.pop(tmp, None)
@@ -405,14 +421,9 @@ def _stage(path: Path, data: bytes, into: list[tuple[str, Path]]) -> None:
     try:
         handle = _writer(tmp, fd)
         handle.write(data)
-        handle.flush()
-        os.fsync(handle.fileno())
-        handle.close()
-        os.chmod(tmp, _mode_for(path))
+        _finish(handle, tmp, path)
     except BaseException as err:
-        if handle is not None:
-            handle.abort()
-        _discard(tmp)
+        _drop(handle, tmp)
         if isinstance(err, OSError):
             raise write_failure(path, err) from None
         raise
@@ -525,13 +536,9 @@ class atomic_open:
         assert self._handle is not None and self._tmp is not None
         try:
             if exc_type is not None:     # the output is dropped: nothing more written, the first error kept
-                self._handle.abort()
-                _discard(self._tmp)
+                _drop(self._handle, self._tmp)
             else:
-                self._handle.flush()
-                os.fsync(self._handle.fileno())
-                self._handle.close()
-                os.chmod(self._tmp, _mode_for(self.path))
+                _finish(self._handle, self._tmp, self.path)
                 if _staging.get() is None:
                     os.replace(self._tmp, self.path)
                     _release(self._tmp)
@@ -540,12 +547,10 @@ class atomic_open:
                     _land([(self._tmp, self.path)])
                 return False
         except OSError as err:
-            self._handle.abort()         # a full disk's temporary file is closed, so its space is freed
-            _discard(self._tmp)
+            _drop(self._handle, self._tmp)
             raise write_failure(self.path, err) from None
         except BaseException:
-            self._handle.abort()
-            _discard(self._tmp)
+            _drop(self._handle, self._tmp)
             raise
         if isinstance(exc, OSError) and exc.filename is None:
             # A write to the handle failed (a full disk, a file size limit): its error names no

@@ -47,13 +47,10 @@ def _set_direct(fd: int, on: bool) -> bool:
 
 
 def _take_buffer() -> mmap.mmap:
-    while _spare:
-        try:
-            buffer = _spare.pop()      # atomic under the GIL: two threads never get the same one
-        except IndexError:
-            break
-        if len(buffer) == BLOCK:       # else BLOCK changed (a test): dropped
-            return buffer
+    try:
+        return _spare.pop()            # atomic under the GIL: two threads never get the same one
+    except IndexError:
+        pass
     private = {"flags": mmap.MAP_PRIVATE} if hasattr(mmap, "MAP_PRIVATE") else {}
     try:
         return mmap.mmap(-1, BLOCK, **private)   # page-aligned, as O_DIRECT needs; never shared with a child
