@@ -5,8 +5,10 @@
     python benchmarks/clouds.py --writers-only  # CSV vs PLY writer, 10^6 particles
     python benchmarks/clouds.py --light-only    # lighting vs fill, and lit vs unlit whole runs
     python benchmarks/clouds.py --cost          # issue 32: the whole command's marginal cost per
-                                                # particle, lit and --no-light, against plain loops
+                                                # particle, lit, --no-light and with numpy's huge
+                                                # pages on, against plain loops
     python benchmarks/clouds.py --cost --baseline /work/main   # the same, beside another checkout's
+    python benchmarks/clouds.py --cost --settle 10   # each run on cold memory, as on an idle machine
     chrt -f 10 python benchmarks/clouds.py --light-only   # the same, ahead of everything else
                                                           # running (root; a busy shared machine)
 
@@ -142,6 +144,9 @@ COMMANDS = {
     "fishgen": lambda awn, ply: [sys.executable, "-m", "fishgen", "clouds", str(awn), "-o", str(ply)],
     "no-light": lambda awn, ply: [sys.executable, "-m", "fishgen", "clouds", str(awn), "-o", str(ply),
                                   "--no-light"],
+    # the command as it ran before it turned numpy's huge pages off (docs/decisions.md)
+    "huge-pages": lambda awn, ply: ["env", "NUMPY_MADVISE_HUGEPAGE=1", sys.executable, "-m", "fishgen",
+                                    "clouds", str(awn), "-o", str(ply)],
     "unlit": lambda awn, ply: [sys.executable, __file__, "--run", "unlit", str(awn), str(ply)],
     "lit": lambda awn, ply: [sys.executable, __file__, "--run", "lit", str(awn), str(ply)],
     "plain": lambda awn, ply: [sys.executable, __file__, "--run", "plain", str(awn), str(ply)],
@@ -174,12 +179,15 @@ def run(kind: str, awn: str, ply: str) -> None:
 
 
 def whole_command(n: int, workdir: Path, repeats: int, kinds=("fishgen",), baseline: Path | None = None,
-                  cpu: dict[str, float] | None = None) -> dict[str, tuple[float, int]]:
+                  cpu: dict[str, float] | None = None, settle: float = 0.0) -> dict[str, tuple[float, int]]:
     """Per kind of COMMANDS: median wall time and peak RSS (bytes) of the whole run on a
     Table 4.4 cloud of n particles to PLY, the kinds interleaved run by run. A kind ``base:K`` is
     K run from ``baseline`` (another checkout: its fishgen, its benchmarks/clouds.py). ``cpu``, if
     given, gets each kind's median CPU seconds in user mode and in the kernel (all threads), as
-    ``kind`` and ``kind:system``."""
+    ``kind`` and ``kind:system``. ``settle``: seconds to wait before each run, so it starts on memory
+    the kernel has let go cold, as a command run on an idle machine does (a run that follows
+    another's exit within a second or two gets the pages that exit freed, and pays far less for
+    its first touches)."""
     awn, ply = workdir / f"cloud_{n}.awn", workdir / f"cloud_{n}.ply"
     write_awn(scaled_cubes(n), awn)
     # Each measurement runs in its own wrapper so RUSAGE_CHILDREN sees only that command.
@@ -193,6 +201,7 @@ def whole_command(n: int, workdir: Path, repeats: int, kinds=("fishgen",), basel
     peaks: dict[str, list[int]] = {k: [] for k in kinds}
     for _ in range(repeats):
         for kind in kinds:
+            time.sleep(settle)
             base = kind.startswith("base:")
             if base and baseline is None:
                 raise ValueError(f"{kind} needs a baseline checkout")
@@ -251,7 +260,7 @@ def light_report(sizes: list[int], command_size: int, repeats: int, workdir: Pat
 
 
 def cost_report(small: int, large: int, plain_size: int, repeats: int, workdir: Path,
-                baseline: Path | None = None) -> None:
+                baseline: Path | None = None, settle: float = 0.0) -> None:
     """Issue 32, item 3: the whole command's marginal cost per particle between ``small`` and
     ``large`` particles, lit (as shipped) and --no-light, against the plain loops' cost per
     particle at ``plain_size`` (each a fresh process, so the loop's heap is its own): the fill
@@ -260,19 +269,22 @@ def cost_report(small: int, large: int, plain_size: int, repeats: int, workdir: 
     checkout, e.g. main's), its two commands run interleaved with these. The CPU time (all
     threads) is given beside the wall time, in user mode (the steadier figure on a shared machine)
     and in the kernel (page faults of fresh arrays, the page cache, fsync: it varies 5x there)."""
-    kinds = ("fishgen", "no-light", *(("base:fishgen", "base:no-light") if baseline else ()), "write-floor")
+    kinds = ("fishgen", "no-light", "huge-pages", *(("base:fishgen", "base:no-light") if baseline else ()),
+             "write-floor")
     cpu_low: dict[str, float] = {}
     cpu_high: dict[str, float] = {}
-    low = whole_command(small, workdir, repeats, kinds, baseline, cpu_low)
-    high = whole_command(large, workdir, repeats, kinds, baseline, cpu_high)
-    plain = whole_command(plain_size, workdir, repeats, ("plain", "plain-ply"))
+    low = whole_command(small, workdir, repeats, kinds, baseline, cpu_low, settle)
+    high = whole_command(large, workdir, repeats, kinds, baseline, cpu_high, settle)
+    plain = whole_command(plain_size, workdir, repeats, ("plain", "plain-ply"), settle=settle)
     per = {k: plain[k][0] / plain_size for k in plain}   # start-up (~30 ms) left in: < 2 %
     print(f"\nwhole command, Table 4.4 cloud to PLY, medians of {repeats}, kinds interleaved run by run"
-          f"{f'; base: {baseline}' if baseline else ''}:")
+          f"{f'; base: {baseline}' if baseline else ''}"
+          f"{f'; {settle:g} s idle before each' if settle else ''}:")
     print("| command | " + f"{small:,} | {large:,} | marginal per particle | plain fill / marginal "
           f"| plain fill+PLY / marginal | user CPU marginal | kernel CPU marginal | peak at {large:,} |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     labels = {"fishgen": "`fishgen clouds` (lit)", "no-light": "`fishgen clouds --no-light`",
+              "huge-pages": "`fishgen clouds` (lit), numpy's huge pages on",
               "write-floor": f"writing {PLY_RECORD} bytes a particle alone (fsync'd, nothing computed)"}
     for kind in kinds:
         label = labels[kind.removeprefix("base:")] + (" (base)" if kind.startswith("base:") else "")
@@ -325,6 +337,9 @@ def main() -> None:
     parser.add_argument("--baseline", type=Path, metavar="DIR",
                         help="with --cost: also run the commands of the checkout in DIR (e.g. main's), "
                              "interleaved with these [default: none]")
+    parser.add_argument("--settle", type=float, default=0.0, metavar="SECONDS",
+                        help="with --cost: wait this long before each run, so each starts on cold memory, "
+                             "as a command run on an idle machine does (10 is enough here) [default: 0]")
     parser.add_argument("--run", nargs=3, metavar=("KIND", "AWN", "PLY"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.run:
@@ -333,7 +348,7 @@ def main() -> None:
     if args.cost:
         with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:
             cost_report(10**6, int(args.command_size), 10**6, args.repeats if args.repeats != 5 else 3,
-                        Path(tmp), args.baseline.resolve() if args.baseline else None)
+                        Path(tmp), args.baseline.resolve() if args.baseline else None, args.settle)
         return
     if args.light_only:
         with tempfile.TemporaryDirectory(dir=ROOT / "out" if (ROOT / "out").is_dir() else None) as tmp:

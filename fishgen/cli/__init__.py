@@ -18,6 +18,14 @@ from fishgen import __version__, interrupts
 from fishgen.cli.common import add_common_options, error_line, json_errors, reset
 from fishgen.commands import MODULES, command
 
+# numpy asks the kernel for transparent huge pages on every array of 4 MiB or more. Where the
+# kernel then compacts memory to find one at each fault (THP defrag "madvise", a common default),
+# first touching a fresh 500 MB array took 1.9 s instead of 0.22 s, and a 10^7-particle cloud's
+# command spent more time in those faults than in its own work (docs/decisions.md). fishgen runs
+# through its big arrays in order, where huge pages gain little, so the command turns them off
+# before numpy is first imported; NUMPY_MADVISE_HUGEPAGE=1 in the environment turns them back on.
+os.environ.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
+
 
 class LazyGroup(click.Group):
     def list_commands(self, ctx):

@@ -1,0 +1,37 @@
+"""The command's process: what the entry point sets up before any work is done."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+# whether numpy asks for huge pages, as the command's process has it (numpy 2 moved the module)
+PROBE = ("import fishgen.cli, numpy\n"
+         "try:\n    from numpy._core.multiarray import _set_madvise_hugepage as flip\n"
+         "except ImportError:\n    from numpy.core.multiarray import _set_madvise_hugepage as flip\n"
+         "print(flip(False))")
+
+
+def _huge_pages(env_value: str | None) -> str:
+    env = {k: v for k, v in os.environ.items() if k != "NUMPY_MADVISE_HUGEPAGE"}
+    if env_value is not None:
+        env["NUMPY_MADVISE_HUGEPAGE"] = env_value
+    out = subprocess.run([sys.executable, "-c", PROBE], capture_output=True, text=True, cwd=ROOT, env=env,
+                         check=True)
+    return out.stdout.strip()
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="numpy asks for huge pages on Linux only")
+def test_the_command_turns_numpys_huge_pages_off():
+    # a fresh 500 MB array's first touch took 1.9 s with them and 0.22 s without (docs/decisions.md)
+    assert _huge_pages(None) == "False"
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="numpy asks for huge pages on Linux only")
+def test_a_users_choice_of_huge_pages_stands():
+    assert _huge_pages("1") == "True"
