@@ -81,8 +81,10 @@ def parse_background(text: str) -> tuple[int, int, int, int]:
                            f"found {text!r}") from None
 
 
-def check_output(out: Path, options: PreviewOptions, inputs: int = 1) -> int:
+def check_output(out: Path, options: PreviewOptions, inputs: int = 1, particles: bool = False) -> int:
     """Validate the output name against the options; returns the number of frames to render.
+    ``particles``: an input may hold particles (anything but a species file), which are blended
+    in finer colour (:class:`~fishgen.preview.render.Renderer`).
 
     Also refuses, before anything is allocated, a request whose contact sheet
     would exceed ``MAX_SHEET_PIXELS`` or whose frames and sheets for ``inputs``
@@ -120,7 +122,7 @@ def check_output(out: Path, options: PreviewOptions, inputs: int = 1) -> int:
                            f"at {options.width}x{options.height}; use a smaller --size or fewer --frames")
     from fishgen.preview.memory import check_fits
 
-    check_fits(options.width, options.height, total if frames > 1 or inputs > 1 else 0)
+    check_fits(options.width, options.height, total if frames > 1 or inputs > 1 else 0, fine=particles)
     return frames
 
 
@@ -229,7 +231,8 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
     plans = [_frame_plan(scene, options, frames) for scene in scenes]
     if on_planned:
         on_planned(sum(len(times) for times, _, _ in plans))
-    renderer = Renderer(options.width, options.height)
+    particles = any(prim.mode == "POINTS" for scene in scenes for _, prim in scene.drawn())
+    renderer = Renderer(options.width, options.height, fine_blending=particles)
     r, g, b, a = (c / 255.0 for c in options.background)
     bg = (r, g, b, a)
     out, seconds = [], []
@@ -313,7 +316,8 @@ def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options
     out = Path(out)
     if not inputs:
         raise FishgenError("expected at least one input, found none")
-    frames = check_output(out, options, len(inputs))
+    # only a species file is sure to hold no particles before it is read
+    frames = check_output(out, options, len(inputs), any(Path(p).suffix.lower() != ".txt" for p in inputs))
     scenes = [load_input(p, textures_dir=options.textures_dir, seed=options.seed, lighting=options.lighting)
               for p in inputs]
     for scene in scenes:  # e.g. a cloud previewed with fewer particles than it holds
