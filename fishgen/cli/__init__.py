@@ -24,7 +24,9 @@ from fishgen.commands import MODULES, command
 # command spent more time in those faults than in its own work (docs/decisions.md). fishgen runs
 # through its big arrays in order, where huge pages gain little, so the command turns them off
 # before numpy is first imported; NUMPY_MADVISE_HUGEPAGE=1 in the environment turns them back on.
-os.environ.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
+# numpy itself stops with a traceback on a value that is not a whole number (empty, "yes").
+if not os.environ.get("NUMPY_MADVISE_HUGEPAGE", "").strip().isdigit():
+    os.environ["NUMPY_MADVISE_HUGEPAGE"] = "0"
 
 
 class LazyGroup(click.Group):

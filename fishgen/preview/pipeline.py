@@ -231,8 +231,7 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
     plans = [_frame_plan(scene, options, frames) for scene in scenes]
     if on_planned:
         on_planned(sum(len(times) for times, _, _ in plans))
-    particles = any(prim.mode == "POINTS" for scene in scenes for _, prim in scene.drawn())
-    renderer = Renderer(options.width, options.height, fine_blending=particles)
+    renderer = Renderer(options.width, options.height, fine_blending=any(map(_has_particles, scenes)))
     r, g, b, a = (c / 255.0 for c in options.background)
     bg = (r, g, b, a)
     out, seconds = [], []
@@ -254,6 +253,16 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
     finally:
         renderer.release()
     return out, max(seconds)
+
+
+def _has_particles(scene: Scene) -> bool:
+    """Points, or a cloud's billboards (unlit, alpha-blended quads): many faint layers over a pixel,
+    to blend in finer colour than 8 bits."""
+    def particle(prim) -> bool:
+        material = scene.materials[prim.material] if prim.material is not None else None
+        return prim.mode == "POINTS" or (material is not None and material.alpha_mode == "BLEND"
+                                         and material.unlit)
+    return any(particle(prim) for _, prim in scene.drawn())
 
 
 def compose(per_scene: list[list], labels: list[str], options: PreviewOptions) -> list:

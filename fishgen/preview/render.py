@@ -191,7 +191,7 @@ class Renderer:
         """``fine_blending``: blend in 16-bit float colour, not 8-bit. Thousands of faint soft
         discs over one pixel (a cloud's particles) each rounded to 8 bits drew rings and grain over
         a smooth cloud; 16 bits cost 28 bytes a pixel more at 4x multisampling, so only a scene
-        with particles asks for it."""
+        with particles (points or billboards) asks for it."""
         import moderngl
 
         try:
