@@ -84,6 +84,10 @@ PEAK_LEVELS = 16384
 
 _F32 = np.float32
 _LEVELS = np.arange(PEAK_LEVELS + 1, dtype=np.float64)
+SHARE_LEVELS = 65535
+"""A particle's share of its slab nearer the sun is kept in 65535ths: a dense cloud's first slab
+holds optical depths in the hundreds at a cell, and in 255ths its sunlit face read the light in
+steps of 1, 0.53, 0.27."""
 
 
 def light_cloud(cloud: Cloud, lighting: Lighting | None = None) -> Cloud:
@@ -247,8 +251,11 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     at that cell. That factor is ``e^-e`` for an *effective* depth e(d) <= d, so a slab's
     particles only need their effective depths summed: each splatted as a Gaussian of the
     same total (``_effective_table``), as a point into its width class, and the class maps
-    blurred. A particle also sits behind about half the rest of its own slab, so it reads
-    the light before its slab passed through half the slab's depth at its centre, less its own.
+    blurred. A particle also sits behind the part of its own slab nearer the sun, so it reads
+    the light before its slab passed through that share of the slab's depth at its centre, less
+    its own: the share of the slab's particles nearer the sun than it (``_slab_numbers``). Half
+    of it for every particle, as before, left a dense cloud's sunlit face in the shade of half
+    the first slab: exactly 0 light where the pairs gave up to 0.57.
 
     Nothing here visits the particles in depth order (on a big cloud, reading memory out of
     order cost more than all the arithmetic). Three passes in memory order, each chunk on
@@ -264,7 +271,7 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     with ThreadPoolExecutor(WORKERS) as pool:
         depth, a, b = np.empty(n, _F32), np.empty(n, _F32), np.empty(n, _F32)
         ends = _project(centers, frame, middle, out=(depth, a, b), pool=pool)
-        slab = _slab_numbers(depth, slabs, pool, ends[0])
+        slab, nearer = _slab_numbers(depth, slabs, pool, ends[0])
         grid = _Grid(ends[1:, 0].astype(np.float64), ends[1:, 1].astype(np.float64), radii,
                      most=grid_cells)
         cells = grid.shape[0] * grid.shape[1]
@@ -295,7 +302,7 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
             for k in range(last - first):
                 before[k] = reached
                 reached += depths[k]
-            read = functools.partial(_read_chunk, grid, place, own, before, depths, light)
+            read = functools.partial(_read_chunk, grid, place, own, nearer, before, depths, light)
             list(pool.map(read, spans))
     return light
 
@@ -383,10 +390,10 @@ def _splat_share(grid: _Grid, place, radii, density, table, size: int, own: np.n
     return total
 
 
-def _read_chunk(grid: _Grid, place, own: np.ndarray, before: np.ndarray, depths: np.ndarray,
-                light: np.ndarray, span: tuple[int, int]) -> None:
-    """Each particle's light: behind the depth before its slab, at its centre, and about half of
-    what the rest of its own slab holds there."""
+def _read_chunk(grid: _Grid, place, own: np.ndarray, nearer: np.ndarray, before: np.ndarray,
+                depths: np.ndarray, light: np.ndarray, span: tuple[int, int]) -> None:
+    """Each particle's light: behind the depth before its slab, at its centre, and the share of
+    what the rest of its own slab holds there that lies nearer the sun (``nearer``, in SHARE_LEVELS)."""
     pick, number, (flat, fx, fy), near = place(span)
     start, stop = span
     number *= np.int32(grid.shape[0] * grid.shape[1])
@@ -396,7 +403,9 @@ def _read_chunk(grid: _Grid, place, own: np.ndarray, before: np.ndarray, depths:
     half = np.take(depths.ravel(), near)
     half -= own[start:stop] if pick is None else own[start:stop][pick]          # less its own
     np.maximum(half, 0, out=half)
-    half *= _F32(0.5)
+    share = (nearer[start:stop] if pick is None else nearer[start:stop][pick]).astype(_F32)
+    share *= _F32(1 / SHARE_LEVELS)
+    half *= share
     got += half
     np.maximum(got, 0, out=got)
     got = _light_into(got, half)
@@ -546,8 +555,10 @@ def _each(pool: ThreadPoolExecutor | None, work, spans: list) -> list:
 
 
 def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None = None,
-                  ends: np.ndarray | None = None) -> np.ndarray:
-    """Each particle's slab, 0 nearest the sun (uint8, or uint16 for more than 256 slabs).
+                  ends: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Each particle's slab, 0 nearest the sun (uint8, or uint16 for more than 256 slabs), and
+    the share of its slab's particles nearer the sun than it, in SHARE_LEVELS (uint16; its own
+    level's count half).
 
     The depth is cut into KEY_LEVELS + 1 levels and the levels into ``slabs`` runs of about
     equal count; a level is never split, so a slab may hold more or fewer, or none. ``ends``:
@@ -577,13 +588,23 @@ def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None
     before = np.cumsum(per_level) - per_level                # particles on nearer levels
     slab_of_level = (before * slabs) // n                     # the slab each level begins in
     table = slab_of_level.astype(np.uint8 if slabs <= 256 else np.uint16)
+    # each slab's first particle (counted over all) and count, then each level's share of its slab
+    # nearer the sun: the particles of the slab's nearer levels and half its own level's
+    starts = np.searchsorted(slab_of_level, np.arange(slabs + 1), "left")
+    first = np.append(before, n)[starts]
+    in_slab = np.diff(first)[slab_of_level]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        fraction = (before - first[slab_of_level] + per_level / 2) / in_slab
+    shares = np.rint(np.nan_to_num(fraction, nan=0.5).clip(0, 1) * SHARE_LEVELS).astype(np.uint16)
     slab = np.empty(n, table.dtype)
+    nearer = np.empty(n, np.uint16)
 
     def number(span: tuple[int, int]) -> None:
         np.take(table, key[span[0]:span[1]], out=slab[span[0]:span[1]])
+        np.take(shares, key[span[0]:span[1]], out=nearer[span[0]:span[1]])
 
     _each(pool, number, spans)
-    return slab
+    return slab, nearer
 
 
 class _Grid:

@@ -57,8 +57,9 @@ class Lighting:
     albedo: float = option(FiniteRange(0, 1), "Fraction of the light a particle stops that it scatters "
                            "rather than absorbs.", ALBEDO)
     extinction: float = option(FiniteRange(0, 1000), "Optical depth through the centre of a particle of "
-                               "density 1 (SkyWorks' 80: opaque cores); lower makes a thinner, brighter "
-                               "cloud.", EXTINCTION)
+                               "density 1 (SkyWorks' 80: opaque cores). It also sets the light scattered "
+                               "forward (SkyWorks' formula, at most the albedo), so a lower value often "
+                               "makes a darker cloud, not a thinner one.", EXTINCTION)
     solid_angle: float = option(FiniteRange(0, 4 * math.pi, min_open=True), "Cone over which "
                                 "forward-scattered light is gathered, steradians (SkyWorks' 0.09).",
                                 SOLID_ANGLE, metavar="STERADIANS")
@@ -103,12 +104,15 @@ class Lighting:
         """Share of the light a particle stops that it passes on towards the particles behind it.
 
         Harris's first pass, as SkyWorks computes it: albedo x extinction x p(0) x solid angle / 4 pi
-        (0.773 with the defaults), at most 1; 0 with scattering off.
+        (0.773 with the defaults), at most the albedo: a particle passes on no more than it scatters.
+        Capped at 1, every particle let all the light through past an extinction of 104 (or
+        anisotropy 0.1, or a solid angle of 0.12), and the cloud was one flat white; 0 with
+        scattering off.
         """
         if not self.scattering:
             return 0.0
         share = self.albedo * self.extinction * self.phase(1.0) * self.solid_angle / (4 * math.pi)
-        return min(1.0, share)
+        return min(self.albedo, share)
 
     def extras(self) -> dict[str, Any]:
         """What a glTF file records of this light (the scene's ``extras["fishgen_light"]``), so a

@@ -212,9 +212,9 @@ def test_a_high_sun_leaves_the_base_darker_than_the_top():
 
 
 def test_a_big_cloud_in_slabs_agrees_with_the_pairs(monkeypatch):
-    """The slabs rank the light as the pairs do (0.99 here). Their mean is looser: a particle
-    reads half its own slab's depth wherever it lies in the slab, which leaves Table 4.2, a
-    dense cloud whose light is 2 % of the sun's, 1.6x brighter than its pairs."""
+    """The slabs rank the light as the pairs do (0.97 here). Their mean is looser: the pairs take
+    a particle's light at its sunward face, the slabs at its centre, which leaves Table 4.2, a
+    dense cloud whose light is 6 % of the sun's, 0.6x as bright in slabs."""
     cloud = fill_cloud(load_cubes(TABLES["4.2"]), seed=1)
     lighting = Lighting(sun=SUNS["side"])
     exact = incident_light(cloud.centers, cloud.radii, cloud.density, lighting)
@@ -233,6 +233,21 @@ def test_a_dense_big_cloud_keeps_light_above_zero_and_in_order_in_its_slabs():
                            Lighting(sun=(0, 1, 0)))
     assert light.min() > 0 and np.median(light) < 1e-5          # e^-E alone: 0 below ~1e-45
     assert stats.spearmanr(light, centers[:, 1]).statistic > 0.9
+
+
+def test_a_dense_big_clouds_sunlit_face_is_lit():
+    """Table 4.4's cubes holding 100,000 particles: each particle read half its own slab's depth,
+    so the 20 nearest the sun, 1,000 to a slab, got exactly 0 (the pairs gave up to 0.57 at
+    9,840). Each now reads the share of its slab nearer the sun than it: 0.96 down to 0.18."""
+    cubes = load_cubes(TABLES["4.4"])
+    total = sum(c.particles for c in cubes.cubes)
+    scaled = tuple(c.__class__(c.particles * 100_000 // total, c.size, c.centre, c.max_radius, c.line)
+                   for c in cubes.cubes)
+    cloud = fill_cloud(cubes.__class__(cubes.path, sum(c.particles for c in scaled), scaled), seed=0)
+    lighting = Lighting()
+    light = incident_light(cloud.centers, cloud.radii, cloud.density, lighting)
+    nearest = np.argsort(-(cloud.centers.astype(float) @ np.array(lighting.sun_unit)))[:20]
+    assert light[nearest].max() > 0.9 and light[nearest].min() > 0.1
 
 
 def test_same_bytes_whatever_the_thread_count(monkeypatch):
@@ -309,6 +324,17 @@ def test_unlit_files_stay_as_they_were(tmp_path):
 
 
 # -- the lighting parameters ------------------------------------------------------------------
+
+@pytest.mark.parametrize("kwargs", [{"extinction": 110}, {"anisotropy": 0.5}, {"solid_angle": 1.0},
+                                    {"extinction": 1000, "albedo": 0.5}])
+def test_no_lighting_in_range_lets_all_the_light_through(kwargs):
+    """Past SkyWorks' forward share of 1 (extinction 104 with the defaults) every particle passed
+    all the light on: a cloud of one flat white. A particle passes on at most what it scatters."""
+    lighting = Lighting(**kwargs)
+    assert lighting.forward_fraction <= lighting.albedo
+    cloud = light_cloud(fill_cloud(load_cubes(TABLES["4.4"]), seed=0), lighting)
+    assert cloud.light.min() < 0.5 and len(np.unique(cloud.colors[:, 0])) > 20
+
 
 def test_defaults_are_skyworks_constants():
     lighting = Lighting()
