@@ -48,9 +48,27 @@ class CloudsOptions:
 
 
 def check_options(options: CloudsOptions, output: str | os.PathLike | None = None) -> None:
-    """Options that would be ignored, refused before any work (and at a manifest job's line)."""
+    """Options that would be ignored or cannot be met, refused before any work (and at a manifest
+    job's line, before any job runs)."""
     from fishgen.errors import UsageError
 
+    if not options.light and options.lighting != Lighting():
+        from dataclasses import fields
+
+        def flag(name: str, value: object) -> str:   # a switch given off reads --no-NAME
+            return f"--{'no-' if value is False else ''}{name.replace('_', '-')}"
+
+        given = [flag(f.name, getattr(options.lighting, f.name)) for f in fields(Lighting)
+                 if getattr(options.lighting, f.name) != getattr(Lighting(), f.name)]
+        raise UsageError(f"expected no lighting options with --no-light, found {', '.join(given)}")
+    if options.billboards and output is not None:
+        from fishgen.errors import FishgenError
+        from fishgen.exchange.clouds import check_output
+
+        try:
+            check_output(output, billboards=True)
+        except FishgenError as err:     # the options' fault, not the file's: a manifest job's line
+            raise UsageError(err.message, output) from None
     if options.voxel_size is not None and output is not None:
         from fishgen.exchange.clouds import VOLUME_FORMATS
 
@@ -122,15 +140,6 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     check_output(output, billboards)
     check_options(options, output)
     check_targets([output], inputs)
-    if not options.light and options.lighting != Lighting():
-        from dataclasses import fields
-
-        def flag(name: str, value: object) -> str:   # a switch given off reads --no-NAME
-            return f"--{'no-' if value is False else ''}{name.replace('_', '-')}"
-
-        given = [flag(f.name, getattr(options.lighting, f.name)) for f in fields(Lighting)
-                 if getattr(options.lighting, f.name) != getattr(Lighting(), f.name)]
-        raise UsageError(f"expected no lighting options with --no-light, found {', '.join(given)}")
     if options.offset and len(options.offset) != len(inputs):
         raise UsageError(f"expected one --offset per input ({len(inputs)}), found {len(options.offset)}")
     files = read_cube_files(inputs, max_particles=options.max_particles, textures_dir=options.textures,

@@ -124,6 +124,11 @@ preset = "torus"
      "expected swim body with speed (it sets the body wave's tail beat, which swim fins does not have)"),
     ('[[clouds]]\ninput = "a.awn"\noutput = "a.glb"\nvoxel-size = 0.5\n', 3,
      "expected a .nvdb or .vdb output with voxel-size, found '.glb'"),
+    # or cannot be met: each failed later as a job, one at a time (QA pass 9)
+    ('[[clouds]]\ninput = "a.awn"\noutput = "a.ply"\nbillboards = true\n', 3,
+     "expected a .glb or .gltf output with billboards, found '.ply'"),
+    ('[[clouds]]\ninput = "a.awn"\noutput = "a.ply"\nlight = false\nsun = [1, 1, 1]\n', 3,
+     "expected no lighting options with no-light, found sun"),
     ('[[build]\ninput = "a.txt"\n', 1, "expected TOML"),
     ('out = "o"\n', None, "expected at least one job ([[build]], [[clouds]], [[school]])"),
 ])
