@@ -99,17 +99,30 @@ def _sprite_material(scene: Scene) -> int:
 
 
 def _texture_material(scene: Scene, path: str) -> int:
-    """An unlit, alpha-blended material showing the PNG at ``path`` (read as it is)."""
+    """An unlit, alpha-blended material showing the picture at ``path``."""
     from pathlib import Path
 
     name = Path(path).name
+    image = texture_image(Path(path))
     for k, m in enumerate(scene.materials):  # another cloud of the scene carries it already
         if m.name == f"cloud texture {name}" and m.texture is not None \
-                and scene.images[m.texture].data == Path(path).read_bytes():
+                and scene.images[m.texture].encoded() == image.encoded():
             return k
-    texture = scene.add_image(Image(name, Path(path).read_bytes()))
+    texture = scene.add_image(image)
     return scene.add_material(Material(f"cloud texture {name}", texture=texture, alpha_mode="BLEND",
                                        double_sided=True, unlit=True, roughness=1.0))
+
+
+def texture_image(path) -> Image:
+    """A texture cloud's picture as glTF takes it: a PNG or JPEG as it is (by its bytes, whatever
+    its name: a JPEG named .png was declared image/png, which glTF validators refuse), anything
+    else the cube file allows (a GIF, a BMP) decoded and written as PNG."""
+    data = path.read_bytes()
+    if data.startswith(b"\x89PNG\r\n\x1a\n"):
+        return Image(path.name, data)
+    if data.startswith(b"\xff\xd8\xff"):
+        return Image(path.name, data, "image/jpeg")
+    return Image(path.name, b"", pixels=Image(path.name, data).rgba())
 
 
 def _billboard_primitive(cloud: Cloud, members: np.ndarray, material: int) -> Primitive:

@@ -2,6 +2,7 @@
 and the textured, lit billboards they export to."""
 from __future__ import annotations
 
+import io
 import os
 
 import numpy as np
@@ -154,3 +155,19 @@ def test_the_preview_reader_takes_awa(gl_available):
     finally:
         renderer.release()
     assert (image[..., 3] > 128).mean() > 0.01
+
+
+@pytest.mark.parametrize("kind,mime", [("JPEG", "image/jpeg"), ("GIF", "image/png")])
+def test_a_texture_goes_into_gltf_as_what_its_bytes_are(folder, kind, mime, gltf_validator):
+    """A JPEG named .png was declared image/png (the validator's IMAGE_MIME_TYPE_INVALID); a GIF,
+    which glTF does not take, is written as PNG."""
+    Image.new("RGB", (16, 16), (200, 210, 230)).save(folder / "sky" / "near.png", format=kind)
+    cloud = light_cloud(fill_cloud(load_cubes(write(folder, "4\n1\n4, 1, 1, 1, 0, 0, 0, 1, near.png\n")),
+                                   seed=0))
+    path = folder / "out.glb"
+    export_cloud(cloud, path, billboards=True)
+    gltf_validator(path)
+    scene = cloud_scene(cloud, billboards=True)
+    (image,) = scene.images
+    assert image.mime_type == mime
+    assert Image.open(io.BytesIO(image.encoded())).format == mime.split("/")[1].upper()
