@@ -37,7 +37,8 @@ class CloudsOptions:
     billboards: bool = option(click.BOOL,
                               f"glTF only: three crossed quads per particle ({BILLBOARD_TRIANGLES} "
                               "triangles, 12 vertices), an alpha-blended Gaussian sprite, instead of points; "
-                              "a texture cloud (.awa) is always billboards, with its PNGs.", False, flag=True)
+                              "a texture cloud (.awa) is always billboards, with its PNGs, and so are "
+                              ".awn clouds given with one.", False, flag=True)
     max_particles: int = max_particles_option(DEFAULT_MAX_PARTICLES)
     voxel_size: float | None = voxel_size_option(DEFAULT_VOXEL_SIZE)
     textures: Path | None = cloud_textures_option()

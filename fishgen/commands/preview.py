@@ -110,4 +110,8 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
     if options.duration is not None and options.frames is None and output.suffix.lower() != ".gif":
         # said once it is written: a failed run's one line stays its only one
         events.note(f"{output}: a still; --duration makes a loop in a .gif, or in a .webp with --frames")
+    if options.lighting != Lighting() and not any(p.suffix.lower() in (".awn", ".awa") for p in inputs):
+        # an asset's light is baked into it; the preview shows it as the file says
+        events.note(f"{output}: the lighting options light cube files (.awn, .awa) only; "
+                    "an asset shows the light it was written with")
     return Made((out,), (*inputs, *beside), (f"wrote {out}",))

@@ -220,3 +220,13 @@ def test_a_loop_lasts_its_duration_though_a_gif_counts_in_hundredths(tmp_path, n
             loop.load()       # a WebP frame's duration is known once it is read
             times.append(loop.info["duration"])
     assert len(times) == 7 and sum(times) == 600 and max(times) - min(times) <= 10
+
+
+def test_lighting_options_on_an_asset_say_they_light_cube_files_only(tmp_path, assets):
+    """A glb's light is baked: --sun gave the same picture, and nothing said so (QA pass 9)."""
+    result = run_cli("preview", str(assets["cloud.glb"]), "-o", str(tmp_path / "c.png"), "--sun", "-1,0.2,0")
+    assert result.returncode == 0, result.stderr
+    assert "the lighting options light cube files (.awn, .awa) only" in result.stderr
+    quiet = run_cli("preview", str(PARAMS / "clouds" / "table_4_3.awn"), "-o", str(tmp_path / "d.png"),
+                    "--sun", "-1,0.2,0")
+    assert quiet.returncode == 0 and "light cube files" not in quiet.stderr
