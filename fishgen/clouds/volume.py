@@ -59,7 +59,14 @@ def voxel_box(lo, hi, voxel_size: float, where=None) -> tuple[np.ndarray, np.nda
     limit = 2.0 ** 30
     if not np.all(np.isfinite([lo_v, hi_v])) or math.isnan(total):
         total = math.inf
-    if not total <= MAX_VOXELS or np.abs(lo_v).max() > limit or np.abs(hi_v).max() > limit:
+    if total <= MAX_VOXELS and (np.abs(lo_v).max() > limit or np.abs(hi_v).max() > limit):
+        # few voxels, but so far from the origin that a grid's 32-bit indices cannot reach them
+        far = float(np.abs(np.concatenate([np.ravel(lo), np.ravel(hi)]).astype(np.float64)).max())
+        raise FishgenError(f"expected a volume within 2^30 voxels of the origin (a grid's indices), "
+                           f"found it {far:.6g} from the origin at voxel size {voxel_size:g}; use "
+                           f"--voxel-size {far / limit * 1.001:.3g} or more, or a cloud nearer the origin",
+                           where)
+    if not total <= MAX_VOXELS:
         least = _least_voxel_size(np.asarray(hi, np.float64) - np.asarray(lo, np.float64))
         found = (f"{total:,.0f}" if total < 1e15 else f"about {total:.2g}" if math.isfinite(total)
                  else "too many to count")

@@ -86,6 +86,16 @@ def test_a_box_of_too_many_voxels_is_refused_naming_a_size_that_fits():
         voxel_box((-100, -100, -100), (100, 100, 100), least * 0.9)
 
 
+def test_a_small_volume_far_from_the_origin_says_the_indices_are_what_it_is_past():
+    """At 4e6 with voxels of 0.0035 the box held 27 million voxels, and the refusal said "at most
+    33,554,432 ... found 27,270,901; use 0.00327", under the limit and smaller than given (QA pass 9)."""
+    with pytest.raises(FishgenError) as refused:
+        voxel_box((4e6 - 0.5, -0.5, -0.5), (4e6 + 0.5, 0.5, 0.5), 0.0035, "cloud.vdb")
+    assert "expected a volume within 2^30 voxels of the origin" in str(refused.value)
+    assert "use --voxel-size 0.00373 or more" in str(refused.value)
+    voxel_box((4e6 - 0.5, -0.5, -0.5), (4e6 + 0.5, 0.5, 0.5), 0.00373)
+
+
 @pytest.mark.parametrize("voxel_size,found", [(1e-300, "too many to count"), (1e-10, "about 8e+36")])
 def test_a_voxel_too_small_to_count_is_refused_without_a_numpy_warning(voxel_size, found):
     """At 1e-300 the box's product overflowed, and numpy's RuntimeWarning reached stderr."""
