@@ -24,8 +24,9 @@ from fishgen.commands import MODULES, command
 # command spent more time in those faults than in its own work (docs/decisions.md). fishgen runs
 # through its big arrays in order, where huge pages gain little, so the command turns them off
 # before numpy is first imported; NUMPY_MADVISE_HUGEPAGE=1 in the environment turns them back on.
-# numpy itself stops with a traceback on a value that is not a whole number (empty, "yes").
-if not os.environ.get("NUMPY_MADVISE_HUGEPAGE", "").strip().isdigit():
+try:    # unset, or a value numpy's int() cannot read (empty, "yes": a traceback at its import)
+    int(os.environ.get("NUMPY_MADVISE_HUGEPAGE", ""))
+except ValueError:
     os.environ["NUMPY_MADVISE_HUGEPAGE"] = "0"
 
 

@@ -586,7 +586,9 @@ def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None
 
     per_level = sum(_each(pool, levels, _halves(spans)))   # whole numbers: any order is exact
     before = np.cumsum(per_level) - per_level                # particles on nearer levels
-    slab_of_level = (before * slabs) // n                     # the slab each level begins in
+    # the slab each level begins in; empty levels past the last particle would count as slab
+    # `slabs` (all at one depth: one level), which no slab's count has
+    slab_of_level = np.minimum((before * slabs) // n, slabs - 1)
     table = slab_of_level.astype(np.uint8 if slabs <= 256 else np.uint16)
     # each slab's first particle (counted over all) and count, then each level's share of its slab
     # nearer the sun: the particles of the slab's nearer levels and half its own level's

@@ -59,23 +59,32 @@ def voxel_box(lo, hi, voxel_size: float, where=None) -> tuple[np.ndarray, np.nda
     limit = 2.0 ** 30
     if not np.all(np.isfinite([lo_v, hi_v])) or math.isnan(total):
         total = math.inf
+    far = float(np.abs(np.concatenate([np.ravel(lo), np.ravel(hi)]).astype(np.float64)).max())
+    reach = far / limit * 1.001           # the least voxel whose indices reach the farthest corner
     if total <= MAX_VOXELS and (np.abs(lo_v).max() > limit or np.abs(hi_v).max() > limit):
         # few voxels, but so far from the origin that a grid's 32-bit indices cannot reach them
-        far = float(np.abs(np.concatenate([np.ravel(lo), np.ravel(hi)]).astype(np.float64)).max())
         raise FishgenError(f"expected a volume within 2^30 voxels of the origin (a grid's indices), "
                            f"found it {far:.6g} from the origin at voxel size {voxel_size:g}; use "
-                           f"--voxel-size {far / limit * 1.001:.3g} or more, or a cloud nearer the origin",
+                           f"--voxel-size {_rounded_up(reach)} or more, or a cloud nearer the origin",
                            where)
     if not total <= MAX_VOXELS:
-        least = _least_voxel_size(np.asarray(hi, np.float64) - np.asarray(lo, np.float64))
+        least = max(_least_voxel_size(np.asarray(hi, np.float64) - np.asarray(lo, np.float64)), reach)
         found = (f"{total:,.0f}" if total < 1e15 else f"about {total:.2g}" if math.isfinite(total)
                  else "too many to count")
         raise FishgenError(f"expected at most {MAX_VOXELS:,} voxels in the volume's bounding box, found "
-                           f"{found} at voxel size {voxel_size:g}; use --voxel-size {least:.3g} or more",
-                           where)
+                           f"{found} at voxel size {voxel_size:g}; use --voxel-size {_rounded_up(least)} "
+                           "or more", where)
     first = (np.floor_divide(lo_v, LEAF) * LEAF).astype(np.int64)
     last = ((np.floor_divide(hi_v, LEAF) + 1) * LEAF).astype(np.int64)
     return first, last
+
+
+def _rounded_up(size: float) -> str:
+    """``size`` to three significant figures, rounded up: a suggested voxel size that is met."""
+    if not (math.isfinite(size) and size > 0):
+        return f"{size:.3g}"
+    step = 10.0 ** (math.floor(math.log10(size)) - 2)
+    return f"{math.ceil(size / step * (1 - 1e-12)) * step:.3g}"
 
 
 def _least_voxel_size(sides: np.ndarray) -> float:

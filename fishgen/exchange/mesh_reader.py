@@ -418,9 +418,14 @@ def _points(vertices, metadata: dict, path: Path) -> Primitive:
             rgb8[:, j] = columns[k]
         attributes["COLOR_0"] = srgb8_to_linear16()[rgb8]
     elif all(k in columns for k in rgb_names):
+        kinds = {columns[k].dtype for k in rgb_names}
         rgb = np.stack([columns[k] for k in rgb_names], 1).astype(np.float32)
+        if all(kind.kind in "ui" for kind in kinds):     # whole numbers: of their type's full range
+            scale = float(max(np.iinfo(kind).max for kind in kinds))
+        else:                                             # floats: 0 to 1, or 0 to 255 as some write
+            scale = 255.0 if rgb.max() > 1 else 1.0
         rgba = np.ones((len(positions), 4), np.float32)
-        rgba[:, :3] = srgb_to_linear(rgb / (255.0 if rgb.max() > 1 else 1.0))
+        rgba[:, :3] = srgb_to_linear(np.clip(rgb / scale, 0, 1))
         attributes["COLOR_0"] = rgba
     if "density" in columns:
         attributes["_DENSITY"] = np.clip(columns["density"].astype(np.float32), 0, 1)

@@ -33,11 +33,12 @@ def test_the_command_turns_numpys_huge_pages_off():
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="numpy asks for huge pages on Linux only")
-def test_a_users_choice_of_huge_pages_stands():
-    assert _huge_pages("1") == "True"
+@pytest.mark.parametrize("value", ["1", "-1", "+1"])
+def test_a_users_choice_of_huge_pages_stands(value):
+    assert _huge_pages(value) == "True"       # numpy reads any whole number but 0 as on
 
 
-@pytest.mark.parametrize("value", ["", "yes"])
+@pytest.mark.parametrize("value", ["", "yes", "\u00b2"])
 def test_a_setting_numpy_cannot_read_is_not_a_traceback(value):
     # numpy raised ValueError at its import, before any of fishgen's error handling
     assert _huge_pages(value) == "False"

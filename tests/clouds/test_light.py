@@ -250,6 +250,15 @@ def test_a_dense_big_clouds_sunlit_face_is_lit():
     assert light[nearest].max() > 0.9 and light[nearest].min() > 0.1
 
 
+@pytest.mark.parametrize("n,slabs", [(1, 1), (1, 16), (3000, None)])
+def test_particles_all_at_one_depth_go_through_the_slabs(n, slabs):
+    """All at one depth make one depth level, and the empty levels past it counted as a slab that
+    none is: an IndexError (a one-particle cloud in `fishgen sky`, which lights in 16 slabs)."""
+    light = incident_light(np.zeros((n, 3), np.float32), np.full(n, 0.5, np.float32),
+                           np.ones(n, np.float32), Lighting(), slabs=slabs)
+    assert light.shape == (n,) and np.isfinite(light).all() and (light > 0).all()
+
+
 def test_same_bytes_whatever_the_thread_count(monkeypatch):
     cubes = load_cubes(TABLES["4.4"])
     big = fill_cloud(cubes.__class__(cubes.path, 200_000, tuple(
@@ -327,9 +336,10 @@ def test_unlit_files_stay_as_they_were(tmp_path):
 
 @pytest.mark.parametrize("kwargs", [{"extinction": 110}, {"anisotropy": 0.5}, {"solid_angle": 1.0},
                                     {"extinction": 1000, "albedo": 0.5}])
-def test_no_lighting_in_range_lets_all_the_light_through(kwargs):
+def test_a_particle_passes_on_at_most_what_it_scatters(kwargs):
     """Past SkyWorks' forward share of 1 (extinction 104 with the defaults) every particle passed
-    all the light on: a cloud of one flat white. A particle passes on at most what it scatters."""
+    all the light on: a cloud of one flat white. The share is capped at the albedo, so only an
+    albedo of 1 (nothing absorbed) with a share that reaches it still lets all the light through."""
     lighting = Lighting(**kwargs)
     assert lighting.forward_fraction <= lighting.albedo
     cloud = light_cloud(fill_cloud(load_cubes(TABLES["4.4"]), seed=0), lighting)

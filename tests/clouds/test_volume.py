@@ -96,6 +96,18 @@ def test_a_small_volume_far_from_the_origin_says_the_indices_are_what_it_is_past
     voxel_box((4e6 - 0.5, -0.5, -0.5), (4e6 + 0.5, 0.5, 0.5), 0.00373)
 
 
+@pytest.mark.parametrize("far", [0.0037212 * 2**30, 4e6, 1e9])
+def test_the_voxel_size_a_refusal_suggests_is_taken(far):
+    """Rounded to three figures it could fall under what it had to reach: 0.00372, refused again."""
+    import re
+
+    lo, hi = (far - 0.5, -0.5, -0.5), (far + 0.5, 0.5, 0.5)
+    with pytest.raises(FishgenError) as refused:
+        voxel_box(lo, hi, far / 2**30 * 0.9)
+    suggested = float(re.search(r"--voxel-size ([0-9.e+-]+) or more", str(refused.value)).group(1))
+    voxel_box(lo, hi, suggested)
+
+
 @pytest.mark.parametrize("voxel_size,found", [(1e-300, "too many to count"), (1e-10, "about 8e+36")])
 def test_a_voxel_too_small_to_count_is_refused_without_a_numpy_warning(voxel_size, found):
     """At 1e-300 the box's product overflowed, and numpy's RuntimeWarning reached stderr."""

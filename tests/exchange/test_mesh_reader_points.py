@@ -38,3 +38,19 @@ def test_colour_bytes_of_at_most_one_are_bytes_not_fractions(tmp_path):
     assert colour.dtype == np.uint16
     np.testing.assert_array_equal(colour[:, 0], srgb8_to_linear16()[[0, 1, 1]])
     assert colour.max() < 100                      # sRGB 1 of 255 is nearly black in linear light
+
+
+def test_colours_of_16_bits_span_their_range(tmp_path):
+    """ushort 65535 was divided by 255 and came out 534,881 times full light (review, 2026-12-05)."""
+    path = tmp_path / "wide.ply"
+    rows = np.zeros(2, [("x", "<f4"), ("y", "<f4"), ("z", "<f4"),
+                        ("red", "<u2"), ("green", "<u2"), ("blue", "<u2")])
+    rows["red"] = [65535, 0]
+    rows["green"] = [32768, 0]
+    header = ("ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+              "property float z\nproperty ushort red\nproperty ushort green\nproperty ushort blue\n"
+              "end_header\n")
+    path.write_bytes(header.encode("ascii") + rows.tobytes())
+    colour = read_mesh_file(path).meshes[0].primitives[0].attributes["COLOR_0"]
+    np.testing.assert_allclose(colour[0, :3], [1.0, 0.2140, 0.0], atol=1e-3)   # sRGB 0.5: linear 0.214
+    np.testing.assert_array_equal(colour[1, :3], 0)
