@@ -267,6 +267,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         faint = faint_edges(photo, sil.mask)
     chosen = _candidate(photo, sil.mask, base, out, options, imported, textures, level_by=given)
     shown: tuple[np.ndarray, float] | None = None   # the chosen fish rendered, and its IoU
+    target_faint = None   # the faint edges the fit took as fish (over a backdrop)
     fitted, problems, fit = False, [], None
     step = progress if progress is not None and options.fit_shape else (lambda _n: None)
     if options.fit_shape:
@@ -280,6 +281,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         # without them was 0.85 in Blender where the command's own measure said 0.93: the fit
         # takes the faint edges too (an alpha channel keeps the tips; a mask file is the truth).
         target = sil.mask | faint if sil.source == "background model" and faint is not None else sil.mask
+        target_faint = faint if target is not sil.mask else None
         # Told the lens, a fitted fin takes its texture where the render from there shows it
         # (compare.seen_fins), out to the faint edges it was fitted to; a mask texture cut from the
         # bare silhouette is transparent there and trims the tip (703 on BonyBream in Blender: 0.885
@@ -347,9 +349,18 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         from fishgen.authoring.photo.compare import HALF_ALPHA, silhouette_iou
 
         faded = silhouette_iou(chosen.measured.frame_mask, shown[0][:, :, 3] >= HALF_ALPHA)
+    # Fitted to the silhouette with its faint edges, the rebuilt fish is measured against them too;
+    # against the bare silhouette it may score less (the faint pixels may not be fish), and counted
+    # at half coverage less again. Each doubt alone is said when it alone falls under the line; both
+    # at once take their losses together (605 in Blender, a grey-blue fish over grey-blue water: 0.894
+    # by its own figure, 0.857 bare, 0.874 at half coverage, 0.840 in Blender).
+    doubt = None    # (IoU with both doubts taken, the bare silhouette's, at half coverage)
+    if shown is not None and faded is not None and fitted and target_faint is not None:
+        bare = _iou_with(chosen, sil.mask, shown[0])
+        doubt = (faded + bare - shown[1], bare, faded)
     apart = None    # (share, IoU): the rebuilt fish seen from another distance, the worse of two
     if shown is not None and distance is not None and faded is not None \
-            and faded >= ADVICE_IOU + RENDERERS_DIFFER:
+            and faded >= ADVICE_IOU + RENDERERS_DIFFER and (doubt is None or doubt[0] >= ADVICE_IOU):
         apart = min(((k, _rendered(photo, chosen, out, distance * (1 + k))[1])
                      for k in (-DISTANCE_UNSURE, DISTANCE_UNSURE)), key=lambda v: v[1])
     step(1)    # the bar's last step: the rebuilt fish measured (the slowest render of a fit)
@@ -363,6 +374,11 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         note(f"silhouette IoU {shown[1]:.3f}, but {faded:.{4 if near else 3}f} counting only the pixels the "
              f"rebuilt fish covers at least half (thin or translucent fin parts fade out there){margin}: it "
              "may look unlike the photographed fish in another renderer; see --compare")
+    elif shown is not None and doubt is not None and doubt[0] < ADVICE_IOU:
+        note(f"silhouette IoU {shown[1]:.3f}, but {doubt[1]:.3f} without the faint pixels round the photo's "
+             f"outline and {doubt[2]:.3f} counting only the pixels the rebuilt fish covers at least half, "
+             f"{doubt[0]:.3f} with both (a fish near the backdrop's colour): the rebuilt fish may be unlike "
+             "the photographed one; give --mask to be sure")
     elif shown is not None and apart is not None and apart[1] < ADVICE_IOU:
         note(f"silhouette IoU {shown[1]:.3f}, but {apart[1]:.3f} seen from {abs(apart[0]):.0%} "
              f"{'nearer' if apart[0] < 0 else 'farther'} (the camera's distance is estimated from the "
