@@ -165,10 +165,7 @@ def _local_contrast(img: np.ndarray, fish: np.ndarray) -> tuple[np.ndarray, np.n
     known = away & ((distance < 3.0) | _swirls(img, fish, away))
     if not known.any():
         return None
-    weight = ndimage.gaussian_filter(known.astype(np.float32), LOCAL_SIGMA)
-    local = np.stack([ndimage.gaussian_filter(img[..., i] * known, LOCAL_SIGMA) for i in range(3)], axis=-1)
-    diff = img - local / np.maximum(weight, 1e-6)[..., None]
-    contrast = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+    contrast, weight = _off_smoothed(img, known, LOCAL_SIGMA)
     # the spread is the backdrop's near the fish: JPEG rings round an outline, a flat frame does not
     band = known & ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=NEAR_BAND)
     near = band if band.sum() >= 50 else known
@@ -188,12 +185,18 @@ def _swirls(img: np.ndarray, fish: np.ndarray, away: np.ndarray) -> np.ndarray:
     clear = ~ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=SWIRL_CLEAR)
     if not clear.any():
         return clear
-    weight = ndimage.gaussian_filter(clear.astype(np.float32), SWIRL_SIGMA)
-    smooth = np.stack([ndimage.gaussian_filter(img[..., i] * clear, SWIRL_SIGMA) for i in range(3)], axis=-1)
-    diff = img - smooth / np.maximum(weight, 1e-6)[..., None]
-    off = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff))
+    off, weight = _off_smoothed(img, clear, SWIRL_SIGMA)
     spread = float(np.median(off[clear])) * 1.4826 + 0.5
     return away & (off < SWIRL_SIGMAS * spread) & (weight > 0.02)
+
+
+def _off_smoothed(img: np.ndarray, known: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """(distance, weight): each pixel's colour distance (0-255 units) from the ``known`` pixels
+    spread over ``sigma`` px by a normalised Gaussian, and how much known backdrop is near it."""
+    weight = ndimage.gaussian_filter(known.astype(np.float32), sigma)
+    local = np.stack([ndimage.gaussian_filter(img[..., i] * known, sigma) for i in range(3)], axis=-1)
+    diff = img - local / np.maximum(weight, 1e-6)[..., None]
+    return np.sqrt(np.einsum("ijk,ijk->ij", diff, diff)), weight
 
 
 def _off_backdrop(img: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
