@@ -400,15 +400,15 @@ def _read_chunk(grid: _Grid, place, own: np.ndarray, nearer: np.ndarray, before:
     flat += number
     near += number
     got = _bilinear(before.ravel(), flat, fx, fy, grid.shape[1])
-    half = np.take(depths.ravel(), near)
-    half -= own[start:stop] if pick is None else own[start:stop][pick]          # less its own
-    np.maximum(half, 0, out=half)
+    ahead = np.take(depths.ravel(), near)           # its own slab's depth nearer the sun
+    ahead -= own[start:stop] if pick is None else own[start:stop][pick]          # less its own
+    np.maximum(ahead, 0, out=ahead)
     share = (nearer[start:stop] if pick is None else nearer[start:stop][pick]).astype(_F32)
     share *= _F32(1 / SHARE_LEVELS)
-    half *= share
-    got += half
+    ahead *= share
+    got += ahead
     np.maximum(got, 0, out=got)
-    got = _light_into(got, half)
+    got = _light_into(got, ahead)
     if pick is None:
         light[start:stop] = got
     else:
