@@ -78,6 +78,26 @@ BLUR_SLABS = 8
 """Slabs blurred in one FFT call."""
 MAP_VALUES = 1 << 23
 """Most map values (slabs x classes x cells) held at once; a finer grid goes in groups of slabs."""
+LEAD = 0.35
+"""Just past SMALL particles the slabs read a particle's light this many of its sigmas nearer the
+sun than its centre; the lead fades out over LEAD_OCTAVES doublings of the particle count.
+
+The pairs take the light at the face (FRONT sigma ahead), shaded by each neighbour's smooth
+Phi; the slabs count a neighbour ahead or not (a step). Read at the centre, the slabs gave the
+shipped tables at 2,049 particles 0.50-0.70 of the pairs' mean light at 2,048 (a cloud dimmed
+by half for one particle more); read at the face, 1.5-3.1x. At 0.35 sigma they give 0.85-1.1x
+there (random cube files: 0.80-1.03x). A lead kept on big dense clouds takes their light's
+rank against the optical depth at the centre down to 0.75 (seed 201), so it fades out."""
+LEAD_OCTAVES = 3
+
+
+def slab_lead(n: int) -> float:
+    """How many sigmas nearer the sun than its centre a cloud of ``n`` particles (lit through
+    slabs) reads a particle's light: LEAD at SMALL, 0 from SMALL x 2^LEAD_OCTAVES."""
+    octaves = math.log2(max(n, 1) / max(SMALL, 1))
+    return LEAD * min(1.0, max(0.0, 1.0 - octaves / LEAD_OCTAVES))
+
+
 KEY_LEVELS = 65535
 CHUNK = 1 << 16
 PEAK_LEVELS = 16384
@@ -255,7 +275,8 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     the light before its slab passed through that share of the slab's depth at its centre, less
     its own: the share of the slab's particles nearer the sun than it (``_slab_numbers``). Half
     of it for every particle, as before, left a dense cloud's sunlit face in the shade of half
-    the first slab: exactly 0 light where the pairs gave up to 0.57.
+    the first slab: exactly 0 light where the pairs gave up to 0.57. Just past SMALL particles
+    that point is ``slab_lead`` sigmas nearer the sun than the centre, in whichever slab it lies.
 
     Nothing here visits the particles in depth order (on a big cloud, reading memory out of
     order cost more than all the arithmetic). Three passes in memory order, each chunk on
@@ -271,7 +292,9 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     with ThreadPoolExecutor(WORKERS) as pool:
         depth, a, b = np.empty(n, _F32), np.empty(n, _F32), np.empty(n, _F32)
         ends = _project(centers, frame, middle, out=(depth, a, b), pool=pool)
-        slab, nearer = _slab_numbers(depth, slabs, pool, ends[0])
+        lead = slab_lead(n)
+        slab, face, nearer = _slab_numbers(depth, slabs, pool, ends[0],
+                                           lead=(radii, _F32(lead * SIGMA)) if lead > 0 else None)
         grid = _Grid(ends[1:, 0].astype(np.float64), ends[1:, 1].astype(np.float64), radii,
                      most=grid_cells)
         cells = grid.shape[0] * grid.shape[1]
@@ -302,7 +325,8 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
             for k in range(last - first):
                 before[k] = reached
                 reached += depths[k]
-            read = functools.partial(_read_chunk, grid, place, own, nearer, before, depths, light)
+            read = functools.partial(_read_chunk, grid, place, own, face, nearer, before, depths, light,
+                                     first)
             list(pool.map(read, spans))
     return light
 
@@ -390,21 +414,34 @@ def _splat_share(grid: _Grid, place, radii, density, table, size: int, own: np.n
     return total
 
 
-def _read_chunk(grid: _Grid, place, own: np.ndarray, nearer: np.ndarray, before: np.ndarray,
-                depths: np.ndarray, light: np.ndarray, span: tuple[int, int]) -> None:
-    """Each particle's light: behind the depth before its slab, at its centre, and the share of
-    what the rest of its own slab holds there that lies nearer the sun (``nearer``, in SHARE_LEVELS)."""
+def _read_chunk(grid: _Grid, place, own: np.ndarray, face: np.ndarray, nearer: np.ndarray,
+                before: np.ndarray, depths: np.ndarray, light: np.ndarray, first: int,
+                span: tuple[int, int]) -> None:
+    """Each particle's light at its sunward face (FRONT sigma nearer the sun than its centre, as
+    the pairs take it): behind the depth before the face's slab (``face``), at its centre's cell,
+    and the share of what that slab holds there nearer the sun than the face (``nearer``, in
+    SHARE_LEVELS), less its own footprint when the face lies in its own slab. A face in a slab
+    of an earlier group (a sky's fine grid) is read at its group's first slab."""
     pick, number, (flat, fx, fy), near = place(span)
     start, stop = span
-    number *= np.int32(grid.shape[0] * grid.shape[1])
-    flat += number
-    near += number
-    got = _bilinear(before.ravel(), flat, fx, fy, grid.shape[1])
-    ahead = np.take(depths.ravel(), near)           # its own slab's depth nearer the sun
-    ahead -= own[start:stop] if pick is None else own[start:stop][pick]          # less its own
-    np.maximum(ahead, 0, out=ahead)
+    at = (face[start:stop] if pick is None else face[start:stop][pick]).astype(np.int32)
+    if first:
+        at -= np.int32(first)
     share = (nearer[start:stop] if pick is None else nearer[start:stop][pick]).astype(_F32)
     share *= _F32(1 / SHARE_LEVELS)
+    if first:
+        earlier = at < 0
+        at[earlier] = 0
+        share[earlier] = 0
+    mine = own[start:stop] if pick is None else own[start:stop][pick]
+    mine = np.where(at == number, mine, _F32(0))        # its own footprint is in its own slab only
+    at *= np.int32(grid.shape[0] * grid.shape[1])
+    flat += at
+    near += at
+    got = _bilinear(before.ravel(), flat, fx, fy, grid.shape[1])
+    ahead = np.take(depths.ravel(), near)           # the face's slab's depth at its cell
+    ahead -= mine                                   # less its own
+    np.maximum(ahead, 0, out=ahead)
     ahead *= share
     got += ahead
     np.maximum(got, 0, out=got)
@@ -555,14 +592,16 @@ def _each(pool: ThreadPoolExecutor | None, work, spans: list) -> list:
 
 
 def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None = None,
-                  ends: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Each particle's slab, 0 nearest the sun (uint8, or uint16 for more than 256 slabs), and
-    the share of its slab's particles nearer the sun than it, in SHARE_LEVELS (uint16; its own
-    level's count half).
+                  ends: np.ndarray | None = None, lead: tuple[np.ndarray, np.float32] | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each particle's slab, 0 nearest the sun (uint8, or uint16 for more than 256 slabs); the
+    slab its light is read in (the same type); and the share of that slab's particles nearer the
+    sun than where it is read, in SHARE_LEVELS (uint16; the level's own count half).
 
-    The depth is cut into KEY_LEVELS + 1 levels and the levels into ``slabs`` runs of about
-    equal count; a level is never split, so a slab may hold more or fewer, or none. ``ends``:
-    the depth's (least, greatest), when known.
+    The light is read at the centre, or with ``lead`` (radii, factor) that factor x the radius
+    nearer the sun, in the slab found there. The depth is cut into KEY_LEVELS + 1 levels and the
+    levels into ``slabs`` runs of about equal count; a level is never split, so a slab may hold
+    more or fewer, or none. ``ends``: the depth's (least, greatest), when known.
     """
     n = len(depth)
     spans = _spans(n, CHUNK)
@@ -573,11 +612,18 @@ def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None
     span = top - bottom
     scale = _F32(KEY_LEVELS / span) if span > 0 else _F32(0)
     key = np.empty(n, np.uint16)
+    read = np.empty(n, np.uint16) if lead is not None else key
 
     def levels(share: list[tuple[int, int]]) -> np.ndarray:
         count = np.zeros(KEY_LEVELS + 1, np.int64)
         for start, stop in share:
             part = (_F32(top) - depth[start:stop]) * scale
+            if lead is not None:
+                ahead = lead[0][start:stop] * (lead[1] * scale)
+                ahead = np.subtract(part, ahead, out=ahead)
+                np.clip(ahead, 0, KEY_LEVELS, out=ahead)
+                ahead += _F32(0.5)
+                read[start:stop] = ahead
             np.clip(part, 0, KEY_LEVELS, out=part)
             part += _F32(0.5)
             key[start:stop] = part
@@ -599,14 +645,17 @@ def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None
         fraction = (before - first[slab_of_level] + per_level / 2) / in_slab
     shares = np.rint(np.nan_to_num(fraction, nan=0.5).clip(0, 1) * SHARE_LEVELS).astype(np.uint16)
     slab = np.empty(n, table.dtype)
+    face = np.empty(n, table.dtype) if lead is not None else slab
     nearer = np.empty(n, np.uint16)
 
     def number(span: tuple[int, int]) -> None:
         np.take(table, key[span[0]:span[1]], out=slab[span[0]:span[1]])
-        np.take(shares, key[span[0]:span[1]], out=nearer[span[0]:span[1]])
+        if lead is not None:
+            np.take(table, read[span[0]:span[1]], out=face[span[0]:span[1]])
+        np.take(shares, read[span[0]:span[1]], out=nearer[span[0]:span[1]])
 
     _each(pool, number, spans)
-    return slab, nearer
+    return slab, face, nearer
 
 
 class _Grid:

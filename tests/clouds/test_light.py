@@ -402,3 +402,30 @@ def test_lighting_warns_about_nothing():
         for sun in SUNS.values():
             light_cloud(cloud, Lighting(sun=sun, extinction=0.0))
             light_cloud(cloud, Lighting(sun=sun))
+
+
+def _scaled(cube_file, n):
+    """``cube_file``'s cubes with their counts scaled to a total of ``n``."""
+    from fishgen.clouds import Cube, CubeFile
+
+    total = sum(c.particles for c in cube_file.cubes)
+    counts = [c.particles * n // total for c in cube_file.cubes]
+    counts[0] += n - sum(counts)
+    return CubeFile(cube_file.path, n, tuple(Cube(k, c.size, c.centre, c.max_radius, c.line)
+                                             for k, c in zip(counts, cube_file.cubes, strict=True)))
+
+
+@pytest.mark.parametrize("table", ["4.2", "4.3", "4.4"])
+def test_one_particle_more_does_not_dim_the_cloud(table):
+    """At 2,049 particles the light goes from pairs to slabs: the cloud's mean light stays within
+    20 % of its 2,048-particle self (read at the centre, the slabs gave half)."""
+    cubes = load_cubes(TABLES[table])
+    pairs, slabs = (light_cloud(fill_cloud(_scaled(cubes, n), seed=0)).light.mean() for n in (2048, 2049))
+    assert 0.8 < slabs / pairs < 1.25
+
+
+def test_the_slabs_lead_fades_out():
+    assert light_module.slab_lead(light_module.SMALL + 1) == pytest.approx(light_module.LEAD, rel=1e-3)
+    assert light_module.slab_lead(2 * light_module.SMALL) < light_module.LEAD
+    assert light_module.slab_lead(light_module.SMALL << light_module.LEAD_OCTAVES) == 0
+    assert light_module.slab_lead(10**7) == 0
