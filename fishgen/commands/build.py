@@ -101,8 +101,9 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
         for source, target in zip(inputs, outputs, strict=True):
             with each_input(events, errors, len(inputs) > 1):
                 species = load_species(source, options.textures)
-                check_targets([target], species.side_files)  # its textures are inputs, and the side files'
                 fish = fish_of(species, options)
+                # its textures are inputs, and the side files' of the images the fish holds
+                check_targets([target], species.side_files, [image.name for image in fish.scene.images])
                 with protecting(species.side_files):
                     files = export(fish.scene, target, require=[MESHES])
                 read += [source, *species.side_files]

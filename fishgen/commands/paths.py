@@ -99,29 +99,38 @@ def targets(inputs: Sequence[Path], given: str | os.PathLike | None, *, fmt: str
     return [folder / name for name in made]
 
 
-def check_targets(outputs: Iterable[str | os.PathLike | None], inputs: Iterable[str | os.PathLike]) -> None:
+def check_targets(outputs: Iterable[str | os.PathLike | None], inputs: Iterable[str | os.PathLike],
+                  images: Sequence[str] | None = None) -> None:
     """Every output may be written: a missing or regular file, none of the command's inputs, none
     of the side files its format writes beside it an input either (a glTF's ``NAME_skin.png`` over a
     species' texture), and no two outputs one file (checked before any work; the writers check
-    again, see :func:`fishgen.atomic.protecting`)."""
+    again, see :func:`fishgen.atomic.protecting`). ``images``: the names of the images the scene
+    will hold, when known, so only their side files count (else any ``NAME_*.png`` does)."""
     targets = [Path(t) for t in outputs if t is not None]
     read = [Path(p) for p in inputs]
     with protecting(read):
         for target in targets:
             check_target(target)
-    check_beside(targets, read)
+    check_beside(targets, read, images)
     check_apart(targets)
 
 
-def check_beside(outputs: Iterable[Path], inputs: Iterable[Path]) -> None:
-    """No input is a file that writing one of ``outputs`` may make beside it (its side files)."""
-    from fishgen.exchange.registry import written_names
+def check_beside(outputs: Iterable[Path], inputs: Iterable[Path],
+                 images: Sequence[str] | None = None) -> None:
+    """No input is a file that writing one of ``outputs`` may make beside it (its side files; with
+    ``images``, an image's side file only for the images named)."""
+    from fishgen.exchange.registry import Written, written_names
+    from fishgen.exchange.sidefiles import image_stem
 
     folders: dict[Path, list[Path]] = {}
     for path in inputs:
         folders.setdefault(Path(os.path.abspath(path)).parent.resolve(), []).append(path)
     for target in outputs:
         sides = written_names(target)[1:]
+        if images is not None:  # fish7.glb of a fish with a skin writes fish7_skin.png, not fish7_mask.png
+            sides = tuple(w for side in sides for w in (
+                [side] if side.after is None else
+                [Written(side.before + image_stem(name) + side.after) for name in images]))
         for path in folders.get(Path(os.path.abspath(target)).parent.resolve(), ()) if sides else ():
             side = next((s for s in sides if s.matches(path.name)), None)
             if side is not None:

@@ -220,6 +220,19 @@ def test_an_output_whose_side_files_are_the_species_textures_is_refused(tmp_path
     assert {p: p.read_bytes() for p in inputs} == inputs
 
 
+@pytest.mark.parametrize("output", ["o.gltf", "o.obj", "o.ply"])
+def test_an_output_beside_its_species_own_textures_is_built(tmp_path, output):
+    """`fishgen species -o o.txt` writes o.png and o_mask.png; `build o.txt -o o.ply` writes only
+    o_skin.png beside it, yet was refused because o_mask.png matched o_*.png (QA pass 10)."""
+    from tests.conftest import species_textured_as
+
+    inputs = species_textured_as(tmp_path, "o.png", "o_mask.png")
+    result = run_cli("build", "bonybream.txt", "-o", output, cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "o_skin.png").is_file()
+    assert {p: p.read_bytes() for p in inputs} == inputs
+
+
 def test_a_texture_past_pillows_own_limit_is_one_line(tmp_path):
     from tests.species.test_parser import png_header
 
