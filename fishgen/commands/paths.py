@@ -130,7 +130,7 @@ def check_beside(outputs: Iterable[Path], inputs: Iterable[Path],
         if images is not None:  # fish7.glb of a fish with a skin writes fish7_skin.png, not fish7_mask.png
             sides = tuple(w for side in sides for w in (
                 [side] if side.after is None else
-                [Written(side.before + image_stem(name) + side.after) for name in images]))
+                [Written(side.before + image_stem(name), side.after) for name in images]))  # NAME_skin*.png
         for path in folders.get(Path(os.path.abspath(target)).parent.resolve(), ()) if sides else ():
             side = next((s for s in sides if s.matches(path.name)), None)
             if side is not None:

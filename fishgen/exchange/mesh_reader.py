@@ -25,7 +25,7 @@ from trimesh.resolvers import Resolver
 
 from fishgen.errors import FishgenError, describe, expected
 from fishgen.exchange.guards import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, check_picture, size_text, what_was_found
-from fishgen.exchange.sidefiles import side_file
+from fishgen.exchange.sidefiles import map_file_name, mtl_libraries, side_file
 from fishgen.numeric import srgb8_to_linear16, srgb_to_linear
 from fishgen.scene.model import Image, Material, Mesh, Node, Primitive, Scene
 
@@ -187,9 +187,7 @@ def _mtl_libraries(obj: Path, text: str) -> list[Path]:
     out = []
     for match in re.finditer(r"^[ \t]*mtllib[ \t]+(.+?)[ \t]*\r?$", text, re.M):
         lib = match[1]
-        whole = side_file(obj, lib)
-        names = [lib] if whole.is_file() else lib.split()
-        for name in names:
+        for name in mtl_libraries(obj, lib):
             mtl = side_file(obj, name)
             if not mtl.is_file():
                 raise FishgenError(f"expected the material library {name!r} the OBJ names, in its folder, "
@@ -214,10 +212,10 @@ def _mtl_alpha(obj: Path, text: str) -> dict[str, tuple[str, float]]:
                 continue
             key = words[0].lower()
             if key in _MAP_KEYS and len(words) > 1:
-                # options such as "-imfchan m" come before the file name
-                image = side_file(obj, words[-1])
+                named = map_file_name(obj, line.strip()[len(words[0]):])
+                image = side_file(obj, named)
                 if not image.is_file():
-                    raise FishgenError(f"expected the texture {words[-1]!r} the MTL names, in the OBJ's "
+                    raise FishgenError(f"expected the texture {named!r} the MTL names, in the OBJ's "
                                        "folder, found none", mtl, number)
                 _stat(image, MAX_SIDE_BYTES, "a texture file", obj)
                 if key == "map_kd":  # the one texture decoded: refuse a huge or damaged one now

@@ -57,6 +57,28 @@ def side_file(asset: str | Path, ref: str, *, uri: bool = False, must_exist: boo
     return target
 
 
+def _there(asset: Path, ref: str) -> bool:
+    try:
+        return side_file(asset, ref).is_file()
+    except Exception:  # noqa: BLE001 - a name leading out of the folder is judged by the caller's try
+        return False
+
+
+def mtl_libraries(asset: str | Path, rest: str) -> list[str]:
+    """The MTL names one ``mtllib`` statement gives (``rest``: the text after the keyword): the
+    whole of it when such a file is beside ``asset`` (``my fish.mtl``), else each word."""
+    rest = rest.strip()
+    return [rest] if _there(Path(asset), rest) else rest.split()
+
+
+def map_file_name(asset: str | Path, rest: str) -> str:
+    """The picture a texture map statement names (``rest``: the text after ``map_Kd`` and the
+    like): the whole of it when such a file is beside ``asset``, as trimesh and three.js read it
+    (``my fish_skin.png``), else its last word (options such as ``-imfchan m`` come first)."""
+    rest = rest.strip()
+    return rest if _there(Path(asset), rest) else rest.split()[-1]
+
+
 _IMAGE_SUFFIX = re.compile(r"\.(png|jpe?g|gif|webp)$", re.IGNORECASE)
 
 

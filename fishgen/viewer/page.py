@@ -15,7 +15,7 @@ from urllib.parse import unquote
 
 from fishgen.errors import FishgenError
 from fishgen.exchange.registry import FORMATS, formats
-from fishgen.exchange.sidefiles import side_file
+from fishgen.exchange.sidefiles import map_file_name, mtl_libraries, side_file
 from fishgen.web.page import page_html
 
 KINDS = {ext: fmt.name for fmt in formats(viewer=True) for ext in fmt.extensions}
@@ -60,13 +60,13 @@ def sidecars(asset: Path) -> tuple[dict[str, Path], str | None]:
     elif ext == ".obj":
         text = asset.read_text(encoding="utf-8", errors="replace")
         for line in re.findall(r"^\s*mtllib\s+(.+?)\s*$", text, re.M):
-            for lib in line.split():  # one mtllib statement may name several files
+            for lib in mtl_libraries(asset, line):  # one mtllib statement may name several files
                 mtl = add(lib)
                 if mtl is None:
                     continue
                 mtl_name = mtl_name or lib
                 for ref in _MTL_MAPS.findall(mtl.read_text(encoding="utf-8", errors="replace")):
-                    add(ref.split()[-1])  # options such as "-imfchan m" come before the file name
+                    add(map_file_name(mtl, ref))
     return found, mtl_name
 
 

@@ -83,6 +83,19 @@ def test_inline_subfolder_and_percent_encoded_references_are_embedded(nest):
     assert base64.b64decode(files["data/my skin.bin"]) == b"\x01"
 
 
+def test_an_obj_named_with_a_space_carries_its_mtl_and_texture(tmp_path):
+    """`build -o "my fish.obj"` writes `mtllib my fish.mtl` and `map_Kd my fish_skin.png`, which
+    trimesh and three.js read whole; the page took each word for a file (QA pass 10)."""
+    from fishgen.exchange.mesh_reader import read_mesh_file
+
+    obj = tmp_path / "my fish.obj"
+    assert run_cli("build", ROOT / "params" / "bonybream.txt", "-o", obj).returncode == 0
+    files = _payload(build_page(obj))["files"]
+    assert set(files) == {"my fish.obj", "my fish.mtl", "my fish_skin.png", "my fish_skin_mask.png"}
+    scene = read_mesh_file(obj)
+    assert scene.images and all(image.rgba().shape[:2] == (256, 512) for image in scene.images)
+
+
 # -- the server ------------------------------------------------------------------
 
 class _Served:
