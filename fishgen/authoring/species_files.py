@@ -97,6 +97,24 @@ def _named_by_another(names: TextureNames) -> None:
             if path.name.casefold() in (name.casefold() for name in _named_textures(owner) or ()):
                 raise UsageError(f"expected textures no other species file names, found {path.name!r}, "
                                  f"named by {owner.name!r} beside it; choose another -o")
+    own_names = _named_textures(Path(own)) if os.path.isfile(own) else None
+    for path in names.paths:
+        # A picture already there that this species file does not name (its rerun) may be
+        # another's under any name: y.txt naming shared.png. Only then is the folder read, and
+        # only species files that mention the name, so a folder of thousands costs nothing on a rerun.
+        if not path.is_file() or (own_names is not None and path.name in own_names):
+            continue
+        for owner in sorted(path.parent.glob("*.txt")):
+            if os.path.abspath(owner) == own or not owner.is_file():
+                continue
+            try:
+                if path.name.encode("utf-8").lower() not in owner.read_bytes().lower():
+                    continue
+            except OSError:
+                continue
+            if path.name.casefold() in (name.casefold() for name in _named_textures(owner) or ()):
+                raise UsageError(f"expected textures no other species file names, found {path.name!r}, "
+                                 f"named by {owner.name!r} beside it; choose another -o")
 
 
 def _named_textures(species_file: Path) -> tuple[str, str] | None:
