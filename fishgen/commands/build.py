@@ -143,6 +143,9 @@ def summary(fish, target: Path, written: list[Path]) -> str:
     if len(facts.levels) > 1 and fmt is not None and fmt.name in ("glb", "gltf"):
         motion += ", levels " + ", ".join(f"{lv.bodies}x{lv.circles} ({lv.triangles}{_lost(lv.missing)})"
                                           for lv in facts.levels)
+    elif facts.levels and facts.levels[0].missing:   # the one level written: `--lods 8x6` too
+        level = facts.levels[0]
+        motion += f", {level.bodies}x{level.circles} ({_lost(level.missing).removeprefix('; ')})"
     if facts.merged:
         motion += f", merged ({facts.draw_calls} draw calls)"
     note = f" ({fmt.extensions[0][1:].upper()} holds no {either(dropped)})" if dropped and fmt else ""

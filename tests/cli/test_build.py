@@ -269,3 +269,16 @@ def test_the_summary_names_the_fins_a_coarse_level_drops(tmp_path):
                                    "-o", str(tmp_path / "b.glb")])
     assert ran.exit_code == 0
     assert "levels 32x24 (1518), 16x12 (376), 8x6 (92; no adipose or anal fins)" in ran.output
+
+
+@pytest.mark.parametrize("lods, output", [("8x6", "b.glb"), ("8x6", "b.ply")])
+def test_the_summary_names_the_fins_of_the_one_level_written(tmp_path, lods, output):
+    """`--lods 8x6` alone (or first, to a format of one level) dropped two fins unsaid (QA pass 10)."""
+    from click.testing import CliRunner
+
+    from fishgen.cli import cli
+
+    ran = CliRunner().invoke(cli, ["build", str(PARAMS / "bonybream.txt"), "--lods", lods,
+                                   "-o", str(tmp_path / output)])
+    assert ran.exit_code == 0, ran.output
+    assert "8x6 (no adipose or anal fins)" in ran.output
