@@ -158,6 +158,9 @@ def run(cmd: Command, inputs: tuple[Path, ...], output: str | os.PathLike | None
         from fishgen.commands.paths import names_folder
         from fishgen.errors import UsageError
 
+        if not os.fspath(output):   # Path("") is ".": build and species wrote into the working folder
+            what = "file or folder" if cmd.output.folder else "file"
+            raise UsageError(f"expected -o to name an output {what}, found an empty name")
         folder = names_folder(output)
         if folder and not cmd.output.folder:
             raise UsageError(f"expected -o to name an output file, found the folder {os.fspath(output)!r}")

@@ -179,3 +179,20 @@ def test_a_textures_folder_that_is_not_there_is_a_usage_error(tmp_path, args):
         f"fishgen {args[0]}: expected --textures to name an existing folder, found nothing at "
         f"'{tmp_path / 'typo'}'\n")
     assert not (tmp_path / "x.glb").exists()
+
+
+@pytest.mark.parametrize("args", [
+    ["species", "--random"], ["build", "{fish}"], ["school", "{fish}", "--count", "3", "--frames", "5"],
+    ["clouds", "{cubes}"], ["texture", "{photo}", "-s", "{fish}"],
+])
+def test_an_empty_output_name_is_a_usage_error(tmp_path, args):
+    """`-o ''` is no name: build and species wrote into the working folder, the others said
+    'found the folder' (QA pass 10)."""
+    fill = {"fish": PARAMS / "bonybream.txt", "cubes": PARAMS / "clouds" / "table_4_3.awn",
+            "photo": PARAMS / "photos" / "bonybream-side.png"}
+    filled = [str(fill[a[1:-1]]) if a.startswith("{") else a for a in args]
+    result = run_cli(*filled, "-o", "", cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.startswith(f"fishgen {args[0]}: expected -o to name an output")
+    assert result.stderr.endswith("found an empty name\n") and result.stderr.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
