@@ -32,9 +32,15 @@ const manager = new THREE.LoadingManager();
 manager.setURLModifier( ( url ) => {
 	const at = url.lastIndexOf( FOLDER );
 	if ( at < 0 ) return url;
-	// MTL map options ("-imfchan m skin.png") reach us glued to the name: the file is the last word.
-	const name = decodeURIComponent( url.slice( at + FOLDER.length ) ).trim().split( /\s+/ ).pop().replace( /^\.\//, '' );
-	return blobs[ name ] || blobs[ name.split( '/' ).pop() ] || url;
+	// A name may hold spaces ("my fish_skin.png", as fishgen.exchange.sidefiles reads it); MTL map
+	// options ("-imfchan m skin.png") reach us glued to the name, and then the file is the last word.
+	const whole = decodeURIComponent( url.slice( at + FOLDER.length ) ).trim().replace( /^\.\//, '' );
+	const last = whole.split( /\s+/ ).pop().replace( /^\.\//, '' );
+	for ( const name of [ whole, last ] ) {
+		const found = blobs[ name ] || blobs[ name.split( '/' ).pop() ];
+		if ( found ) return found;
+	}
+	return url;
 } );
 
 const canvas = $( 'view' );

@@ -270,3 +270,24 @@ def test_a_lit_cloud_gets_the_second_pass_and_follows_its_sun(browser, tmp_path,
         finally:
             page.close()
     assert sides[-1] > sides[1] + 0.03
+
+
+def test_an_obj_named_with_spaces_shows_its_texture(browser, tmp_path):
+    """`build -o "my fish.obj"`: the page carries `my fish.mtl` and `my fish_skin.png`, and
+    three.js's loaders, which read a map's whole name, find them in it (QA pass 10)."""
+    from fishgen.viewer.page import write_page
+
+    asset = tmp_path / "my fish.obj"
+    assert run_cli("build", ROOT / "params" / "bonybream.txt", "-o", asset).returncode == 0
+    page, problems, requests = _open(browser, write_page(asset).as_uri())
+    try:
+        assert page.evaluate("window.fishgenViewer.counts.triangles") > 0
+        img = _canvas(page)
+        _assert_not_blank(img)
+        # the skin's colours, not the untextured grey: the subject's pixels vary in hue
+        background = np.median(img.reshape(-1, 3), axis=0)
+        subject = img[np.abs(img - background).max(-1) > 20]
+        assert np.ptp(subject, axis=0).max() > 60
+        assert problems == []
+    finally:
+        page.close()
