@@ -377,3 +377,23 @@ def test_a_level_photo_stays_level_at_any_level_of_detail(tmp_path, cli, bream_p
     coarse = cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "b.txt", option, "3")
     assert plain.returncode == coarse.returncode == 0
     assert "turned" not in plain.stdout and "turned" not in coarse.stdout, coarse.stdout
+
+
+def test_more_body_sections_keep_the_fins_shape(tmp_path, cli, bream_photo):
+    """`--body-sections 96` shrank ThreadfinGoldie's dorsal and anal fins to spikes (IoU 0.882; 0.631
+    at 256): a fin's proportion is per section, and it was copied unchanged (QA pass 10). The
+    levels of detail already converted it."""
+    import re
+
+    from fishgen.species.parser import load_species
+    from tests.authoring.photos import render_photo
+
+    photo = tmp_path / "goldie.png"
+    render_photo(load_species(PARAMS / "threadfingoldie.txt"), SMALL).save(photo)
+    figures = []
+    for sections in ("24", "96"):
+        r = cli("texture", photo, "-s", PARAMS / "threadfingoldie.txt", "-o", tmp_path / f"g{sections}.txt",
+                "--body-sections", sections)
+        assert r.returncode == 0, r.stderr
+        figures.append(float(re.search(r"silhouette IoU of the rebuilt fish: ([0-9.]+)", r.stdout)[1]))
+    assert figures[1] > 0.95 and figures[1] > figures[0] - 0.03, figures

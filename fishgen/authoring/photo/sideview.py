@@ -10,7 +10,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from fishgen.species.model import PectoralFin, PelvicFin, Species, VerticalFin
+from fishgen.species.model import Species
 
 #: Fin names in the species model, with the geometry part that carries them.
 FIN_PARTS = {"caudal": "caudal_fin", "dorsal": "dorsal_fin", "adipose": "adipose_fin",
@@ -104,32 +104,11 @@ def rasterize(view: SideView, pixels_per_unit: float, margin: int = 8) -> tuple[
 
 
 def with_counts(base: Species, sections: int | None, circles: int | None) -> Species:
-    """``base`` at another level of detail: fin sections and circle points move with the body."""
-    b0, c0 = base.body_sections, base.circle_sections
-    b, c = sections or b0, circles or c0
-    if (b, c) == (b0, c0):
-        return base
+    """``base`` at another level of detail, as a level of detail maps it
+    (:func:`fishgen.assembly.levels.at_level`): fin sections, circle points and the fins' per-step
+    proportions move with the body, so a fin keeps its shape (`--body-sections 96` had shrunk
+    ThreadfinGoldie's dorsal and anal fins to spikes: a fin's proportion is per section)."""
+    from fishgen.assembly.levels import at_level
 
-    def sec(k: int) -> int:
-        return int(np.clip(round(k * (b - 1) / (b0 - 1)), 0, b - 1))
-
-    def circ(k: int) -> int:  # by angle, as a level of detail maps it (an odd ring is turned)
-        from fishgen.assembly.levels import circle_at
-
-        return circle_at(k, c0, c)
-
-    def vertical(f: VerticalFin) -> VerticalFin:  # a fin spans at least one section's length
-        start = min(sec(f.start_section), b - 2)
-        return replace(f, start_section=start, end_section=max(sec(f.end_section), start + 1))
-
-    p: PelvicFin = base.pelvic
-    ps = min(sec(p.start_section), b - 2)
-    pe = max(sec(p.end_section), ps + 1)
-    q: PectoralFin = base.pectoral
-    return replace(base, body_sections=b, circle_sections=c, dorsal=vertical(base.dorsal),
-                   adipose=vertical(base.adipose), anal=vertical(base.anal),
-                   pelvic=replace(p, start_circle=circ(p.start_circle), start_section=ps,
-                                  end_section=pe),
-                   pectoral=replace(q, start_section=sec(q.start_section), start_circle=circ(q.start_circle),
-                                    triangles=max(1, min(q.triangles, c // 2))),
-                   texture_points=None)
+    b, c = sections or base.body_sections, circles or base.circle_sections
+    return replace(at_level(base, b, c), texture_points=None)
