@@ -176,7 +176,7 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     else:
         count = min(n, SLABS, max(FEW_SLABS, n // 2048)) if slabs is None else max(1, min(n, int(slabs)))
         light = _slabs(centers, radii, density, frame, middle, count, lighting.extinction, forward, light,
-                       grid_cells)
+                       grid_cells, lead=slab_lead(n) if slabs is None else 0.0)
     return light
 
 
@@ -263,7 +263,7 @@ def _cdf_table() -> np.ndarray:
 
 
 def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forward, light,
-           grid_cells: int | None) -> np.ndarray:
+           grid_cells: int | None, lead: float = 0.0) -> np.ndarray:
     """A big cloud, in ``slabs`` slabs along the sun axis, all read from and splatted into one
     light map.
 
@@ -277,7 +277,8 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     its own: the share of the slab's particles nearer the sun than it (``_slab_numbers``). Half
     of it for every particle, as before, left a dense cloud's sunlit face in the shade of half
     the first slab: exactly 0 light where the pairs gave up to 0.57. Just past SMALL particles
-    that point is ``slab_lead`` sigmas nearer the sun than the centre, in whichever slab it lies.
+    that point is ``lead`` sigmas nearer the sun than the centre (``slab_lead``; 0 when a caller
+    sets the slabs), in whichever slab it lies, when one group holds every slab.
 
     Nothing here visits the particles in depth order (on a big cloud, reading memory out of
     order cost more than all the arithmetic). Three passes in memory order, each chunk on
@@ -293,15 +294,16 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     with ThreadPoolExecutor(WORKERS) as pool:
         depth, a, b = np.empty(n, _F32), np.empty(n, _F32), np.empty(n, _F32)
         ends = _project(centers, frame, middle, out=(depth, a, b), pool=pool)
-        lead = slab_lead(n)
-        slab, face, nearer = _slab_numbers(depth, slabs, pool, ends[0],
-                                           lead=(radii, _F32(lead * SIGMA)) if lead > 0 else None)
         grid = _Grid(ends[1:, 0].astype(np.float64), ends[1:, 1].astype(np.float64), radii,
                      most=grid_cells)
         cells = grid.shape[0] * grid.shape[1]
         table = _peak_table(float(extinction), float(forward))
         # the slabs in groups whose maps fit in MAP_VALUES (one group but for a very fine grid)
         group = max(1, min(slabs, MAP_VALUES // (CLASSES * cells)))
+        if group < slabs:   # a point read ahead may lie in a group whose maps are gone: the centre
+            lead = 0.0
+        slab, face, nearer = _slab_numbers(depth, slabs, pool, ends[0],
+                                           lead=(radii, _F32(lead * SIGMA)) if lead > 0 else None)
         own = depth             # each particle's own depth at its centre, once splatted
         if group >= slabs:
             light = a
@@ -418,11 +420,10 @@ def _splat_share(grid: _Grid, place, radii, density, table, size: int, own: np.n
 def _read_chunk(grid: _Grid, place, own: np.ndarray, face: np.ndarray, nearer: np.ndarray,
                 before: np.ndarray, depths: np.ndarray, light: np.ndarray, first: int,
                 span: tuple[int, int]) -> None:
-    """Each particle's light at its sunward face (FRONT sigma nearer the sun than its centre, as
-    the pairs take it): behind the depth before the face's slab (``face``), at its centre's cell,
-    and the share of what that slab holds there nearer the sun than the face (``nearer``, in
-    SHARE_LEVELS), less its own footprint when the face lies in its own slab. A face in a slab
-    of an earlier group (a sky's fine grid) is read at its group's first slab."""
+    """Each particle's light where it is read (its centre, or ``slab_lead`` sigmas nearer the sun,
+    in slab ``face``; only when one group holds every slab): behind the depth before that slab,
+    at its centre's cell, and the share of what that slab holds there nearer the sun (``nearer``,
+    in SHARE_LEVELS), less its own footprint when that slab is its own."""
     pick, number, (flat, fx, fy), near = place(span)
     start, stop = span
     at = (face[start:stop] if pick is None else face[start:stop][pick]).astype(np.int32)
@@ -430,10 +431,6 @@ def _read_chunk(grid: _Grid, place, own: np.ndarray, face: np.ndarray, nearer: n
         at -= np.int32(first)
     share = (nearer[start:stop] if pick is None else nearer[start:stop][pick]).astype(_F32)
     share *= _F32(1 / SHARE_LEVELS)
-    if first:
-        earlier = at < 0
-        at[earlier] = 0
-        share[earlier] = 0
     mine = own[start:stop] if pick is None else own[start:stop][pick]
     mine = np.where(at == number, mine, _F32(0))        # its own footprint is in its own slab only
     at *= np.int32(grid.shape[0] * grid.shape[1])

@@ -429,3 +429,19 @@ def test_the_slabs_lead_fades_out():
     assert light_module.slab_lead(2 * light_module.SMALL) < light_module.LEAD
     assert light_module.slab_lead(light_module.SMALL << light_module.LEAD_OCTAVES) == 0
     assert light_module.slab_lead(10**7) == 0
+
+
+def test_a_caller_that_sets_the_slabs_reads_at_the_centre(monkeypatch):
+    """The lead belongs to the automatic path just past SMALL: a sky's clouds (slabs set) and a
+    cloud whose maps go in groups read at the centre, so neither depends on it."""
+    centers, radii, density = random_cloud(n=3000, box=(20, 10, 15))
+    lighting = Lighting(sun=SUNS["side"])
+    before = incident_light(centers, radii, density, lighting, slabs=16)
+    automatic = incident_light(centers, radii, density, lighting)
+    monkeypatch.setattr(light_module, "LEAD", 0.9)
+    assert incident_light(centers, radii, density, lighting, slabs=16).tobytes() == before.tobytes()
+    assert incident_light(centers, radii, density, lighting).tobytes() != automatic.tobytes()
+    monkeypatch.setattr(light_module, "MAP_VALUES", 1)        # every slab a group of its own
+    grouped = incident_light(centers, radii, density, lighting)
+    monkeypatch.setattr(light_module, "LEAD", 0.0)
+    assert incident_light(centers, radii, density, lighting).tobytes() == grouped.tobytes()
