@@ -58,10 +58,14 @@ def side_file(asset: str | Path, ref: str, *, uri: bool = False, must_exist: boo
 
 
 def _there(asset: Path, ref: str) -> bool:
-    try:
-        return side_file(asset, ref).is_file()
-    except Exception:  # noqa: BLE001 - a name leading out of the folder is judged by the caller's try
+    """Whether ``ref`` names something beside ``asset``; if it does, it must stay in the folder
+    (``side_file`` refuses it in one line otherwise: a link out is refused, not skipped)."""
+    name = ref.strip().replace("\\", "/")
+    if not name or "\0" in name or _SCHEME.match(name) or name.startswith(("/", "~")) or too_long(name):
         return False
+    if not os.path.lexists(os.path.join(Path(asset).parent, name)):
+        return False
+    return side_file(asset, ref).is_file()
 
 
 def mtl_libraries(asset: str | Path, rest: str) -> list[str]:

@@ -66,7 +66,7 @@ def sidecars(asset: Path) -> tuple[dict[str, Path], str | None]:
                     continue
                 mtl_name = mtl_name or lib
                 for ref in _MTL_MAPS.findall(mtl.read_text(encoding="utf-8", errors="replace")):
-                    add(map_file_name(mtl, ref))
+                    add(map_file_name(asset, ref))   # resolved in the asset's folder, as add() does
     return found, mtl_name
 
 
