@@ -93,16 +93,15 @@ def _named_by_another(names: TextureNames) -> None:
         for owner in (path.with_name(name) for name in owners):
             if os.path.abspath(owner) == own or not owner.is_file():
                 continue
-            # casefolded: on a case-insensitive disk Fish7_mask.png is fish7_mask.png
-            if path.name.casefold() in (name.casefold() for name in _named_textures(owner) or ()):
+            if _names(owner, path):
                 raise UsageError(f"expected textures no other species file names, found {path.name!r}, "
                                  f"named by {owner.name!r} beside it; choose another -o")
-    own_names = _named_textures(Path(own)) if os.path.isfile(own) else None
+    mine = Path(own) if os.path.isfile(own) else None
     for path in names.paths:
         # A picture already there that this species file does not name (its rerun) may be
         # another's under any name: y.txt naming shared.png. Only then is the folder read, and
         # only species files that mention the name, so a folder of thousands costs nothing on a rerun.
-        if not path.is_file() or (own_names is not None and path.name in own_names):
+        if not path.is_file() or (mine is not None and _names(mine, path)):
             continue
         for owner in sorted(path.parent.glob("*.txt")):
             if os.path.abspath(owner) == own or not owner.is_file():
@@ -112,9 +111,18 @@ def _named_by_another(names: TextureNames) -> None:
                     continue
             except OSError:
                 continue
-            if path.name.casefold() in (name.casefold() for name in _named_textures(owner) or ()):
+            if _names(owner, path):
                 raise UsageError(f"expected textures no other species file names, found {path.name!r}, "
                                  f"named by {owner.name!r} beside it; choose another -o")
+
+
+def _names(owner: Path, picture: Path) -> bool:
+    """Whether the species file ``owner`` names ``picture`` as a texture, however it writes the name
+    (``./shared.png``, ``pics/../shared.png``); casefolded: on a case-insensitive disk
+    Fish7_mask.png is fish7_mask.png."""
+    target = os.path.abspath(picture).casefold()
+    return any(os.path.abspath(owner.parent / name).casefold() == target
+               for name in _named_textures(owner) or ())
 
 
 def _named_textures(species_file: Path) -> tuple[str, str] | None:

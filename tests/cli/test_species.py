@@ -1,6 +1,8 @@
 """`fishgen species --random`: one species or a folder of them, deterministic, buildable."""
 from __future__ import annotations
 
+import pytest
+
 from tests.conftest import assert_valid_gltf
 
 
@@ -81,14 +83,15 @@ def test_a_derived_texture_name_never_replaces_another_species_texture(tmp_path,
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
-def test_a_texture_another_species_file_names_under_any_name_is_never_replaced(tmp_path, cli):
+@pytest.mark.parametrize("written", ["shared.png", "./shared.png"])
+def test_a_texture_another_species_file_names_under_any_name_is_never_replaced(tmp_path, cli, written):
     """y.txt names shared.png: `species -o shared.txt` replaced it and y.txt built another fish
     (QA pass 10). The documented pair's owner alone was looked up."""
     assert cli("species", "--random", "--seed", "7", "-o", tmp_path / "y.txt").returncode == 0
     (tmp_path / "y.png").rename(tmp_path / "shared.png")
     text = (tmp_path / "y.txt").read_text()
     assert text.count("y.png y_mask.png") == 1
-    (tmp_path / "y.txt").write_text(text.replace("y.png y_mask.png", "shared.png y_mask.png"))
+    (tmp_path / "y.txt").write_text(text.replace("y.png y_mask.png", f"{written} y_mask.png"))
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     r = cli("species", "--random", "--seed", "8", "-o", tmp_path / "shared.txt")
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
