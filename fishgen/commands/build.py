@@ -91,6 +91,7 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
     check_inputs(inputs, "build", [FORMATS["species"]], default=FORMATS["species"])
     outputs = targets(inputs, output, fmt=options.format or "glb", holding=[MESHES], noun="species file")
     check_targets(outputs, inputs)
+    textures = _every_texture(inputs, options.textures) if len(inputs) > 1 else ()
     written: list[Path] = []
     read: list[Path] = []
     lines: list[str] = []
@@ -102,9 +103,11 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
             with each_input(events, errors, len(inputs) > 1):
                 species = load_species(source, options.textures)
                 fish = fish_of(species, options)
-                # its textures are inputs, and the side files' of the images the fish holds
-                check_targets([target], species.side_files, [image.name for image in fish.scene.images])
-                with protecting(species.side_files):
+                # every input's textures are inputs (b.txt may name a_skin.png, which a.glb writes),
+                # and only the side files of the images the fish holds count
+                theirs = (*species.side_files, *textures)
+                check_targets([target], theirs, [image.name for image in fish.scene.images])
+                with protecting(theirs):
                     files = export(fish.scene, target, require=[MESHES])
                 read += [source, *species.side_files]
                 written += files
@@ -112,6 +115,21 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
                 lines.append(summary(fish, target, files))
             progress.update(1)
     return Made(tuple(written), tuple(read), tuple(lines), tuple(facts), tuple(errors))
+
+
+def _every_texture(inputs: Sequence[Path], folder: Path | None) -> tuple[Path, ...]:
+    """The textures every readable input names (a few ms a species file); an unreadable one is
+    reported when its turn comes."""
+    from fishgen.errors import FishgenError
+    from fishgen.species.parser import load_species
+
+    found: dict[Path, None] = {}
+    for source in inputs:
+        try:
+            found.update(dict.fromkeys(load_species(source, folder).side_files))
+        except (FishgenError, OSError):
+            continue
+    return tuple(found)
 
 
 def _lost(fins: tuple[str, ...]) -> str:

@@ -282,3 +282,20 @@ def test_the_summary_names_the_fins_of_the_one_level_written(tmp_path, lods, out
                                    "-o", str(tmp_path / output)])
     assert ran.exit_code == 0, ran.output
     assert "8x6 (no adipose or anal fins)" in ran.output
+
+
+def test_one_input_never_overwrites_a_texture_another_input_names(tmp_path):
+    """b.txt's skin is a_skin.png, which building a.txt to a.gltf writes: `build a.txt b.txt` replaced
+    it and built b with a's skin, exit 0 (review of QA pass 10's fixes). a is refused, b is built."""
+    text = (PARAMS / "bonybream.txt").read_text()
+    assert text.count("bonybream.png bonybream_mask.png") == 1
+    (tmp_path / "a.txt").write_text(text.replace("bonybream.png bonybream_mask.png", "ta.png tam.png"))
+    (tmp_path / "b.txt").write_text(text.replace("bonybream.png bonybream_mask.png", "a_skin.png tbm.png"))
+    for name, source in (("ta.png", "bonybream.png"), ("tam.png", "bonybream_mask.png"),
+                         ("a_skin.png", "bonybream.png"), ("tbm.png", "bonybream_mask.png")):
+        shutil.copy(ROOT / "textures" / source, tmp_path / name)
+    before = (tmp_path / "a_skin.png").read_bytes()
+    result = run_cli("build", "a.txt", "b.txt", "-o", "./", "--format", "gltf", cwd=tmp_path)
+    assert result.returncode == 2 and "a_skin" in result.stderr, result.stderr
+    assert (tmp_path / "a_skin.png").read_bytes() == before
+    assert (tmp_path / "b.gltf").is_file() and not (tmp_path / "a.gltf").exists()
