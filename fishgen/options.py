@@ -207,9 +207,18 @@ def _finite_number(value: Any) -> bool:
     return isinstance(value, int) or math.isfinite(value)  # an int of any size is finite; isfinite overflows
 
 
+class NamedPath(click.Path):
+    """A path option that must name something: ``--out ''`` is Path('.'), the working folder."""
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, str) and not value:
+            self.fail("expected a file or folder name, found an empty one", param, ctx)
+        return super().convert(value, param, ctx)
+
+
 SEED = click.IntRange(0, SEED_MAX)
-FOLDER = click.Path(file_okay=False, path_type=Path)
-FILE = click.Path(dir_okay=False, path_type=Path)
+FOLDER = NamedPath(file_okay=False, path_type=Path)
+FILE = NamedPath(dir_okay=False, path_type=Path)
 
 
 # -- the declaration ------------------------------------------------------------------------------

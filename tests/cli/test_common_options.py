@@ -196,3 +196,19 @@ def test_an_empty_output_name_is_a_usage_error(tmp_path, args):
     assert result.stderr.startswith(f"fishgen {args[0]}: expected -o to name an output")
     assert result.stderr.endswith("found an empty name\n") and result.stderr.count("\n") == 1
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("args", [
+    ["batch", "{params}", "--out", ""], ["batch", "{params}", "--out", "{out}", "--report", ""],
+    ["build", "{fish}", "-o", "{out}/x.glb", "--textures", ""],
+])
+def test_an_empty_path_option_is_a_usage_error(tmp_path, args):
+    """`batch DIR --out ''` wrote its outputs and record into the working folder (review of QA pass
+    10's fixes): a folder or file option must name one."""
+    fill = {"params": PARAMS, "fish": PARAMS / "bonybream.txt", "out": tmp_path / "out"}
+    filled = [a.format(**{k: str(v) for k, v in fill.items()}) for a in args]
+    (tmp_path / "here").mkdir()
+    result = run_cli(*filled, cwd=tmp_path / "here")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "expected a file or folder name, found an empty one" in result.stderr
+    assert list((tmp_path / "here").iterdir()) == [] and not (tmp_path / "out").exists()
