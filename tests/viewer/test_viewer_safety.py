@@ -74,6 +74,22 @@ def test_mtl_texture_outside_the_folder_is_refused(nest, line):
     _refused(obj, line.split()[-1])
 
 
+def test_a_spaced_name_leading_out_of_the_folder_is_refused_not_skipped(nest):
+    """`mtllib a b.mtl` where 'a b.mtl' links out of the folder (and 'a', 'b.mtl' are there): the
+    whole name was tried quietly and the words read instead, losing the materials unsaid."""
+    from fishgen.exchange.mesh_reader import read_mesh_file
+
+    (nest.parent / "out.mtl").write_text("newmtl m\n")
+    (nest / "a b.mtl").symlink_to(nest.parent / "out.mtl")
+    (nest / "a").write_text("")
+    (nest / "b.mtl").write_text("newmtl m\n")
+    obj = nest / "t.obj"
+    obj.write_text("mtllib a b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    _refused(obj, "a b.mtl")
+    with pytest.raises(FishgenError, match="leads outside it"):
+        read_mesh_file(obj)
+
+
 def test_inline_subfolder_and_percent_encoded_references_are_embedded(nest):
     (nest / "data").mkdir()
     (nest / "data" / "my skin.bin").write_bytes(b"\x01")
