@@ -445,8 +445,13 @@ def _candidate(photo: Photo, mask: np.ndarray, base: Species, out: Path, options
     name = species_name(out)
     names = texture_names(out)   # NEW.png and NEW_mask.png, unless a species file cannot name them
     colour_name, mask_name = names.colour, names.mask
-    species = replace(base, name=name, textured=True, texture_points=pts, colour_texture=None,
-                      mask_texture=None, source=None)
+    # A fitted fin's straight edges only approach the photographed fin; its mask carries the
+    # outline. A base whose fins blend instead (Centroberyx: alpha 0.6) fades a fitted fin's thin
+    # parts out of every other renderer's coverage, and its texture already holds the photo's own
+    # translucency: a fitted fish's fins are cut by its mask.
+    masked = base.masked or fit is not None
+    species = replace(base, name=name, textured=True, masked=masked, texture_points=pts,
+                      colour_texture=None, mask_texture=None, source=None)
     text = format_species(species, colour_name, mask_name)
     parse_species(text, out)   # what we write must read back (section ranges, counts)
     files = {out: text.encode(), out.with_name(colour_name): textures[0],
