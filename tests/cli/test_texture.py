@@ -397,3 +397,22 @@ def test_more_body_sections_keep_the_fins_shape(tmp_path, cli, bream_photo):
         assert r.returncode == 0, r.stderr
         figures.append(float(re.search(r"silhouette IoU of the rebuilt fish: ([0-9.]+)", r.stdout)[1]))
     assert figures[1] > 0.95 and figures[1] > figures[0] - 0.03, figures
+
+
+def test_a_greyscale_photo_that_misfits_says_so_not_that_the_base_is_wrong(tmp_path, cli):
+    """A grey copy of a fish over water of about its head's grey: the nose is lost to the backdrop,
+    and the advice blamed the base's geometry ("try --fit-shape") on the base's own photo (QA pass
+    10); --mask is what helps."""
+    from PIL import Image
+
+    photo = tmp_path / "grey.png"
+    r = cli("preview", PARAMS / "threadfingoldie.txt", "--view", "side", "--ortho", "-o", tmp_path / "c.png")
+    assert r.returncode == 0, r.stderr
+    Image.open(tmp_path / "c.png").convert("L").save(photo)
+    r = cli("texture", photo, "-s", PARAMS / "threadfingoldie.txt", "-o", tmp_path / "g.txt")
+    assert r.returncode == 0, r.stderr
+    iou = float(r.stdout.split("silhouette IoU of the rebuilt fish: ")[1].split()[0])
+    if iou < 0.85:
+        assert "a greyscale photo" in r.stderr and "give --mask" in r.stderr and "--fit-shape" not in r.stderr
+    else:   # a renderer that draws this fish apart from its water: nothing to advise
+        assert "greyscale" not in r.stderr

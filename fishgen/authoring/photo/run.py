@@ -389,7 +389,11 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         lens = ("" if options.focal_length is not None else
                 "; if it was taken close up, give --focal-length (fishgen preview draws at about 50 mm, "
                 "or none with --ortho)")
-        if options.fit_shape:
+        if sil.source != "alpha" and options.mask is None and _greyscale(photo):
+            # the base is seldom to blame: a grey head beside grey water is lost to the backdrop
+            note(f"silhouette IoU {shown[1]:.3f}: a greyscale photo, whose fish is told from the "
+                 f"backdrop by brightness alone, so its silhouette may be wrong; give --mask{lens}")
+        elif options.fit_shape:
             note(f"silhouette IoU {shown[1]:.3f}: the rebuilt fish is still unlike the photo's; if the "
                  f"silhouette is wrong (a busy background), give --mask{lens}")
         else:
@@ -408,6 +412,12 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     return TextureResult(chosen.species, list(files), chosen.measured.angle, chosen.measured.mirrored,
                          sil.source, list(chosen.unseen), None if shown is None else shown[1],
                          chosen.measured.frame_mask, chosen.measured.frame, fitted, problems, fit)
+
+
+def _greyscale(photo: Photo) -> bool:
+    """Whether every pixel of ``photo`` is grey (its three channels within one level)."""
+    rgb = photo.rgb.astype(np.int16)
+    return bool(np.abs(rgb[..., 0] - rgb[..., 1]).max() <= 1 and np.abs(rgb[..., 1] - rgb[..., 2]).max() <= 1)
 
 
 @dataclass(frozen=True)
