@@ -328,8 +328,8 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
             for k in range(last - first):
                 before[k] = reached
                 reached += depths[k]
-            read = functools.partial(_read_chunk, grid, place, own, face, nearer, before, depths, light,
-                                     first)
+            read = functools.partial(_read_chunk, grid, place, own, face if lead > 0 else None, nearer,
+                                     before, depths, light, first)
             list(pool.map(read, spans))
     return light
 
@@ -417,7 +417,7 @@ def _splat_share(grid: _Grid, place, radii, density, table, size: int, own: np.n
     return total
 
 
-def _read_chunk(grid: _Grid, place, own: np.ndarray, face: np.ndarray, nearer: np.ndarray,
+def _read_chunk(grid: _Grid, place, own: np.ndarray, face: np.ndarray | None, nearer: np.ndarray,
                 before: np.ndarray, depths: np.ndarray, light: np.ndarray, first: int,
                 span: tuple[int, int]) -> None:
     """Each particle's light where it is read (its centre, or ``slab_lead`` sigmas nearer the sun,
@@ -426,13 +426,15 @@ def _read_chunk(grid: _Grid, place, own: np.ndarray, face: np.ndarray, nearer: n
     in SHARE_LEVELS), less its own footprint when that slab is its own."""
     pick, number, (flat, fx, fy), near = place(span)
     start, stop = span
-    at = (face[start:stop] if pick is None else face[start:stop][pick]).astype(np.int32)
-    if first:
-        at -= np.int32(first)
     share = (nearer[start:stop] if pick is None else nearer[start:stop][pick]).astype(_F32)
     share *= _F32(1 / SHARE_LEVELS)
     mine = own[start:stop] if pick is None else own[start:stop][pick]
-    mine = np.where(at == number, mine, _F32(0))        # its own footprint is in its own slab only
+    at = number                                         # read in its own slab (a big cloud: no lead)
+    if face is not None:
+        at = (face[start:stop] if pick is None else face[start:stop][pick]).astype(np.int32)
+        if first:
+            at -= np.int32(first)
+        mine = np.where(at == number, mine, _F32(0))    # its own footprint is in its own slab only
     at *= np.int32(grid.shape[0] * grid.shape[1])
     flat += at
     near += at
