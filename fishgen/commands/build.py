@@ -91,7 +91,8 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
     check_inputs(inputs, "build", [FORMATS["species"]], default=FORMATS["species"])
     outputs = targets(inputs, output, fmt=options.format or "glb", holding=[MESHES], noun="species file")
     check_targets(outputs, inputs)
-    textures = _every_texture(inputs, options.textures) if len(inputs) > 1 else ()
+    loaded = _loadable(inputs, options.textures) if len(inputs) > 1 else {}
+    textures = tuple(dict.fromkeys(path for species in loaded.values() for path in species.side_files))
     written: list[Path] = []
     read: list[Path] = []
     lines: list[str] = []
@@ -101,7 +102,7 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
     with events.progress("building", len(inputs) if len(inputs) > 1 else 0) as progress:
         for source, target in zip(inputs, outputs, strict=True):
             with each_input(events, errors, len(inputs) > 1):
-                species = load_species(source, options.textures)
+                species = loaded.get(source) or load_species(source, options.textures)
                 fish = fish_of(species, options)
                 # every input's textures are inputs (b.txt may name a_skin.png, which a.glb writes),
                 # and only the side files of the images the fish holds count
@@ -117,19 +118,19 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
     return Made(tuple(written), tuple(read), tuple(lines), tuple(facts), tuple(errors))
 
 
-def _every_texture(inputs: Sequence[Path], folder: Path | None) -> tuple[Path, ...]:
-    """The textures every readable input names (a few ms a species file); an unreadable one is
-    reported when its turn comes."""
+def _loadable(inputs: Sequence[Path], folder: Path | None) -> dict:
+    """Every input that loads, by path, read once before any is built: each one's textures are then
+    known to all (an unreadable input is loaded again, and reported, when its turn comes)."""
     from fishgen.errors import FishgenError
     from fishgen.species.parser import load_species
 
-    found: dict[Path, None] = {}
+    found = {}
     for source in inputs:
         try:
-            found.update(dict.fromkeys(load_species(source, folder).side_files))
+            found[source] = load_species(source, folder)
         except (FishgenError, OSError):
             continue
-    return tuple(found)
+    return found
 
 
 def _lost(fins: tuple[str, ...]) -> str:
