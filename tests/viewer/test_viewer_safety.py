@@ -6,6 +6,7 @@ import http.client
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 
@@ -132,9 +133,9 @@ def server(tmp_path, viewer_assets):
     os.symlink(tmp_path / "site" / "private.txt", folder / "link.txt")
     shutil.copy(viewer_assets["cloud"], folder / "cloud.glb")
     page = folder / "cloud page.html"
-    proc = subprocess.Popen([sys.executable, "-u", "-m", "fishgen", "view", str(folder / "cloud.glb"),
-                             "-o", str(page), "--port", "0"], cwd=ROOT, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen([sys.executable, "-X", "faulthandler", "-u", "-m", "fishgen", "view",
+                             str(folder / "cloud.glb"), "-o", str(page), "--port", "0"], cwd=ROOT,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         url = None
         for line in proc.stdout:
@@ -145,7 +146,22 @@ def server(tmp_path, viewer_assets):
         yield _Served(int(url.split(":")[2].split("/")[0]), url.split("token=")[1]), page
     finally:
         proc.terminate()
-        proc.wait(timeout=10)
+        _stops(proc)
+
+
+def _stops(proc: subprocess.Popen) -> None:
+    """The server exits on SIGTERM; if it has not within 30 s (a loaded machine once took over 10),
+    fail with every thread's stack, which faulthandler prints on SIGABRT."""
+    try:
+        proc.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        proc.send_signal(signal.SIGABRT)
+        try:
+            _, err = proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            _, err = proc.communicate()
+        pytest.fail(f"`fishgen view` did not exit within 30 s of SIGTERM; its threads:\n{err}")
 
 
 def _get(srv, path, host=None, method="GET", token=True):
