@@ -125,8 +125,9 @@ def bake(fish_scenes: list[Scene], tracks: Tracks, *, tolerance: float = 0.002, 
     what it was before variants existed), each channel of a variant's colour 1 - ``tint`` to 1."""
     school = Scene(name="school")
     templates = [merge_species(school, fish) for fish in fish_scenes]
-    variants = _tint_variants(school, templates, tints, tint, seed)
     wears = _wears(len(tracks.group), tints, seed)
+    worn = [set(wears[np.asarray(tracks.group) == g].tolist()) for g in range(len(fish_scenes))]
+    variants = _tint_variants(school, templates, tints, tint, seed, worn)
     swims = [fish.clip("swim") for fish in fish_scenes]
     plan = _school_keys(fish_scenes, tracks, tolerance, seed, body_lengths, wave)
     duration, rng, times32 = plan.duration, plan.rng, plan.times32
@@ -179,34 +180,54 @@ def _part(template: Node) -> Node:
 
 
 def _tint_variants(school: Scene, templates: list[list[Part]], tints: int, tint: float,
-                   seed: int) -> list[list[list[Part]]]:
+                   seed: int, worn: list[set[int]]) -> list[list[list[Part]]]:
     """Per species, per variant, its part templates. Variant 0 is the species as merged; each other
-    adds a copy of every species material with its base colour tinted, and a copy of every mesh
-    whose primitives name those materials: the same vertex, index and morph arrays, which the
-    writer stores once."""
+    that a fish of the species wears (``worn[species]``) adds a copy of every species material with
+    its base colour tinted, and a copy of every mesh whose primitives name those materials: the
+    same vertex, index and morph arrays, which the writer stores once.
+
+    The file holds only what some fish shows: a variant nobody wears keeps its place in the list
+    but adds nothing, and when no fish wears the species' own colours, its first worn variant takes
+    their materials' and meshes' places (the validator notes every object nothing uses)."""
     out = []
     factors = _tint_factors(len(templates), tints, tint, seed)
-    for parts, species_factors in zip(templates, factors, strict=True):
-        variants = [parts]
+    for parts, species_factors, wearing in zip(templates, factors, worn, strict=True):
         meshes = sorted({t.mesh for t, _, _ in parts if t.mesh is not None})
         materials = sorted({p.material for m in meshes for p in school.meshes[m].primitives
                             if p.material is not None})
+        own_materials = {m: school.materials[m] for m in materials}  # before a variant takes their place
+        own_meshes = {m: school.meshes[m] for m in meshes}
+        variants: list[list[Part]] = [parts if 0 in wearing else []]
+        in_place = 0 not in wearing
         for v, factor in enumerate(species_factors[1:], start=1):
+            if v not in wearing:
+                variants.append([])
+                continue
             new_material = {}
             for m in materials:
-                base = school.materials[m]
+                base = own_materials[m]
                 r, g, b, a = base.base_color
                 colour = (r * float(factor[0]), g * float(factor[1]), b * float(factor[2]), a)
-                new_material[m] = school.add_material(replace(base, name=f"{base.name}_tint{v}",
-                                                              base_color=colour))
+                tinted = replace(base, name=f"{base.name}_tint{v}", base_color=colour)
+                if in_place:
+                    school.materials[m] = tinted
+                    new_material[m] = m
+                else:
+                    new_material[m] = school.add_material(tinted)
             new_mesh = {}
             for m in meshes:
-                mesh = school.meshes[m]
+                mesh = own_meshes[m]
                 prims = [replace(p, material=None if p.material is None else new_material[p.material])
                          for p in mesh.primitives]
-                new_mesh[m] = school.add_mesh(replace(mesh, name=f"{mesh.name}_tint{v}", primitives=prims))
+                renamed = replace(mesh, name=f"{mesh.name}_tint{v}", primitives=prims)
+                if in_place:
+                    school.meshes[m] = renamed
+                    new_mesh[m] = m
+                else:
+                    new_mesh[m] = school.add_mesh(renamed)
             variants.append([(replace(t, mesh=None if t.mesh is None else new_mesh[t.mesh]), c, w)
                              for t, c, w in parts])
+            in_place = False
         out.append(variants)
     return out
 
@@ -331,13 +352,19 @@ def bake_prototypes(fish_scenes: list[Scene], tracks: Tracks, *, prototypes: int
     times = np.asarray(tracks.times, np.float64)
     duration = float(times[-1]) if len(times) else 0.0
     factors = _tint_factors(len(fish_scenes), tints, tint, seed)
-    protos = [_phase_shifted(_tinted(fish, factor, v), f"{fish.name}{f'_tint{v}' if v else ''}_{p}",
-                             p / prototypes, duration)
-              for fish, species_factors in zip(fish_scenes, factors, strict=True)
-              for v, factor in enumerate(species_factors) for p in range(prototypes)]
     phase = np.random.default_rng((seed, PROTOTYPE_STREAM)).integers(0, prototypes, len(tracks.group))
     variant = _wears(len(tracks.group), tints, seed)
     index = (np.asarray(tracks.group, np.int64) * max(1, tints) + variant) * prototypes + phase
+    # Only the prototypes some fish is: a small school with many tints would otherwise carry
+    # meshes and materials nobody shows (the validator's "unused" notices, and their bytes).
+    used, index = np.unique(index, return_inverse=True)
+    protos = []
+    for key in used.tolist():
+        g, p = divmod(key, prototypes)
+        g, v = divmod(g, max(1, tints))
+        fish = fish_scenes[g]
+        protos.append(_phase_shifted(_tinted(fish, factors[g][v], v),
+                                     f"{fish.name}{f'_tint{v}' if v else ''}_{p}", p / prototypes, duration))
     crowd = Instancer("fish", protos, index, times, np.asarray(tracks.positions, np.float32),
                       np.asarray(tracks.headings, np.float32), np.asarray(tracks.scale, np.float32))
     return Scene(name="school", instancers=[crowd], fps=fps)

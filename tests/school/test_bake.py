@@ -11,7 +11,7 @@ from fishgen.scene.pose import pose
 from fishgen.school.bake import bake
 from fishgen.school.model import Tracks
 from fishgen.species.parser import load_species
-from tests.conftest import PARAMS, assert_valid_gltf
+from tests.conftest import PARAMS, assert_valid_gltf, validate_gltf
 
 
 @pytest.fixture(scope="module")
@@ -143,3 +143,35 @@ def test_prototypes_are_each_species_phase_shifted_and_every_fish_wears_one(fish
     # parts that shared one weights sampler still share one: one blend-shape channel set in USD
     weights = {id(c.sampler) for c in crowd.prototypes[1].clip("swim").channels if c.path == "weights"}
     assert len(weights) == 1
+
+
+def test_a_file_holds_only_the_colour_variants_its_fish_wear(fish, tmp_path):
+    """Four fish and sixteen tints: each fish's variant is there, tinted as with many fish, and no
+    material or mesh nobody wears (the validator notes each as unused), not even the species' own
+    colours when no fish wears them."""
+    tracks = circling(count=4)
+    few = bake(fish, tracks, seed=3, tints=16, tint=0.3)
+    path = tmp_path / "few.glb"
+    path.write_bytes(glb_bytes(few))
+    report = validate_gltf(path)[0]
+    assert report["numErrors"] == report["numWarnings"] == report["numInfos"] == 0, report["messages"][:3]
+    worn = {few.nodes[c].mesh for r in few.roots for c in few.nodes[r].children} - {None}
+    assert worn == set(range(len(few.meshes)))
+    assert not any(m.name.startswith(("bony", "pine")) and "_tint" not in m.name for m in few.materials)
+    # the same variants, tinted the same, as in a school where every variant is worn
+    many = bake(fish, circling(count=400, frames=30), seed=3, tints=16, tint=0.3)
+    colours = {m.name: m.base_color for m in many.materials}
+    assert all(colours[m.name] == m.base_color for m in few.materials)
+
+
+def test_prototypes_are_only_those_some_fish_is(fish):
+    from fishgen.school.bake import bake_prototypes
+
+    tracks = circling(count=3)
+    crowd = bake_prototypes(fish, tracks, prototypes=4, seed=5, tints=8).instancers[0]
+    assert sorted(set(crowd.proto_indices.tolist())) == list(range(len(crowd.prototypes)))
+    assert len(crowd.prototypes) <= 3
+    full = bake_prototypes(fish, circling(count=400), prototypes=4, seed=5, tints=8).instancers[0]
+    assert len(full.prototypes) == 2 * 8 * 4
+    names = {p.name for p in full.prototypes}
+    assert {p.name for p in crowd.prototypes} <= names
