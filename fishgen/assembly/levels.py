@@ -36,16 +36,27 @@ def at_level(species: Species, bodies: int, circles: int) -> Species:
     def circ(k: int) -> int:
         return circle_at(k, c0, circles)
 
-    def vertical(f: VerticalFin) -> VerticalFin:  # a fin spans at least one section's length
-        start = min(sec(f.start_section), bodies - 2)
-        end = max(sec(f.end_section), start + 1)
+    def span(start: int, end: int) -> tuple[int, int]:
+        """A fin's first and last section: at least one section's length. A fin whose ends meet
+        on one ring spans the section its middle lies in (the one before, if the middle is on a
+        ring: a pelvic fin's trailing edge reaches back past its last ring). Stretched to the next
+        ring instead, a fin near the middle of a 3-ring fish reached the tail, and a pelvic fin's
+        trailing edge hung past it (by 17 % of the body on one random species)."""
+        first, last = sec(start), sec(end)
+        if last > first:
+            return min(first, bodies - 2), last
+        middle = (start + end) / 2 * (bodies - 1) / (b0 - 1)
+        first = min(max(math.ceil(middle) - 1, 0), bodies - 2)  # on a ring: the section before it
+        return first, first + 1
+
+    def vertical(f: VerticalFin) -> VerticalFin:
+        start, end = span(f.start_section, f.end_section)
         return replace(f, start_section=start, end_section=end,
                        proportion=_per_step(f.proportion, f.end_section - f.start_section, end - start))
 
     p: PelvicFin = species.pelvic
-    ps = min(sec(p.start_section), bodies - 2)
-    pelvic = replace(p, start_circle=circ(p.start_circle), start_section=ps,
-                     end_section=max(sec(p.end_section), ps + 1))
+    ps, pe = span(p.start_section, p.end_section)
+    pelvic = replace(p, start_circle=circ(p.start_circle), start_section=ps, end_section=pe)
     q: PectoralFin = species.pectoral
     # the same arc of the ring: triangles span CircleSections
     triangles = min(max(_nearest(q.triangles * circles / c0), 1), max(circles // 2, 1))

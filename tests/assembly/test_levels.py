@@ -56,6 +56,30 @@ def test_fins_move_to_the_nearest_section_of_each_level(bony):
     assert coarse.texture_points is not None and len(coarse.texture_points.body) == 8 * 6
 
 
+def test_a_fin_whose_ends_meet_on_one_ring_spans_the_section_its_middle_lies_in():
+    """At 3x3 every random species' pelvic fin (whose ends both round to the middle ring) was
+    stretched back to the tail ring, and its trailing edge hung past the tail by up to 17 % of the
+    body. Now it spans the section its middle lies in, and no fin reaches behind the body."""
+    from fishgen.assembly.fish import build_fish
+    from fishgen.authoring.sampler import sample_species
+
+    for seed in range(100, 116):
+        species = sample_species(seed).species
+        coarse = at_level(species, 3, 3)
+        middle = (species.pelvic.start_section + species.pelvic.end_section) / 2
+        at = middle * 2 / (species.body_sections - 1)
+        assert coarse.pelvic.start_section <= at <= coarse.pelvic.end_section
+        fish = build_fish(coarse)
+        reach = {}
+        for node in fish.nodes:
+            if node.mesh is not None:
+                mesh = fish.meshes[node.mesh]
+                z = np.concatenate([p.attributes["POSITION"][:, 2] for p in mesh.primitives])
+                reach[node.name] = float(z.min() + node.translation[2])
+        tail = reach["body"]
+        assert reach["pelvic_fin_left"] >= tail and reach["pelvic_fin_right"] >= tail, seed
+
+
 def _fin_areas(species) -> dict[str, float]:
     from fishgen.assembly.fins import build_fins
     from fishgen.geometry.body import build_body
