@@ -147,6 +147,7 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
         manifest = scan_folder(source, options.out, kinds=job_kinds())
     else:
         manifest = _manifest(source, options.out)
+    _check_crossed(manifest)
     if options.report is not None:
         _check_report(options.report, manifest)
     workers = options.jobs or os.cpu_count() or 1
@@ -201,6 +202,49 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
                 BatchFacts(tuple(outcomes), seconds, workers), errors, verdict)
 
 
+def _job_reads(manifest: Manifest) -> list[tuple[Job, list[Path]]]:
+    """Each job and the files it reads: its inputs and the files they name (a species' textures, a
+    texture cloud's pictures). An input that cannot be read adds nothing here: it fails its own job
+    when that runs, not the batch."""
+    from fishgen.commands.paths import check_inputs, read_beside
+    from fishgen.exchange.registry import FORMATS
+
+    found = []
+    for job in manifest.jobs:
+        read = list(job.inputs)
+        try:
+            kinds = check_inputs(job.inputs, job.kind, list(FORMATS.values()), default=FORMATS["species"])
+            read += read_beside(job.inputs, kinds, getattr(job.options, "textures", None))
+        except FishgenError:
+            pass
+        found.append((job, read))
+    return found
+
+
+def _check_crossed(manifest: Manifest) -> None:
+    """No job writes a file another job reads, side files included (``a.gltf``'s ``a_b.png`` over
+    the picture another job's texture cloud names): checked before any job runs. Each job's run
+    checks its own inputs, knowing which images it holds; here any side file the output's format
+    may write counts, as an image's name is known only once the job has run."""
+    from fishgen.errors import UsageError
+    from fishgen.exchange.registry import written_names
+
+    writers = [(job, names) for job in manifest.jobs if len(names := written_names(job.output)) > 1]
+    if not writers:  # an output with no side files is never a file another job reads (no job reads .glb)
+        return
+    by_folder: dict[Path, list[tuple[Job, Path]]] = {}
+    for reader, paths in _job_reads(manifest):
+        for path in dict.fromkeys(paths):
+            by_folder.setdefault(Path(os.path.abspath(path)).parent.resolve(), []).append((reader, path))
+    for job, names in writers:
+        for reader, path in by_folder.get(job.output.parent.resolve(), ()):
+            name = next((n for n in names if n.matches(path.name)), None) if reader is not job else None
+            if name is not None:
+                raise UsageError(f"expected jobs that write none of each other's inputs, found {job.name}, "
+                                 f"which writes {str(name)!r} beside it, and {reader.name} "
+                                 f"({reader.where}) reads {os.fspath(path)!r}", job.source, job.line)
+
+
 def _check_report(report: Path, manifest: Manifest) -> None:
     """``--report`` is none of the files the jobs read or write, checked before any job runs: the
     manifest, each job's inputs and the files they name (a species' textures, a texture cloud's
@@ -208,9 +252,9 @@ def _check_report(report: Path, manifest: Manifest) -> None:
     from fishgen.atomic import check_writable
     from fishgen.batch import LOCK_NAME
     from fishgen.batch.record import RECORD_NAME, Record
-    from fishgen.commands.paths import check_inputs, check_targets, read_beside
+    from fishgen.commands.paths import check_targets
     from fishgen.errors import UsageError
-    from fishgen.exchange.registry import FORMATS, first_shared
+    from fishgen.exchange.registry import first_shared
 
     # realpath, not resolve(): a symlink loop is no error here, as the checks below find it
     own = {name for name in (RECORD_NAME, LOCK_NAME)
@@ -221,13 +265,7 @@ def _check_report(report: Path, manifest: Manifest) -> None:
     recorded = Record(manifest.out).jobs  # first: a file named again below is then named as given
     read = [Path(os.path.normpath(manifest.out / name)) for job in manifest.jobs
             if isinstance(inputs := recorded.get(job.name, {}).get("inputs"), dict) for name in inputs]
-    read += [*([manifest.file] if manifest.file else []), *(p for job in manifest.jobs for p in job.inputs)]
-    for job in manifest.jobs:
-        try:  # a bad input fails its own job when it runs, not the batch
-            kinds = check_inputs(job.inputs, job.kind, list(FORMATS.values()), default=FORMATS["species"])
-            read += read_beside(job.inputs, kinds, getattr(job.options, "textures", None))
-        except FishgenError:
-            pass
+    read += [*([manifest.file] if manifest.file else []), *(p for _, ps in _job_reads(manifest) for p in ps)]
     check_targets([report], read)
     check_writable(report)   # before the jobs, not after them
     clash = first_shared([report, *(job.output for job in manifest.jobs)])

@@ -143,6 +143,30 @@ def test_a_report_that_is_a_jobs_input_or_output_is_refused_before_any_job_runs(
     assert not (shipped / "out").exists()
 
 
+def test_a_job_whose_side_files_would_replace_another_jobs_input_is_refused_before_any_job_runs(tmp_path):
+    """a.gltf writes its texture cloud's picture as a_b.png, which replaced the cumulus picture
+    another job's texture cloud reads (exit 0, 2 built); the command alone refused it, as the batch
+    now does, naming both jobs."""
+    for name, picture in (("b.png", "billow.png"), ("a_b.png", "cumulus.png")):
+        shutil.copy(ROOT / "textures" / "clouds" / picture, tmp_path / name)
+    (tmp_path / "x.awa").write_text("1\n1\n1, 1,1,1, 0,0,0, 1, a_b.png\n")
+    (tmp_path / "y.awa").write_text("1\n1\n1, 1,1,1, 0,0,0, 1, b.png\n")
+    manifest = tmp_path / "m.toml"
+    manifest.write_text('out = "."\n[[clouds]]\ninput = "x.awa"\noutput = "x.glb"\n'
+                        '[[clouds]]\ninput = "y.awa"\noutput = "a.gltf"\n')
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    run = batch(manifest, "-j", "1")
+    assert run.returncode == 2 and run.stdout == "" and run.stderr.count("\n") == 1, run.stderr
+    assert run.stderr.startswith(f"{manifest}:7: expected jobs that write none of each other's inputs, "
+                                 "found a.gltf, which writes 'a_*.png' beside it, and x.glb (")
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    # apart, each job's own run is checked as before: the same two jobs in other folders both build
+    manifest.write_text(manifest.read_text().replace('output = "a.gltf"', 'output = "sub/a.gltf"'))
+    assert batch(manifest, "-j", "1").returncode == 0
+    assert (tmp_path / "a_b.png").read_bytes() == before["a_b.png"]
+    assert (tmp_path / "sub" / "a_b.png").is_file()
+
+
 @pytest.mark.parametrize("given, command", [("reef.toml", "school"), ("bonybream.txt", "build"),
                                             ("clouds/table_4_3.awn", "clouds")])
 def test_another_commands_input_given_to_batch_names_that_command(tmp_path, given, command):
