@@ -106,10 +106,11 @@ def frame(points: np.ndarray, view: str, aspect: float, azimuths=(0.0,),
         raise ValueError("frame needs at least one azimuth")
     dist, centre = best
     span = float(np.linalg.norm(hi - lo)) or 1.0
-    dist = max(dist, 1e-3 * span, 1e-6)
+    dist = max(dist, 1e-3 * span)
     d0, up0 = view_basis(view, azimuths[0])
+    depth = max(span * 1.5, dist * 1e-3)  # never a depth range of nothing (near == far)
     return Camera(eye=centre + d0 * dist, target=centre, up=up0, fov_y=FOV_Y, aspect=aspect,
-                  near=max(dist - span * 1.5, dist * 0.01), far=dist + span * 1.5, ortho=ortho)
+                  near=max(dist - depth, dist * 0.01), far=dist + depth, ortho=ortho)
 
 
 def turned(camera: Camera, view: str, azimuth: float) -> Camera:

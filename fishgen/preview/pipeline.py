@@ -10,7 +10,7 @@ import math
 import os
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -166,6 +166,15 @@ def subject_points(scene: Scene, times: Sequence[float | None],
     return np.concatenate(out), np.concatenate(reach)
 
 
+def _check_framed(camera, scene: Scene) -> None:
+    """The renderer's matrices are float32: a scene whose camera stands past its range (a cloud
+    3e38 across) would draw from infinities, so it is refused, not drawn as noise."""
+    reach = float(np.abs(camera.eye).max()) + camera.far
+    if not reach < 1e30:
+        raise FishgenError(f"expected a scene a float32 camera can frame (within 1e30 of the origin), found "
+                           f"one whose camera stands {reach:.3g} away", scene.source or scene.name)
+
+
 def frame_scene(scene: Scene, view: str, aspect: float, times: Sequence[float | None] = (None,),
                 clip: str | None = None, *, azimuths: tuple[float, ...] = (0.0,),
                 ortho: bool = False) -> Camera:
@@ -241,6 +250,7 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
             base = frame_scene(scene, options.view, options.width / options.height,
                                sorted(set(times), key=lambda t: -1 if t is None else t), options.clip,
                                azimuths=tuple(sorted(set(azimuths))), ortho=options.ortho)
+            _check_framed(base, scene)
             images = []
             shots = [(turned(base, options.view, az) if az else base, t)
                      for t, az in zip(times, azimuths, strict=True)]
@@ -329,6 +339,9 @@ def preview(inputs: Sequence[str | os.PathLike], out: str | os.PathLike, options
     frames = check_output(out, options, len(inputs), any(Path(p).suffix.lower() != ".txt" for p in inputs))
     scenes = [load_input(p, textures_dir=options.textures_dir, seed=options.seed, lighting=options.lighting)
               for p in inputs]
+    # a scene built from a species or cube file names no file of its own: its errors name the input
+    scenes = [scene if scene.source else replace(scene, source=os.fspath(p))
+              for scene, p in zip(scenes, inputs, strict=True)]
     for scene in scenes:  # e.g. a cloud previewed with fewer particles than it holds
         if on_note and scene.note:
             on_note(scene.note)

@@ -230,3 +230,24 @@ def test_lighting_options_on_an_asset_say_they_light_cube_files_only(tmp_path, a
     quiet = run_cli("preview", str(PARAMS / "clouds" / "table_4_3.awn"), "-o", str(tmp_path / "d.png"),
                     "--sun", "-1,0.2,0")
     assert quiet.returncode == 0 and "light cube files" not in quiet.stderr
+
+
+@pytest.mark.parametrize("size", ["1e-25", "1e-3"])
+def test_a_cloud_of_any_size_in_float32_range_is_drawn_framed(tmp_path, size):
+    """A cloud 1e-25 across was a ZeroDivisionError traceback (near and far were one float), and
+    until 1e-22 it was framed from 1e-6 away, a blank picture."""
+    cubes = tmp_path / "c.awn"
+    cubes.write_text(f"1\n1\n1, {size},{size},{size}, 0,0,0, {size}\n")
+    out = tmp_path / "c.png"
+    _ok(cubes, "-o", out)
+    img = np.asarray(Image.open(out).convert("RGB"), np.int32)
+    assert 0.1 < (np.abs(img - img[0, 0]).max(-1) > 10).mean() < 0.8
+
+
+def test_a_scene_past_a_float32_cameras_reach_is_one_line_not_noise(tmp_path):
+    cubes = tmp_path / "huge.awn"
+    cubes.write_text("3\n1\n3, 3e38,3e38,3e38, 0,0,0, 3e38\n")
+    result = run_cli("preview", cubes, "-o", tmp_path / "huge.png")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert result.stderr.startswith(f"{cubes}: expected a scene a float32 camera can frame")
+    assert not (tmp_path / "huge.png").exists()
