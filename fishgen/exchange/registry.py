@@ -147,16 +147,16 @@ def output_format(path: str | os.PathLike, holding: Iterable[str] = (), what: st
                                f"{found!r} ({fmt.description}, an input of `fishgen {fmt.command}`)", path)
         raise FishgenError(f"expected an {what} ending in {', '.join(extensions(usable))}, found {found!r}",
                            path)
+    missing = [k for k in need if k not in fmt.holds]
+    if missing:  # before the package: installing usd-core would not make a .usdc hold a cloud
+        raise FishgenError(f"expected a format that holds {' and '.join(missing)}, found "
+                           f"{fmt.extensions[0]} ({fmt.description}), which would lose them; use "
+                           f"{' or '.join(extensions(usable))} instead", path)
     if fmt.extra is not None:
         from fishgen.extras import needs
 
         module, package, extra = fmt.extra
         needs(module, extra, f"writing {Path(path).suffix.lower()}", package)
-    missing = [k for k in need if k not in fmt.holds]
-    if missing:
-        raise FishgenError(f"expected a format that holds {' and '.join(missing)}, found "
-                           f"{fmt.extensions[0]} ({fmt.description}), which would lose them; use "
-                           f"{' or '.join(extensions(usable))} instead", path)
     return fmt
 
 

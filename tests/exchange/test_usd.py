@@ -240,6 +240,15 @@ def test_without_usd_core_the_command_says_so_before_any_work(tmp_path, monkeypa
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_cloud_as_usd_is_refused_for_its_format_first_not_for_a_missing_package(tmp_path, monkeypatch):
+    """Without usd-core, `clouds -o x.usdc` said to install it, and once installed refused the format."""
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == "pxr" else real(name, *a))
+    made = run_cli("clouds", ROOT / "params" / "clouds" / "table_4_3.awn", "-o", tmp_path / "c.usdc")
+    assert made.returncode == 2 and "expected a format that holds points" in made.stderr, made.stderr
+
+
 def test_colour_variants_are_prototypes_that_each_fish_wears_as_in_the_glb(tmp_path):
     """--tints 2: a species' prototypes come in both colours, and each fish wears in USD the body
     colour it wears in the glb of the same seed."""
