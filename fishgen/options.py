@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import MISSING, Field, dataclass, field, fields
 from pathlib import Path
@@ -22,7 +23,7 @@ from typing import Any, TypeVar
 
 import click
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, SystemFailure
 
 OPTION = "fishgen.option"
 FLOAT32_MAX = 3.4028234663852886e38  # mirrors fishgen.numeric without importing numpy at --help time
@@ -216,8 +217,23 @@ class NamedPath(click.Path):
         return super().convert(value, param, ctx)
 
 
+class OutFolder(NamedPath):
+    """A folder written into: a file in its place is the system's refusal (status 1, as for an
+    output's folder anywhere), not a bad command line."""
+
+    def __init__(self) -> None:
+        super().__init__(file_okay=False, path_type=Path)
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, (str, os.PathLike)) and os.fspath(value) and os.path.exists(value) \
+                and not os.path.isdir(value):
+            raise SystemFailure(f"cannot write {os.fspath(value)}: expected a folder, found a file", value)
+        return super().convert(value, param, ctx)
+
+
 SEED = click.IntRange(0, SEED_MAX)
 FOLDER = NamedPath(file_okay=False, path_type=Path)
+OUT_FOLDER = OutFolder()
 FILE = NamedPath(dir_okay=False, path_type=Path)
 
 

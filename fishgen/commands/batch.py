@@ -12,7 +12,7 @@ import click
 
 from fishgen.commands import MODULES, QUIET, Command, Events, Inputs, Made, Progress, command, run
 from fishgen.errors import FishgenError, plural
-from fishgen.options import FILE, FOLDER, option
+from fishgen.options import FILE, OUT_FOLDER, option
 
 if TYPE_CHECKING:
     from fishgen.batch.manifest import Job, Kind, Manifest
@@ -20,8 +20,8 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class BatchOptions:
-    out: Path | None = option(FOLDER, "Folder for the outputs and the record (.fishgen-batch.json). Required "
-                              "with DIR.", shown_default="the manifest's `out`, else ./out")
+    out: Path | None = option(OUT_FOLDER, "Folder for the outputs and the record (.fishgen-batch.json). "
+                              "Required with DIR.", shown_default="the manifest's `out`, else ./out")
     jobs: int | None = option(click.IntRange(1, 1024), "Jobs at once, each in its own process (1: in this "
                               "process).", shown_default="the number of cores", short="-j")
     force: bool = option(click.BOOL, "Rebuild every job, even those the record says are up to date.", False,

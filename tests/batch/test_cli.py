@@ -216,3 +216,15 @@ def test_a_report_through_a_symlink_loop_is_a_line_not_a_traceback(shipped):
     said = f"fishgen: cannot write {loop / 'r.json'}: expected a folder at {loop}, found a broken symbolic " \
            "link"
     assert run.stderr.strip().splitlines() == [said] and not (shipped / "o").exists()
+
+
+def test_out_naming_a_file_is_the_systems_refusal_as_for_any_outputs_folder(shipped, tmp_path):
+    """--out FILE was click's usage error (2); a file where an output's folder should be is status 1
+    everywhere else (the README's table), as it is here now, and nothing is written."""
+    taken = tmp_path / "afile"
+    taken.write_bytes(b"mine")
+    run = batch(shipped / "params" / "assets.toml", "--out", taken)
+    assert run.returncode == 1
+    assert run.stderr == f"fishgen: cannot write {taken}: expected a folder, found a file\n"
+    assert taken.read_bytes() == b"mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "params", "textures"]
