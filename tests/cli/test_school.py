@@ -132,7 +132,8 @@ def test_school_options_reach_the_run_as_the_scene_file_keys_do(tmp_path):
     assert_valid_gltf(out)
     doc = pygltflib.GLTF2().load(str(out))
     assert doc.scenes[0].extras["fishgen_school"]["warmup"] == 1.0
-    assert len(doc.meshes) == 9 * 3                                      # three tints of every part
+    # three tints, of which these 12 fish (seed 0) wear two: every part in each worn one
+    assert len(doc.meshes) == 9 * 2 and sum("_tint2" in m.name for m in doc.meshes) == 9
     scales = {tuple(doc.nodes[n].scale or (1, 1, 1)) for n in doc.scenes[0].nodes}
     assert len(scales) == 1                                              # no size variety
     refused = run_cli("school", PARAMS / "bonybream.txt", "-o", out, "--model", "pso", "--preset", "torus")
