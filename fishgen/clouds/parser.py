@@ -201,8 +201,8 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
                        rows[0][0] if declared_total == 0 else cube_rows[0][0])
     notes: list[str] = []
     if total != declared_total:
-        notes.append(f"{name}:{rows[0][0]}: warning: declared total {declared_total} {noun}s, "
-                     f"but the cubes hold {total}; using the cubes' counts")
+        notes.append(f"{name}:{rows[0][0]}: warning: declared total {plural(declared_total, noun)}, "
+                     f"but the cubes hold {total:,}; using the cubes' counts")
         warnings.warn(notes[-1], CubeFileWarning, stacklevel=3)
     return CubeFile(path=name, declared_total=declared_total, cubes=tuple(cubes),
                     warnings=tuple(notes))
@@ -256,14 +256,15 @@ def _real(token: str, what: str, name: str, number: int, positive: bool) -> floa
         _reject_non_number(token, what, name, number)
         raise expected(f"a number for the {what}", describe(token), name, number)
     value = float(token)
+    article = "an" if what.startswith(("x ", "a", "e", "i", "o", "u")) else "a"  # an x size
     if not math.isfinite(value):  # e.g. 1e999 overflows to infinity
         raise expected(f"a finite number for the {what}", describe(token), name, number)
     if positive and value <= 0:
-        raise expected(f"a {what} greater than 0", describe(token), name, number)
+        raise expected(f"{article} {what} greater than 0", describe(token), name, number)
     # Particles are stored as float32: values it cannot hold would turn into 0 or infinity.
     if abs(value) > _FLOAT32_MAX or (positive and value < _FLOAT32_TINY):
         low = f"{_FLOAT32_TINY:.3g}" if positive else f"{-_FLOAT32_MAX:.3g}"
-        raise expected(f"a {what} within float32 range ({low} to {_FLOAT32_MAX:.3g})",
+        raise expected(f"{article} {what} within float32 range ({low} to {_FLOAT32_MAX:.3g})",
                        describe(token), name, number)
     return value
 

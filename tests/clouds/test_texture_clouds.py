@@ -70,7 +70,7 @@ def test_textures_resolve_beside_the_file_and_in_textures_beside_it(folder):
     ("1, 1, 1, 1, 0, 0, 0, 1, ../../secret.png", "expected a texture path inside"),
     ("1, 1, 1, 1, 0, 0, 0, 1, /etc/passwd.png", "expected a texture path inside"),
     ("x, 1, 1, 1, 0, 0, 0, 1, near.png", "expected a whole number for the billboard count, found 'x'"),
-    ("1, 0, 1, 1, 0, 0, 0, 1, near.png", "expected a x size greater than 0, found '0'"),
+    ("1, 0, 1, 1, 0, 0, 0, 1, near.png", "expected an x size greater than 0, found '0'"),
 ])
 def test_a_bad_cube_line_is_one_line_naming_file_and_line(folder, line, message):
     path = write(folder, f"1\n1\n\n{line}\n")

@@ -71,7 +71,7 @@ WHOLE = "x.awn:3: expected a whole number of 0 or more for the particle count"
     (EditCube(2.5, (1, 1, 1), (0, 0, 0), 1), WHOLE + ", found '2.5'"),
     (EditCube(-1, (1, 1, 1), (0, 0, 0), 1), WHOLE + ", found '-1'"),
     (EditCube(1, (1, 1, 1), (math.nan, 0, 0), 1), "x.awn:3: expected a finite number for the centre x"),
-    (EditCube(1, (1e39, 1, 1), (0, 0, 0), 1), "x.awn:3: expected a x size within float32 range"),
+    (EditCube(1, (1e39, 1, 1), (0, 0, 0), 1), "x.awn:3: expected an x size within float32 range"),
     (EditCube(0, (1, 1, 1), (0, 0, 0), 1), "x.awn:1: expected at least 1 particle in the cubes, found 0"),
 ])
 def test_values_the_parser_refuses_are_its_one_line_with_the_cube_line(cube, message):
