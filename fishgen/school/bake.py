@@ -16,13 +16,14 @@ fish that speeds up beats faster without a jump.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
 from fishgen.assembly.body_wave import wave_nodes
 from fishgen.assembly.instance import add_species
 from fishgen.geometry.body_wave import BodyWave, integrate_phase, wave_weights
-from fishgen.scene.model import Channel, Clip, Instancer, Node, Path_, Sampler, Scene
+from fishgen.scene.model import Channel, Clip, Instancer, Material, Node, Path_, Sampler, Scene
 from fishgen.scene.pose import sample
 from fishgen.school.model import Tracks
 
@@ -203,33 +204,36 @@ def _tint_variants(school: Scene, templates: list[list[Part]], tints: int, tint:
             if v not in wearing:
                 variants.append([])
                 continue
-            new_material = {}
-            for m in materials:
-                base = own_materials[m]
-                r, g, b, a = base.base_color
-                colour = (r * float(factor[0]), g * float(factor[1]), b * float(factor[2]), a)
-                tinted = replace(base, name=f"{base.name}_tint{v}", base_color=colour)
-                if in_place:
-                    school.materials[m] = tinted
-                    new_material[m] = m
-                else:
-                    new_material[m] = school.add_material(tinted)
+            new_material = {m: _placed(school.materials, m, _tint(own_materials[m], factor, v), in_place)
+                            for m in materials}
             new_mesh = {}
             for m in meshes:
                 mesh = own_meshes[m]
                 prims = [replace(p, material=None if p.material is None else new_material[p.material])
                          for p in mesh.primitives]
-                renamed = replace(mesh, name=f"{mesh.name}_tint{v}", primitives=prims)
-                if in_place:
-                    school.meshes[m] = renamed
-                    new_mesh[m] = m
-                else:
-                    new_mesh[m] = school.add_mesh(renamed)
+                new_mesh[m] = _placed(school.meshes, m, replace(mesh, name=f"{mesh.name}_tint{v}",
+                                                                primitives=prims), in_place)
             variants.append([(replace(t, mesh=None if t.mesh is None else new_mesh[t.mesh]), c, w)
                              for t, c, w in parts])
             in_place = False
         out.append(variants)
     return out
+
+
+def _tint(material: Material, factor: np.ndarray, variant: int) -> Material:
+    """``material`` as colour variant ``variant`` wears it: its base colour times ``factor``."""
+    r, g, b, a = material.base_color
+    return replace(material, name=f"{material.name}_tint{variant}",
+                   base_color=(r * float(factor[0]), g * float(factor[1]), b * float(factor[2]), a))
+
+
+def _placed(items: list, at: int, item: Any, in_place: bool) -> int:
+    """Put ``item`` at ``at`` in ``items`` (in place of what is there) or after the last; its index."""
+    if in_place:
+        items[at] = item
+        return at
+    items.append(item)
+    return len(items) - 1
 
 
 def _tint_factors(species: int, tints: int, tint: float, seed: int) -> list[list[np.ndarray]]:
@@ -374,12 +378,7 @@ def _tinted(fish: Scene, factor: np.ndarray, variant: int) -> Scene:
     """``fish`` with every material's base colour multiplied by ``factor`` (variant 0: as it is)."""
     if variant == 0:
         return fish
-    materials = []
-    for m in fish.materials:
-        r, g, b, a = m.base_color
-        materials.append(replace(m, name=f"{m.name}_tint{variant}", base_color=(
-            r * float(factor[0]), g * float(factor[1]), b * float(factor[2]), a)))
-    return replace(fish, materials=materials)
+    return replace(fish, materials=[_tint(m, factor, variant) for m in fish.materials])
 
 
 def _phase_shifted(fish: Scene, name: str, share: float, duration: float) -> Scene:
