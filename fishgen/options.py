@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 import numbers
-import os
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import MISSING, Field, dataclass, field, fields
 from pathlib import Path
@@ -23,7 +22,7 @@ from typing import Any, TypeVar
 
 import click
 
-from fishgen.errors import FishgenError, SystemFailure
+from fishgen.errors import FishgenError
 
 OPTION = "fishgen.option"
 FLOAT32_MAX = 3.4028234663852886e38  # mirrors fishgen.numeric without importing numpy at --help time
@@ -218,17 +217,12 @@ class NamedPath(click.Path):
 
 
 class OutFolder(NamedPath):
-    """A folder written into: a file in its place is the system's refusal (status 1, as for an
-    output's folder anywhere), not a bad command line."""
+    """A folder written into. A file in its place is the system's refusal (status 1), said when the
+    folder is made, after the command line and the inputs are judged, as for any output's folder;
+    click's own check made it a usage error (2), before them."""
 
     def __init__(self) -> None:
-        super().__init__(file_okay=False, path_type=Path)
-
-    def convert(self, value, param, ctx):
-        if isinstance(value, (str, os.PathLike)) and os.fspath(value) and os.path.exists(value) \
-                and not os.path.isdir(value):
-            raise SystemFailure(f"cannot write {os.fspath(value)}: expected a folder, found a file", value)
-        return super().convert(value, param, ctx)
+        super().__init__(path_type=Path)
 
 
 SEED = click.IntRange(0, SEED_MAX)
@@ -468,7 +462,8 @@ def prototypes_option() -> Any:
     # None when not given: a glb has no prototypes, and a --prototypes given with one is refused
     return option(click.IntRange(1, 64), "In a USD file (.usdc, .usda, .usdz), each species as this many "
                   "prototypes of a PointInstancer, their swim clips phase-shifted by an equal share of a "
-                  "loop; each fish wears one, seeded (more: fewer fish swim in step, a larger file).", None,
+                  "loop; each fish wears one, seeded, and only those some fish wears are written (more: "
+                  "fewer fish swim in step, a larger file).", None,
                   shown_default=str(PROTOTYPES))
 
 

@@ -45,13 +45,16 @@ class Outcome:
 def run_batch(manifest: Manifest, work: Work, *, workers: int = 1, force: bool = False,
               fail_fast: bool = False, scheduler: str | None = None, preload: Sequence[str] = (),
               started: Callable[[int], None] | None = None,
-              finished: Callable[[Outcome], None] | None = None) -> list[Outcome]:
+              finished: Callable[[Outcome], None] | None = None,
+              guarded: Callable[[list[Job]], list[Job]] | None = None) -> list[Outcome]:
     """Bring every output of ``manifest`` up to date, running each job that is not through ``work``;
     returns one outcome per job, in manifest order. ``preload``: the modules ``work`` imports (see
     :func:`fishgen.batch.runner.run_jobs`).
 
     ``started(n)`` is called once with the number of jobs that will run; ``finished`` with each
-    job's outcome as it is known (skipped ones first).
+    job's outcome as it is known (skipped ones first). ``guarded`` turns the jobs that will run into
+    the jobs to run (each with its guards), only when there are some: a batch with nothing to do
+    reads no more than the record asks.
     """
     from fishgen.batch.runner import run_jobs
 
@@ -89,7 +92,10 @@ def run_batch(manifest: Manifest, work: Work, *, workers: int = 1, force: bool =
 
         unsaved: FishgenError | None = None
         try:
-            run_jobs([job for job, _ in todo], work, done, workers=workers, scheduler=scheduler,
+            running = [job for job, _ in todo]
+            if running and guarded is not None:
+                running = guarded(running)
+            run_jobs(running, work, done, workers=workers, scheduler=scheduler,
                      fail_fast=fail_fast, preload=preload)
         finally:
             # once, durably, however the run ended; an unreadable record is replaced once this run

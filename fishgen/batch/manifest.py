@@ -25,7 +25,7 @@ from __future__ import annotations
 import hashlib
 import os
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path, PurePosixPath
 from typing import Any
 
@@ -61,6 +61,8 @@ class Job:
     options: Any = None              # the command's options record
     source: str = ""                 # the manifest (or the input of a folder scan) naming the job
     line: int | None = None          # the job's output line in its manifest
+    # other jobs' inputs in this job's output folder, which its writers may not replace
+    guard: tuple[Path, ...] = field(default=(), compare=False, repr=False)
 
     @property
     def where(self) -> str:

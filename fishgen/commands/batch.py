@@ -4,7 +4,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Sequence
 from contextlib import ExitStack
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -21,7 +21,8 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class BatchOptions:
     out: Path | None = option(OUT_FOLDER, "Folder for the outputs and the record (.fishgen-batch.json). "
-                              "Required with DIR.", shown_default="the manifest's `out`, else ./out")
+                              "Required with DIR.", shown_default="the manifest's `out`, else ./out",
+                              metavar="DIRECTORY")
     jobs: int | None = option(click.IntRange(1, 1024), "Jobs at once, each in its own process (1: in this "
                               "process).", shown_default="the number of cores", short="-j")
     force: bool = option(click.BOOL, "Rebuild every job, even those the record says are up to date.", False,
@@ -74,7 +75,10 @@ def job_kinds() -> tuple[Kind, ...]:
 def run_job(job: Job, note: Callable[[str], None]) -> tuple[tuple[Path, ...], tuple[Path, ...]]:
     """One batch job: its command's library function, run as the CLI runs it, quiet but for its notes
     (the batch's :data:`~fishgen.batch.jobs.Work`); the files it read and wrote."""
-    made = run(command(job.kind), job.inputs, job.output, job.options, Events(note=note, summary=False))
+    from fishgen.atomic import protecting
+
+    with protecting(job.guard):
+        made = run(command(job.kind), job.inputs, job.output, job.options, Events(note=note, summary=False))
     return made.read, made.written
 
 
@@ -147,9 +151,15 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
         manifest = scan_folder(source, options.out, kinds=job_kinds())
     else:
         manifest = _manifest(source, options.out)
-    _check_crossed(manifest)
+    reads: list = []
+
+    def job_reads() -> list[tuple[Job, list[Path]]]:   # once, and only if asked: loading imports numpy
+        if not reads:
+            reads.extend(_job_reads(manifest))
+        return reads
+
     if options.report is not None:
-        _check_report(options.report, manifest)
+        _check_report(options.report, manifest, job_reads())
     workers = options.jobs or os.cpu_count() or 1
     with ExitStack() as stack:
         bar: list[Progress] = []
@@ -166,7 +176,7 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
             outcomes = run_batch(manifest, run_job, workers=workers, force=options.force,
                                  fail_fast=options.fail_fast, scheduler=options.scheduler,
                                  preload=preload({job.kind for job in manifest.jobs}), started=started,
-                                 finished=finished)
+                                 finished=finished, guarded=lambda jobs: _guarded(jobs, job_reads()))
         except RecordNotSaved as err:  # the summary still says what ran, then why the record did not
             outcomes, unsaved = err.outcomes, err
     seconds = time.perf_counter() - start
@@ -221,31 +231,26 @@ def _job_reads(manifest: Manifest) -> list[tuple[Job, list[Path]]]:
     return found
 
 
-def _check_crossed(manifest: Manifest) -> None:
-    """No job writes a file another job reads, side files included (``a.gltf``'s ``a_b.png`` over
-    the picture another job's texture cloud names): checked before any job runs. Each job's run
-    checks its own inputs, knowing which images it holds; here any side file the output's format
-    may write counts, as an image's name is known only once the job has run."""
-    from fishgen.errors import UsageError
-    from fishgen.exchange.registry import written_names
-
-    writers = [(job, names) for job in manifest.jobs if len(names := written_names(job.output)) > 1]
-    if not writers:  # an output with no side files is never a file another job reads (no job reads .glb)
-        return
-    by_folder: dict[Path, list[tuple[Job, Path]]] = {}
-    for reader, paths in _job_reads(manifest):
-        for path in dict.fromkeys(paths):
-            by_folder.setdefault(Path(os.path.abspath(path)).parent.resolve(), []).append((reader, path))
-    for job, names in writers:
-        for reader, path in by_folder.get(job.output.parent.resolve(), ()):
-            name = next((n for n in names if n.matches(path.name)), None) if reader is not job else None
-            if name is not None:
-                raise UsageError(f"expected jobs that write none of each other's inputs, found {job.name}, "
-                                 f"which writes {str(name)!r} beside it, and {reader.name} "
-                                 f"({reader.where}) reads {os.fspath(path)!r}", job.source, job.line)
+def _guarded(jobs: list[Job], reads: list[tuple[Job, list[Path]]]) -> list[Job]:
+    """``jobs`` each guarded against replacing the files any job reads in its output folder: a side
+    file (``a.gltf``'s ``a_b.png``) over another job's texture cloud picture. Which side files a
+    job writes is known only as it writes them (the images it holds), so its writers refuse such a
+    file then, as a command's writers refuse its own inputs; the job fails, and the others run.
+    Only files in some output folder are guards: most batches have none."""
+    folders = {job.output.parent.resolve() for job in jobs}
+    by_folder: dict[Path, list[Path]] = {}
+    for _, paths in reads:
+        for path in paths:
+            folder = Path(os.path.abspath(path)).parent.resolve()
+            if folder in folders:
+                by_folder.setdefault(folder, []).append(path)
+    if not by_folder:
+        return jobs
+    guards = {folder: tuple(dict.fromkeys(paths)) for folder, paths in by_folder.items()}
+    return [replace(job, guard=guards.get(job.output.parent.resolve(), ())) for job in jobs]
 
 
-def _check_report(report: Path, manifest: Manifest) -> None:
+def _check_report(report: Path, manifest: Manifest, reads: list[tuple[Job, list[Path]]]) -> None:
     """``--report`` is none of the files the jobs read or write, checked before any job runs: the
     manifest, each job's inputs and the files they name (a species' textures, a texture cloud's
     pictures, what the record says a job read last time), and each job's output and side files."""
@@ -265,7 +270,7 @@ def _check_report(report: Path, manifest: Manifest) -> None:
     recorded = Record(manifest.out).jobs  # first: a file named again below is then named as given
     read = [Path(os.path.normpath(manifest.out / name)) for job in manifest.jobs
             if isinstance(inputs := recorded.get(job.name, {}).get("inputs"), dict) for name in inputs]
-    read += [*([manifest.file] if manifest.file else []), *(p for _, ps in _job_reads(manifest) for p in ps)]
+    read += [*([manifest.file] if manifest.file else []), *(p for _, ps in reads for p in ps)]
     check_targets([report], read)
     check_writable(report)   # before the jobs, not after them
     clash = first_shared([report, *(job.output for job in manifest.jobs)])

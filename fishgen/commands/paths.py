@@ -46,11 +46,20 @@ def check_inputs(paths: Iterable[str | os.PathLike], command: str, kinds: Sequen
 def read_beside(inputs: Sequence[Path], kinds: Sequence[Format],
                 textures: str | os.PathLike | None = None) -> list[Path]:
     """The files source inputs read besides themselves, found before any work so that no output
-    replaces one: a species file's textures, a texture cloud's pictures (``kinds``: each input's
-    format, as :func:`check_inputs` found it; ``textures``: the command's ``--textures``)."""
+    replaces one: a species file's textures, a texture cloud's pictures, a school scene's species
+    files, their textures and its path files (``kinds``: each input's format, as
+    :func:`check_inputs` found it; ``textures``: the command's ``--textures``)."""
     found: list[Path] = []
     for path, kind in zip(inputs, kinds, strict=True):
-        if kind.name == "species":
+        if kind.name == "school scene":
+            from fishgen.exchange.registry import FORMATS
+            from fishgen.school.scene_file import load_scene_file
+
+            scene = load_scene_file(path)
+            species = [entry.file for entry in scene.species]
+            found += [*species, *scene.read]
+            found += read_beside(species, [FORMATS["species"]] * len(species), textures)
+        elif kind.name == "species":
             from fishgen.species.parser import load_species
 
             found += load_species(path, textures).side_files

@@ -168,11 +168,19 @@ def subject_points(scene: Scene, times: Sequence[float | None],
 
 def _check_framed(camera, scene: Scene) -> None:
     """The renderer's matrices are float32: a scene whose camera stands past its range (a cloud
-    3e38 across) would draw from infinities, so it is refused, not drawn as noise."""
+    3e38 across) would draw from infinities, and one too small for float32 at its distance from
+    the origin (1e-8 across at 1,1,1: the eye and the target one float) from nothing; each is
+    refused, not drawn as noise or a blank picture."""
     reach = float(np.abs(camera.eye).max()) + camera.far
     if not reach < 1e30:
         raise FishgenError(f"expected a scene a float32 camera can frame (within 1e30 of the origin), found "
                            f"one whose camera stands {reach:.3g} away", scene.source or scene.name)
+    away = float(np.linalg.norm(camera.eye - camera.target))
+    where = float(np.abs(camera.target).max())
+    if away < 4 * float(np.finfo(np.float32).eps) * where:
+        raise FishgenError(f"expected a scene large enough for a float32 camera at its distance from the "
+                           f"origin, found the camera {away:.3g} from a scene {where:.3g} from the origin",
+                           scene.source or scene.name)
 
 
 def frame_scene(scene: Scene, view: str, aspect: float, times: Sequence[float | None] = (None,),

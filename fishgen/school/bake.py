@@ -351,8 +351,9 @@ def bake_prototypes(fish_scenes: list[Scene], tracks: Tracks, *, prototypes: int
     """The school as one :class:`Instancer`: ``prototypes`` copies of each species' fish (of each of
     its ``tints`` colour variants, as :func:`bake` tints them and its fish wear them) whose swim
     clips run phase-shifted (by 1/``prototypes`` of a loop each) over the whole run, and every fish
-    one of its species' prototypes, seeded, placed every frame by its tracks. Fish of one prototype
-    share one pose: the tail beats at the species' own speed, not the fish's (:func:`bake`'s)."""
+    one of its species' prototypes, seeded, placed every frame by its tracks; only the prototypes
+    some fish is are kept. Fish of one prototype share one pose: the tail beats at the species' own
+    speed, not the fish's (:func:`bake`'s)."""
     times = np.asarray(tracks.times, np.float64)
     duration = float(times[-1]) if len(times) else 0.0
     factors = _tint_factors(len(fish_scenes), tints, tint, seed)

@@ -143,28 +143,65 @@ def test_a_report_that_is_a_jobs_input_or_output_is_refused_before_any_job_runs(
     assert not (shipped / "out").exists()
 
 
-def test_a_job_whose_side_files_would_replace_another_jobs_input_is_refused_before_any_job_runs(tmp_path):
-    """a.gltf writes its texture cloud's picture as a_b.png, which replaced the cumulus picture
-    another job's texture cloud reads (exit 0, 2 built); the command alone refused it, as the batch
-    now does, naming both jobs."""
+def _two_pictures(folder):
     for name, picture in (("b.png", "billow.png"), ("a_b.png", "cumulus.png")):
-        shutil.copy(ROOT / "textures" / "clouds" / picture, tmp_path / name)
+        shutil.copy(ROOT / "textures" / "clouds" / picture, folder / name)
+    (folder / "y.awa").write_text("1\n1\n1, 1,1,1, 0,0,0, 1, b.png\n")   # a.gltf of it writes a_b.png
+
+
+def test_a_job_whose_side_file_would_replace_another_jobs_input_fails_and_the_input_is_kept(tmp_path):
+    """a.gltf wrote its texture cloud's picture as a_b.png over the cumulus picture another job's
+    texture cloud reads (exit 0, 2 built). Its writers now refuse it as they refuse its own inputs:
+    that job fails in one line, leaving nothing, and the other builds."""
+    _two_pictures(tmp_path)
     (tmp_path / "x.awa").write_text("1\n1\n1, 1,1,1, 0,0,0, 1, a_b.png\n")
-    (tmp_path / "y.awa").write_text("1\n1\n1, 1,1,1, 0,0,0, 1, b.png\n")
     manifest = tmp_path / "m.toml"
     manifest.write_text('out = "."\n[[clouds]]\ninput = "x.awa"\noutput = "x.glb"\n'
                         '[[clouds]]\ninput = "y.awa"\noutput = "a.gltf"\n')
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    for workers in ("1", "2"):
+        run = batch(manifest, "-j", workers)
+        assert run.returncode == 2, run.stderr
+        assert run.stderr.splitlines() == [
+            f"fishgen batch: a.gltf: expected an output that is not one of the command's inputs, found "
+            f"'{tmp_path / 'a_b.png'}', which is the input '{tmp_path / 'a_b.png'}'",
+            "fishgen: 1 of 2 jobs failed (each said why above)"]
+        assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.name in before} == before
+        assert not (tmp_path / "a.gltf").exists() and not (tmp_path / "a.bin").exists()
+        assert (tmp_path / "x.glb").is_file()
+
+
+def test_a_school_scenes_textures_are_guarded_too(tmp_path):
+    """A scene file's species' texture was not among the files a batch knew its jobs read."""
+    _two_pictures(tmp_path)
+    text = (PARAMS / "bonybream.txt").read_text()
+    (tmp_path / "bony.txt").write_text(text.replace("bonybream.png bonybream_mask.png", "a_b.png a_m.png"))
+    shutil.copy(ROOT / "textures" / "bonybream_mask.png", tmp_path / "a_m.png")
+    (tmp_path / "sch.toml").write_text('[[species]]\nfile = "bony.txt"\ncount = 3\n')
+    manifest = tmp_path / "m.toml"
+    manifest.write_text('out = "."\n[[school]]\ninput = "sch.toml"\noutput = "s.glb"\nframes = 10\n'
+                        '[[clouds]]\ninput = "y.awa"\noutput = "a.gltf"\n')
+    skin = (tmp_path / "a_b.png").read_bytes()
     run = batch(manifest, "-j", "1")
-    assert run.returncode == 2 and run.stdout == "" and run.stderr.count("\n") == 1, run.stderr
-    assert run.stderr.startswith(f"{manifest}:7: expected jobs that write none of each other's inputs, "
-                                 "found a.gltf, which writes 'a_*.png' beside it, and x.glb (")
-    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
-    # apart, each job's own run is checked as before: the same two jobs in other folders both build
-    manifest.write_text(manifest.read_text().replace('output = "a.gltf"', 'output = "sub/a.gltf"'))
-    assert batch(manifest, "-j", "1").returncode == 0
-    assert (tmp_path / "a_b.png").read_bytes() == before["a_b.png"]
-    assert (tmp_path / "sub" / "a_b.png").is_file()
+    assert run.returncode == 2 and "a.gltf: expected an output that is not one of" in run.stderr
+    assert (tmp_path / "a_b.png").read_bytes() == skin and (tmp_path / "s.glb").is_file()
+
+
+def test_a_side_file_pattern_alone_refuses_nothing(shipped):
+    """bonybream.gltf writes bonybream_skin.png: the species' own bonybream_mask.png, which the
+    pattern bonybream_*.png would match, is no reason to refuse a batch that reads it."""
+    folder = shipped / "params"
+    for name in ("bonybream.png", "bonybream_mask.png"):
+        shutil.copy(shipped / "textures" / name, folder / name)
+    manifest = folder / "m.toml"
+    manifest.write_text('out = "."\n[[build]]\ninput = "bonybream.txt"\noutput = "bonybream.gltf"\n'
+                        '[[school]]\ninput = "bonybream.txt"\noutput = "school.glb"\n'
+                        'count = 3\nframes = 10\n')
+    pictures = {name: (folder / name).read_bytes() for name in ("bonybream.png", "bonybream_mask.png")}
+    run = batch(manifest, "-j", "1")
+    assert run.returncode == 0, run.stderr
+    assert {name: (folder / name).read_bytes() for name in pictures} == pictures
+    assert (folder / "bonybream_skin.png").is_file()
 
 
 @pytest.mark.parametrize("given, command", [("reef.toml", "school"), ("bonybream.txt", "build"),
@@ -225,6 +262,6 @@ def test_out_naming_a_file_is_the_systems_refusal_as_for_any_outputs_folder(ship
     taken.write_bytes(b"mine")
     run = batch(shipped / "params" / "assets.toml", "--out", taken)
     assert run.returncode == 1
-    assert run.stderr == f"fishgen: cannot write {taken}: expected a folder, found a file\n"
+    assert run.stderr == f"fishgen: cannot write {taken}: expected a folder at {taken}, found a file\n"
     assert taken.read_bytes() == b"mine"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "params", "textures"]

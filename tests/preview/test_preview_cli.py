@@ -233,7 +233,7 @@ def test_lighting_options_on_an_asset_say_they_light_cube_files_only(tmp_path, a
 
 
 @pytest.mark.parametrize("size", ["1e-25", "1e-3"])
-def test_a_cloud_of_any_size_in_float32_range_is_drawn_framed(tmp_path, size):
+def test_a_cloud_at_the_origin_of_any_size_in_float32_range_is_drawn_framed(tmp_path, size):
     """A cloud 1e-25 across was a ZeroDivisionError traceback (near and far were one float), and
     until 1e-22 it was framed from 1e-6 away, a blank picture."""
     cubes = tmp_path / "c.awn"
@@ -251,3 +251,12 @@ def test_a_scene_past_a_float32_cameras_reach_is_one_line_not_noise(tmp_path):
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert result.stderr.startswith(f"{cubes}: expected a scene a float32 camera can frame")
     assert not (tmp_path / "huge.png").exists()
+
+
+def test_a_cloud_too_small_for_float32_where_it_is_is_one_line_not_a_blank_picture(tmp_path):
+    """1e-8 across at (1, 1, 1): the eye and the target were one float32, and the picture blank."""
+    cubes = tmp_path / "c.awn"
+    cubes.write_text("1\n1\n1, 1e-8,1e-8,1e-8, 1,1,1, 1e-8\n")
+    result = run_cli("preview", cubes, "-o", tmp_path / "c.png")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert result.stderr.startswith(f"{cubes}: expected a scene large enough for a float32 camera")
