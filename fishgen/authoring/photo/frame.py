@@ -24,6 +24,11 @@ STEEPEST_AXIS = 30.0
 #: vertical this many times deeper than any along the horizontal says the fish stands on end. Such a
 #: photo is refused: fish within STEEPEST_AXIS degrees of level are supported.
 STANDING_NECK = 1.5
+#: A midline still this many degrees off level once turned (the nose or tail base found on the
+#: turned fish is another point than on the first turn) is levelled again, up to RELEVELS times.
+#: Within it the fit's own turns (:data:`.run.TURNS`, 2 degrees and more) take the rest.
+RELEVEL_DEGREES = 2.0
+RELEVELS = 6
 
 
 @dataclass(frozen=True)
@@ -86,13 +91,42 @@ def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
     level, _ = _resample(mask, flip @ _rotation(-theta))
     from fishgen.authoring.photo.anatomy import nose_and_tail_base
 
-    (nx, ny), (px, py) = nose_and_tail_base(level, drop=tail_drop)
-    delta = float(np.degrees(np.arctan2(py - ny, px - nx)))
+    def midline(level: np.ndarray) -> float:
+        (nx, ny), (px, py) = nose_and_tail_base(level, drop=tail_drop)
+        return float(np.degrees(np.arctan2(py - ny, px - nx)))
+
+    def levelled(phi: float) -> tuple[float, float, np.ndarray, np.ndarray, np.ndarray]:
+        """(midline's degrees off level, phi, linear, mask, shift) with the fish turned by phi,
+        then levelled again on its own turn while it is RELEVEL_DEGREES off, up to RELEVELS times."""
+        linear = flip @ _rotation(-phi)
+        out, shift = _resample(mask, linear)
+        best = (midline(out), phi, linear, out, shift)
+        for _ in range(RELEVELS):
+            if abs(best[0]) <= RELEVEL_DEGREES:
+                break
+            phi = best[1] - best[0] if mirrored else best[1] + best[0]
+            linear = flip @ _rotation(-phi)
+            out, shift = _resample(mask, linear)
+            if abs(midline(out)) >= abs(best[0]):
+                break
+            best = (midline(out), phi, linear, out, shift)
+        return best
+
+    delta = midline(level)
     phi = theta - delta if mirrored else theta + delta
     if abs(phi) < LEVEL_DEGREES:
         phi = 0.0
-    linear = flip @ _rotation(-phi)
-    out, shift = _resample(mask, linear)
+    # The nose is the silhouette's first columns and the tail base its deepest neck, both read on
+    # the fish as first turned; once turned by phi a blunt head's other corner, or another neck,
+    # may lead, and the midline is then many degrees off level (704: turned 15 degrees, still 8
+    # off; the principal axis, 21 degrees, was pulled off by tall fins on a fish nearly as tall as
+    # long). Such a fish is levelled again on its own turn, and also from level (side photos show
+    # fish about level): the turn whose midline ends nearest level, within STEEPEST_AXIS, is kept.
+    settled = levelled(phi)
+    if settled[1] != phi or abs(settled[1]) > STEEPEST_AXIS:
+        tries = [settled, levelled(0.0)]
+        settled = min(tries, key=lambda t: (abs(t[1]) > STEEPEST_AXIS, abs(t[0])))
+    _, phi, linear, out, shift = settled
     return Frame(linear, shift, out, phi, mirrored)
 
 
