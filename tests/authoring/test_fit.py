@@ -305,3 +305,28 @@ def test_a_belly_strip_does_not_join_the_pelvic_fin_to_the_anal_fin():
     assert runs == [(1, 7), (12, 21)]
     falling = np.array([0, 60, 50, 30, 12, 6, 5, 4, 4, 0])   # a dorsal's long low end
     assert _runs(_valleys_out(falling, falling > 3)) == [(1, 9)]
+
+
+def test_a_pelvic_fin_swept_back_under_the_anal_fin_is_read_as_two_fins():
+    """A long pelvic fin swept back under the anal fin's front shares columns with it, and no
+    valley parts them: the two were read as one anal fin from the pelvic's base to the anal's
+    end, long, and the pelvic fin was the throat's sliver (the Blender photos 301, 401, 701, 1206).
+    Clear of the body they are two parts, each read as its own fin."""
+    from PIL import Image, ImageDraw
+
+    from fishgen.authoring.photo.frame import fish_frame
+    from fishgen.authoring.photo.measure import measure_body, measured, working_mask
+
+    img = Image.new("L", (420, 260), 0)
+    pen = ImageDraw.Draw(img)
+    pen.ellipse((40, 80, 280, 160), fill=255)                                  # body
+    pen.polygon([(275, 120), (330, 80), (315, 120), (330, 160)], fill=255)     # caudal fin
+    pen.polygon([(130, 80), (180, 82), (150, 30)], fill=255)                   # dorsal fin
+    pen.polygon([(110, 150), (135, 154), (215, 225), (205, 228)], fill=255)    # pelvic, swept back
+    pen.polygon([(190, 155), (240, 148), (200, 200)], fill=255)                # anal fin
+    work, _, _ = working_mask(fish_frame(np.asarray(img) > 127).mask)
+    body = measure_body(work)
+    sp, _ = measured(load_species(PARAMS / "bonybream.txt"), work, body)
+    assert sp.pelvic.end_length > 0.8, sp.pelvic          # its long blade (0.27 read as one fin)
+    assert sp.anal.start_section > sp.pelvic.start_section + 2, (sp.anal, sp.pelvic)
+    assert sp.anal.start_length < 1.0, sp.anal            # the anal fin alone (1.40 with the pelvic)
