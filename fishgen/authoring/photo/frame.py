@@ -26,8 +26,8 @@ STEEPEST_AXIS = 30.0
 STANDING_NECK = 1.5
 #: A midline still this many degrees off level once turned (the nose or tail base found on the
 #: turned fish is another point than on the first turn) is levelled again, up to RELEVELS times.
-#: Within it the fit's own turns (:data:`.run.TURNS`, 2 degrees and more) take the rest.
-RELEVEL_DEGREES = 2.0
+#: Within it the fit's own turns (:data:`.run.TURNS`, up to 4 degrees) take the rest.
+RELEVEL_DEGREES = 4.0
 RELEVELS = 6
 
 
