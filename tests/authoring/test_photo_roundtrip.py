@@ -176,3 +176,29 @@ def test_a_fish_near_the_line_at_half_coverage_is_said_so(tmp_path, gl_available
     # widened until the line takes in every figure under 1
     monkeypatch.setattr(run_module, "RENDERERS_DIFFER", 0.15)
     _said(path, species, tmp_path / "a.txt", "at least half", "within 0.15 of 0.85")
+
+
+def test_a_thin_thread_of_the_outline_stays_in_the_mask_texture():
+    """A fin's last thread, a pixel or two wide in the photo's outline, was a pixel or two wide in
+    the mask texture too, and a glTF client filtering it (Blender: bilinear, clipped at half) read
+    it under half and trimmed the fin's tip (401 on Centroberyx: 0.873 every triangle, 0.840 as
+    shown). A fitted fish's mask widens a thread narrower than 3 px by a pixel each side; the rest
+    keeps its outline, and so does the base geometry's mask (its fins are not fitted to the threads)."""
+    import io
+
+    from PIL import Image
+
+    from fishgen.authoring.photo.image import Photo
+    from fishgen.authoring.photo.run import texture_bytes
+
+    mask = np.zeros((60, 80), bool)
+    mask[20:40, 10:50] = True          # a body
+    mask[29, 50:75] = True             # a 1-px thread off it
+    photo = Photo(np.full((60, 80, 3), 128, np.uint8), None, None)
+    _, plain = texture_bytes(photo, photo, mask)
+    assert ((np.asarray(Image.open(io.BytesIO(plain)))[::-1] >= 128) == mask).all()
+    _, written = texture_bytes(photo, photo, mask, threads=True)
+    got = np.asarray(Image.open(io.BytesIO(written)))[::-1] >= 128   # stored upside down
+    assert got[28:31, 52:74].all()                                   # the thread, 3 px wide
+    assert (got[20:40, 10:50] == mask[20:40, 10:50]).all() and not got[:19].any() and not got[41:].any()
+    assert not got[20:27, 50:].any() and not got[32:40, 50:].any()

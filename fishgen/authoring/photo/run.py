@@ -177,11 +177,15 @@ def measure(photo: Photo, base: Species, mask: np.ndarray, spacing: str = "proje
     return Measured(TexturePoints(**parts), a.frame.mask, a.frame.angle, a.frame.mirrored, unseen, a.frame)
 
 
-def texture_bytes(original: Photo, work: Photo, mask: np.ndarray) -> tuple[bytes, bytes]:
+def texture_bytes(original: Photo, work: Photo, mask: np.ndarray,
+                  threads: bool = False) -> tuple[bytes, bytes]:
     """(colour, mask) PNGs stored upside down as VRFish wants them (chapter 6), from the photo at
     up to MAX_TEXTURE_SIDE pixels a side. The background around the fish takes the nearest fish
     colour, so blended fin edges and mipmaps show fish, not the photo's backdrop; the mask keeps
-    the true outline. ``mask`` is the silhouette measured on ``work``."""
+    the true outline. ``mask`` is the silhouette measured on ``work``. With ``threads`` (a fitted
+    fish's), a part of the outline under 3 px wide is a pixel wider each side in the mask: a fitted
+    fin reaches out along the photo's thread, and a client filtering a 1-px thread (Blender:
+    bilinear, clipped at half) reads it under half and trims the fin's tip."""
     from PIL import Image, ImageOps
     from scipy import ndimage
 
@@ -195,6 +199,9 @@ def texture_bytes(original: Photo, work: Photo, mask: np.ndarray) -> tuple[bytes
     if bw.size != colour.size:   # measured on a smaller copy: a smooth edge, not blocks
         bw = bw.resize(colour.size, Image.Resampling.BILINEAR).point(lambda v: 255 if v >= 128 else 0)
     fish = np.asarray(bw) >= 128
+    if threads:
+        thin = fish & ~ndimage.binary_opening(fish, structure=np.ones((3, 3), bool))
+        bw = Image.fromarray((fish | ndimage.binary_dilation(thin)).astype(np.uint8) * 255, "L")
     _, (iy, ix) = ndimage.distance_transform_edt(~fish, return_indices=True)
     colour = Image.fromarray(np.ascontiguousarray(np.asarray(colour)[iy, ix]), "RGB")
     out = []
@@ -288,8 +295,9 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         # -> 0.777; its points moved onto the bare silhouette: 0.838, the tip's 1 px thread too thin
         # to hold). So that fit's mask is cut from its own target. Without the lens it stays bare:
         # three.js's water fits lost up to 0.03 with faint edges (docs/blender-photos.md).
-        seen_textures = texture_bytes(original, photo, target) \
-            if distance is not None and target is not sil.mask else None
+        # A fitted fin reaches out along the photo's 1-px threads: its mask keeps them (threads=True).
+        seen = target if distance is not None and target is not sil.mask else sil.mask
+        seen_textures = texture_bytes(original, photo, seen, threads=True)
         for k, turn in enumerate((0.0, *TURNS)):
             if tried is not None and tried[1] >= TURN_GOOD:
                 step(LEVELS - k + 1)  # the level just fitted, and those left unneeded
@@ -306,7 +314,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
             if found:
                 continue
             candidate = _candidate(photo, sil.mask, attempt.species, out, options, imported,
-                                   seen_textures or textures, attempt, distance=distance)
+                                   seen_textures, attempt, distance=distance)
             rendered = _rendered(photo, candidate, out, distance)
             # another level is kept only for a clear gain: the renders differ by a little anyway
             if tried is None or rendered[1] >= tried[1] + TURN_GAIN:
