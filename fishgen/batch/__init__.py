@@ -98,9 +98,10 @@ def run_batch(manifest: Manifest, work: Work, *, workers: int = 1, force: bool =
             run_jobs(running, work, done, workers=workers, scheduler=scheduler,
                      fail_fast=fail_fast, preload=preload)
         finally:
-            # once, durably, however the run ended; an unreadable record is replaced once this run
-            # has something to put in its place (it started empty)
-            if todo and (record.jobs or not record.damaged):
+            # once, durably, however the run ended, when a job was built: a batch whose every job
+            # failed writes no record it did not have (and an unreadable one stays until this run
+            # has something to put in its place)
+            if record.changed:
                 try:
                     record.save()
                 except FishgenError as err:  # a full disk: the outputs are whole, their record is not

@@ -113,6 +113,7 @@ class Record:
         self.path = out / RECORD_NAME
         self.jobs: dict[str, dict[str, Any]] = {}
         self.damaged = False  # unreadable: every job rebuilds, and the next save repairs it
+        self.changed = False  # a job's entry was put since the file was read
         self._saved = time.monotonic()
         try:
             data = json.loads(self.path.read_bytes())
@@ -173,6 +174,7 @@ class Record:
         A failed job keeps its old entry: its old output is still there, whole, and its changed
         inputs make it run again."""
         self.jobs[name] = entry
+        self.changed = True
         if time.monotonic() - self._saved >= SAVE_INTERVAL:
             try:
                 self.save(durable=False)

@@ -120,8 +120,8 @@ def test_a_full_disk_says_one_line_per_failed_job_and_one_summary(shipped, monke
     assert run.stderr.splitlines() == [
         f"cannot write {out / 'a.ply'}: No space left on device",
         f"cannot write {out / 'b.ply'}: No space left on device",
-        f"fishgen: 2 of 2 jobs failed (each said why above); cannot write {out / '.fishgen-batch.json'}: "
-        f"No space left on device; cannot write {shipped / 'report.json'}: No space left on device"]
+        f"fishgen: 2 of 2 jobs failed (each said why above); cannot write {shipped / 'report.json'}: "
+        f"No space left on device"]   # no job built: no record to write, where there was none
     assert run.stdout.startswith(f"{out}: 2 jobs, 0 built, 0 skipped, 2 failed in ")
     assert [p.name for p in out.rglob("*") if p.is_file()] == [".fishgen-batch.lock"]
 
@@ -265,3 +265,14 @@ def test_out_naming_a_file_is_the_systems_refusal_as_for_any_outputs_folder(ship
     assert run.stderr == f"fishgen: cannot write {taken}: expected a folder at {taken}, found a file\n"
     assert taken.read_bytes() == b"mine"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "params", "textures"]
+
+
+def test_a_batch_whose_every_job_fails_writes_no_record(shipped):
+    """It wrote an empty record where there was none (the eleventh QA pass); the lock, which
+    keeps two batches out of one folder, stays, as after every batch."""
+    manifest = shipped / "params" / "m.toml"
+    manifest.write_text('[[clouds]]\ninput = "clouds/table_4_3.awn"\noutput = "x.glb"\nmax-particles = 10\n')
+    out = shipped / "o"
+    run = batch(manifest, "--out", out)
+    assert run.returncode == 2, run.stderr
+    assert [p.name for p in out.iterdir()] == [".fishgen-batch.lock"]
