@@ -132,7 +132,8 @@ def sky(inputs: Sequence[Path], output: str | os.PathLike, options: SkyOptions =
     sun = ",".join(f"{v:g}" for v in options.lighting.sun)
     line = (f"{output}: {built.mode} sky, {len(built.clouds)} clouds, {built.particles:,} particles"
             + (f" (+{built.distant_particles:,} in distant levels)" if built.distant_particles else "")
-            + f", {size / 1e6:.1f} MB (seed {options.seed}, sun {sun})")
+            + f", {f'{size / 1e6:.1f} MB' if size >= 50_000 else f'{size / 1e3:.0f} KB'}"  # not "0.0 MB"
+            + f" (seed {options.seed}, sun {sun})")
     facts = SkyFacts(built.mode, len(built.clouds), built.particles, built.distant_particles, size,
                      options.seed)
     return Made(tuple(written), (*built.models, *built.textures), (line,), facts)

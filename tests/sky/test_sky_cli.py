@@ -11,7 +11,7 @@ import pytest
 from fishgen.commands.sky import SkyOptions, sky
 from fishgen.sky.modes import LOD_LEVELS, MODES
 from fishgen.sky.scene import LEVELS_IN_A_SCENE
-from tests.conftest import PARAMS, assert_valid_gltf, validate_gltf
+from tests.conftest import PARAMS, assert_valid_gltf, run_cli, validate_gltf
 
 
 def glb_json(path: Path) -> dict:
@@ -185,3 +185,11 @@ def test_max_particles_bounds_the_sky_not_the_model_files_it_re_fills(tmp_path, 
                   "-o", tmp_path / "s.glb")
         assert run.returncode == 0, run.stderr
         assert "500 particles" in run.stdout
+
+
+def test_a_small_skys_summary_says_its_size_in_kilobytes(tmp_path):
+    """400 particles said "0.0 MB"."""
+    path = tmp_path / "s.glb"
+    made = run_cli("sky", "--mode", "thin", "--particles", "400", "-o", path)
+    assert made.returncode == 0, made.stderr
+    assert f", {path.stat().st_size / 1e3:.0f} KB (seed 0" in made.stdout
