@@ -39,9 +39,10 @@ def check_output(path: str | os.PathLike, billboards: bool = False, particles: i
 
         most = (GLB_LIMIT - GLTF_HEADROOM) // (BILLBOARD_BYTES if billboards else POINT_BYTES)
         if particles > most:
-            raise FishgenError(f"expected at most {most:,} particles for {'--billboards ' * billboards}"
-                               f"glTF (4 GiB buffer limit), found {particles:,}; use .ply, .csv or .npy",
-                               path)
+            drawn = "billboards" if billboards else "points"   # asked for, or a texture cloud's
+            raise FishgenError(f"expected at most {most:,} particles as {drawn} in glTF (4 GiB buffer "
+                               f"limit), found {particles:,}; use .ply, .csv or .npy (the particles alone, "
+                               "without pictures)", path)
     return suffix
 
 

@@ -178,6 +178,8 @@ def test_glb_too_large_for_4_gib_is_refused_before_filling(cli, tmp_path, billbo
     result = cli(*args, *(["--billboards"] if billboards else []))
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert "4 GiB buffer limit" in result.stderr and f"found {count:,}" in result.stderr
+    # said as what is drawn, not as an option: a texture cloud is billboards without --billboards
+    assert f"particles as {'billboards' if billboards else 'points'} in glTF" in result.stderr
     assert list(tmp_path.iterdir()) == [cubes]
 
 
