@@ -216,18 +216,12 @@ class NamedPath(click.Path):
         return super().convert(value, param, ctx)
 
 
-class OutFolder(NamedPath):
-    """A folder written into. A file in its place is the system's refusal (status 1), said when the
-    folder is made, after the command line and the inputs are judged, as for any output's folder;
-    click's own check made it a usage error (2), before them."""
-
-    def __init__(self) -> None:
-        super().__init__(path_type=Path)
-
-
 SEED = click.IntRange(0, SEED_MAX)
 FOLDER = NamedPath(file_okay=False, path_type=Path)
-OUT_FOLDER = OutFolder()
+# A folder written into: a file in its place is the system's refusal (status 1), said when the
+# folder is made, after the command line and the inputs are judged, as for any output's folder;
+# click's file_okay=False made it a usage error (2), before them.
+OUT_FOLDER = NamedPath(path_type=Path)
 FILE = NamedPath(dir_okay=False, path_type=Path)
 
 

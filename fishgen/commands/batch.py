@@ -151,7 +151,7 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
         manifest = scan_folder(source, options.out, kinds=job_kinds())
     else:
         manifest = _manifest(source, options.out)
-    reads: list = []
+    reads: list[tuple[Job, list[Path]]] = []
 
     def job_reads() -> list[tuple[Job, list[Path]]]:   # once, and only if asked: loading imports numpy
         if not reads:

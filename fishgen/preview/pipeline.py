@@ -166,7 +166,7 @@ def subject_points(scene: Scene, times: Sequence[float | None],
     return np.concatenate(out), np.concatenate(reach)
 
 
-def _check_framed(camera, scene: Scene) -> None:
+def _check_framed(camera: Camera, scene: Scene) -> None:
     """The renderer's matrices are float32: a scene whose camera stands past its range (a cloud
     3e38 across) would draw from infinities, and one too small for float32 at its distance from
     the origin (1e-8 across at 1,1,1: the eye and the target one float) from nothing; each is
