@@ -82,6 +82,7 @@ def map_file_name(asset: str | Path, rest: str) -> str:
 
 
 _IMAGE_SUFFIX = re.compile(r"\.(png|jpe?g|gif|webp)$", re.IGNORECASE)
+_NOT_PORTABLE = re.compile(r"[^A-Za-z0-9._-]+")
 
 
 def image_stem(name: str) -> str:
@@ -94,10 +95,12 @@ def image_side_stems(asset_stem: str, image_names: list[str]) -> list[str]:
     image and all different: ``x_billow`` for an image named ``billow.png`` (a texture cloud
     names its images by their files), never ``x_billow.png``, to which the writer adds its own
     extension; ``x_billow_2`` for a second image of that name (two clouds' different
-    ``billow.png``), which would otherwise overwrite the first."""
+    ``billow.png``), which would otherwise overwrite the first. Outside letters, digits, ``.``,
+    ``_`` and ``-``, an image's name becomes ``_``: the billboards' sprite, named ``gaussian
+    sprite``, went to ``x_gaussian sprite.png`` (the asset's own stem is the user's and is kept)."""
     stems: list[str] = []
     for name in image_names:
-        stem = f"{asset_stem}_{image_stem(name)}"
+        stem = f"{asset_stem}_{_NOT_PORTABLE.sub('_', image_stem(name))}"
         unique, n = stem, 1
         while unique in stems:
             n += 1

@@ -162,6 +162,8 @@ def test_images_named_by_their_files_get_one_extension_beside_a_gltf_and_never_s
 
     assert image_side_stems("x", ["billow.png", "skin", "Wisp.JPEG", "billow.png", "billow"]) == \
         ["x_billow", "x_skin", "x_Wisp", "x_billow_2", "x_billow_3"]
+    assert image_side_stems("my fish", ["gaussian sprite", "sky/é  x.png", "gaussian_sprite"]) == \
+        ["my fish_gaussian_sprite", "my fish_sky_x", "my fish_gaussian_sprite_2"]
     scene = Scene("two billows")
     first, second = (np.zeros((2, 2, 4), np.uint8), np.full((2, 2, 4), 255, np.uint8))
     for k, pixels in enumerate((first, second)):
