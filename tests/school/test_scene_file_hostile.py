@@ -53,3 +53,21 @@ def test_a_file_that_is_not_a_species_file_is_not_echoed(tmp_path):
     with pytest.raises(FishgenError) as caught:
         load_species(tmp_path / "secret.txt")
     assert "hunter2" not in str(caught.value) and "not one" in str(caught.value)
+
+
+def test_a_scene_holds_at_most_64_species_tables_each_building_its_own_fish(tmp_path):
+    """QA pass 12: 1,000 one-fish tables of one file took 126 s and 96 MB of glb where one table of
+    1,000 fish took 2.5 s and 2.5 MB; 40,000 of them (a 920 KB scene) ran past 1.7 GB. Refused at
+    the first table too many, before any fish is built."""
+    from fishgen.school.scene_file import MAX_SPECIES
+
+    scene = tmp_path / "s.toml"
+    table = '[[species]]\nfile = "bonybream.txt"\ncount = 1\n'
+    scene.write_text("frames = 2\n" + table * MAX_SPECIES)
+    assert len(load_scene_file(scene).species) == MAX_SPECIES
+    scene.write_text("frames = 2\n" + table * 1000)
+    with pytest.raises(FishgenError) as caught:
+        load_scene_file(scene)
+    assert caught.value.line == 2 + 3 * MAX_SPECIES + 1   # the 65th table's file key
+    assert caught.value.message == ("expected at most 64 [[species]] tables (each builds its own fish; one "
+                                    "table's count gives a species many fish), found 1,000")
