@@ -52,11 +52,7 @@ from fishgen.geometry.fins import Fin
 from fishgen.geometry.mesh import normal_deltas, vertex_normals
 from fishgen.geometry.shapes import profile_for
 from fishgen.scene.model import Channel, Clip, Image, Mesh, Node, Primitive, Sampler, Scene, Skin
-from fishgen.species.model import Species
-
-#: One VRFish world unit in metres (docs/decisions.md): BonyBream's world scale
-#: 25.5 x scaleX 0.26 then gives a 0.33 m body, a typical adult bony bream.
-METRES_PER_WORLD_UNIT = 0.05
+from fishgen.species.model import METRES_PER_WORLD_UNIT, Species
 
 #: Thesis axes (x nose->tail, y up, z left) to glTF (+Y up, head towards +Z, left = +X).
 THESIS_TO_GLTF = np.array([[0.0, 0.0, 1.0],

@@ -8,6 +8,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+#: One VRFish world unit in metres (docs/decisions.md): BonyBream's world scale
+#: 25.5 x scaleX 0.26 then gives a 0.33 m body, a typical adult bony bream.
+METRES_PER_WORLD_UNIT = 0.05
+
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
 

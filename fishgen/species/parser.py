@@ -20,6 +20,7 @@ from fishgen.file_names import resolve_texture
 from fishgen.reading import read_capped
 from fishgen.shape_names import SHAPE_NAMES, check_shape_params
 from fishgen.species.model import (
+    METRES_PER_WORLD_UNIT,
     Behaviour,
     CaudalFin,
     PectoralFin,
@@ -39,6 +40,11 @@ MAX_SPECIES_FILE_BYTES = 64 * 1024 * 1024  # a 1024 x 1024 body with texture poi
 MAX_MAGNITUDE = 1e6
 MAX_WORLD_SCALE = 1e4
 MAX_SCALE = 100.0
+MIN_LENGTH = 0.001
+"""Shortest body, metres (world_scale x METRES_PER_WORLD_UNIT x scaleX), as `--length`'s floor:
+a world_scale of 1e-300 built a fish of zero size (float32 zeros) and exited 0."""
+MIN_ASPECT = 1e-3
+"""scaleY and scaleZ against scaleX: a body 1,000 times longer than it is tall or wide is a line."""
 MAX_FIN_LENGTH = 100.0
 MAX_LINE_CHARS = 65536
 """Longest record line: a spline of 2,048 control points fits; a 60 MB line is refused unsplit."""
@@ -327,6 +333,14 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     line = reader.record("the body scale record `scaleX scaleY scaleZ`", 3)
     f = _Fields(reader, line, ("scaleX", "scaleY", "scaleZ"))
     scale = f.vec3(0, 0, MAX_SCALE, open_low=True)
+    long = world_scale * METRES_PER_WORLD_UNIT * scale[0]
+    if long < MIN_LENGTH:
+        raise reader.error(line, f"a body at least {MIN_LENGTH:g} m long (world_scale x "
+                                 f"{METRES_PER_WORLD_UNIT:g} m x scaleX)",
+                           f"{world_scale:g} x {METRES_PER_WORLD_UNIT:g} m x {scale[0]:g} = {long:.3g} m")
+    for k in (1, 2):
+        if scale[k] < MIN_ASPECT * scale[0]:
+            raise f._fail(k, f"a number at least {MIN_ASPECT:g} x scaleX ({MIN_ASPECT * scale[0]:.3g})")
 
     line = reader.record("the caudal fin record", 13, key="caudal")
     f = _Fields(reader, line, [f"caudal {n}" for n in CAUDAL])

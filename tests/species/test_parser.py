@@ -292,6 +292,23 @@ def test_values_beyond_any_sensible_size_are_refused(tmp_path, old, new, needle)
     assert needle in str(err) and err.line == line_number(replace_record(BONY, old, new), new)
 
 
+@pytest.mark.parametrize("old,new,message", [
+    ("bonybream 25.5", "bonybream 1e-300", "expected a body at least 0.001 m long (world_scale x 0.05 m x "
+                                           "scaleX), found 1e-300 x 0.05 m x 0.26 = 1.3e-302 m"),
+    ("0.26 0.1 0.04", "1e-300 1e-300 1e-300", "expected a body at least 0.001 m long (world_scale x 0.05 m x "
+                                              "scaleX), found 25.5 x 0.05 m x 1e-300 = 1.28e-300 m"),
+    ("0.26 0.1 0.04", "0.26 0.1 1e-300", "expected scaleZ as a number at least 0.001 x scaleX (0.00026), "
+                                         "found '1e-300'"),
+])
+def test_a_body_too_small_to_draw_is_refused_at_its_scale_record(tmp_path, old, new, message):
+    """QA pass 12: a world_scale of 1e-300 built a fish of float32 zeros, '0.000 m long', and exited
+    0; --length refuses under 1 mm, and so does the file now, on the body scale record."""
+    text = replace_record(BONY, old, new)
+    err = error_of(tmp_path, text)
+    assert err.message == message and err.line == line_number(text, "0.26 0.1 0.04" if old != "0.26 0.1 0.04"
+                                                              else new)
+
+
 def test_form_feed_in_a_comment_does_not_split_the_line():
     text = BONY.replace("//fish_colours_RGB", "//fish_colours\x0cRGB \u2028 (yellow)")
     assert parse_species(text, "ff.txt").colour == (1.0, 1.0, 0.0)
