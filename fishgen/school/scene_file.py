@@ -472,8 +472,8 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
     if not isinstance(entries, list) or not entries or not all(isinstance(e, dict) for e in entries):
         raise where.fail("one or more [[species]] tables", "none" if not entries else entries, "species")
     if len(entries) > MAX_SPECIES:
-        raise FishgenError(f"expected at most {MAX_SPECIES} [[species]] tables (each builds its own fish; one "
-                           f"table's count gives a species many fish), found {len(entries):,}",
+        raise FishgenError(f"expected at most {MAX_SPECIES} [[species]] tables (each builds its own fish; "
+                           f"one table's count gives a species many fish), found {len(entries):,}",
                            where.file, where.line("file", "species", MAX_SPECIES))
     species = []
     for k, entry in enumerate(entries):
