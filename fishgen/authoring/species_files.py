@@ -60,24 +60,27 @@ def texture_names(species_file: str | os.PathLike) -> TextureNames:
 
 
 def check_texture_names(names: TextureNames, others: Iterable[str | os.PathLike | None] = ()) -> None:
-    """Derived texture names may be neither another output of the run (``others``) nor a file that
-    is already there and that the species file at ``names.species_file`` does not name (a rerun
-    replaces its own textures). Names kept as ``-o`` gave them are the documented pair, but neither
-    may be a texture another species file beside it names (see :func:`_named_by_another`)."""
+    """Texture names may not be a file that is already there and that the species file at
+    ``names.species_file`` does not name (a rerun replaces its own textures), nor a texture another
+    species file beside it names (see :func:`_named_by_another`); derived names may not be another
+    output of the run (``others``) either."""
     _named_by_another(names)
-    if names.why is None:
-        return
     taken = {os.path.abspath(p) for p in others if p is not None}
     named = _named_textures(names.species_file)
+    whence = "derived from -o" if names.why is not None else "beside"
     for path in names.paths:
-        if os.path.abspath(path) in taken:
+        if names.why is not None and os.path.abspath(path) in taken:
             raise UsageError(f"expected texture names that are no other output, found {path.name!r} "
                              f"(derived from -o {os.fspath(names.species_file)!r}) also named as an "
                              f"output; choose another -o")
-        if os.path.lexists(path) and (names.colour, names.mask) != named:
+        # A rerun replaces the pictures its own species file names; any other file of that name is
+        # someone's (an unrelated fish.png beside a new fish.txt was silently replaced); a folder
+        # there is said as every output's is.
+        if os.path.lexists(path) and not os.path.isdir(path) and (names.colour, names.mask) != named:
+            there = "which does not name it" if os.path.lexists(names.species_file) else "not there yet"
             raise UsageError(f"expected texture names that are no file already there, found "
-                             f"{os.fspath(path)!r} (derived from -o {os.fspath(names.species_file)!r}, "
-                             f"which does not name it); choose another -o")
+                             f"{os.fspath(path)!r} ({whence} {os.fspath(names.species_file)!r}, "
+                             f"{there}); move it or choose another -o")
 
 
 def _named_by_another(names: TextureNames) -> None:
@@ -187,6 +190,8 @@ def write_samples(seed: int, count: int, output: Path, folder: bool | None = Non
         if output.exists() and not output.is_dir():
             raise FishgenError("expected a folder, found a file", output)
         plan = [(output, stem, None) for stem in (f"species_{seed + k}" for k in range(count))]
+        for where, stem, _ in plan:
+            check_texture_names(texture_names(where / f"{stem}.txt"))
     written: list[Path] = []
     with together():
         for k, (where, stem, given) in enumerate(plan):

@@ -59,6 +59,22 @@ def test_derived_names_never_take_another_file(tmp_path):
         write_samples(4, 1, tmp_path / "my fish.txt")
 
 
+@pytest.mark.parametrize("folder", [False, True])
+def test_the_documented_pair_never_takes_a_file_its_species_file_does_not_name(tmp_path, folder):
+    """QA pass 12: `species -o fish.txt` replaced an unrelated fish.png and fish_mask.png, exit 0
+    (derived names were refused in that case, the documented pair was not)."""
+    out = tmp_path / "reef" if folder else tmp_path / "fish.txt"
+    picture = tmp_path / "reef" / "species_4.png" if folder else tmp_path / "fish.png"
+    picture.parent.mkdir(exist_ok=True)
+    picture.write_bytes(b"precious")
+    with pytest.raises(UsageError, match="no file already there, found .*not there yet"):
+        write_samples(3, 2, out, folder=True) if folder else write_samples(3, 1, out)
+    assert picture.read_bytes() == b"precious" and len(list(picture.parent.iterdir())) == 1
+    picture.unlink()
+    write_samples(3, 2, out, folder=True) if folder else write_samples(3, 1, out)
+    write_samples(3, 2, out, folder=True) if folder else write_samples(3, 1, out)  # a rerun replaces its own
+
+
 @pytest.mark.parametrize("first,second", [("fish7.txt", "fish7_mask.txt"), ("fish7_mask.txt", "fish7.txt")])
 def test_a_texture_another_species_file_names_is_never_replaced(tmp_path, first, second):
     """fish7_mask.txt's colour texture is fish7_mask.png, fish7.txt's fin mask: it was replaced by a
