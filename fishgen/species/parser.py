@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
-from fishgen.errors import FishgenError, plural
+from fishgen.errors import FishgenError, describe, plural
 from fishgen.file_names import resolve_texture
 from fishgen.reading import read_capped
 from fishgen.shape_names import SHAPE_NAMES, check_shape_params
@@ -148,7 +148,7 @@ class _Fields:
 
     def _fail(self, i: int, what: str) -> FishgenError:
         token = self.tokens[i]
-        return self.reader.error(self.line, f"{self.names[i]} as {what}", f"{token!r}{_hint(token)}")
+        return self.reader.error(self.line, f"{self.names[i]} as {what}", f"{describe(token)}{_hint(token)}")
 
     def number(self, i: int, low: float = -MAX_MAGNITUDE, high: float = MAX_MAGNITUDE,
                open_low: bool = False) -> float:

@@ -309,6 +309,12 @@ def test_a_body_too_small_to_draw_is_refused_at_its_scale_record(tmp_path, old, 
                                                               else new)
 
 
+def test_a_long_value_is_shortened_in_the_error(tmp_path):
+    """QA pass 12: a 5,000-digit BodySections was echoed whole on the one error line."""
+    err = error_of(tmp_path, replace_record(BONY, "FishShapeSin 16 12", "FishShapeSin " + "9" * 5000 + " 12"))
+    assert "BodySections" in err.message and len(str(err)) < 300 and "9" * 39 + "…" in err.message
+
+
 def test_form_feed_in_a_comment_does_not_split_the_line():
     text = BONY.replace("//fish_colours_RGB", "//fish_colours\x0cRGB \u2028 (yellow)")
     assert parse_species(text, "ff.txt").colour == (1.0, 1.0, 0.0)
