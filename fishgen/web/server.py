@@ -156,12 +156,21 @@ class _Handler(BaseHTTPRequestHandler):
         if method != "HEAD":
             self.wfile.write(response.body)
 
+    def version_string(self) -> str:  # "fishgen", not "fishgen " + an empty Python version
+        return self.server_version
+
     def _route(self, method: str) -> Response:
-        host = (self.headers.get("Host") or "").strip().lower()
+        hosts = self.headers.get_all("Host") or []
+        host = hosts[0].strip().lower() if len(hosts) == 1 else ""   # two Host headers: a 400 in RFC 9112
         if host not in self.server.allowed_hosts():
             raise Refused(HTTPStatus.FORBIDDEN, "only 127.0.0.1 and localhost may ask")
+        if not self.path.startswith("/"):   # absolute form (http://elsewhere/...) is for proxies
+            raise Refused(HTTPStatus.BAD_REQUEST, "expected a path, found another form of address")
         parts = urlsplit(self.path)
-        query = {k: v[-1] for k, v in parse_qs(parts.query, keep_blank_values=True).items()}
+        values = parse_qs(parts.query, keep_blank_values=True)
+        if len(values.get("token", ())) > 1 or len(self.headers.get_all("X-Fishgen-Token") or []) > 1:
+            raise Refused(HTTPStatus.FORBIDDEN, "expected this run's token once, found it given twice")
+        query = {k: v[-1] for k, v in values.items()}
         given = self.headers.get("X-Fishgen-Token") or query.get("token") or ""
         if not hmac.compare_digest(given.encode("utf-8", "replace"), self.server.token.encode()):
             raise Refused(HTTPStatus.FORBIDDEN, "expected this run's token, found none or another")

@@ -65,6 +65,27 @@ def test_a_request_without_the_token_or_from_another_host_is_refused(server, cas
     assert status == 403 and b"<p>hi</p>" not in body
 
 
+def test_a_request_that_says_its_host_or_token_twice_or_names_another_site_is_refused(server):
+    """QA pass 12: a second Host header, a second token and an absolute-form address were read past
+    (the first Host, the last token, the path of http://evil.example/...)."""
+    good = f"127.0.0.1:{server.port}"
+    assert ask(server, token=server.token, headers={"Host": good})[0] == 403
+    assert ask(server, token=f"bad&token={server.token}")[0] == 403
+    conn = http.client.HTTPConnection("127.0.0.1", server.port, timeout=5)
+    conn.putrequest("GET", "/", skip_host=True)
+    for header, value in (("Host", good), ("X-Fishgen-Token", "bad"), ("X-Fishgen-Token", server.token)):
+        conn.putheader(header, value)
+    conn.endheaders()
+    assert conn.getresponse().status == 403
+    conn = http.client.HTTPConnection("127.0.0.1", server.port, timeout=5)
+    conn.putrequest("GET", f"http://evil.example/?token={server.token}", skip_host=True)
+    conn.putheader("Host", good)
+    conn.endheaders()
+    response = conn.getresponse()
+    assert response.status == 400 and b"<p>hi</p>" not in response.read()
+    assert response.getheader("Server") == "fishgen"
+
+
 def test_bodies_are_capped_before_they_are_read_and_must_be_json(server):
     assert ask(server, "POST", "/echo", b'{"a": 1}', token=server.token) == (200, b'{"got": {"a": 1}}')
     status, body = ask(server, "POST", "/echo", b"x" * 1001, token=server.token)
