@@ -11,8 +11,9 @@ def label_height(tile_height: int) -> int:
 
 
 def grid(tiles: int, columns: int | None) -> tuple[int, int]:
-    """(columns, rows) of a sheet of ``tiles``: about square unless ``columns`` is given."""
-    columns = columns or math.ceil(math.sqrt(tiles))
+    """(columns, rows) of a sheet of ``tiles``: about square unless ``columns`` is given, and never
+    more columns than tiles (``--columns 10**12`` for two inputs sized a sheet of 8e14 pixels)."""
+    columns = min(columns or math.ceil(math.sqrt(tiles)), max(tiles, 1))
     return columns, math.ceil(tiles / columns)
 
 

@@ -66,6 +66,13 @@ def test_contact_sheet_is_a_labelled_grid(tmp_path):
     assert w == 600 and 150 < h < 200  # one row of three tiles plus a label strip
 
 
+def test_a_sheet_has_no_more_columns_than_inputs():
+    """QA pass 12: --columns 10**12 for two inputs was refused as a sheet of 8e14 pixels."""
+    from fishgen.preview.sheet import grid
+
+    assert grid(2, 10**12) == (2, 1) and grid(5, 2) == (2, 3) and grid(5, None) == (3, 2)
+
+
 def test_gif_swim_loop_moves(tmp_path):
     out = tmp_path / "swim.gif"
     _ok(BREAM, "-o", out, "--frames", "6", "--size", "200x150", "--view", "top")
