@@ -18,7 +18,7 @@ from typing import NamedTuple
 from fishgen.errors import FishgenError, describe, plural
 from fishgen.file_names import resolve_texture
 from fishgen.reading import read_capped
-from fishgen.shape_names import SHAPE_NAMES, check_shape_params
+from fishgen.shape_names import SHAPE_NAMES, check_shape_params, shape_params_found
 from fishgen.species.model import (
     METRES_PER_WORLD_UNIT,
     Behaviour,
@@ -328,7 +328,7 @@ def parse_species(text: str, file: str | os.PathLike = "<species>",
     shape_params = tuple(f.number(k) for k in range(7, len(line.tokens)))
     problem = check_shape_params(shape_class, shape_params)
     if problem:
-        raise reader.error(line, problem, f"{len(shape_params)} extra values")
+        raise reader.error(line, problem, shape_params_found(shape_class, shape_params))
 
     line = reader.record("the body scale record `scaleX scaleY scaleZ`", 3)
     f = _Fields(reader, line, ("scaleX", "scaleY", "scaleZ"))

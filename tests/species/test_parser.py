@@ -315,6 +315,19 @@ def test_a_long_value_is_shortened_in_the_error(tmp_path):
     assert "BodySections" in err.message and len(str(err)) < 300 and "9" * 39 + "…" in err.message
 
 
+@pytest.mark.parametrize("points,found", [
+    ("0.2 0.5 0.1 0.4", "control point 2 of 2 at x 0.1, r 0.4 (after x 0.2)"),
+    ("0.2 0.5 0.6 0", "control point 2 of 2 at x 0.6, r 0"),
+    ("1.5 0.5", "control point 1 of 1 at x 1.5, r 0.5"),
+    ("0.2 0.5 0.6", "3 extra values"),
+])
+def test_a_spline_point_out_of_order_or_range_is_named(tmp_path, points, found):
+    """QA pass 12: every bad FishShapeSpline said `found 10 extra values`, naming no point."""
+    err = error_of(tmp_path, replace_record(BONY, "FishShapeSin 16 12 true true false false",
+                                            f"FishShapeSpline 16 12 true true false false {points}"))
+    assert err.message.endswith(f", found {found}")
+
+
 def test_form_feed_in_a_comment_does_not_split_the_line():
     text = BONY.replace("//fish_colours_RGB", "//fish_colours\x0cRGB \u2028 (yellow)")
     assert parse_species(text, "ff.txt").colour == (1.0, 1.0, 0.0)
