@@ -40,9 +40,14 @@ from fishgen.clouds.model import Cloud
 from fishgen.clouds.sprite import SIGMA
 
 SLABS = 128
-"""Most slabs along the sun axis for a big cloud (more than SMALL particles): one per 2,048
-particles, at least FEW_SLABS (each costs an FFT of the grid, ~1 ms)."""
+"""Most slabs along the sun axis for a big cloud (more than SMALL particles): one per
+SLAB_PARTICLES particles, at least FEW_SLABS (each costs an FFT of the grid, ~1 ms)."""
 FEW_SLABS = 32
+SLAB_PARTICLES = 64
+"""A big cloud gets a slab per this many particles, up to SLABS. With a particle's light read at
+its face, a sigma sunward, slabs of hundreds of particles (one per 2,048, at least 32) left
+9,582 particles of random cube file 201 ranked 0.71 against the optical depth there; 128 slabs
+0.92."""
 SMALL = 2048
 """Up to this many particles a cloud is lit pair by pair (``_pairs``), with no grid."""
 REACH = 8.0
@@ -78,25 +83,23 @@ BLUR_SLABS = 8
 """Slabs blurred in one FFT call."""
 MAP_VALUES = 1 << 23
 """Most map values (slabs x classes x cells) held at once; a finer grid goes in groups of slabs."""
-LEAD = 0.3
-"""Just past SMALL particles the slabs read a particle's light this many of its sigmas nearer the
-sun than its centre; the lead fades out over LEAD_OCTAVES doublings of the particle count.
 
-The pairs take the light at the face (FRONT sigma ahead), shaded by each neighbour's smooth
-Phi; the slabs count a neighbour ahead or not (a step). Read at the centre, the slabs gave the
-shipped tables at 2,049 particles 0.52-0.60 of the pairs' mean light at 2,048 (a cloud dimmed
-by half for one particle more); read at the face, 1.5-3.1x; 0.3 sigma ahead, 0.78-1.18x
-(random cube files held out of the choice: 0.77-0.97x, median 0.88). A lead kept on big dense clouds takes
-their light's rank against the optical depth at the centre down to 0.75 (seed 201), and 0.35
-sigma over three doublings cost the test's files 0.883 -> 0.847, so it is 0.3 over two."""
-LEAD_OCTAVES = 2
+
+LEAD = 0.4
+"""How many of its sigmas nearer the sun than its centre the slabs read a particle's light, at
+every size: what a particle's colour stands for is the light at its sunward face (FRONT sigma
+ahead), which the pairs take exactly, each neighbour shading by its smooth Phi. The slabs count a
+neighbour ahead or not (a step), which misses the sunward tails of the neighbours just behind the
+face: read at the face, the shipped tables' mean light at 2,049 particles was 1.9-2.1x the pairs'
+at 2,048 (10-20x the reference's with scattering off); 0.3 sigma gave 0.84-0.95x, 0.4 gives
+0.97-1.10x, 0.5 1.10-1.25x. It used to fade out by 8,192 particles, to keep the rank against the
+optical depth at the centre; the reference now takes it at the face, as the colour does."""
 
 
 def slab_lead(n: int) -> float:
-    """How many sigmas nearer the sun than its centre a cloud of ``n`` particles (lit through
-    slabs) reads a particle's light: LEAD at SMALL, 0 from SMALL x 2^LEAD_OCTAVES."""
-    octaves = math.log2(max(n, 1) / max(SMALL, 1))
-    return LEAD * min(1.0, max(0.0, 1.0 - octaves / LEAD_OCTAVES))
+    """How many sigmas nearer the sun than its centre a cloud of ``n`` particles lit through slabs
+    reads a particle's light: LEAD, whatever the size (``n`` is kept for callers)."""
+    return LEAD
 
 
 CROWDING = 36.0
@@ -232,9 +235,9 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
         _pairs(centers, radii, density, frame, middle, lighting.extinction, lighting.forward_fraction, light,
                share)
     else:
-        count = min(n, SLABS, max(FEW_SLABS, n // 2048)) if slabs is None else max(1, min(n, int(slabs)))
+        count = min(n, SLABS, max(FEW_SLABS, n // SLAB_PARTICLES)) if slabs is None else max(1, min(n, int(slabs)))
         light = _slabs(centers, radii, density, frame, middle, count, lighting.extinction, forward, light,
-                       grid_cells, lead=slab_lead(n) if slabs is None else 0.0, share=share)
+                       grid_cells, lead=slab_lead(n), share=share)
     return light
 
 
@@ -361,8 +364,6 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
         table = _peak_table(float(extinction), float(forward), float(share))
         # the slabs in groups whose maps fit in MAP_VALUES (one group but for a very fine grid)
         group = max(1, min(slabs, MAP_VALUES // (CLASSES * cells)))
-        if group < slabs:   # a point read ahead may lie in a group whose maps are gone: the centre
-            lead = 0.0
         slab, face, nearer = _slab_numbers(depth, slabs, pool, ends[0],
                                            lead=(radii, _F32(lead * SIGMA)) if lead > 0 else None)
         own = depth             # each particle's own depth at its centre, once splatted
@@ -389,7 +390,9 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
             for k in range(last - first):
                 before[k] = reached
                 reached += depths[k]
-            read = functools.partial(_read_chunk, grid, place, own, face if lead > 0 else None, nearer,
+            # a particle is read with the group that holds the slab its face lies in
+            reading = place if lead <= 0 else functools.partial(_place, grid, face, a, b, first, last, slabs)
+            read = functools.partial(_read_chunk, grid, reading, own, slab if lead > 0 else None, nearer,
                                      before, depths, light, first)
             list(pool.map(read, spans))
     return light
@@ -478,24 +481,24 @@ def _splat_share(grid: _Grid, place, radii, density, table, size: int, own: np.n
     return total
 
 
-def _read_chunk(grid: _Grid, place, own: np.ndarray, face: np.ndarray | None, nearer: np.ndarray,
+def _read_chunk(grid: _Grid, place, own: np.ndarray, slab: np.ndarray | None, nearer: np.ndarray,
                 before: np.ndarray, depths: np.ndarray, light: np.ndarray, first: int,
                 span: tuple[int, int]) -> None:
-    """Each particle's light where it is read (its centre, or ``slab_lead`` sigmas nearer the sun,
-    in slab ``face``; only when one group holds every slab): behind the depth before that slab,
-    at its centre's cell, and the share of what that slab holds there nearer the sun (``nearer``,
-    in SHARE_LEVELS), less its own footprint when that slab is its own."""
+    """Each particle's light where it is read (``place`` numbers the slab that point lies in:
+    its own, or with a lead, the slab of its face, ``slab`` then giving its own): behind the depth
+    before that slab, at its centre's cell, and the share of what that slab holds there nearer the
+    sun (``nearer``, in SHARE_LEVELS), less its own footprint when that slab is its own."""
     pick, number, (flat, fx, fy), near = place(span)
     start, stop = span
     share = (nearer[start:stop] if pick is None else nearer[start:stop][pick]).astype(_F32)
     share *= _F32(1 / SHARE_LEVELS)
     mine = own[start:stop] if pick is None else own[start:stop][pick]
-    at = number                                         # read in its own slab (a big cloud: no lead)
-    if face is not None:
-        at = (face[start:stop] if pick is None else face[start:stop][pick]).astype(np.int32)
+    at = number                                         # the slab it is read in, counted from first
+    if slab is not None:
+        home = (slab[start:stop] if pick is None else slab[start:stop][pick]).astype(np.int32)
         if first:
-            at -= np.int32(first)
-        mine = np.where(at == number, mine, _F32(0))    # its own footprint is in its own slab only
+            home -= np.int32(first)
+        mine = np.where(at == home, mine, _F32(0))      # its own footprint is in its own slab only
     at *= np.int32(grid.shape[0] * grid.shape[1])
     flat += at
     near += at

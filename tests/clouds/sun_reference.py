@@ -65,10 +65,16 @@ def peak_depth(density: np.ndarray, extinction: float) -> np.ndarray:
     return special.spence(np.exp(-np.asarray(density, np.float64) * extinction))
 
 
+FACE = 1.0
+"""Where a particle's light stands for, in sigmas sunward of its centre: its sunward face, the
+side its billboard shows the sun (docs/decisions.md, "Dense clouds, grey")."""
+
+
 def optical_depth(centers: np.ndarray, radii: np.ndarray, density: np.ndarray, sun,
-                  query: np.ndarray, extinction: float = 80.0, chunk: int = 256) -> np.ndarray:
-    """Optical depth from each ``query`` particle's centre towards ``sun`` through every other
-    particle's Gaussian (float64, one per query index)."""
+                  query: np.ndarray, extinction: float = 80.0, chunk: int = 256,
+                  face: float = FACE) -> np.ndarray:
+    """Optical depth towards ``sun`` through every other particle's Gaussian (float64, one per
+    query index), from ``face`` x its sigma sunward of each ``query`` particle's centre."""
     s = np.asarray(sun, np.float64)
     s /= np.linalg.norm(s)
     p = centers.astype(np.float64)
@@ -94,7 +100,7 @@ def optical_depth(centers: np.ndarray, radii: np.ndarray, density: np.ndarray, s
         i, j = i[keep], j[keep]
         owner = np.repeat(np.arange(len(rows)), lengths)[keep]
         d2 = ((across[j] - across[i]) ** 2).sum(axis=1)
-        t = along[j] - along[i]
+        t = along[j] - (along[i] + face * sigma[i])
         sj = sigma[j]
         share = peak[j] * np.exp(-0.5 * d2 / (sj * sj)) * special.ndtr(t / sj)
         tau[start:start + len(rows)] = np.bincount(owner, share, len(rows))
