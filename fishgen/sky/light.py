@@ -61,7 +61,7 @@ SKY_GRID = 96
 
 def _each_cloud(centers: np.ndarray, radii: np.ndarray, density: np.ndarray, starts: np.ndarray,
                 lighting: Lighting, slabs: int | None) -> list[np.ndarray]:
-    from fishgen.clouds.light import incident_light
+    from fishgen.clouds.light import depth_share, incident_light
 
     sun = np.array(lighting.sun_unit, np.float64)
     helper = np.zeros(3)
@@ -98,8 +98,11 @@ def _each_cloud(centers: np.ndarray, radii: np.ndarray, density: np.ndarray, sta
         index = np.concatenate(pieces)
         # A sky's cloud is one compact model (and its shadowing neighbours): 96 cells a side give it
         # the same light as 256 to within 0.02 RMS, at 45-60 % less time for the whole sky.
+        # the cloud's own crowding sets the share of its optical depth each particle casts (its
+        # occluders' too: they only shade it), so a cloud is lit alike with or without neighbours
+        share = depth_share(centers[s:e], radii[s:e], density[s:e], lighting)
         light = incident_light(centers[index].astype(np.float32), radii[index], density[index], lighting,
-                               slabs=slabs, grid_cells=SKY_GRID)
+                               slabs=slabs, grid_cells=SKY_GRID, share=share)
         return light[:e - s]
 
     import os

@@ -442,3 +442,73 @@ def test_the_lead_holds_for_a_caller_that_sets_the_slabs_and_for_slabs_in_groups
     monkeypatch.setattr(light_module, "LEAD", lead)
     monkeypatch.setattr(light_module, "MAP_VALUES", 1)        # every slab a group of its own
     assert incident_light(centers, radii, density, lighting).tobytes() == automatic.tobytes()
+
+
+# -- dense clouds (the eleventh QA pass: grey) -------------------------------------------------
+
+def _box(n: int, seed: int = 0):
+    """The QA pass's cloud: one 7 x 3 x 3 cube of ``n`` particles of radius up to 2."""
+    from fishgen.clouds import parse_cubes
+
+    return fill_cloud(parse_cubes(f"{n}\n1\n{n}, 7, 3, 3, 0, 0, 0, 2\n".encode(), "box.awn"), seed=seed)
+
+
+def _bright(colors: np.ndarray) -> np.ndarray:
+    return colors.astype(int).mean(axis=1) > 200
+
+
+@pytest.mark.parametrize("sun", list(SUNS))
+def test_a_dense_box_is_white_where_the_sun_strikes_it_and_grey_beneath(sun):
+    """8,000 particles in the box: every centre lies far inside the field, and the light read at
+    the centres (the slabs past 8,192, nearly so at 8,000) left its sunlit side as grey as its
+    belly (0.2 % of it brighter than 200). The 2 % of it nearest the sun, its sunlit skin, are now
+    mostly white (78-99 % brighter than 200 under the three suns; 9-19 % before) and the tenth
+    farthest from it grey."""
+    lighting = Lighting(sun=SUNS[sun])
+    lit = light_cloud(_box(8000), lighting)
+    toward = lit.centers.astype(np.float64) @ np.array(lighting.sun_unit)
+    order = np.argsort(toward)
+    near, far = order[-160:], order[:800]
+    assert _bright(lit.colors[near]).mean() > 0.6
+    assert not _bright(lit.colors[far]).any()
+    assert np.median(lit.colors[far].astype(int).mean(axis=1)) < 185
+
+
+def test_more_particles_in_the_same_box_do_not_turn_it_grey():
+    """615 particles in the box: 17.7 % brighter than 200; 8,000 gave 0.2 % and 32,000 less. A
+    cloud more crowded than CROWDING shares out its optical depth, so filling the same cubes more
+    finely keeps a sunlit share of the same order."""
+    shares = [_bright(light_cloud(_box(n)).colors).mean() for n in (615, 8000, 32_000)]
+    assert shares[0] == pytest.approx(0.177, abs=0.002)            # the pairs: as before
+    assert min(shares[1:]) > shares[0] / 4
+
+
+def test_the_report_s_clouds_are_not_crowded():
+    """The share is 1, and their light as before, for every shipped table; a box of 8,000 more than
+    CROWDING, and the share brings it back there."""
+    lighting = Lighting()
+    for table in TABLES.values():
+        cloud = fill_cloud(load_cubes(table), seed=0)
+        assert light_module.depth_share(cloud.centers, cloud.radii, cloud.density, lighting) == 1.0
+    box = _box(8000)
+    crowd = light_module.crowding(box.centers, box.radii, box.density, lighting.extinction)
+    assert crowd > 4 * light_module.CROWDING
+    share = light_module.depth_share(box.centers, box.radii, box.density, lighting)
+    assert share == pytest.approx(light_module.CROWDING / crowd)
+
+
+def test_the_crowding_of_a_big_cloud_is_estimated_without_bias():
+    """Evenly spaced samples of a big cloud give its crowding to within 10 % of every particle's."""
+    box = _box(20_000, seed=3)
+    estimate = light_module.crowding(box.centers, box.radii, box.density, 80.0)
+    sample = np.arange(0, 20_000, 7)
+    sigma = box.radii.astype(np.float64) * 0.4
+    p = box.centers.astype(np.float64)
+    peak = peak_optical_depth(box.density, 80.0)
+    total = 0.0
+    for i in sample:
+        d2 = ((p - p[i]) ** 2).sum(axis=1) / sigma ** 2
+        w = peak / sigma * np.exp(-0.5 * d2)
+        w[i] = 0
+        total += w.sum() * sigma[i]
+    assert estimate == pytest.approx(total / len(sample), rel=0.1)
