@@ -209,7 +209,8 @@ _RGB_WORD = np.dtype({"names": ["rgb"], "formats": ["V3"], "offsets": [0], "item
 def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
                    lighting: Lighting | None = None, *, slabs: int | None = None,
                    grid_cells: int | None = None, share: float | None = None) -> np.ndarray:
-    """The fraction of sunlight (0 to 1) reaching each particle's centre, float32.
+    """The fraction of sunlight (0 to 1) reaching each particle's sunward face (FRONT sigma nearer
+    the sun than its centre; the slabs read LEAD sigma ahead, which gives the same light), float32.
 
     ``centers`` (N, 3), ``radii`` (N,) and ``density`` (N,) as in :class:`fishgen.clouds.Cloud`.
     ``slabs``: go through that many slabs (at most N), whatever the size; by default a cloud of up
@@ -235,7 +236,8 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
         _pairs(centers, radii, density, frame, middle, lighting.extinction, lighting.forward_fraction, light,
                share)
     else:
-        count = min(n, SLABS, max(FEW_SLABS, n // SLAB_PARTICLES)) if slabs is None else max(1, min(n, int(slabs)))
+        count = (min(n, SLABS, max(FEW_SLABS, n // SLAB_PARTICLES)) if slabs is None
+                 else max(1, min(n, int(slabs))))
         light = _slabs(centers, radii, density, frame, middle, count, lighting.extinction, forward, light,
                        grid_cells, lead=slab_lead(n), share=share)
     return light
@@ -340,9 +342,9 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     the light before its slab passed through that share of the slab's depth at its centre, less
     its own: the share of the slab's particles nearer the sun than it (``_slab_numbers``). Half
     of it for every particle, as before, left a dense cloud's sunlit face in the shade of half
-    the first slab: exactly 0 light where the pairs gave up to 0.57. Just past SMALL particles
-    that point is ``lead`` sigmas nearer the sun than the centre (``slab_lead``; 0 when a caller
-    sets the slabs), in whichever slab it lies, when one group holds every slab.
+    the first slab: exactly 0 light where the pairs gave up to 0.57. That point is ``lead``
+    sigmas nearer the sun than the centre (``slab_lead``), in whichever slab it lies; with the
+    slabs in groups, a particle is read with the group that holds that slab.
 
     Nothing here visits the particles in depth order (on a big cloud, reading memory out of
     order cost more than all the arithmetic). Three passes in memory order, each chunk on
