@@ -154,9 +154,9 @@ def test_pixel_budget_is_checked_before_any_input_is_read(tmp_path):
     huge = PreviewOptions(width=8192, height=8192, frames=1000)
     with pytest.raises(FishgenError, match=f"expected at most {MAX_TOTAL_PIXELS} pixels"):
         preview(missing, tmp_path / "x.gif", huge)
-    wide = PreviewOptions(width=800, height=600, columns=10**9)  # a sheet a billion tiles wide
+    wide = PreviewOptions(width=8192, height=8192, columns=10**9)  # one row of 5 tiles, 40,960 px wide
     with pytest.raises(FishgenError, match=f"expected a contact sheet of at most {MAX_SHEET_PIXELS}"):
-        preview(missing, tmp_path / "x.png", wide)
+        preview(missing * 4 + missing[:1], tmp_path / "x.png", wide)
     big_tiles = PreviewOptions(width=8192, height=8192)  # 2x2 tiles of 8192 px: a 17k x 17k sheet
     with pytest.raises(FishgenError, match="contact sheet"):
         preview(missing * 2, tmp_path / "x.png", big_tiles)
