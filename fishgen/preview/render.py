@@ -187,11 +187,12 @@ class Renderer:
     """Transparent parts write no depth, as in three.js. (On, they hide what is drawn after them:
     fishgen's preview before issue 20 showed a billboard cloud as hard-edged rectangles.)"""
 
-    def __init__(self, width: int, height: int, *, fine_blending: bool = False):
+    def __init__(self, width: int, height: int, *, fine_blending: bool = False, samples: int = SAMPLES):
         """``fine_blending``: blend in 16-bit float colour, not 8-bit. Thousands of faint soft
         discs over one pixel (a cloud's particles) each rounded to 8 bits drew rings and grain over
         a smooth cloud; 16 bits cost 28 bytes a pixel more at 4x multisampling, so only a scene
-        with particles (points or billboards) asks for it."""
+        with particles (points or billboards) asks for it. ``samples``: multisamples a pixel (1:
+        none, each pixel one sample, its masked materials' alpha tested at its centre)."""
         import moderngl
 
         try:
@@ -202,7 +203,7 @@ class Renderer:
                 "expected an OpenGL 3.3 context from EGL (Debian: apt-get install libegl1 "
                 f"libgl1-mesa-dri), found none ({err})") from None
         self.width, self.height = width, height
-        samples = min(SAMPLES, self.ctx.max_samples)
+        samples = min(samples, self.ctx.max_samples) if samples > 1 else 0
         self.colour = "f2" if fine_blending else "f1"
         try:
             self.msaa = self.ctx.framebuffer(
@@ -214,7 +215,7 @@ class Renderer:
         except moderngl.Error as err:  # out of memory: the driver leaves the framebuffer incomplete
             self.ctx.release()
             colour = 8 if fine_blending else 4
-            need = width * height * (colour + 4) * samples + width * height * colour
+            need = width * height * (colour + 4) * max(samples, 1) + width * height * colour
             # past the estimate (preview.memory): the system's refusal, as an out-of-memory error is
             raise SystemFailure(f"out of memory for a {width}x{height} framebuffer ({need / 2**20:,.0f} MiB "
                                 f"with {samples}x anti-aliasing): the driver could not make one ({err})"
