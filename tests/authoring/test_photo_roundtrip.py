@@ -6,6 +6,8 @@ ones; every fin's points within 5 %. Measures with tolerances, never pixel diffs
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -176,6 +178,52 @@ def test_a_fish_near_the_line_at_half_coverage_is_said_so(tmp_path, gl_available
     # widened until the line takes in every figure under 1
     monkeypatch.setattr(run_module, "RENDERERS_DIFFER", 0.15)
     _said(path, species, tmp_path / "a.txt", "at least half", "within 0.15 of 0.85")
+
+
+def test_a_fish_that_falls_with_every_sample_alpha_tested_is_said_so(
+        tmp_path, gl_available, photos, monkeypatch):
+    """The half-coverage figure is also counted with every sample alpha-tested
+    (compare.half_covered), as Blender counts it, and the worst of its grids is the one said: a
+    fish that loses its back half there is said to, one line with both figures."""
+    from fishgen.authoring.photo import compare
+
+    species, photo = photos["centroberyx"]
+    path = tmp_path / "photo.png"
+    photo.save(path, "PNG")
+    real = compare.half_covered
+    grids = []
+
+    def back_half_trimmed(species, width, height, distance=None, grid=4):
+        grids.append(grid)
+        covered = real(species, width, height, distance, grid)
+        if grid == max(compare.SAMPLE_GRIDS):   # only one grid: the worst of them is said
+            cols = np.flatnonzero(covered.any(axis=0))
+            covered[:, (cols[0] + cols[-1]) // 2:] = False
+        return covered
+
+    monkeypatch.setattr(compare, "half_covered", back_half_trimmed)
+    _said(path, species, tmp_path / "b.txt", "at least half", "another renderer")
+    assert sorted(grids) == sorted(compare.SAMPLE_GRIDS)
+
+
+def test_half_coverage_counts_a_masked_tip_as_blender_does(gl_available):
+    """fishgen's render alpha-tests a masked fin once a pixel (4 samples shaded as one), so a thin
+    tip its mask texture trims at most of a pixel's samples is drawn whole; Blender tests every
+    sample. On a committed fit whose dorsal tip that trims (1502 on BonyBream: the command said
+    0.896, Blender showed the file at 0.847, unsaid), compare.half_covered draws the file as
+    Blender did, and the multisampled render at half coverage does not."""
+    from PIL import Image
+
+    from fishgen.authoring.photo.compare import HALF_ALPHA, SAMPLE_GRIDS, half_covered, render_side
+
+    folder = Path(__file__).resolve().parents[1] / "fixtures" / "blender_fits"
+    species = load_species(folder / "bonybream.txt")
+    blender = np.asarray(Image.open(folder / "bonybream_blender.png").convert("L")) >= 128
+    distance = 2.14   # fish lengths: the photo's 50 mm lens
+    multisampled = render_side(species, 640, 360, distance)[:, :, 3] >= HALF_ALPHA
+    assert silhouette_iou(blender, multisampled) < 0.96
+    for grid in SAMPLE_GRIDS:
+        assert silhouette_iou(blender, half_covered(species, 640, 360, distance, grid)) > 0.98, grid
 
 
 def test_a_thin_thread_of_the_outline_stays_in_the_mask_texture():
