@@ -1,10 +1,11 @@
 """`fishgen texture`: a species file, its texture and fin mask from one side photo of a fish."""
 from __future__ import annotations
 
+import contextlib
 import io
 import os
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -487,6 +488,17 @@ def _rendered(photo: Photo, candidate: _Candidate, out: Path,
     ``distance`` fish lengths, in perspective, when the lens is known), and its silhouette IoU with
     the photo's fish (head left, level)."""
     from fishgen.authoring.photo.compare import DRAWN_ALPHA, render_side, silhouette_iou
+
+    with _rebuilt(candidate, out) as rebuilt:
+        render = render_side(rebuilt, *_render_size(photo), distance)
+    return render, silhouette_iou(candidate.measured.frame_mask, render[:, :, 3] >= DRAWN_ALPHA)
+
+
+@contextlib.contextmanager
+def _rebuilt(candidate: _Candidate, out: Path) -> Iterator[Species]:
+    """The candidate's species as its written files give it, read back from a scratch folder that
+    lasts while it is used (its textures are read from there when it is built), so what is
+    measured is what a user's renderer will load."""
     from fishgen.species.parser import load_species
 
     with tempfile.TemporaryDirectory(prefix="fishgen-texture-") as tmp:
@@ -495,9 +507,7 @@ def _rendered(photo: Photo, candidate: _Candidate, out: Path,
                 (Path(tmp) / path.name).write_bytes(data)
             except OSError as err:  # a full scratch disk: say which output it was for, and where
                 raise cannot(f"check {path} in the scratch folder", tmp, err) from None
-        rebuilt = load_species(Path(tmp) / out.name)
-        render = render_side(rebuilt, *_render_size(photo), distance)
-    return render, silhouette_iou(candidate.measured.frame_mask, render[:, :, 3] >= DRAWN_ALPHA)
+        yield load_species(Path(tmp) / out.name)
 
 
 def _half_covered_ious(photo: Photo, candidate: _Candidate, out: Path,
@@ -506,15 +516,8 @@ def _half_covered_ious(photo: Photo, candidate: _Candidate, out: Path,
     every sample alpha-tested (:func:`.compare.half_covered`) at each of
     :data:`.compare.SAMPLE_GRIDS`, and its silhouette IoU with the photo's fish at each."""
     from fishgen.authoring.photo.compare import SAMPLE_GRIDS, half_covered, silhouette_iou
-    from fishgen.species.parser import load_species
 
-    with tempfile.TemporaryDirectory(prefix="fishgen-texture-") as tmp:
-        for path, data in candidate.files.items():
-            try:
-                (Path(tmp) / path.name).write_bytes(data)
-            except OSError as err:
-                raise cannot(f"check {path} in the scratch folder", tmp, err) from None
-        rebuilt = load_species(Path(tmp) / out.name)
+    with _rebuilt(candidate, out) as rebuilt:
         return [silhouette_iou(candidate.measured.frame_mask,
                                half_covered(rebuilt, *_render_size(photo), distance, grid))
                 for grid in SAMPLE_GRIDS]
