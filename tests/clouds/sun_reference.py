@@ -71,7 +71,7 @@ side its billboard shows the sun (docs/decisions.md, "Dense clouds, grey")."""
 
 
 def optical_depth(centers: np.ndarray, radii: np.ndarray, density: np.ndarray, sun,
-                  query: np.ndarray, extinction: float = 80.0, chunk: int = 256,
+                  query: np.ndarray, extinction: float = 80.0, chunk: int = 1024,
                   face: float = FACE) -> np.ndarray:
     """Optical depth towards ``sun`` through every other particle's Gaussian (float64, one per
     query index), from ``face`` x its sigma sunward of each ``query`` particle's centre."""
@@ -92,17 +92,15 @@ def optical_depth(centers: np.ndarray, radii: np.ndarray, density: np.ndarray, s
     tau = np.zeros(len(query))
     for start in range(0, len(query), chunk):
         rows = query[start:start + chunk]
-        near = tree.query_ball_point(across[rows], reach)
-        lengths = np.fromiter((len(x) for x in near), np.intp, len(near))
-        i = np.repeat(rows, lengths)
-        j = np.fromiter((k for x in near for k in x), np.intp, int(lengths.sum()))
-        keep = i != j
-        i, j = i[keep], j[keep]
-        owner = np.repeat(np.arange(len(rows)), lengths)[keep]
-        d2 = ((across[j] - across[i]) ** 2).sum(axis=1)
+        # every pair within reach across the rays, as arrays (no per-pair Python objects)
+        pairs = cKDTree(across[rows]).sparse_distance_matrix(tree, reach, output_type="ndarray")
+        owner, j = pairs["i"], pairs["j"]
+        keep = rows[owner] != j
+        owner, j, d = owner[keep], j[keep], pairs["v"][keep]
+        i = rows[owner]
         t = along[j] - (along[i] + face * sigma[i])
         sj = sigma[j]
-        share = peak[j] * np.exp(-0.5 * d2 / (sj * sj)) * special.ndtr(t / sj)
+        share = peak[j] * np.exp(-0.5 * (d * d) / (sj * sj)) * special.ndtr(t / sj)
         tau[start:start + len(rows)] = np.bincount(owner, share, len(rows))
     return tau
 
