@@ -347,7 +347,8 @@ def test_checks_hold_under_softpipe():
     """The checks on correct renders again, in a subprocess on Mesa's softpipe (no multisampling).
 
     The fault tests stay out of the rerun to keep the suite quick: a fault's distance from
-    the thresholds is far larger than anything a rasterizer changes (see the thresholds)."""
+    the thresholds is far larger than anything a rasterizer changes (see the thresholds). So do the
+    clouds' side views but the three-quarter one: the same point sprites from other cameras."""
     if os.environ.get("GALLIUM_DRIVER") == "softpipe":
         pytest.skip("already running under softpipe")
     env = {**os.environ, "GALLIUM_DRIVER": "softpipe",
@@ -357,7 +358,7 @@ def test_checks_hold_under_softpipe():
                            env=env, capture_output=True, text=True, check=False)
     assert "softpipe" in probe.stdout, f"expected Mesa softpipe, found {probe.stdout!r} {probe.stderr}"
     run = subprocess.run([sys.executable, "-m", "pytest", __file__, "-q", "-p", "no:cacheprovider",
-                          "-k", "not softpipe and not catches"],
+                          "-k", "not softpipe and not catches and (not every_side or three-quarter)"],
                          cwd=ROOT, env=env, capture_output=True, text=True, check=False)
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-2000:]
 
