@@ -107,14 +107,25 @@ def midline_point(rings: np.ndarray, section: int, side: float) -> np.ndarray:
     Fins sit here, on the mesh's own surface rather than on the true curve, so
     there is no gap between fin and body at any level of detail (thesis 8.2.1).
     """
-    ring = rings[section]
-    z, y = ring[:, 2], ring[:, 1]
-    z_next, y_next = np.roll(z, -1), np.roll(y, -1)
+    return midline_points(rings, np.array([section]), side)[0]
+
+
+def midline_points(rings: np.ndarray, sections: np.ndarray, side: float) -> np.ndarray:
+    """:func:`midline_point` of each of ``sections`` (N, 3), all at once: on each ring the first
+    edge (in vertex order) that crosses z = 0 on the ``side`` half, where it crosses; the axis
+    when none does."""
+    ring = rings[np.asarray(sections, np.intp)]
+    z, y = ring[:, :, 2], ring[:, :, 1]
+    z_next, y_next = np.roll(z, -1, axis=1), np.roll(y, -1, axis=1)
     crossing = (z >= 0) & (z_next <= 0) if side > 0 else (z <= 0) & (z_next >= 0)
-    for k in np.flatnonzero(crossing):
-        dz = z[k] - z_next[k]
-        t = 0.0 if dz == 0 else z[k] / dz
-        yk = y[k] + t * (y_next[k] - y[k])
-        if yk * side >= 0:
-            return np.array([ring[0, 0], yk, 0.0])
-    return np.array([ring[0, 0], 0.0, 0.0])
+    dz = z - z_next
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(dz == 0, 0.0, z / np.where(dz == 0, 1.0, dz))
+    yk = y + t * (y_next - y)
+    good = crossing & (yk * side >= 0)
+    first = np.argmax(good, axis=1)
+    found = good[np.arange(len(ring)), first]
+    out = np.zeros((len(ring), 3))
+    out[:, 0] = ring[:, 0, 0]
+    out[:, 1] = np.where(found, yk[np.arange(len(ring)), first], 0.0)
+    return out

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fishgen.geometry.body import midline_point
+from fishgen.geometry.body import midline_points
 from fishgen.geometry.mesh import Mesh, strip_faces
 
 #: Paired fins stand off the flank by this angle instead of lying in it (decisions.md).
@@ -151,7 +151,7 @@ def vertical_fin(name: str, fin: VerticalParams, rings: np.ndarray, scale: np.nd
     """
     sections = np.arange(fin.start_section, fin.end_section + 1)
     n = sections.size
-    base = np.array([midline_point(rings, int(s), side) for s in sections])
+    base = midline_points(rings, sections, side)
     a = np.radians(abs(fin.start_angle))
     top = np.empty_like(base)
     top[0] = base[0] + _scaled(fin.start_length * np.cos(a), side * fin.start_length * np.sin(a), scale)
