@@ -107,6 +107,7 @@ class Drawer:
                                   np.stack([xs, self.rings[:, :, 1].min(axis=1)], 1)[::-1]])
         self.body = self._polygons([outline])
         self.layers: dict[str, np.ndarray] = {}
+        self._caudals: dict[tuple, Any] = {}
         self.sp = sp
         for name in FIN_RECORDS:
             self.layers[name] = self.fin(sp, name)
@@ -140,7 +141,12 @@ class Drawer:
         rings = self.rings
         built = []
         if name in ("caudal", "dorsal", "adipose", "anal"):
-            caudal = caudal_fin(caudal_params(sp.caudal), s, None, tail_x=float(rings[-1, :, 0].max()))
+            # every vertical fin's layer needs the caudal fin's front; it changes only with its record
+            key = (sp.caudal, tuple(sp.scale))
+            if key not in self._caudals:
+                self._caudals[key] = caudal_fin(caudal_params(sp.caudal), s, None,
+                                                tail_x=float(rings[-1, :, 0].max()))
+            caudal = self._caudals[key]
             if name == "caudal":
                 built = [caudal]
             elif getattr(sp, name).present:
