@@ -108,6 +108,7 @@ class Drawer:
         self.body = self._polygons([outline])
         self.layers: dict[str, np.ndarray] = {}
         self._caudals: dict[tuple, Any] = {}
+        self._rests: dict[str, tuple[tuple[np.ndarray, ...], np.ndarray]] = {}
         self.sp = sp
         for name in FIN_RECORDS:
             self.layers[name] = self.fin(sp, name)
@@ -168,10 +169,28 @@ class Drawer:
         return self._triangles([(f.mesh.positions[:, :2], f.mesh.faces) for f in built])
 
     def whole(self, replaced: dict[str, np.ndarray] | None = None) -> np.ndarray:
+        """The body and every fin layer (those in ``replaced`` instead of the drawer's own)."""
+        if replaced and len(replaced) == 1:
+            # a fit tries one fin at a time: the rest of the fish, kept while its layers stay, and it
+            (name, layer), = replaced.items()
+            return self._all_but(name) | layer
         out = self.body.copy()
         for name, layer in self.layers.items():
             out |= (replaced or {}).get(name, layer)
         return out
+
+    def _all_but(self, name: str) -> np.ndarray:
+        """The body and every layer but ``name``'s, drawn once for as long as those layers are the
+        same arrays (kept here, so their identities cannot be reused by others)."""
+        others = tuple(layer for n, layer in self.layers.items() if n != name)
+        kept = self._rests.get(name)
+        if (kept is None or len(kept[0]) != len(others)
+                or any(a is not b for a, b in zip(kept[0], others, strict=True))):
+            out = self.body.copy()
+            for layer in others:
+                out |= layer
+            kept = self._rests[name] = (others, out)
+        return kept[1]
 
 
 def redrawn(drawer: Drawer, trial: Species, record: str) -> dict[str, np.ndarray]:
