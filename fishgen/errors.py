@@ -117,6 +117,28 @@ def cannot(action: str, path: str | os.PathLike, err: OSError) -> SystemFailure:
     return SystemFailure(f"cannot {action} {os.fspath(path)}: {err.strerror or err}", path)
 
 
+NAME_MAX = 255
+"""The longest name a part of a path may have on the file systems fishgen runs on, in bytes."""
+
+
+def too_long(err: OSError) -> str | None:
+    """For a path the system refused as too long, what was expected and what was found, with the
+    overlong part cut short (the whole path may be thousands of characters); else None."""
+    import errno
+
+    if err.errno != errno.ENAMETOOLONG or not err.filename:
+        return None
+    path = os.fspath(err.filename)
+    parts = path.split(os.sep)
+    size = max(len(os.fsencode(part)) for part in parts)
+    if size <= NAME_MAX:
+        return (f"{path[:40]}…: expected a path of at most {os.pathconf('/', 'PC_PATH_MAX')} bytes, "
+                f"found {len(os.fsencode(path))}")
+    shown = os.sep.join(p if len(os.fsencode(p)) <= NAME_MAX else p[:24] + "…" for p in parts)
+    return (f"{shown}: expected names of at most {NAME_MAX} bytes (the file system's limit), "
+            f"found one of {size}")
+
+
 def plural(count: int, noun: str) -> str:
     """``1 cube``, ``2 cubes``, ``1,000 files``: a count and its noun, as messages and summaries say it."""
     return f"{count:,} {noun}{'s' * (count != 1)}"

@@ -112,8 +112,11 @@ def main(argv: list[str] | None = None) -> None:
         detail = str(err).strip()  # numpy names the array it could not allocate; Python names nothing
         _fail(f"fishgen: out of memory{': ' + detail if detail else ''}", 1, kind="os")
     except OSError as err:  # one no layer below turned into a SystemFailure with its path
-        where = f"{err.filename}: " if err.filename else ""
-        _fail(f"fishgen: {where}{err.strerror or err}", 1, err.filename, kind="os")
+        from fishgen.errors import too_long
+
+        long = too_long(err)
+        where = f"{err.filename}: " if err.filename and long is None else ""
+        _fail(f"fishgen: {where}{long or err.strerror or err}", 1, err.filename, kind="os")
 
 
 def status_of(argv: list[str] | None = None) -> int:

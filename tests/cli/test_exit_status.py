@@ -64,6 +64,26 @@ def test_a_write_the_system_refuses_exits_1_naming_the_file(tmp_path, name):
     assert [p for p in leftovers if p.name.endswith(".tmp")] == []
 
 
+@pytest.mark.parametrize("where", ["output", "input", "folder"])
+def test_a_name_too_long_for_the_file_system_says_its_limit_in_one_short_line(tmp_path, where):
+    """A path part over 255 bytes: status 1, one line giving the limit and the part's length, the
+    part cut short (the generic OS message repeated all of it and said only "File name too long")."""
+    long = "n" * 300
+    species, out = PARAMS / "bonybream.txt", tmp_path / "fish.glb"
+    if where == "output":
+        out = tmp_path / f"{long}.glb"
+    elif where == "input":
+        species = tmp_path / f"{long}.txt"
+    else:
+        out = tmp_path / long / "fish.glb"
+    result = run(["build", str(species), "-o", str(out)])
+    error = one_error(result)
+    assert result.returncode == 1 and error["kind"] == "os", result.stderr
+    assert "expected names of at most 255 bytes" in error["error"] and "found one of 30" in error["error"]
+    assert long not in error["error"] and len(error["error"]) < 200, error
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.fixture
 def small_disk(tmp_path):
     """A real 64 KiB file system, and a read-only one (root only: mount)."""
