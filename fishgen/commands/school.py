@@ -227,6 +227,9 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     if scene.warmup is not None and round(scene.warmup * scene.fps) > warmup:
         events.note(f"{output}: a warm-up of {scene.warmup:g} s is as long as the run or longer "
                     f"({scene.frames / scene.fps:.1f} s): the summary measures its last frame only")
+    crowded = _crowded(run.config)
+    if crowded:
+        events.note(f"{output}: {crowded}")
     size = sum(n for p, n in sizes.items() if p not in sides.values())
     counted = tuple(zip(run.species_names, (e.count for e in scene.species), strict=True))
     kinds_line = ", ".join(f"{count} {name}" for name, count in counted)
@@ -243,6 +246,21 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
                         scene.model, size, warmup, table)
     read = tuple(dict.fromkeys([*inputs, *scene.read, *run.read]))
     return Made(tuple(files), read, (line, table) if table else (line,), facts)
+
+
+def _crowded(config) -> str | None:
+    """What to say of bounds smaller than a body length cubed for each fish (the school then crowds
+    and its fish overlap whatever the model does), or None."""
+    import math
+
+    lo, hi = config.bounds
+    volume = math.prod(float(b) - float(a) for a, b in zip(lo, hi, strict=True))
+    need = sum(g.count * g.body_length ** 3 for g in config.groups)
+    if volume >= need:
+        return None
+    count = sum(g.count for g in config.groups)
+    return (f"the bounds hold {volume:.3g} m³, less than a body length cubed for each fish ({need:.3g} m³ "
+            f"for {count:,}): they crowd and overlap; give wider --bounds")
 
 
 def _write_all(output: Path, run, sides: dict[str, Path], per_frame: dict, numbers: dict,

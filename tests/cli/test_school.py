@@ -347,6 +347,19 @@ def test_a_warm_up_as_long_as_the_run_is_said_in_a_note(tmp_path):
     assert short.returncode == 0 and short.stderr == ""
 
 
+def test_bounds_too_small_for_the_fish_are_said_in_a_note(tmp_path):
+    """Less than a body length cubed for each fish: the school runs, and a note says it crowds."""
+    out = tmp_path / "c.glb"
+    tight = run_cli("school", PARAMS / "bonybream.txt", "--count", "40", "--frames", "10",
+                    "--bounds", "0,0,0,0.2,0.2,0.2", "-o", out)
+    assert tight.returncode == 0, tight.stderr
+    assert tight.stderr.startswith(f"{out}: the bounds hold 0.008 m³, less than a body length cubed for each "
+                                   "fish (") and tight.stderr.endswith("give wider --bounds\n")
+    assert tight.stderr.count("\n") == 1
+    roomy = run_cli("school", PARAMS / "bonybream.txt", "--count", "40", "--frames", "10", "-o", out)
+    assert roomy.returncode == 0 and roomy.stderr == ""
+
+
 @pytest.mark.parametrize("name, beside", [("s.glb", ""), ("s.gltf", " (+2 files)"), ("s.usda", " (+1 file)")])
 def test_the_summary_counts_the_files_written_beside_the_school(tmp_path, name, beside):
     """A USD school wrote its fish's texture beside it and did not say so, as `build` does."""
