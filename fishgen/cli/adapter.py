@@ -52,7 +52,7 @@ def execute(cmd: Command, inputs: tuple[Path, ...], output: str | None, options:
     events = TerminalEvents(cmd.name)
     # A summary that cannot be printed (stdout on a full disk) fails the run: with `together`, its
     # files are still staged then, and none lands.
-    with together() if cmd.together else nullcontext():
+    with together() if cmd.together else nullcontext(), _warnings_as_notes(events):
         made = run(cmd, inputs, output, options, events.as_events())
         for line in made.lines:
             click.echo(line)
@@ -70,6 +70,28 @@ def execute(cmd: Command, inputs: tuple[Path, ...], output: str | None, options:
             pass
         finally:
             made.server.server_close()
+
+
+@contextmanager
+def _warnings_as_notes(events: TerminalEvents) -> Iterator[None]:
+    """A cube file's warning (``CubeFileWarning``, already ``FILE:LINE: warning: …``) said as a
+    note, in one line, by whichever command read the file: Python's own form added the warning's
+    class and the line of fishgen's source that raised it (sky, preview, fly)."""
+    import warnings
+
+    from fishgen.clouds.parser import CubeFileWarning
+
+    with warnings.catch_warnings():
+        shown = warnings.showwarning
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            if issubclass(category, CubeFileWarning):
+                events.note(str(message))
+            else:
+                shown(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = show
+        yield
 
 
 class TerminalEvents:

@@ -100,6 +100,18 @@ def test_total_mismatch_is_a_warning_on_stderr(cli, write_awn, tmp_path):
     assert len((tmp_path / "c.csv").read_text().splitlines()) == 1 + 5
 
 
+@pytest.mark.parametrize("command", [["sky", "--mode", "thin", "--particles", "400", "--clouds"], ["preview"]])
+def test_every_command_says_a_cube_files_warning_in_one_line(cli, write_awn, tmp_path, command):
+    """sky and preview read cube files too: the warning is the same one line as `clouds` gives, not
+    Python's warning form with fishgen's source line under it."""
+    path = write_awn("99\n1\n5, 1, 1, 1, 0, 0, 0, 1\n")
+    out = tmp_path / ("s.glb" if command[0] == "sky" else "p.png")
+    result = cli(*command, path, "-o", out)
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == (f"{path}:1: warning: declared total 99 particles, but the cubes hold 5; "
+                             "using the cubes' counts\n")
+
+
 @pytest.mark.parametrize("args,message", [
     (["--offset", "1,2"], "fishgen clouds: Invalid value for '--offset': expected X,Y,Z with three finite "
                           "numbers within float32 range, found '1,2'"),
