@@ -85,7 +85,7 @@ def prepare_assets(inputs: Sequence[str | os.PathLike], *, mode: str | None = No
 def _glb(path: Path) -> bytes:
     """A .glb's bytes as they are, once fishgen's reader has checked them; a .gltf (and its side
     files, only from its folder) read and written as one glb."""
-    from fishgen.exchange.gltf import glb_bytes
+    from fishgen.exchange.gltf import glb_bytes, require_shown
     from fishgen.exchange.registry import FORMATS
 
     if not path.is_file():
@@ -95,6 +95,7 @@ def _glb(path: Path) -> bytes:
         raise FishgenError(f"expected at most {MAX_ASSET_BYTES >> 20} MiB of glTF to fly through, found "
                            f"{size / 2**20:.0f} MiB", path)
     scene = FORMATS[path.suffix.lower()[1:]].read(path)   # refuses what is not glTF, before the page sees it
+    require_shown(path, scene)
     if path.suffix.lower() == ".glb":
         return path.read_bytes()
     return glb_bytes(scene, path)

@@ -96,21 +96,29 @@ def run_headless(session: FlySession, *, webgl: str = "swiftshader", chromium: s
             try:
                 browser = pw.chromium.launch(executable_path=chromium, args=args)
             except PlaywrightError as err:
-                raise SystemFailure(f"fishgen: cannot start Chromium ({str(err).splitlines()[0]})") from None
+                raise SystemFailure(f"cannot start Chromium ({_first_line(err)})") from None
             try:
                 page = browser.new_page(viewport={"width": width, "height": height})
                 page.on("pageerror", lambda e: errors.append(str(e)))
                 page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
                 # nothing but the local server: the page never fetches anything else
                 page.route("**/*", lambda r: r.continue_() if r.request.url.startswith(base) else r.abort())
-                page.goto(session.url())
+                try:
+                    page.goto(session.url())
+                except PlaywrightError as err:     # e.g. a port Chromium never opens (6000, 10080)
+                    # Chromium's reason, without the address (it holds the page's token)
+                    found = _first_line(err).removeprefix("Page.goto: ").split(" at http", 1)[0]
+                    raise SystemFailure(f"expected Chromium to open the page on port {session.server.port}, "
+                                        f"found {found}; try another --port, or --port 0") from None
                 allowed = LOAD_SECONDS + config.warmup + config.timeout * 3 + 30
                 limit = time.monotonic() + allowed
                 while not session.received.is_set():
                     if errors:
-                        raise FishgenError(f"expected the page to fly, found an error: {errors[0]}")
+                        # a script error's first line: the stack under it names minified functions
+                        found = _first_line(errors[0])
+                        raise FishgenError(f"expected the page to fly, found an error: {found}")
                     if time.monotonic() > limit:
-                        raise SystemFailure(f"fishgen: the page did not report within {allowed:.0f} s")
+                        raise SystemFailure(f"the page did not report within {allowed:.0f} s")
                     page.wait_for_timeout(500)   # lets Playwright deliver the page's events; runs no script
                 version = browser.version
                 if screenshot is not None:
@@ -123,6 +131,11 @@ def run_headless(session: FlySession, *, webgl: str = "swiftshader", chromium: s
         session.close()
     return {"headless": True, "browser": f"Chromium {version}", "webgl": webgl, "flags": args,
             "cpus": os.cpu_count(), "load_average": [load_before, _load()]}
+
+
+def _first_line(err: object) -> str:
+    lines = str(err).strip().splitlines()
+    return lines[0] if lines else type(err).__name__
 
 
 def _load() -> float | None:

@@ -100,7 +100,8 @@ def test_total_mismatch_is_a_warning_on_stderr(cli, write_awn, tmp_path):
     assert len((tmp_path / "c.csv").read_text().splitlines()) == 1 + 5
 
 
-@pytest.mark.parametrize("command", [["sky", "--mode", "thin", "--particles", "400", "--clouds"], ["preview"]])
+@pytest.mark.parametrize("command", [["sky", "--mode", "thin", "--particles", "400", "--clouds"],
+                                     ["preview"]])
 def test_every_command_says_a_cube_files_warning_in_one_line(cli, write_awn, tmp_path, command):
     """sky and preview read cube files too: the warning is the same one line as `clouds` gives, not
     Python's warning form with fishgen's source line under it."""

@@ -49,3 +49,31 @@ def test_a_damaged_glb_is_refused_before_the_page_sees_it(tmp_path):
     bad.write_bytes(b"glTF" + bytes(20))
     with pytest.raises(FishgenError):
         prepare_assets([bad])
+
+
+def _glb(path, doc: dict):
+    """A glb of this JSON alone (no binary chunk), padded as the format asks."""
+    import json
+    import struct
+
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    header = struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(text))
+    path.write_bytes(header + struct.pack("<I4s", len(text), b"JSON") + text)
+    return path
+
+
+@pytest.mark.parametrize("doc, found", [
+    ({"asset": {"version": "2.0"}, "nodes": [{}]}, "found no scenes"),
+    ({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{}]}, "draws something, found none"),
+    ({"asset": {"version": "2.0"}, "scenes": [{}]}, "draws something, found none"),
+])
+def test_a_glb_the_page_would_show_nothing_of_is_refused(tmp_path, doc, found):
+    """Valid glTF, but nothing to show: fly's page failed with a script's stack trace (no scene for
+    three.js, or no point for the camera to aim at); now one line naming the file. (`view` writes
+    its page, which says it could not show the asset.)"""
+    path = _glb(tmp_path / "empty.glb", doc)
+    read_gltf(path)                                  # fishgen's reader takes it: it is valid glTF
+    with pytest.raises(FishgenError, match=found) as caught:
+        prepare_assets([path])
+    assert caught.value.file == str(path)

@@ -42,6 +42,34 @@ def test_a_cube_file_flown_headless_reports_its_particles_and_frames(tmp_path, c
     assert "FPS median" in run.stdout and "615 particles" in run.stdout
 
 
+def test_a_port_chromium_will_not_open_is_said_in_one_line_without_the_token(cli):
+    """Chromium refuses some ports outright (X11's 6000, 10080): one line saying so and what to give,
+    not Playwright's traceback; the page's address, which holds its token, is left out."""
+    import socket
+
+    def free(port: int) -> bool:
+        with socket.socket() as s:
+            try:
+                s.bind(("127.0.0.1", port))
+            except OSError:
+                return False
+            return True
+
+    port = next(p for p in (6000, 10080, 6665, 6697) if free(p))
+    run = cli("fly", PARAMS / "clouds" / "table_4_4.awn", "--headless", "--timeout", "1", "--port", str(port))
+    assert run.returncode == 1 and run.stderr.count("\n") == 1 and "Traceback" not in run.stderr, run.stderr
+    assert run.stderr.startswith(f"fishgen: expected Chromium to open the page on port {port}, found "
+                                 "net::ERR_UNSAFE_PORT; try another --port"), run.stderr
+    assert "token" not in run.stderr
+
+
+def test_a_chromium_that_will_not_start_is_said_once(cli, monkeypatch):
+    monkeypatch.setenv("FISHGEN_CHROMIUM", "/bin/false")
+    run = cli("fly", PARAMS / "clouds" / "table_4_4.awn", "--headless", "--timeout", "1")
+    assert run.returncode == 1 and run.stderr.startswith("fishgen: cannot start Chromium ("), run.stderr
+    assert run.stderr.count("\n") == 1
+
+
 def test_a_sky_flown_headless_reports_its_particles_per_second_in_csv(tmp_path, cli, thin_sky):
     path, facts = thin_sky
     report = tmp_path / "r.csv"
