@@ -106,16 +106,21 @@ def cube_files_scene(paths: Sequence[Path], *, seed: int = 0, lighting: Lighting
                      max_particles: int = DEFAULT_MAX_PARTICLES):
     """Each cube file one cloud (input i filled with seed + i), side by side along +x, lit together
     (clouds shadow clouds), each its own node with a lower level: the scene and the files read."""
+    from fishgen.clouds.memory import check_fits
     from fishgen.clouds.pipeline import cube_clouds, read_cube_files
     from fishgen.sky.compose import Placement, SkyCloud, model_box
     from fishgen.sky.light import light_sky
     from fishgen.sky.scene import sky_scene
 
     files = [Path(p) for p in paths]
+    models = read_cube_files(files, max_particles=max_particles, textures_dir=textures_dir,
+                             raise_with="--max-particles")
+    # as `fishgen sky` builds it (levels of detail, a texture cloud's billboards), refused before any
+    # is filled: 40 million particles took 5 GB before the system refused the next array
+    billboards = any(c.texture for m in models for c in m.cubes)
+    check_fits(sum(m.total for m in models), ".glb", billboards, sky=True)
     # filled each in its own frame (no offsets) and lit as a sky: each cloud on its own shadow map
-    made = cube_clouds(read_cube_files(files, max_particles=max_particles, textures_dir=textures_dir,
-                                       raise_with="--max-particles"),
-                       seed=seed, light=False, max_particles=max_particles)
+    made = cube_clouds(models, seed=seed, light=False, max_particles=max_particles)
     clouds, edge = [], None
     for i, (model, cloud, path) in enumerate(zip(made.models, made.clouds, files, strict=True)):
         lo, hi = model_box(model)

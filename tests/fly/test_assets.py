@@ -77,3 +77,17 @@ def test_a_glb_the_page_would_show_nothing_of_is_refused(tmp_path, doc, found):
     with pytest.raises(FishgenError, match=found) as caught:
         prepare_assets([path])
     assert caught.value.file == str(path)
+
+
+def test_cube_files_too_big_to_fly_are_refused_before_any_is_filled(tmp_path, monkeypatch):
+    """40 million particles took 5 GB before the system refused an array; with a limit known up front
+    fly refuses them in one line, as `clouds` and `sky` do."""
+    import fishgen.clouds.memory as memory
+    from fishgen.clouds import fill
+
+    monkeypatch.setattr(memory, "allowed", lambda: (600 * 2**20, "this process's address-space limit"))
+    monkeypatch.setattr(fill, "fill_cloud", lambda *a, **k: pytest.fail("filled before it was refused"))
+    big = tmp_path / "big.awn"
+    big.write_text("2000000\n1\n2000000, 10, 10, 10, 0, 0, 0, 1\n")
+    with pytest.raises(UsageError, match=r"fits in 600 MiB .* found 2,000,000 particles for \.glb"):
+        prepare_assets([big])
