@@ -37,8 +37,12 @@ def over(limit: tuple[int, str] | None, need: int) -> tuple[str, str] | None:
     if limit is None or need <= limit[0]:
         return None
     have, want = size_text(limit[0]), size_text(need)
+    places = 2
+    while have == want and places <= 9:     # "fits in 1.43 GiB ... need about 1.43 GiB" read as nonsense
+        have, want = f"{limit[0] / 2**30:.{places}f} GiB", f"{need / 2**30:.{places}f} GiB"
+        places += 1
     if have == want:
-        have, want = f"{limit[0] / 2**30:.2f} GiB", f"{need / 2**30:.2f} GiB"
+        have, want = f"{limit[0]:,} bytes", f"{need:,} bytes"
     return have, want
 
 
