@@ -240,6 +240,12 @@ def render_frames(scenes: list[Scene], options: PreviewOptions, frames: int,
     from fishgen.preview.posing import poser_for
     from fishgen.preview.render import Renderer
 
+    if options.clip is not None and not any(scene.clips for scene in scenes):
+        # a clip-less input in a sheet of fish keeps its pose; with no clip anywhere, --clip did nothing
+        whose = "the input has no" if len(scenes) == 1 else "none of the inputs has"
+        found = f"{options.clip!r}, but {whose} clips"
+        raise FishgenError(f"expected --clip to name an animation clip, found {found}",
+                           (scenes[0].source or scenes[0].name) if len(scenes) == 1 else None)
     for scene in scenes:
         if options.clip is not None and scene.clips and scene.clip(options.clip) is None:
             names = ", ".join(a.name for a in scene.clips)

@@ -121,6 +121,20 @@ def test_bad_options_are_one_line_errors_and_write_nothing(tmp_path, args, messa
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_clip_asked_of_inputs_without_clips_is_refused(tmp_path):
+    """--clip on a cloud (no clips) did nothing, silently; a sheet where a fish has it still poses the
+    fish and leaves the cloud as it is."""
+    cloud = PARAMS / "clouds" / "table_4_3.awn"
+    alone = run_cli("preview", cloud, "-o", tmp_path / "a.png", "--clip", "swim")
+    assert alone.returncode == 2 and alone.stderr == (f"{cloud}: expected --clip to name an animation clip, "
+                                                      "found 'swim', but the input has no clips\n")
+    both = run_cli("preview", cloud, cloud, "-o", tmp_path / "b.png", "--clip", "swim")
+    assert both.returncode == 2 and "but none of the inputs has clips" in both.stderr
+    assert list(tmp_path.iterdir()) == []
+    mixed = run_cli("preview", cloud, BREAM, "-o", tmp_path / "c.png", "--clip", "swim", "--size", "64x48")
+    assert mixed.returncode == 0, mixed.stderr
+
+
 def test_missing_and_bad_inputs_name_the_file(tmp_path):
     bad = tmp_path / "bad.txt"
     bad.write_text("this is not a species file\n")
