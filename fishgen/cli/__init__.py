@@ -99,6 +99,11 @@ def main(argv: list[str] | None = None) -> None:
         _fail("fishgen: interrupted", 130, kind="interrupted")  # the shell's ^C ends the line before ours
     except click.UsageError as err:  # one line, like every other error (`--help` shows the usage)
         command = err.ctx.command_path if err.ctx is not None else "fishgen"
+        if command == "fishgen":
+            # click says an option given no value in the group's context, not its command's: the
+            # command is found in the arguments, so the line names it as every other usage error does
+            named = next((a for a in args if a in MODULES), None)
+            command = f"fishgen {named}" if named else command
         _fail(f"{command}: {err.format_message()}", err.exit_code, kind="usage")
     except click.ClickException as err:
         if not json_errors():

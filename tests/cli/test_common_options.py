@@ -136,6 +136,19 @@ def test_a_required_option_left_out_is_a_usage_error_in_one_line(tmp_path, name)
     assert not (tmp_path / "x.txt").exists()
 
 
+@pytest.mark.parametrize("args", [["clouds", str(PARAMS / "clouds" / "table_4_3.awn"), "-o"],
+                                  ["build", str(PARAMS / "bonybream.txt"), "--fps"],
+                                  ["--json", "sky", "--mode"]])
+def test_an_option_given_no_value_names_its_command(args):
+    """click raises it in the group's context: the line read `fishgen: Option '-o' requires an
+    argument.`, where every other usage error names the command (QA pass 13)."""
+    result = run_cli(*args)
+    name = next(a for a in args if a in COMMANDS)
+    assert result.returncode == 2, result.stderr
+    assert f"fishgen {name}: Option '{args[-1]}' requires an argument" in result.stderr
+    assert result.stderr.count("\n") == 1
+
+
 @pytest.mark.parametrize("args", [
     ["sky", "--mode", "thin", "--particles", "500"], ["school", "{fish}", "--count", "3", "--frames", "5"],
     ["clouds", "{cubes}"], ["species", "--random"], ["build", "{fish}"],
