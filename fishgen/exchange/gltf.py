@@ -299,19 +299,3 @@ def write_gltf(scene: Scene, path: Path) -> list[Path]:
     check_shared(path, files)
     write_files(files)
     return list(files)
-
-
-def require_shown(path: Path, scene: Scene) -> None:
-    """Refuse a glTF asset fly's page would show nothing of: a document with no ``scenes`` (three.js
-    then has no scene to add: the page failed) or whose scene draws no primitive (the camera path
-    had no point to aim at). ``scene`` is fishgen's reading of ``path``, which was checked whole."""
-    if path.suffix.lower() == ".glb":
-        data = path.read_bytes()
-        (length,) = struct.unpack_from("<I", data, 12)
-        declared = bool(json.loads(data[20:20 + length]).get("scenes"))
-    else:
-        declared = bool(json.loads(path.read_bytes()).get("scenes"))
-    if not declared:
-        raise FishgenError("expected a glTF asset with a scene to show, found no scenes", path)
-    if not any(prim.vertex_count for _, prim in scene.drawn()):
-        raise FishgenError("expected a glTF asset whose scene draws something, found none", path)

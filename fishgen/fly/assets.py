@@ -85,8 +85,9 @@ def prepare_assets(inputs: Sequence[str | os.PathLike], *, mode: str | None = No
 def _glb(path: Path) -> bytes:
     """A .glb's bytes as they are, once fishgen's reader has checked them; a .gltf (and its side
     files, only from its folder) read and written as one glb."""
-    from fishgen.exchange.gltf import glb_bytes, require_shown
-    from fishgen.exchange.registry import FORMATS
+    from fishgen.exchange.gltf import glb_bytes
+    from fishgen.exchange.gltf_container import unpack
+    from fishgen.exchange.gltf_reader import read_gltf
 
     if not path.is_file():
         raise FishgenError("expected an existing file, found none", path)
@@ -94,11 +95,15 @@ def _glb(path: Path) -> bytes:
     if size > MAX_ASSET_BYTES:
         raise FishgenError(f"expected at most {MAX_ASSET_BYTES >> 20} MiB of glTF to fly through, found "
                            f"{size / 2**20:.0f} MiB", path)
-    scene = FORMATS[path.suffix.lower()[1:]].read(path)   # refuses what is not glTF, before the page sees it
-    require_shown(path, scene)
-    if path.suffix.lower() == ".glb":
-        return path.read_bytes()
-    return glb_bytes(scene, path)
+    data = path.read_bytes()       # read once: checked, looked into, and handed on as it is
+    scene = read_gltf(path, data=data)     # refuses what is not glTF, before the page sees it
+    # A valid asset may show nothing: with no `scenes` three.js has no scene to add, and a scene of
+    # empty nodes gives the camera's path no point to aim at (the page failed with a stack trace).
+    if not unpack(data)[0].get("scenes"):
+        raise FishgenError("expected a glTF asset with a scene to show, found no scenes", path)
+    if not any(prim.vertex_count for _, prim in scene.drawn()):
+        raise FishgenError("expected a glTF asset whose scene draws something, found none", path)
+    return data if path.suffix.lower() == ".glb" else glb_bytes(scene, path)
 
 
 def cube_files_scene(paths: Sequence[Path], *, seed: int = 0, lighting: Lighting | None = None,
