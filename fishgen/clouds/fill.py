@@ -21,7 +21,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from fishgen.clouds.model import METHODS, Cloud, CubeFile
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, UsageError
 
 CHUNK = 1 << 16
 CLUMP = 0.25
@@ -95,21 +95,34 @@ def _float32_bounds(cube_file: CubeFile, offset, lo: np.ndarray, hi: np.ndarray)
         raise FishgenError(f"expected an offset within float32 range (-{limit:.3g} to "
                            f"{limit:.3g} per axis), found {_xyz(shift)}", cube_file.path)
     outside = ~((np.abs(lo) <= limit) & (np.abs(hi) <= limit))   # NaN compares False too
-    if outside.any():
-        k = int(np.flatnonzero(outside.any(axis=1))[0])
+    with np.errstate(over="ignore", invalid="ignore"):  # cubes out of range are refused below
+        lo32, hi32 = _round_inward(lo, up=True), _round_inward(hi, up=False)
+    thin = ~outside & (lo32 > hi32)  # e.g. 1 unit wide at y = 3e38, where float32 steps are 2e31
+    for bad, fault in ((outside, f"within float32 range (-{limit:.3g} to {limit:.3g} per axis)"),
+                       (thin, "at least one float32 step wide on each axis")):
+        if not bad.any():
+            continue
+        k = int(np.flatnonzero(bad.any(axis=1))[0])
         cube = cube_file.cubes[k]
-        moved = " after the offset" if any(shift) else ""
-        raise FishgenError(f"expected a cube within float32 range (-{limit:.3g} to {limit:.3g} "
-                           f"per axis){moved}, found corners {_xyz(lo[k])} to {_xyz(hi[k])}",
+        corners = f"corners {_xyz(lo[k])} to {_xyz(hi[k])}"
+        if any(shift) and _holds(lo[k] - shift, hi[k] - shift):
+            # the cube is fine where its file puts it: the offset is what to change
+            where = f"{cube_file.path}:{cube.line}" if cube.line else str(cube_file.path)
+            raise UsageError(f"expected an offset that keeps each cube {fault}, found "
+                             f"{_xyz(shift)}, which moves the cube of {where} to {corners}")
+        tail = " (too thin for float32 there)" if bad is thin else ""
+        raise FishgenError(f"expected a cube {fault}, found {corners}{tail}",
                            cube_file.path, cube.line or None)
-    lo32, hi32 = _round_inward(lo, up=True), _round_inward(hi, up=False)
-    thin = lo32 > hi32
-    if thin.any():  # e.g. 1 unit wide at y = 3e38, where float32 steps are 2e31
-        k = int(np.flatnonzero(thin.any(axis=1))[0])
-        raise FishgenError(f"expected a cube at least one float32 step wide on each axis, found "
-                           f"corners {_xyz(lo[k])} to {_xyz(hi[k])} (too thin for float32 there)",
-                           cube_file.path, cube_file.cubes[k].line or None)
     return lo32, hi32
+
+
+def _holds(lo: np.ndarray, hi: np.ndarray) -> bool:
+    """Whether float32 can hold a cube from ``lo`` to ``hi``: in range, a float32 step wide."""
+    limit = float(np.finfo(np.float32).max)
+    if not ((np.abs(lo) <= limit) & (np.abs(hi) <= limit)).all():
+        return False
+    with np.errstate(over="ignore"):
+        return bool((_round_inward(lo, up=True) <= _round_inward(hi, up=False)).all())
 
 
 def _xyz(values) -> str:

@@ -167,18 +167,21 @@ def test_command_module_does_not_import_numpy():
                           check=True).stdout.strip() == "False"
 
 
-def test_offset_pushing_a_cube_past_float32_is_refused_at_its_line(cli, tmp_path, write_awn):
+def test_offset_pushing_a_cube_past_float32_is_refused_as_the_offsets_fault(cli, tmp_path, write_awn):
     # The offset fits float32, but the cube then reaches past 3.4e38: every particle
-    # used to be clamped to 3.4e38 with overflow warnings, and exit 0.
+    # used to be clamped to 3.4e38 with overflow warnings, and exit 0. The cube is fine where the
+    # file puts it, so the message names the offset and says which cube it pushed out.
     path = write_awn("5\n1\n5, 2e37, 1, 1, 2e38, 0, 0, 1\n")
     result = cli("clouds", path, "--offset", "1.5e38,0,0", "-o", tmp_path / "x.ply")
-    assert_one_line_error(result, f"{path}:3: expected a cube within float32 range "
-                                  "(-3.4e+38 to 3.4e+38 per axis) after the offset, found corners "
+    assert_one_line_error(result, "fishgen clouds: expected an offset that keeps each cube within "
+                                  "float32 range (-3.4e+38 to 3.4e+38 per axis), found (1.5e+38, 0, 0), "
+                                  f"which moves the cube of {path}:3 to corners "
                                   "(3.4e+38, -0.5, -0.5) to (3.6e+38, 0.5, 0.5)")
     # Table 4.2 moved to x = 3.4e38, where float32 steps are 2e31: no x inside its cubes.
     result = cli("clouds", TABLES["4.2"], "--offset", "3.4e38,0,0", "-o", tmp_path / "x.ply")
-    assert_one_line_error(result, f"{TABLES['4.2']}:3: expected a cube at least one float32 "
-                                  "step wide on each axis")
+    assert_one_line_error(result, "fishgen clouds: expected an offset that keeps each cube at least "
+                                  "one float32 step wide on each axis, found (3.4e+38, 0, 0), which "
+                                  f"moves the cube of {TABLES['4.2']}:3 to corners")
     assert list(tmp_path.iterdir()) == [path]
 
 

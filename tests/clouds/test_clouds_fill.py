@@ -180,8 +180,10 @@ def test_phase_shift_is_eq_4_5_to_4_7_as_decided():
 @pytest.mark.parametrize("offset,message", [
     ((1e300, 0, 0), r"^test: expected an offset within float32 range .*found \(1e\+300, 0, 0\)"),
     ((0, float("nan"), 0), r"^test: expected an offset within float32 range"),
-    ((0, 0, 3.4e38), r"^test:7: expected a cube at least one float32 step wide"),
-    ((0, 0, -3.4e38), r"^test:7: expected a cube at least one float32 step wide"),
+    # the cube is fine where its file puts it, so the offset is blamed, not the file's line
+    ((0, 0, 3.4e38), r"^expected an offset that keeps each cube at least one float32 step wide on "
+                     r"each axis, found \(0, 0, 3.4e\+38\), which moves the cube of test:7 to corners"),
+    ((0, 0, -3.4e38), r"^expected an offset that keeps each cube at least one float32 step wide"),
 ])
 def test_offsets_and_cubes_outside_float32_are_refused(offset, message):
     from fishgen.errors import FishgenError
@@ -190,12 +192,21 @@ def test_offsets_and_cubes_outside_float32_are_refused(offset, message):
         fill_cloud(cube_file, offset=offset)
 
 
-def test_cube_past_float32_after_the_offset_is_refused():
-    from fishgen.errors import FishgenError
+def test_cube_past_float32_after_the_offset_is_refused_as_the_offsets_fault():
+    from fishgen.errors import UsageError
     cube_file = CubeFile("test", 5, (Cube(5, (2e37, 1.0, 1.0), (2e38, 0.0, 0.0), 2.0, 3),))
-    with pytest.raises(FishgenError, match=r"^test:3: expected a cube within float32 range "
-                                           r".* after the offset, found corners \(3.4e\+38"):
+    with pytest.raises(UsageError, match=r"^expected an offset that keeps each cube within float32 "
+                                         r"range .*, found \(1.5e\+38, 0, 0\), which moves the cube of "
+                                         r"test:3 to corners \(3.4e\+38"):
         fill_cloud(cube_file, offset=(1.5e38, 0, 0))
+
+
+def test_cube_past_float32_on_its_own_is_the_files_fault_whatever_the_offset():
+    from fishgen.errors import FishgenError, UsageError
+    cube_file = CubeFile("test", 5, (Cube(5, (2e38, 1.0, 1.0), (2.5e38, 0.0, 0.0), 2.0, 3),))
+    with pytest.raises(FishgenError, match=r"^test:3: expected a cube within float32 range") as caught:
+        fill_cloud(cube_file, offset=(1.0, 0, 0))
+    assert not isinstance(caught.value, UsageError)
 
 
 def test_cube_too_thin_for_float32_at_its_position_is_refused():
