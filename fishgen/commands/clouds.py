@@ -158,8 +158,12 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     voxel_size = options.voxel_size if options.voxel_size is not None else DEFAULT_VOXEL_SIZE
     if volume:
         from fishgen.clouds.volume import check_cube_files
+        from fishgen.errors import FishgenError
 
-        check_cube_files(files, options.offset, voxel_size, output)
+        try:
+            check_cube_files(files, options.offset, voxel_size)
+        except FishgenError as err:     # too fine a --voxel-size: the option's fault, not the output's
+            raise UsageError(err.message) from None
     seed = options.seed or 0
     made = cube_clouds(files, seed=seed, method=options.method, offsets=options.offset,
                        lighting=options.lighting, light=options.light, max_particles=options.max_particles)
