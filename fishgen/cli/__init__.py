@@ -15,7 +15,7 @@ import threading
 import click
 
 from fishgen import __version__, interrupts
-from fishgen.cli.common import add_common_options, error_line, json_errors, reset
+from fishgen.cli.common import add_common_options, error_line, error_text, json_errors, reset
 from fishgen.commands import MODULES, command
 
 # numpy asks the kernel for transparent huge pages on every array of 4 MiB or more. Where the
@@ -90,10 +90,7 @@ def main(argv: list[str] | None = None) -> None:
     try:
         cli.main(args=args, prog_name="fishgen", standalone_mode=False)
     except FishgenError as err:
-        from fishgen.errors import SystemFailure
-
-        plain = err.file is None or isinstance(err, SystemFailure)  # a system's refusal names its path
-        _fail(f"fishgen: {err}" if plain else str(err), err.status, err.file, err.line, err.kind)
+        _fail(error_text(err), err.status, err.file, err.line, err.kind)
     except click.exceptions.Abort:
         interrupts.stopped()
         _fail("fishgen: interrupted", 130, kind="interrupted")  # the shell's ^C ends the line before ours

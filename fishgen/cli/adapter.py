@@ -14,7 +14,7 @@ from typing import Any
 
 import click
 
-from fishgen.cli.common import QUIET, VERBOSE, error_line, verbosity
+from fishgen.cli.common import QUIET, VERBOSE, error_line, error_text, verbosity
 from fishgen.commands import Command, Events, Progress
 from fishgen.options import click_params, from_values
 
@@ -122,11 +122,7 @@ class TerminalEvents:
             bar.render_progress()
 
     def failed(self, err: Any) -> None:
-        from fishgen.errors import UsageError
-
-        message = str(err)
-        if isinstance(err, UsageError) and err.file is None and self.command:
-            message = f"fishgen {self.command}: {message}"     # as a usage error that stops the command
+        message = error_text(err, self.command)    # as the error that stops a command reads
         detail = getattr(err, "detail", "")
         self._above_bar(error_line(message, err.status, file=err.file, line=err.line, kind=err.kind,
                                    **({"job": err.job} if err.job else {}))

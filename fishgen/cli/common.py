@@ -45,6 +45,17 @@ def json_errors() -> bool:
     return bool(_state["json"])
 
 
+def error_text(err: Any, command: str | None = None) -> str:
+    """A FishgenError as its one line reads: ``FILE:LINE: …`` where the input is at fault, else
+    after ``fishgen COMMAND:`` (a usage error) or ``fishgen:`` (the system's refusal, or no place)."""
+    from fishgen.errors import SystemFailure, UsageError
+
+    if isinstance(err, UsageError) and err.file is None and command:
+        return f"fishgen {command}: {err}"
+    plain = err.file is None or isinstance(err, SystemFailure)  # a system's refusal names its path
+    return f"fishgen: {err}" if plain else str(err)
+
+
 def error_line(message: str, status: int, *, file: str | None = None, line: int | None = None,
                kind: str = "input", **extra: Any) -> str:
     """An error as the user asked for it: the plain one line, or one JSON object."""

@@ -118,8 +118,8 @@ def test_a_full_disk_says_one_line_per_failed_job_and_one_summary(shipped, monke
     out = shipped / "out"
     assert run.returncode == 1, run.stderr
     assert run.stderr.splitlines() == [
-        f"cannot write {out / 'a.ply'}: No space left on device",
-        f"cannot write {out / 'b.ply'}: No space left on device",
+        f"fishgen: cannot write {out / 'a.ply'}: No space left on device",
+        f"fishgen: cannot write {out / 'b.ply'}: No space left on device",
         f"fishgen: 2 of 2 jobs failed (each said why above); cannot write {shipped / 'report.json'}: "
         f"No space left on device"]   # no job built: no record to write, where there was none
     assert run.stdout.startswith(f"{out}: 2 jobs, 0 built, 0 skipped, 2 failed in ")
