@@ -99,9 +99,13 @@ def _read(path: Path) -> Scene:
                               metadata={"file_name": path.name})
     else:
         alpha = {}
-        if not _check_ply_header(path):
-            return _point_set(path)
-        loaded = trimesh.load(str(path), process=False, resolver=resolver)
+        try:
+            if not _check_ply_header(path):
+                return _point_set(path)
+            loaded = trimesh.load(str(path), process=False, resolver=resolver)
+        except ValueError:  # numpy's "could not be read to its end": said at the line that stopped it
+            _ascii_ply_fault(path)
+            raise
     geoms = loaded.dump(concatenate=False) if isinstance(loaded, trimesh.Scene) else [loaded]
     scene = Scene(name=path.stem, source=str(path))
     for k, geom in enumerate(geoms):
@@ -114,6 +118,8 @@ def _read(path: Path) -> Scene:
         name = str(geom.metadata.get("name") or f"{path.stem}{k}")
         scene.add_node(Node(name=name, mesh=scene.add_mesh(Mesh(name, [prim]))))
     if not scene.meshes:
+        if not obj:
+            _ascii_ply_fault(path)    # a face list shorter than its count reads as no faces
         raise FishgenError("expected triangles or points, found an empty asset", path)
     return scene
 
@@ -315,6 +321,53 @@ def _check_ply_header(path: Path) -> bool:
         raise expected(f"at least {need:,} bytes of {fmt} data for {counts}",
                        f"{body:,} bytes after the header", path)
     return any(name == "face" and count for name, count, _ in elements)
+
+
+def _ascii_ply_fault(path: Path) -> None:
+    """Raise at the first line of an ASCII PLY's body that is not one element's numbers (a comma,
+    a word, a list shorter than its count); return if there is none, or the file is binary."""
+    with path.open("rb") as f:
+        head = f.read(MAX_PLY_HEADER)
+    end = re.search(rb"(^|\n)end_header[ \t]*\r?\n", head)
+    header = head[: end.end()].decode("latin-1").splitlines() if end else []
+    if not any(line.split()[:2] == ["format", "ascii"] for line in header):
+        return
+    elements: list[tuple[str, int, list[tuple[str, bool]]]] = []  # name, count, (property, is a list)
+    for line in header:
+        words = line.split()
+        if words[:1] == ["element"]:
+            elements.append((words[1], int(words[2]), []))
+        elif words[:1] == ["property"] and elements:
+            elements[-1][2].append((words[-1], words[1] == "list"))
+    with path.open("rb") as f:
+        f.seek(end.end())  # type: ignore[union-attr]  # a header with no end_header was refused
+        rows = iter(enumerate(f, len(header) + 1))
+        for name, count, props in elements:
+            what = f"{name} ({' '.join(p for p, _ in props)})"
+            for _ in range(count):
+                number, raw = next(rows, (None, b""))
+                if number is None:
+                    return  # too few lines: the size check or trimesh says it
+                text = raw.decode("latin-1").strip()
+                words = text.split()
+                try:
+                    values = [float(w) for w in words]
+                except ValueError:
+                    raise expected(f"numbers for a {what}", describe(text),
+                                   path, number) from None
+                want, at = 0, 0
+                for _, is_list in props:
+                    if is_list and at < len(values):
+                        items = values[at]
+                        if not math.isfinite(items) or items != int(items) or items < 0:
+                            raise expected(f"a whole count before a {name}'s list", describe(text),
+                                           path, number)
+                        want, at = want + 1 + int(items), at + 1 + int(items)
+                    else:
+                        want, at = want + 1, at + 1
+                if len(values) != want:
+                    raise expected(f"{want} numbers for a {what}", f"{len(values)}: {describe(text)}",
+                                   path, number)
 
 
 def _finite(positions: np.ndarray, path: Path) -> None:

@@ -159,6 +159,31 @@ def test_ply_header_faults(tmp_path, header, pattern):
     refused(path, pattern)
 
 
+ASCII_HEAD = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+              "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n")
+
+
+@pytest.mark.parametrize("body,pattern", [
+    ("0 0 0\n1 0 0\nzz 1 0\n3 0 1 2\n", r":12: expected numbers for a vertex \(x y z\), found 'zz 1 0'$"),
+    ("0,0,0\n1 0 0\n0 1 0\n3 0 1 2\n", r":10: expected numbers for a vertex \(x y z\), found '0,0,0'$"),
+    ("0 0 0\n1 0 0\n0 1 0\n3 0 1 x\n", r":13: expected numbers for a face \(vertex_indices\), found '3 0 1 x'"),
+    ("0 0 0\n1 0 0\n0 1 0\n3 0 1\n", r":13: expected 4 numbers for a face \(vertex_indices\), found 3: '3 0 1'"),
+])
+def test_an_ascii_ply_body_fault_is_said_at_its_line_in_its_own_words(tmp_path, body, pattern):
+    """numpy's "string or file could not be read to its end due to unmatched data" (or, for a
+    short face list, "an empty asset") said nothing of where: the first bad line is named."""
+    path = tmp_path / "bad.ply"
+    path.write_text(ASCII_HEAD + body)
+    text = refused(path, pattern)
+    assert "unmatched data" not in text and "empty asset" not in text
+
+
+def test_a_well_formed_ascii_ply_with_faces_loads(tmp_path):
+    path = tmp_path / "ok.ply"
+    path.write_text(ASCII_HEAD + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    assert read_mesh_file(path).meshes
+
+
 def test_ply_over_the_cap_is_refused_by_stat(tmp_path):
     path = _sparse(tmp_path / "big.ply", 2**30, b"ply\nformat binary_little_endian 1.0\nelement vertex 3\n"
                    b"property float x\nproperty float y\nproperty float z\nend_header\n")
