@@ -103,7 +103,9 @@ def _read(path: Path) -> Scene:
             if not _check_ply_header(path):
                 return _point_set(path)
             loaded = trimesh.load(str(path), process=False, resolver=resolver)
-        except ValueError:  # numpy's "could not be read to its end": said at the line that stopped it
+        except FishgenError:
+            raise
+        except Exception:  # numpy's "could not be read to its end": said at the line that stopped it
             _ascii_ply_fault(path)
             raise
     geoms = loaded.dump(concatenate=False) if isinstance(loaded, trimesh.Scene) else [loaded]
