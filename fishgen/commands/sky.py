@@ -21,13 +21,17 @@ from fishgen.options import (
     option,
     seed_option,
 )
-from fishgen.sky.modes import ALTITUDE, AREA, MODES, NOISE
+from fishgen.sky.modes import ALTITUDE, AREA, MODES, NOISE, SHIPPED_CUBES
 
 
 def _modes_help() -> str:
     return "; ".join(f"{m.name}: {m.clouds} clouds, {m.particles:,} particles, "
                      f"scale {m.scale[0]:g}-{m.scale[1]:g}"
                      for m in MODES.values())
+
+
+def _least_help() -> str:
+    return ", ".join(f"{m.name} {m.clouds * SHIPPED_CUBES:,}" for m in MODES.values())
 
 
 @dataclass(frozen=True)
@@ -47,7 +51,9 @@ class SkyOptions:
                           "scaled by 1 + NOISE x fBm (mostly within +-0.4); 0 turns it off.", NOISE,
                           metavar="AMOUNT")
     particles: int | None = option(click.IntRange(1, DEFAULT_MAX_PARTICLES), "Particles in the whole sky, "
-                                   "shared by the clouds by volume.", shown_default="the mode's",
+                                   "shared by the clouds by volume; at least one for each cube of every "
+                                   "cloud: the mode's clouds times the most cubes in a --clouds file "
+                                   f"(with the shipped files, {_least_help()}).", shown_default="the mode's",
                                    metavar="N")
     shadow_map: str = option(click.Choice(("cloud", "sky")), "cloud: each cloud lit on its own shadow map, "
                              "the clouds between it and the sun as occluders (fine, 3-10x slower); sky: one "

@@ -42,6 +42,11 @@ MODES: dict[str, SkyMode] = {m.name: m for m in (
 )}
 """Pakawan's modes 1, 2, 3."""
 
+SHIPPED_CUBES = 23
+"""The most cubes with particles in one of the default cloud files (Table 4.4's 23; 4.3 has fewer):
+a sky needs a particle in each cube of every cloud, so the least --particles is a mode's clouds times
+this (a test checks it against the files)."""
+
 AREA = (400.0, 400.0)
 """Default sky area, width (x) by depth (z), centred on the origin."""
 ALTITUDE = (40.0, 80.0)

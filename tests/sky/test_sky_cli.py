@@ -193,3 +193,15 @@ def test_a_small_skys_summary_says_its_size_in_kilobytes(tmp_path):
     made = run_cli("sky", "--mode", "thin", "--particles", "400", "-o", path)
     assert made.returncode == 0, made.stderr
     assert f", {path.stat().st_size / 1e3:.0f} KB (seed 0" in made.stdout
+
+
+def test_help_gives_each_modes_least_particles_as_the_shipped_files_make_it():
+    """--help gave --particles' range as 1 to 50,000,000, where a thin sky needs 368 (QA pass 13)."""
+    from fishgen.sky.build import load_models
+    from fishgen.sky.modes import SHIPPED_CUBES
+
+    cubes, _ = load_models()
+    assert SHIPPED_CUBES == max(sum(1 for c in f.cubes if c.particles) for f in cubes)
+    run = run_cli("sky", "--help")
+    text = " ".join(run.stdout.split())
+    assert "(with the shipped files, thin 368, medium 1,104, thick 2,760)" in text, text
