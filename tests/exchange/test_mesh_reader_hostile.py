@@ -166,8 +166,10 @@ ASCII_HEAD = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproper
 @pytest.mark.parametrize("body,pattern", [
     ("0 0 0\n1 0 0\nzz 1 0\n3 0 1 2\n", r":12: expected numbers for a vertex \(x y z\), found 'zz 1 0'$"),
     ("0,0,0\n1 0 0\n0 1 0\n3 0 1 2\n", r":10: expected numbers for a vertex \(x y z\), found '0,0,0'$"),
-    ("0 0 0\n1 0 0\n0 1 0\n3 0 1 x\n", r":13: expected numbers for a face \(vertex_indices\), found '3 0 1 x'"),
-    ("0 0 0\n1 0 0\n0 1 0\n3 0 1\n", r":13: expected 4 numbers for a face \(vertex_indices\), found 3: '3 0 1'"),
+    ("0 0 0\n1 0 0\n0 1 0\n3 0 1 x\n",
+     r":13: expected numbers for a face \(vertex_indices\), found '3 0 1 x'"),
+    ("0 0 0\n1 0 0\n0 1 0\n3 0 1\n",
+     r":13: expected 4 numbers for a face \(vertex_indices\), found 3: '3 0 1'"),
     ("0 0 0\n1 0 0\n0 1 0\ninf 0 1\n", r":13: expected a whole count before a face's list, found 'inf 0 1'"),
 ])
 def test_an_ascii_ply_body_fault_is_said_at_its_line_in_its_own_words(tmp_path, body, pattern):
