@@ -16,12 +16,11 @@ from urllib.parse import unquote
 from fishgen.errors import FishgenError
 from fishgen.exchange.registry import FORMATS, formats
 from fishgen.exchange.sidefiles import map_file_name, mtl_libraries, side_file
+from fishgen.viewer import MAX_EMBED_BYTES
 from fishgen.web.page import page_html
 
 KINDS = {ext: fmt.name for fmt in formats(viewer=True) for ext in fmt.extensions}
 """What three.js's loaders show, from the format registry: extension -> loader kind."""
-MAX_EMBED_BYTES = 256 << 20
-"""Beyond this a browser struggles with a base64 page; such assets need a desktop tool."""
 _MTL_MAPS = re.compile(r"^\s*(?:map_\w+|bump|disp|decal|refl|norm)\s+(.+?)\s*$", re.M | re.I)
 
 
