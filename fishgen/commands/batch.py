@@ -104,7 +104,8 @@ PRELOAD = {"build": _FISH,
 def preload(kinds: set[str]) -> list[str]:
     """The modules jobs of these kinds need, in import order."""
     jobs = [m for kind in sorted(kinds) for m in (MODULES[kind], *PRELOAD[kind])]
-    return list(dict.fromkeys([__name__, "fishgen.commands.paths", *jobs, "fishgen.exchange.gltf"]))
+    return list(dict.fromkeys([__name__, "fishgen.commands.paths", *jobs, "fishgen.exchange.gltf",
+                                "fishgen.exchange.gltf_container", "fishgen.viewer"]))
 
 
 @dataclass(frozen=True)
