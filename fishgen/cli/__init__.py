@@ -15,7 +15,7 @@ import threading
 import click
 
 from fishgen import __version__, interrupts
-from fishgen.cli.common import add_common_options, error_line, error_text, json_errors, reset
+from fishgen.cli.common import add_common_options, error_line, error_text, json_errors, reset, say
 from fishgen.commands import MODULES, command
 
 # numpy asks the kernel for transparent huge pages on every array of 4 MiB or more. Where the
@@ -162,5 +162,10 @@ def run() -> None:
 
 def _fail(message: str, status: int, file: str | None = None, line: int | None = None,
           kind: str = "input") -> None:
-    click.echo(error_line(message, status, file=file, line=line, kind=kind), err=True)
+    from fishgen.errors import SystemFailure
+
+    try:
+        say([error_line(message, status, file=file, line=line, kind=kind)], err=True)
+    except SystemFailure:
+        pass      # stderr itself refused (a full disk): the status is all there is left to say
     sys.exit(status)

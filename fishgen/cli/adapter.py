@@ -14,7 +14,7 @@ from typing import Any
 
 import click
 
-from fishgen.cli.common import QUIET, VERBOSE, error_line, error_text, verbosity
+from fishgen.cli.common import QUIET, VERBOSE, error_line, error_text, say, verbosity
 from fishgen.commands import Command, Events, Progress
 from fishgen.options import click_params, from_values
 
@@ -51,13 +51,10 @@ def execute(cmd: Command, inputs: tuple[Path, ...], output: str | None, options:
 
     events = TerminalEvents(cmd.name)
     # A summary that cannot be printed (stdout on a full disk) fails the run: with `together`, its
-    # files are still staged then, and none lands.
+    # files are still staged then, and none lands. A reader that has gone (`| head -1`) fails nothing.
     with together() if cmd.together else nullcontext(), _warnings_as_notes(events):
         made = run(cmd, inputs, output, options, events.as_events())
-        for line in made.lines:
-            click.echo(line)
-        if cmd.together:
-            sys.stdout.flush()
+        say(made.lines)
     if made.verdict is not None:
         raise made.verdict
     if made.failed:
@@ -115,7 +112,7 @@ class TerminalEvents:
         (as tqdm's write): no line of the bar left half drawn, no blank line when it ends."""
         if self.bars:
             sys.stderr.write("\r\x1b[K")
-        click.echo(text, err=True)
+        say([text], err=True)
         if self.bars:
             bar = self.bars[-1]
             bar._last_line = None       # click skips drawing the line it drew last: it was cleared
@@ -131,7 +128,7 @@ class TerminalEvents:
     def line(self, text: str, detail: str | None) -> None:
         if self.bars or verbosity() <= QUIET:
             return
-        click.echo(text + (f": {detail}" if detail and verbosity() >= VERBOSE else ""))
+        say([text + (f": {detail}" if detail and verbosity() >= VERBOSE else "")])
 
     @contextmanager
     def progress(self, label: str, total: int) -> Iterator[Progress]:

@@ -19,6 +19,7 @@ import functools
 import json
 import sys
 import time
+from collections.abc import Iterable
 from contextlib import nullcontext, redirect_stdout
 from typing import Any
 
@@ -120,6 +121,39 @@ def _wrapped(callback, name: str):
             click.echo(f"fishgen {name}: done in {time.perf_counter() - start:.2f} s", err=True)
         return result
     return run
+
+
+def say(lines: Iterable[str], err: bool = False) -> None:
+    """Print ``lines`` (stdout, or stderr with ``err``) and flush them. A reader that has gone (a
+    closed pipe: `fishgen school … | head -1`) stops only the printing: the stream goes to
+    /dev/null from then on and the command carries on, its files landing as they would; click's
+    own handling exited 1 in silence, and a school's staged files never landed. Any other failure
+    to print (stdout on a full disk) fails the command, saying so."""
+    stream = sys.stderr if err else sys.stdout
+    try:
+        for line in lines:
+            click.echo(line, err=err)
+        stream.flush()
+    except BrokenPipeError:
+        _gone(stream)
+    except OSError as error:
+        from fishgen.errors import SystemFailure
+
+        raise SystemFailure(f"cannot write to {'stderr' if err else 'stdout'}: "
+                            f"{error.strerror or error}") from None
+
+
+def _gone(stream: Any) -> None:
+    """Point a stream whose reader has gone at /dev/null, its unwritten bytes dropped."""
+    import os
+
+    try:
+        fd = stream.fileno()
+    except (OSError, ValueError):   # not a file (a test's buffer): nothing to point anywhere
+        return
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, fd)
+    os.close(null)
 
 
 def _devnull():

@@ -276,3 +276,12 @@ def test_a_batch_whose_every_job_fails_writes_no_record(shipped):
     run = batch(manifest, "--out", out)
     assert run.returncode == 2, run.stderr
     assert [p.name for p in out.iterdir()] == [".fishgen-batch.lock"]
+
+
+def test_a_batch_whose_reader_has_gone_runs_every_job(tmp_path, shipped):
+    """`fishgen batch … -j 1 | true` stopped after its first job (QA pass 14)."""
+    from tests.cli.test_school import closed_stdout
+
+    result = closed_stdout("batch", shipped / "params" / "assets.toml", "--out", tmp_path / "out", "-j", "1")
+    assert result.returncode == 0 and result.stderr == "", result.stderr
+    assert len([p for p in (tmp_path / "out").rglob("*.glb")]) >= 9

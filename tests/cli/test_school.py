@@ -236,8 +236,29 @@ def test_a_summary_that_cannot_be_printed_fails_the_run_and_leaves_no_file(tmp_p
                                  "-o", str(tmp_path / "new" / "s.glb"), "--count", "3", "--frames", "10",
                                  "--metrics", str(tmp_path / "m.json")],
                                 cwd=ROOT, stdout=full, stderr=subprocess.PIPE, text=True)
-    assert result.returncode == 1 and result.stderr == "fishgen: No space left on device\n"
+    assert result.returncode == 1
+    assert result.stderr == "fishgen: cannot write to stdout: No space left on device\n"
     assert list(tmp_path.iterdir()) == []  # nor the folder made for the glb
+
+
+def closed_stdout(*args, cwd=ROOT) -> subprocess.CompletedProcess:
+    """The command with its stdout a pipe whose reader has gone before it prints (`| true`)."""
+    read, write = os.pipe()
+    os.close(read)
+    try:
+        return subprocess.run([sys.executable, "-m", "fishgen", *map(str, args)], cwd=cwd, stdout=write,
+                              stderr=subprocess.PIPE, text=True)
+    finally:
+        os.close(write)
+
+
+def test_a_reader_that_has_gone_stops_the_printing_not_the_run(tmp_path):
+    """`fishgen school … | true` exited 1 in silence and its glb never landed (QA pass 14): click
+    exits 1 on a broken pipe, and a school lands its files only once its summary is out."""
+    result = closed_stdout("school", PARAMS / "bonybream.txt", "-o", tmp_path / "s.glb", "--count", "3",
+                           "--frames", "10")
+    assert result.returncode == 0 and result.stderr == "", result.stderr
+    assert (tmp_path / "s.glb").stat().st_size > 0
 
 
 def test_two_outputs_naming_one_file_are_refused_and_nothing_is_written(tmp_path):
