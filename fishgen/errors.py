@@ -50,6 +50,11 @@ class FishgenError(Exception):
         below read another spelling of it)."""
         return self._with(file=os.fspath(file))
 
+    def at(self, file: str | os.PathLike | None, line: int | None = None) -> FishgenError:
+        """This error said at ``file:line`` (a manifest job's line), its class, status and kind
+        kept: a missing package stays exit 1, ``dependency``."""
+        return self._with(file=os.fspath(file) if file is not None else None, line=line)
+
     def _with(self, **changes: Any) -> FishgenError:
         """A copy of this error (its class kept) with ``changes`` to its attributes."""
         clone = copy.copy(self)

@@ -173,7 +173,7 @@ def _job(where: Where, of: Kind, nth: int, entry: dict[str, Any], folder: Path, 
     try:
         output_format(relative, of.holds)
     except FishgenError as err:
-        raise FishgenError(err.message, where.file, where.line("output", kind, nth)) from None
+        raise err.at(where.file, where.line("output", kind, nth)) from None
     name = relative.as_posix()
     values: dict[str, Any] = {}
     for key, (f, spec) in declared.items():

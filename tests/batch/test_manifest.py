@@ -195,3 +195,21 @@ def test_a_school_job_with_prototypes_and_a_glb_is_refused_at_its_line(tmp_path)
     with pytest.raises(FishgenError, match="expected prototypes with a USD output"):
         load_manifest(path)
     assert load_manifest(write(tmp_path, '[[school]]\ninput = "a.txt"\noutput = "s.usdc"\nprototypes = 2\n'))
+
+
+def test_a_usd_job_without_usd_core_is_a_missing_package_at_its_line(tmp_path, monkeypatch):
+    """It was said at the job's line as bad input (exit 2, kind input), where `build` and `school`
+    say exit 1, kind dependency, as the README's table does (QA pass 14)."""
+    import importlib.util
+
+    from fishgen.errors import MissingDependency
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == "pxr" else real(name, *a))
+    path = write(tmp_path, '[[build]]\ninput = "a.txt"\noutput = "a.usdz"\n')
+    with pytest.raises(MissingDependency) as caught:
+        load_manifest(path)
+    assert (caught.value.status, caught.value.kind) == (1, "dependency")
+    assert str(caught.value) == (f"{path}:3: writing .usdz needs usd-core (pxr), which is not installed; "
+                                 "install it with pip install 'fishgen[usd]'")
