@@ -208,6 +208,59 @@ def _gone(pid: int, seconds: float) -> bool:
     return True
 
 
+PROBE_SECONDS = 10.0
+"""How long a TCP scheduler address has to connect, and then to send its greeting."""
+
+
+def _probe(address: str, seconds: float = PROBE_SECONDS) -> None:
+    """Refuse, in one line and within ``seconds`` twice, a TCP address where no Dask scheduler
+    answers. A scheduler speaks first: a frame of its handshake (an 8-byte little-endian length, a
+    frame count, the frames' lengths). Dask's Client hung for good on a server that waits for a
+    request (its dashboard's HTTP port: 13 minutes and counting), and on one that answers HTTP it
+    read a length of 3 EiB and died out of memory, its own time-out never firing."""
+    import socket
+    import struct
+    from urllib.parse import urlsplit
+
+    scheme, _, rest = address.rpartition("://")
+    if scheme not in ("", "tcp"):
+        return              # tls://, ucx://, inproc://: Dask's own connection says what it finds
+    try:
+        where = urlsplit(f"tcp://{rest}")
+        host, port = where.hostname, where.port
+    except ValueError:
+        return              # Dask says what is wrong with the address
+    if host is None or port is None:
+        return
+
+    def refused(why: str) -> SystemFailure:
+        return SystemFailure(f"cannot reach a Dask scheduler at {address} ({why})")
+
+    try:
+        sock = socket.create_connection((host, port), timeout=seconds)
+    except TimeoutError:
+        raise refused(f"no connection in {seconds:g} s") from None
+    except OSError as err:
+        raise refused(err.strerror or str(err)) from None
+    head = b""
+    with sock:
+        try:
+            while len(head) < 16:
+                got = sock.recv(16 - len(head))
+                if not got:
+                    break
+                head += got
+        except TimeoutError:
+            raise refused(f"something there said nothing in {seconds:g} s, where a scheduler greets at "
+                          "once: another port, such as its dashboard's?") from None
+        except OSError as err:
+            raise refused(err.strerror or str(err)) from None
+    total, frames = struct.unpack("<QQ", head) if len(head) == 16 else (0, 0)
+    if not (0 < total <= 1 << 20 and 0 < frames <= 64):
+        said = head[:12].decode("latin-1").encode("unicode_escape").decode("ascii")
+        raise refused(f"something else answers there: {said!r}" if head else "it closed at once")
+
+
 def _dask(jobs: Sequence[Job], work: Work, done: Done, address: str) -> None:
     """Dask distributed: the scheduler places each job on a worker; outputs go to their shared paths."""
     try:
@@ -216,10 +269,14 @@ def _dask(jobs: Sequence[Job], work: Work, done: Done, address: str) -> None:
         raise MissingDependency("--scheduler needs Dask distributed, which is not installed; install it "
                                 "with pip install 'fishgen[cluster]'") from None
 
+    _probe(address)
     try:
         client = Client(address, timeout=30, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as err:
         raise SystemFailure(f"cannot reach a Dask scheduler at {address} ({err})") from None
+    except (MemoryError, Exception) as err:  # it answered in another protocol after all
+        raise SystemFailure(f"cannot reach a Dask scheduler at {address} (it does not answer as one: "
+                            f"{type(err).__name__})") from None
     futures = {}
     try:
         for index, job in enumerate(jobs):

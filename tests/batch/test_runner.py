@@ -2,12 +2,14 @@
 leaves whole files and a consistent record, and the next run finishes only what is missing."""
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -297,3 +299,74 @@ def test_a_dask_cluster_builds_the_same_bytes_as_the_local_pool(shipped):
     assert set(statuses(again.stdout).values()) == {"skipped"}
     report = json.loads((shipped / "dask.json").read_text())
     assert report["scheduler"] == cluster.scheduler_address and report["counts"]["built"] == 9
+
+
+@contextlib.contextmanager
+def server(answer: bytes | None):
+    """A TCP server on 127.0.0.1 that, to each connection, says ``answer`` and closes, or (None)
+    says nothing until the test ends: what a scheduler address may find that is no scheduler."""
+    import socket
+
+    listener = socket.create_server(("127.0.0.1", 0))
+    held: list[socket.socket] = []
+    stop = threading.Event()
+
+    def serve() -> None:
+        listener.settimeout(0.1)
+        while not stop.is_set():
+            try:
+                conn, _ = listener.accept()
+            except TimeoutError:
+                continue
+            if answer is None:
+                held.append(conn)
+            else:
+                with conn:
+                    conn.sendall(answer)
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        yield f"tcp://127.0.0.1:{listener.getsockname()[1]}"
+    finally:
+        stop.set()
+        thread.join()
+        for conn in held:
+            conn.close()
+        listener.close()
+
+
+@pytest.mark.parametrize("answer,said", [
+    (None, "something there said nothing in 0.5 s, where a scheduler greets at once: another port, "
+           "such as its dashboard's?"),
+    (b"HTTP/1.1 400 Bad Request\r\n\r\n", "something else answers there: 'HTTP/1.1 400'"),
+    (b"", "it closed at once"),
+])
+def test_an_address_where_no_scheduler_answers_is_refused_in_one_line(answer, said):
+    """Dask's Client hung for good on a port that waits for a request (a dashboard's), and read a
+    length of 3 EiB from one that answers HTTP, then died 'out of memory' (QA pass 14)."""
+    from fishgen.batch.runner import _probe
+    from fishgen.errors import SystemFailure
+
+    with server(answer) as address, pytest.raises(SystemFailure) as caught:
+        _probe(address, seconds=0.5)
+    assert str(caught.value) == f"cannot reach a Dask scheduler at {address} ({said})"
+
+
+def test_batch_names_what_answers_at_a_scheduler_address_at_once(shipped):
+    pytest.importorskip("distributed")
+    with server(b"HTTP/1.1 400 Bad Request\r\n\r\n") as address:
+        start = time.monotonic()
+        run = batch(shipped / "params" / "assets.toml", "--scheduler", address)
+    assert run.returncode == 1 and time.monotonic() - start < 10
+    assert run.stderr == (f"fishgen: cannot reach a Dask scheduler at {address} (something else answers "
+                          "there: 'HTTP/1.1 400')\n")
+
+
+def test_a_scheduler_passes_the_probe():
+    distributed = pytest.importorskip("distributed")
+    from fishgen.batch.runner import _probe
+
+    with distributed.LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        _probe(cluster.scheduler_address, seconds=5)
