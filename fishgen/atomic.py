@@ -68,6 +68,16 @@ def together() -> Iterator[list[tuple[str, Path]]]:
         raise
 
 
+def where_now(path: str | os.PathLike) -> Path:
+    """Where ``path``'s bytes are now: inside a :func:`together` block, its staged temporary file
+    (the target is not there yet); else ``path`` itself."""
+    target = os.path.abspath(path)
+    for tmp, staged in _staging.get() or ():
+        if os.path.abspath(staged) == target:
+            return Path(tmp)
+    return Path(path)
+
+
 @contextmanager
 def protecting(paths: Iterable[str | os.PathLike]) -> Iterator[None]:
     """No file written inside may be one of ``paths`` (the command's inputs), whatever its name."""

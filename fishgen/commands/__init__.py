@@ -169,30 +169,11 @@ def run(cmd: Command, inputs: tuple[Path, ...], output: str | os.PathLike | None
     _folders_there(options)
     with protecting(inputs):
         made = cmd.function()(inputs, output, options, events)
-    _too_big_to_look_at(made.written, events)
+    from fishgen.exchange.client_limits import notes
+
+    for note in notes(made.written):    # what a client will not read or play of it
+        events.note(note)
     return made
-
-
-def _too_big_to_look_at(written: tuple[Path, ...], events: Events) -> None:
-    """A note for each glTF written past what fishgen's own viewers read (an engine loads it): `sky
-    --billboards --particles 1200000` wrote 528 MiB that `preview` and `fly` then refused."""
-    for path in written:
-        if Path(path).suffix.lower() not in (".glb", ".gltf", ".bin"):   # each read against the cap
-            continue
-        from fishgen.exchange.gltf_container import MAX_FILE_BYTES
-        from fishgen.viewer import MAX_EMBED_BYTES
-
-        try:
-            size = Path(path).stat().st_size
-        except OSError:
-            continue      # not landed yet (a command whose outputs land with its summary)
-        mib, read, embed = f"{size / 2**20:,.0f} MiB", MAX_FILE_BYTES >> 20, MAX_EMBED_BYTES >> 20
-        if size > MAX_FILE_BYTES:
-            events.note(f"{path}: {mib}, more than `fishgen preview` and `fishgen fly` read ({read} MiB) "
-                        f"or `fishgen view` embeds ({embed} MiB); engines load it")
-        elif size > MAX_EMBED_BYTES:
-            events.note(f"{path}: {mib}, more than `fishgen view` embeds in a page ({embed} MiB); "
-                        "`fishgen preview`, `fishgen fly` and engines load it")
 
 
 def _folders_there(options: Any) -> None:

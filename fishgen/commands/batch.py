@@ -105,7 +105,8 @@ def preload(kinds: set[str]) -> list[str]:
     """The modules jobs of these kinds need, in import order."""
     jobs = [m for kind in sorted(kinds) for m in (MODULES[kind], *PRELOAD[kind])]
     return list(dict.fromkeys([__name__, "fishgen.commands.paths", *jobs, "fishgen.exchange.gltf",
-                                "fishgen.exchange.gltf_container", "fishgen.viewer"]))
+                                "fishgen.exchange.gltf_container", "fishgen.viewer",
+                                "fishgen.exchange.client_limits"]))
 
 
 @dataclass(frozen=True)
