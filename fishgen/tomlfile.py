@@ -13,6 +13,17 @@ from typing import Any
 from fishgen.errors import FishgenError, describe
 
 
+def text_of(data: bytes, file: str) -> str:
+    """A TOML file's text: UTF-8, as TOML must be (a BOM dropped). Bytes that are not were read as
+    U+FFFD and came back as a job's input named 'bonybream\ufffd.txt', missing."""
+    try:
+        return data.decode("utf-8").removeprefix("\ufeff")
+    except UnicodeDecodeError as err:
+        line = data.count(b"\n", 0, err.start) + 1
+        raise FishgenError(f"expected UTF-8 text (TOML), found the byte {data[err.start]:#04x}", file,
+                           line) from None
+
+
 def loads(text: str, file: str) -> dict[str, Any]:
     """Parse TOML text; a syntax error is the one-line ``FILE:LINE: expected TOML, found ...``."""
     if sys.version_info >= (3, 11):
@@ -31,8 +42,11 @@ def loads(text: str, file: str) -> dict[str, Any]:
                                f"{len(run[0]) if run else 'thousands of'} digits", file, line) from None
         match = re.search(r"\(at line (\d+), column \d+\)", str(err))
         message = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(err)) or "valid TOML"
-        raise FishgenError(f"expected TOML, found {message[0].lower() + message[1:]}", file,
-                           int(match[1]) if match else None) from None
+        line = int(match[1]) if match else None
+        if message.startswith("Cannot overwrite a value"):   # tomllib's words for a key given twice
+            raise FishgenError("expected each key once in its table, found one given again", file,
+                               line) from None
+        raise FishgenError(f"expected TOML, found {message[0].lower() + message[1:]}", file, line) from None
 
 
 class Where:

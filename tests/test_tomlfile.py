@@ -57,3 +57,12 @@ def test_an_integer_of_thousands_of_digits_is_one_line_at_its_place():
         loads('out = "o"\n\nframes = ' + "9" * 5000 + "\n", "m.toml")
     assert str(caught.value) == ("m.toml:3: expected a number of at most a few hundred digits, "
                                  "found one of 5000 digits")
+
+
+def test_a_scene_file_that_is_not_utf8_is_said_at_its_line(tmp_path):
+    from fishgen.school.scene_file import load_scene_file
+
+    path = tmp_path / "s.toml"
+    path.write_bytes(b'frames = 10\n# caf\xe9 in Latin-1\n')
+    with pytest.raises(FishgenError, match=r":2: expected UTF-8 text \(TOML\), found the byte 0xe9$"):
+        load_scene_file(path)

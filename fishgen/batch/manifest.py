@@ -32,7 +32,7 @@ from typing import Any
 from fishgen.errors import FishgenError, UsageError
 from fishgen.exchange.registry import first_shared, output_format
 from fishgen.options import build, check_value, manifest_options
-from fishgen.tomlfile import Where, loads
+from fishgen.tomlfile import Where, loads, text_of
 
 MAX_MANIFEST_BYTES = 16 << 20
 
@@ -94,7 +94,7 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None,
     if path.stat().st_size > MAX_MANIFEST_BYTES:
         raise FishgenError(f"expected a manifest of at most {MAX_MANIFEST_BYTES:,} bytes, "
                            "found a larger file", file)
-    text = path.read_bytes().decode("utf-8", errors="replace").removeprefix("\ufeff")
+    text = text_of(path.read_bytes(), file)
     data = loads(text, file)
     where = Where(text, file)
     tables = ", ".join(f"[[{k.name}]]" for k in kinds)
@@ -113,6 +113,9 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None,
     seen: dict[str, str] = {}
     for kind in kinds:
         entries = data.get(kind.name, [])
+        if isinstance(entries, dict):   # [build], one table, where each job is a [[build]]
+            raise FishgenError(f"expected [[{kind.name}]] tables (one a job), found a single [{kind.name}] "
+                               "table", file, where.line("", kind.name))
         if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
             raise where.fail(f"[[{kind.name}]] tables", entries, kind.name)
         for nth, entry in enumerate(entries):

@@ -149,7 +149,7 @@ def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOpt
         needs("distributed", "cluster", "--scheduler")
     if source.is_dir():
         if options.out is None:
-            raise UsageError("expected --out FOLDER with a folder of inputs, found none", source)
+            raise UsageError(f"expected --out FOLDER with a folder of inputs ({source}), found none")
         manifest = scan_folder(source, options.out, kinds=job_kinds())
     else:
         manifest = _manifest(source, options.out)

@@ -72,6 +72,7 @@ from fishgen.school.model import (
 )
 from fishgen.tomlfile import Where as _Where
 from fishgen.tomlfile import loads as _loads
+from fishgen.tomlfile import text_of as _text_of
 
 MAX_FISH = 100_000
 MAX_FRAMES = 100_000
@@ -454,7 +455,7 @@ def load_scene_file(path: str | os.PathLike) -> SceneFile:
     if path.stat().st_size > MAX_SCENE_BYTES:
         raise FishgenError(f"expected a scene file of at most {MAX_SCENE_BYTES:,} bytes, found a larger file",
                            path)
-    text = path.read_bytes().decode("utf-8", errors="replace").removeprefix("\ufeff")
+    text = _text_of(path.read_bytes(), file)
     data = _loads(text, file)
     where = _Where(text, file)
     known = {"model", "frames", "fps", "seed", "bounds", "layout", "species", "target", "predator", "pso",

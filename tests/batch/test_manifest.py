@@ -213,3 +213,20 @@ def test_a_usd_job_without_usd_core_is_a_missing_package_at_its_line(tmp_path, m
     assert (caught.value.status, caught.value.kind) == (1, "dependency")
     assert str(caught.value) == (f"{path}:3: writing .usdz needs usd-core (pxr), which is not installed; "
                                  "install it with pip install 'fishgen[usd]'")
+
+
+@pytest.mark.parametrize("text,message", [
+    (b'[build]\ninput = "a.txt"\noutput = "a.glb"\n',
+     ":1: expected [[build]] tables (one a job), found a single [build] table"),      # was a Python dict
+    (b'[[build]]\ninput = "a.txt"\ninput = "b.txt"\noutput = "a.glb"\n',
+     ":3: expected each key once in its table, found one given again"),    # was "cannot overwrite a value"
+    (b'[[build]]\ninput = "a\xff.txt"\noutput = "a.glb"\n',
+     ":2: expected UTF-8 text (TOML), found the byte 0xff"),       # was a job's missing 'a\ufffd.txt'
+])
+def test_a_manifest_fault_is_said_at_its_line_in_its_own_words(tmp_path, text, message):
+    """QA pass 14's manifest notes: each now FILE:LINE, said as a user would say it."""
+    path = tmp_path / "m.toml"
+    path.write_bytes(text)
+    with pytest.raises(FishgenError) as caught:
+        load_manifest(path)
+    assert str(caught.value) == f"{path}{message}"

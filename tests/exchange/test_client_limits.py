@@ -52,7 +52,7 @@ def test_a_school_past_what_godot_3_animates_is_said(tmp_path, count, noted):
 def test_a_rigid_school_past_godot_3s_nodes_is_said(tmp_path, count, noted):
     """With --swim fins a fish animates 6 nodes and no weights: 29 of 200 stood still (QA pass 14)."""
     out = tmp_path / "s.glb"
-    run = run_cli("school", PARAMS / "bonybream.txt", "--count", str(count), "--frames", "4", "--swim", "fins",
-                  "-o", out)
+    run = run_cli("school", PARAMS / "bonybream.txt", "--count", str(count), "--frames", "4",
+                  "--swim", "fins", "-o", out)
     assert run.returncode == 0, run.stderr
     assert ("animates 1,026 nodes; Godot 3 plays at most 1,024" in run.stderr) == noted, run.stderr
