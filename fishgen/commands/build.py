@@ -51,8 +51,9 @@ COMMAND = Command(
     summary="Build a species file into a textured, fin-animated fish asset.",
     help="""Build SPECIES_FILE (VRFish parameter files) into game-ready fish.
 
-    glTF outputs carry the node hierarchy, materials, textures and a looping
-    `swim` clip; OBJ and PLY carry the rest pose. Axes: +Y up, head towards +Z,
+    glTF and USD outputs carry the node hierarchy, materials, textures and a
+    looping `swim` clip (USD needs pip install 'fishgen[usd]'); OBJ and PLY
+    carry the rest pose. Axes: +Y up, head towards +Z,
     metres. Outputs are written atomically: a failed run leaves no file. With
     several species every good file is built, each bad one is reported on its
     own line, and the exit status is non-zero if any failed.

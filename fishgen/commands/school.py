@@ -109,8 +109,8 @@ def check_options(options: SchoolOptions, output: str | os.PathLike | None = Non
 
 COMMAND = Command(
     name="school",
-    summary="Simulate a fish school and bake it into an animated glb, tracks and measures.",
-    help="""Simulate a school of SPECIES files (or a SCENE.toml) and bake it into an animated glb.
+    summary="Simulate a fish school and bake it into an animated glTF or USD, tracks and measures.",
+    help="""Simulate a school of SPECIES files (or a SCENE.toml) and bake it into an animated glTF or USD.
 
     Every fish of a species shares its meshes; each fish is a node with translation and
     rotation keys for the whole run, its body wave follows its own speed, and its fins beat
