@@ -20,7 +20,7 @@ from pathlib import Path
 
 from fishgen.clouds.parser import texture_roots
 from fishgen.editor.document import SUFFIX
-from fishgen.errors import FishgenError, describe, expected
+from fishgen.errors import NAME_MAX, FishgenError, describe, expected
 from fishgen.reading import read_capped
 
 SUFFIXES = tuple(SUFFIX.values())
@@ -53,6 +53,9 @@ class Workspace:
                            describe(name) if isinstance(name, str) else repr(name))
         if Path(name).suffix.lower() not in SUFFIXES:
             raise expected(f"a name ending in {' or '.join(SUFFIXES)}", describe(name))
+        if len(os.fsencode(name)) > NAME_MAX:   # 255 characters of é are 510 bytes: ENAMETOOLONG
+            raise expected(f"a name of at most {NAME_MAX} bytes (the file system's limit)",
+                           f"{describe(name)}, of {len(os.fsencode(name))}")
         path = self.folder / name
         if name == self.name:
             path = Path(os.path.realpath(self.given))  # the file it was given, wherever it leads

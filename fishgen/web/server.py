@@ -6,7 +6,10 @@
 - Every request carries the random token of this run (``?token=`` in the URL, or the
   ``X-Fishgen-Token`` header that the pages' own requests send), compared in constant time: another
   local user's or another site's guess is refused.
-- Request bodies are capped before they are read, and a client that sends too slowly is cut off.
+- Request bodies are capped before they are read, at most MAX_IN_FLIGHT are taken at once (a
+  busy server answers 503), and a client that sends nothing for TIMEOUT seconds is cut off (one
+  that trickles a byte at a time is not: it holds a thread, which idles, and the pending
+  connections queue behind QUEUE).
 - It serves only the routes a command gives it: no folder, no directory listing, no file by name.
 """
 from __future__ import annotations
@@ -14,6 +17,7 @@ from __future__ import annotations
 import hmac
 import json
 import secrets
+import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from http import HTTPStatus
@@ -25,7 +29,14 @@ HOST = "127.0.0.1"
 MAX_BODY = 16 << 20
 """Largest request body any route takes (a cube file of 100,000 cubes is about 8 MB)."""
 TIMEOUT = 10.0
-"""Seconds a client may take to send its request: a slow sender is cut off, not waited for."""
+"""Seconds a client may stay silent while sending its request: then it is cut off."""
+MAX_IN_FLIGHT = 2
+"""Request bodies parsed at once: a 16 MiB cube file takes 110-150 MB while it is read and checked,
+and the threads a client can open are not otherwise bounded (QA pass 15: four saves at once took the
+server from 175 to 626 MB)."""
+QUEUE = 64
+"""Connections the kernel holds for the server to accept (http.server's 5 made a burst of page
+requests wait for SYN retries of a second each)."""
 
 
 @dataclass(frozen=True)
@@ -48,6 +59,8 @@ class Request:
         except RecursionError:
             raise Refused(HTTPStatus.BAD_REQUEST,
                           "expected a JSON body, found JSON nested too deeply") from None
+        except ValueError as err:  # Python's limit on an integer's digits: not a JSONDecodeError
+            raise Refused(HTTPStatus.BAD_REQUEST, f"expected a JSON body, found {str(err)[:120]}") from None
 
 
 @dataclass(frozen=True)
@@ -81,6 +94,7 @@ class LocalServer(ThreadingHTTPServer):
     """Loopback, Host-checked, token-checked routes: ``{("GET", "/"): page, ("POST", "/api/save"): save}``."""
 
     daemon_threads = True
+    request_queue_size = QUEUE
 
     def __init__(self, routes: Mapping[tuple[str, str], Route], port: int = 0, max_body: int = MAX_BODY,
                  token: str | None = None, timeout: float = TIMEOUT):
@@ -88,6 +102,7 @@ class LocalServer(ThreadingHTTPServer):
         self.max_body = max_body
         self.timeout_seconds = timeout
         self.token = token or secrets.token_urlsafe(24)
+        self.in_flight = threading.BoundedSemaphore(MAX_IN_FLIGHT)
         super().__init__((HOST, port), _Handler)
 
     def handle_error(self, request, client_address) -> None:  # a dropped client is not news
@@ -102,7 +117,9 @@ class LocalServer(ThreadingHTTPServer):
         return f"http://{HOST}:{self.port}{path}?token={self.token}"
 
     def allowed_hosts(self) -> set[str]:
-        return {f"{HOST}:{self.port}", f"localhost:{self.port}"}
+        hosts = {f"{HOST}:{self.port}", f"localhost:{self.port}"}
+        # on port 80 a browser leaves the port out of Host (every request was refused)
+        return hosts | {HOST, "localhost"} if self.port == 80 else hosts
 
 
 class _Handler(BaseHTTPRequestHandler):
@@ -132,6 +149,12 @@ class _Handler(BaseHTTPRequestHandler):
     def do_DELETE(self):
         self._answer("DELETE")
 
+    def do_PATCH(self):     # answered by the same checks, not http.server's HTML 501 page
+        self._answer("PATCH")
+
+    def do_OPTIONS(self):
+        self._answer("OPTIONS")
+
     def _answer(self, method: str) -> None:
         from fishgen.errors import FishgenError
 
@@ -145,6 +168,14 @@ class _Handler(BaseHTTPRequestHandler):
         except TimeoutError:
             self.close_connection = True
             return
+        except OSError as err:  # a name too long for the file system, say: answered, not dropped
+            from fishgen.errors import too_long
+
+            message = too_long(err) or f"cannot {method} {self.path[:100]}: {err.strerror or err}"
+            response = Response.of_json({"error": message}, HTTPStatus.UNPROCESSABLE_ENTITY)
+        except Exception as err:  # a bug: the page hears of it, and the server goes on
+            response = Response.of_json({"error": f"fishgen could not answer ({type(err).__name__})"},
+                                        HTTPStatus.INTERNAL_SERVER_ERROR)
         self.send_response(response.status)
         self.send_header("Content-Type", response.type)
         self.send_header("Content-Length", str(len(response.body)))
@@ -178,7 +209,16 @@ class _Handler(BaseHTTPRequestHandler):
         route = self.server.routes.get(("GET" if method == "HEAD" else method, path))
         if route is None:
             raise Refused(HTTPStatus.NOT_FOUND, f"no {method} {path[:100]}")
-        return route(Request(method, path, query, self._body()))
+        if not self.headers.get("Content-Length"):
+            return route(Request(method, path, query, self._body()))
+        # a body is read and parsed by at most MAX_IN_FLIGHT requests at once
+        if not self.server.in_flight.acquire(timeout=self.server.timeout_seconds):
+            raise Refused(HTTPStatus.SERVICE_UNAVAILABLE, "expected fewer requests at once, found the "
+                          "server busy; try again")
+        try:
+            return route(Request(method, path, query, self._body()))
+        finally:
+            self.server.in_flight.release()
 
     def _body(self) -> bytes:
         length = self.headers.get("Content-Length")

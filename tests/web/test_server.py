@@ -115,3 +115,94 @@ def test_a_slow_client_is_cut_off(server):
         assert sock.recv(100) == b""  # closed, not waiting for the other 99 bytes
         assert time.monotonic() - start < 5
     assert ask(server, token=server.token)[0] == 200  # and the server goes on
+
+
+def test_an_integer_past_pythons_digit_limit_is_a_400_not_a_dropped_connection(server):
+    """Python's int-digit limit raises a plain ValueError, which the JSON check let through: the
+    connection closed with no answer (QA pass 15)."""
+    status, body = ask(server, "POST", "/echo", b'{"x": ' + b"9" * 900 + b"}", token=server.token)
+    assert status == 200
+    huge = LocalServer({("POST", "/echo"): lambda r: Response.of_json(r.json())}, max_body=10_000)
+    thread = threading.Thread(target=huge.serve_forever, daemon=True)
+    thread.start()
+    try:
+        status, body = ask(huge, "POST", "/echo", b'{"x": ' + b"9" * 5000 + b"}", token=huge.token)
+        assert status == 400 and body.startswith(b'{"error": "expected a JSON body, found '), body
+    finally:
+        huge.shutdown()
+        huge.server_close()
+
+
+def test_a_route_that_fails_outside_fishgens_errors_is_answered_and_the_server_goes_on():
+    def long_name(request: Request) -> Response:
+        open("x" * 300)           # ENAMETOOLONG: an OSError no route turned into a FishgenError
+        raise AssertionError
+
+    def bug(request: Request) -> Response:
+        raise KeyError("oops")
+
+    server = LocalServer({("GET", "/long"): long_name, ("GET", "/bug"): bug,
+                          ("GET", "/"): lambda r: Response()})
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        status, body = ask(server, path="/long", token=server.token)
+        assert status == 422 and b"expected names of at most 255 bytes" in body, body
+        assert ask(server, path="/bug", token=server.token) == (
+            500, b'{"error": "fishgen could not answer (KeyError)"}')
+        assert ask(server, token=server.token)[0] == 200
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+def test_options_and_patch_meet_the_same_checks(server):
+    """They got http.server's HTML 501 page, before the Host check and without its headers."""
+    for method in ("OPTIONS", "PATCH"):
+        assert ask(server, method, host="evil.example:80", token=server.token)[0] == 403
+        status, body = ask(server, method, token=server.token)
+        assert status == 404 and body == f'{{"error": "no {method} /"}}'.encode()
+
+
+def test_on_port_80_a_host_without_its_port_is_the_server_itself():
+    """Browsers leave :80 out of Host, and every request to `--port 80` was refused (QA pass 15)."""
+    server = LocalServer({}, 0)
+    server.server_close()
+    server.server_address = ("127.0.0.1", 80)
+    assert {"127.0.0.1", "localhost", "127.0.0.1:80"} <= server.allowed_hosts()
+    other = LocalServer({}, 0)
+    other.server_close()
+    assert "127.0.0.1" not in other.allowed_hosts()
+
+
+def test_bodies_are_parsed_two_at_a_time_and_a_busy_server_says_so():
+    """Four 7 MB saves at once took the server from 175 to 626 MB (QA pass 15): bodies beyond
+    MAX_IN_FLIGHT wait, and past the time-out get a 503."""
+    from fishgen.web.server import MAX_IN_FLIGHT
+
+    inside, release = threading.Semaphore(0), threading.Event()
+
+    def slow(request: Request) -> Response:
+        inside.release()
+        release.wait(10)
+        return Response.of_json({"ok": True})
+
+    server = LocalServer({("POST", "/slow"): slow}, timeout=0.5)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    results: list[int] = []
+    try:
+        workers = [threading.Thread(target=lambda: results.append(
+            ask(server, "POST", "/slow", b"{}", token=server.token)[0])) for _ in range(MAX_IN_FLIGHT)]
+        for worker in workers:
+            worker.start()
+        for _ in workers:
+            assert inside.acquire(timeout=5)
+        status, body = ask(server, "POST", "/slow", b"{}", token=server.token)
+        assert status == 503 and b"server busy" in body
+        release.set()
+        for worker in workers:
+            worker.join(10)
+        assert results == [200] * MAX_IN_FLIGHT
+    finally:
+        release.set()
+        server.shutdown()
+        server.server_close()
