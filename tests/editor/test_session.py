@@ -99,6 +99,18 @@ def test_a_name_must_suit_the_system(skies, start_editor):
 SAVE = {"name": "x.awn", "mode": "particles", "cubes": [EditCube(5, (1, 1, 1), (0, 0, 0), 1).json()]}
 
 
+def test_a_name_past_the_file_systems_bytes_is_refused_in_one_line(skies, start_editor):
+    """200 characters of é are 400 bytes: the name passed the 255-character check and the system's
+    ENAMETOOLONG closed the connection with no answer (QA pass 15)."""
+    client = start_editor(skies / "table_4_3.awn")
+    name = "é" * 200 + ".awn"
+    for route in ("/api/open", "/api/save"):
+        answer = client.post(route, dict(SAVE, name=name) if route == "/api/save" else {"name": name})
+        assert answer.status == 422, answer.body
+        assert answer.json()["error"].startswith("expected a name of at most 255 bytes (the file "
+                                                 "system's limit)")
+
+
 @pytest.mark.parametrize("case", ["foreign host", "rebound name", "no token", "wrong token", "../ name",
                                   "absolute name", "link out", "oversized", "not json"])
 def test_every_refusal_writes_nothing(skies, start_editor, case):
