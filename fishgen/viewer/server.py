@@ -2,16 +2,22 @@
 
 The page is self-contained (three.js and the asset are inside it), so the server hands out that
 one file and nothing else: not the folder it sits in (which may hold anything), no directory
-listing, no symlinks to follow. It is a :class:`fishgen.web.server.LocalServer`: loopback only,
+listing, no symlink put in its place. It is a :class:`fishgen.web.server.LocalServer`: loopback only,
 Host checked, and this run's token in the URL that every request must carry.
 """
 from __future__ import annotations
 
+import os
+import stat
 from http import HTTPStatus
 from pathlib import Path
 from urllib.parse import quote
 
+from fishgen.viewer import MAX_EMBED_BYTES
 from fishgen.web.server import LocalServer, Refused, Request, Response
+
+MAX_PAGE_BYTES = 2 * MAX_EMBED_BYTES
+"""Largest page served: an embedded asset grows by a third in base64, and three.js comes with it."""
 
 
 def make_server(page: Path, port: int) -> LocalServer:
@@ -20,10 +26,17 @@ def make_server(page: Path, port: int) -> LocalServer:
     page = Path(page).absolute()
 
     def serve(request: Request) -> Response:
+        # not through a link put in the page's place, nor from a FIFO or device there: a regular
+        # file of at most the largest page a viewer writes (QA pass 15 had a link serve a secret)
         try:
-            return Response.of_html(page.read_text(encoding="utf-8"))
+            fd = os.open(page, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
         except OSError:
             raise Refused(HTTPStatus.NOT_FOUND, "the page is gone") from None
+        with os.fdopen(fd, "rb") as handle:
+            info = os.fstat(handle.fileno())
+            if not stat.S_ISREG(info.st_mode) or info.st_size > MAX_PAGE_BYTES:
+                raise Refused(HTTPStatus.NOT_FOUND, "the page is gone")
+            return Response.of_html(handle.read().decode("utf-8", errors="replace"))
 
     def no_icon(request: Request) -> Response:  # the page's icon is inline; a stray ask gets nothing
         return Response(HTTPStatus.NO_CONTENT)

@@ -9,6 +9,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 
 import pytest
 
@@ -213,3 +214,26 @@ def test_server_refuses_other_host_headers(server, host):
         host = host.format(port=srv.server_address[1]) or ""
     status, body = _get(srv, "/", host=host if host != "" else " ")
     assert status == 403 and page.read_bytes()[:200] not in body
+
+
+def test_a_link_or_a_fifo_put_in_the_pages_place_is_not_served(tmp_path):
+    """QA pass 15: `ln -sf secret page.html` while `view` served, and GET / returned the secret."""
+    from fishgen.viewer.server import make_server
+
+    page = tmp_path / "page.html"
+    page.write_text("<p>page</p>")
+    srv = make_server(page, 0)
+    threading.Thread(target=srv.serve_forever, daemon=True).start()
+    try:
+        assert _get(srv, "/") == (200, b"<p>page</p>")
+        page.unlink()
+        (tmp_path / "secret.txt").write_bytes(SECRET)
+        os.symlink(tmp_path / "secret.txt", page)
+        status, body = _get(srv, "/")
+        assert status == 404 and SECRET not in body
+        page.unlink()
+        os.mkfifo(page)        # a FIFO would hold a thread for good
+        assert _get(srv, "/")[0] == 404
+    finally:
+        srv.shutdown()
+        srv.server_close()
