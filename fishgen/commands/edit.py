@@ -91,8 +91,26 @@ def edit(inputs: Sequence[Path], output: str | os.PathLike | None = None,
 
 
 def _open_browser(url: str) -> None:
-    """Open ``url`` in the system's browser, off the main thread (some browsers block their caller)."""
+    """Open ``url`` in the system's browser, off the main thread (some browsers block their caller).
+
+    The browser is given a private file that forwards to ``url``, not ``url`` itself: a browser
+    started with the address on its command line showed the token to every local user (`ps`), and
+    with it the folder's cube files (QA pass 15). The file is 0600 in a 0700 folder, removed when
+    fishgen exits; the browser has read it long before (Jupyter opens its pages the same way)."""
+    import atexit
+    import html
+    import shutil
+    import tempfile
     import threading
     import webbrowser
 
-    threading.Thread(target=webbrowser.open, args=(url,), daemon=True).start()
+    folder = tempfile.mkdtemp(prefix="fishgen-edit-")
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
+    forward = Path(folder) / "open.html"
+    shown = html.escape(url, quote=True)
+    fd = os.open(forward, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    with os.fdopen(fd, "w", encoding="utf-8") as handle:
+        handle.write(f'<!DOCTYPE html><meta charset="utf-8"><meta http-equiv="refresh" '
+                     f'content="0;url={shown}"><title>fishgen edit</title>'
+                     f'<a href="{shown}">Open the editor</a>\n')
+    threading.Thread(target=webbrowser.open, args=(forward.as_uri(),), daemon=True).start()

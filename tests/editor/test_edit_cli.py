@@ -8,6 +8,7 @@ import socket
 import subprocess
 import sys
 import threading
+from pathlib import Path
 from urllib.parse import urlsplit
 
 import pytest
@@ -114,3 +115,36 @@ def test_a_bad_file_is_named_as_it_was_given_not_as_resolved(tmp_path):
     assert out.returncode == 2
     assert out.stderr == ("garbage.awn:1: expected a whole number for the total particle count, "
                           "found 'garbage'\n")
+
+
+def test_the_browser_is_given_a_private_file_not_the_token(tmp_path):
+    """`fishgen edit` started the browser with the tokened address on its command line, which every
+    local user can read in `ps` (QA pass 15). It gets a 0600 file that forwards to the address."""
+    import os
+    import signal
+    import stat
+    import time
+
+    told = tmp_path / "told.txt"
+    browser = tmp_path / "browser.sh"
+    browser.write_text(f'#!/bin/sh\nprintf "%s\\n" "$@" > {told}\n')
+    browser.chmod(0o755)
+    env = {**os.environ, "BROWSER": str(browser)}
+    proc = subprocess.Popen([sys.executable, "-u", "-m", "fishgen", "edit", str(tmp_path / "x.awn")],
+                            cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        url = proc.stdout.readline().strip()
+        deadline = time.monotonic() + 30
+        while not (told.exists() and told.read_text()) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        argv = told.read_text()
+        token = url.split("token=")[1]
+        assert token not in argv and argv.startswith("file://"), argv
+        forward = Path(argv.strip().removeprefix("file://"))
+        assert stat.S_IMODE(forward.stat().st_mode) == 0o600
+        assert stat.S_IMODE(forward.parent.stat().st_mode) == 0o700
+        assert f'content="0;url={url}"' in forward.read_text()
+    finally:
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(timeout=30)
+    assert proc.returncode == 143 and not forward.exists()    # removed when fishgen exits
