@@ -17,6 +17,7 @@ const doc = { mode: 'particles', cubes: [] };   // what a file holds: cubes {par
 let name = '';                                 // the file the document was opened from or saved as
 let selected = - 1;
 let saved = '';                                // the document as last opened or saved (JSON)
+let stamp = null;                              // the file's bytes as last read or written (its hash), or null
 let textures = [];                             // names a .awa file may use
 let files = [];
 let settings = { seed: 0, sun: [ 0.35, 1, 0.55 ], limits: {} };
@@ -788,6 +789,7 @@ function load( answer, fresh ) {
 	doc.mode = answer.mode;
 	doc.cubes = answer.cubes;
 	name = answer.name;
+	stamp = answer.stamp ?? null;
 	files = answer.files;
 	textures = answer.textures;
 	selected = doc.cubes.length ? 0 : - 1;
@@ -822,8 +824,11 @@ async function saveFile() {
 	if ( ! /\.(awn|awa)$/i.test( target ) ) target += SUFFIX[ doc.mode ];
 	const sent = json();
 	try {
-		const answer = await api( '/api/save', { name: target, mode: doc.mode, cubes: doc.cubes } );
+		const body = { name: target, mode: doc.mode, cubes: doc.cubes };
+		if ( target === name ) body.stamp = stamp;   // refused if another program changed the file since
+		const answer = await api( '/api/save', body );
 		saved = sent;
+		stamp = answer.stamp;
 		name = answer.saved;
 		files = answer.files;
 		$( 'file-name' ).value = name;

@@ -5,7 +5,7 @@
 | ``GET /`` | the page (three.js and the editor inlined) |
 | ``GET /api/document`` | the file ``fishgen edit`` was given: its cubes, or none if it does not exist yet |
 | ``POST /api/open`` ``{name}`` | another .awn/.awa file of the folder |
-| ``POST /api/save`` ``{name, mode, cubes}`` | write the cubes, parsed back first, atomically |
+| ``POST /api/save`` ``{name, mode, cubes, stamp}`` | write, parsed back, atomically; 409 if changed since |
 | ``POST /api/fill`` ``{name, mode, cubes, seed, sun}`` | fill and light them as `fishgen clouds` does |
 | ``GET /api/texture?name=`` | a texture's PNG, from the allowed texture folders only |
 | ``GET /api/lists`` | the folder's cube files and the textures a .awa file may use |
@@ -17,6 +17,7 @@ answers with its one line (422). What is written and read is decided by
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import struct
@@ -24,6 +25,7 @@ import threading
 import time
 import warnings
 from dataclasses import dataclass, field, replace
+from http import HTTPStatus
 from pathlib import Path
 from typing import Any
 
@@ -44,7 +46,7 @@ from fishgen.editor.document import (
 from fishgen.editor.workspace import Workspace
 from fishgen.errors import describe, expected
 from fishgen.options import SEED_MAX
-from fishgen.web.server import MAX_BODY, LocalServer, Request, Response
+from fishgen.web.server import MAX_BODY, LocalServer, Refused, Request, Response
 
 PREVIEW_BILLBOARDS = 20_000
 """Most billboards a texture fill for the page holds: each is three textured quads, 408 bytes of GLB.
@@ -100,7 +102,7 @@ class Session:
         ws = self.workspace
         if not os.path.lexists(ws.given):
             return {"name": ws.name, "exists": False, "mode": mode_of(ws.name), "cubes": [], "warnings": [],
-                    **self._settings(), **self._lists(ws.given)}
+                    "stamp": None, **self._settings(), **self._lists(ws.given)}
         return self.opened(ws.name)
 
     def opened(self, name: object) -> dict[str, Any]:
@@ -109,12 +111,14 @@ class Session:
 
         path = self.workspace.cube_file(name, must_exist=True)
         shown = str(name)
+        stamp = _stamp(path)    # before the read: a change made during it is caught at the save
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", CubeFileWarning)  # the file keeps them: they go to the page
             cubes = load_cubes(path, max_particles=self.max_particles, textures_dir=self.textures)
         doc = document_json(cubes, self.workspace.roots(path))
         doc["warnings"] = [w.replace(str(path), shown, 1) for w in doc["warnings"]]
-        return {"name": shown, "exists": True, **doc, **self._settings(), **self._lists(path)}
+        return {"name": shown, "exists": True, "stamp": stamp, **doc, **self._settings(),
+                **self._lists(path)}
 
     def save(self, request: Request) -> Response:
         """Write the page's cubes under ``name``: checked, parsed back, then written atomically.
@@ -131,10 +135,17 @@ class Session:
         text = cube_text(cubes, mode, str(name))
         parsed = read_back(text, mode, str(name), cubes, roots=self.workspace.roots(path),
                            max_particles=self.max_particles)
+        data = text.encode("utf-8")
         with self._save_lock:
-            write_bytes(path, text.encode("utf-8"))
+            # the page says which bytes it read (or last wrote) under this name: another program's
+            # change since is refused, not overwritten (QA pass 15: it was lost without a word)
+            if "stamp" in body and _stamp(path) != body["stamp"]:
+                raise Refused(HTTPStatus.CONFLICT, f"expected {name} as this page read it, found it changed "
+                              "on disk since (by another program); open it again, or save under another name")
+            write_bytes(path, data)
         return Response.of_json({"saved": name, "particles": parsed.total, "cubes": len(parsed.cubes),
-                                 "bytes": len(text.encode("utf-8")), **self._lists(path)})
+                                 "bytes": len(data), "stamp": hashlib.sha256(data).hexdigest(),
+                                 **self._lists(path)})
 
     def fill(self, request: Request) -> Response:
         """The page's cubes filled and lit as `fishgen clouds NAME --seed SEED --sun SUN` fills and
@@ -193,6 +204,14 @@ def fill_glb(cube_file: CubeFile, mode: str, seed: int, lighting: Lighting) -> t
     note = made.note and f"{made.note}, every cube scaled alike"
     return glb, {"particles": made.particles, "whole": made.whole, "cubes": len(cube_file.cubes),
                  "note": note, "seed": seed, "mode": mode}
+
+
+def _stamp(path: Path) -> str | None:
+    """The SHA-256 of the file's bytes, or None where there is none."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except (FileNotFoundError, NotADirectoryError):
+        return None
 
 
 def _shown(folder: Path) -> str:

@@ -210,3 +210,23 @@ def test_a_cloud_past_the_preview_limit_is_scaled_down_alike_and_says_so(skies, 
 def test_a_fill_the_parser_or_the_options_refuse_is_one_line(skies, start_editor, body, message):
     answer = start_editor(skies / "table_4_3.awn").post("/api/fill", body)
     assert answer.status == 422 and answer.json()["error"].startswith(message), answer.body
+
+
+def test_a_save_over_a_file_another_program_changed_since_is_refused(skies, start_editor):
+    """QA pass 15: another program's write between the page's read and its save was lost without a
+    word. The page sends the stamp it read; a file changed since is refused (409) and kept."""
+    path = skies / "table_4_3.awn"
+    client = start_editor(path)
+    doc = client.get("/api/document").json()
+    body = {"name": "table_4_3.awn", "mode": "particles", "cubes": doc["cubes"], "stamp": doc["stamp"]}
+    answer = client.post("/api/save", body)
+    assert answer.status == 200, answer.body
+    mine = path.read_bytes()
+    path.write_text("7\n1\n7, 2, 2, 2, 0, 0, 0, 1\n")              # another program's edit
+    answer = client.post("/api/save", dict(body, stamp=answer.json()["stamp"]))
+    assert answer.status == 409 and "changed on disk since" in answer.json()["error"], answer.body
+    assert path.read_text() == "7\n1\n7, 2, 2, 2, 0, 0, 0, 1\n" and path.read_bytes() != mine
+    fresh = client.post("/api/open", {"name": "table_4_3.awn"}).json()       # read again: saved
+    assert client.post("/api/save", dict(body, stamp=fresh["stamp"])).status == 200
+    new = client.post("/api/save", {**SAVE, "name": "brand_new.awn", "stamp": None})   # none there yet
+    assert new.status == 200, new.body
