@@ -55,6 +55,13 @@ def execute(cmd: Command, inputs: tuple[Path, ...], output: str | None, options:
     with together() if cmd.together else nullcontext(), _warnings_as_notes(events):
         made = run(cmd, inputs, output, options, events.as_events())
         say(made.lines)
+    if made.server is not None and verbosity() <= QUIET and sys.__stdout__ is not None:
+        # --quiet drops the summary, not the address: without it and its token the page cannot be
+        # opened (QA pass 15: `edit -q` served on a random port and said nothing)
+        from contextlib import redirect_stdout
+
+        with redirect_stdout(sys.__stdout__):
+            say([line for line in made.lines if made.server.token in line])
     if made.verdict is not None:
         raise made.verdict
     if made.failed:

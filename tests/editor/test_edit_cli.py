@@ -148,3 +148,21 @@ def test_the_browser_is_given_a_private_file_not_the_token(tmp_path):
         proc.send_signal(signal.SIGTERM)
         proc.wait(timeout=30)
     assert proc.returncode == 143 and not forward.exists()    # removed when fishgen exits
+
+
+def test_quiet_still_gives_the_address_and_nothing_else(tmp_path):
+    """`edit -q` served on a random port with a random token and said nothing (QA pass 15): --quiet
+    drops the summary, not the one line the page can be opened by."""
+    proc = subprocess.Popen([sys.executable, "-u", "-m", "fishgen", "edit", str(tmp_path / "x.awn"),
+                             "--no-open", "-q"], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    try:
+        import select
+
+        ready, _, _ = select.select([proc.stdout], [], [], 30)     # nothing said: fail, not hang
+        line = proc.stdout.readline() if ready else ""
+        assert line.startswith("http://127.0.0.1:") and "token=" in line, line
+    finally:
+        proc.send_signal(signal.SIGTERM)
+        out, _ = proc.communicate(timeout=30)
+    assert out == ""            # the summary's other line stays unsaid
