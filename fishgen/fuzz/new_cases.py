@@ -238,6 +238,8 @@ def _run_editor(case: Case, workdir: Path) -> Outcome:
                 .replace(b"{OUTSIDE}", str(outside).encode())
             )
             answer, err = _exchange(server, _Handler, data)
+            if err is None and server.bugs:     # answered with a 500: where it was raised is the finding
+                err = server.bugs.pop()
             if err is not None:
                 where = innermost_fishgen_frame(err.__traceback__)
 

@@ -103,6 +103,7 @@ class LocalServer(ThreadingHTTPServer):
         self.timeout_seconds = timeout
         self.token = token or secrets.token_urlsafe(24)
         self.in_flight = threading.BoundedSemaphore(MAX_IN_FLIGHT)
+        self.bugs: list[BaseException] = []   # errors answered with a 500, the last few (for a harness)
         super().__init__((HOST, port), _Handler)
 
     def handle_error(self, request, client_address) -> None:  # a dropped client is not news
@@ -174,6 +175,7 @@ class _Handler(BaseHTTPRequestHandler):
             message = too_long(err) or f"cannot {method} {self.path[:100]}: {err.strerror or err}"
             response = Response.of_json({"error": message}, HTTPStatus.UNPROCESSABLE_ENTITY)
         except Exception as err:  # a bug: the page hears of it, and the server goes on
+            self.server.bugs[:] = [*self.server.bugs[-15:], err]
             response = Response.of_json({"error": f"fishgen could not answer ({type(err).__name__})"},
                                         HTTPStatus.INTERNAL_SERVER_ERROR)
         self.send_response(response.status)
