@@ -51,7 +51,7 @@ def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> P
         raise FishgenError(f"expected a texture file name of at most {NAME_MAX} bytes a part, found "
                            f"{describe(name)}", file, line)
     escaped = False
-    folder = None
+    folder = other = None
     for root in roots:
         candidate = (root / name).resolve()
         if not candidate.is_relative_to(root):
@@ -62,12 +62,17 @@ def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> P
             return candidate
         if candidate.is_dir() and folder is None:
             folder = candidate
+        elif candidate.exists() and other is None:    # a FIFO, a socket, a device: there, not a file
+            other = candidate
     if escaped or os.path.isabs(name):
         raise FishgenError(f"expected a texture path inside {shown}, found {name!r} "
                            "(texture paths may not leave the texture folder; use --textures DIR)",
                            file, line)
     if folder is not None:
         raise FishgenError(f"expected a texture file, found {name!r}, a folder", file, line)
+    if other is not None:
+        raise FishgenError(f"expected a texture file, found {name!r}, not a regular file (a pipe, a "
+                           "socket or a device)", file, line)
     raise FishgenError(f"expected an existing texture file, found {name!r} missing from {shown}",
                        file, line)
 

@@ -258,6 +258,19 @@ def test_a_texture_name_that_is_a_folder_is_called_a_folder_not_missing(tmp_path
                               "texture file, found 'bonybream.png', a folder")
 
 
+def test_a_texture_name_that_is_a_pipe_is_called_so_not_missing(tmp_path):
+    """QA pass 15: a FIFO named as a texture was said to be missing; it is there, not a file."""
+    import os
+
+    path = write(tmp_path, BONY)
+    (tmp_path / "bonybream.png").unlink()
+    os.mkfifo(tmp_path / "bonybream.png")
+    with pytest.raises(FishgenError) as err:
+        load_species(path)
+    assert str(err.value).endswith("expected a texture file, found 'bonybream.png', not a regular file (a "
+                                   "pipe, a socket or a device)")
+
+
 def png_header(width: int, height: int) -> bytes:
     """A PNG that is only its header: what Pillow reads before it decides whether to decode."""
     import struct
