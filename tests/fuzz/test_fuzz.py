@@ -36,7 +36,7 @@ CI_COUNTS = {"species": 2000, "cubes": 4000, "gltf": 1500, "obj": 1000, "ply": 1
 WORK = Path(tempfile.mkdtemp(prefix="fishgen-fuzz-"))
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")   # not module: made once even if a worker's run of this file is split
 def ci_report():
     findings = Path(os.environ.get("FISHGEN_FUZZ_FINDINGS", WORK / "findings"))
     return run(list(TARGETS), seed=CI_SEED, counts=CI_COUNTS, jobs=min(2, os.cpu_count() or 1),
