@@ -19,6 +19,7 @@ import math
 import re
 import warnings
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from trimesh.resolvers import Resolver
@@ -99,14 +100,15 @@ def _read(path: Path) -> Scene:
                               metadata={"file_name": path.name})
     else:
         alpha = {}
+        header = _check_ply_header(path)
         try:
-            if not _check_ply_header(path):
+            if not header.faces:
                 return _point_set(path)
             loaded = trimesh.load(str(path), process=False, resolver=resolver)
         except FishgenError:
             raise
         except Exception:  # numpy's "could not be read to its end": said at the line that stopped it
-            _ascii_ply_fault(path)
+            _ascii_ply_fault(path, header)
             raise
     geoms = loaded.dump(concatenate=False) if isinstance(loaded, trimesh.Scene) else [loaded]
     scene = Scene(name=path.stem, source=str(path))
@@ -121,7 +123,7 @@ def _read(path: Path) -> Scene:
         scene.add_node(Node(name=name, mesh=scene.add_mesh(Mesh(name, [prim]))))
     if not scene.meshes:
         if not obj:
-            _ascii_ply_fault(path)    # a face list shorter than its count reads as no faces
+            _ascii_ply_fault(path, header)    # a face list shorter than its count reads as no faces
         raise FishgenError("expected triangles or points, found an empty asset", path)
     return scene
 
@@ -265,9 +267,22 @@ def _named_texture(path: Path, name: str, line: int) -> None:
                            line)
 
 
-def _check_ply_header(path: Path) -> bool:
-    """Element counts x property sizes must fit in the file, checked before trimesh allocates.
-    Returns whether the file has faces (else it is a point set)."""
+class _PlyHeader(NamedTuple):
+    """A checked PLY header: its format, its elements (name, count, and each property's name,
+    least bytes and whether it is a list), and where its body starts."""
+
+    fmt: str
+    elements: list[tuple[str, int, list[tuple[str, int, bool]]]]
+    body: int
+    lines: int
+
+    @property
+    def faces(self) -> bool:
+        return any(name == "face" and count for name, count, _ in self.elements)
+
+
+def _check_ply_header(path: Path) -> _PlyHeader:
+    """Element counts x property sizes must fit in the file, checked before trimesh allocates."""
     with path.open("rb") as f:
         head = f.read(MAX_PLY_HEADER)
     end = re.search(rb"(^|\n)end_header[ \t]*\r?\n", head)
@@ -278,7 +293,7 @@ def _check_ply_header(path: Path) -> bool:
     size = _stat(path, MAX_BINARY_BYTES, "a PLY file", path)
     body = size - end.end()
     fmt = None
-    elements: list[tuple[str, int, list[tuple[str, int]]]] = []  # name, count, (property, bytes)
+    elements: list[tuple[str, int, list[tuple[str, int, bool]]]] = []
     lines = head[: end.end()].decode("latin-1").splitlines()
     for number, line in enumerate(lines, 1):
         words = line.split()
@@ -300,9 +315,9 @@ def _check_ply_header(path: Path) -> bool:
             if not elements:
                 raise expected("an element before its properties", describe(line), path, number)
             if len(words) == 5 and words[1] == "list" and words[2] in _PLY_SIZES and words[3] in _PLY_SIZES:
-                elements[-1][2].append((words[4], _PLY_SIZES[words[2]]))  # at least the item count
+                elements[-1][2].append((words[4], _PLY_SIZES[words[2]], True))  # at least the count
             elif len(words) == 3 and words[1] in _PLY_SIZES:
-                elements[-1][2].append((words[2], _PLY_SIZES[words[1]]))
+                elements[-1][2].append((words[2], _PLY_SIZES[words[1]], False))
             else:
                 raise expected("property TYPE NAME or property list TYPE TYPE NAME", describe(line),
                                path, number)
@@ -315,37 +330,27 @@ def _check_ply_header(path: Path) -> bool:
     need = 0
     for name, count, props in elements:
         # ASCII: each value takes at least a digit and a separator
-        need += count * (2 * len(props) if fmt == "ascii" else sum(b for _, b in props))
-        if name == "vertex" and count and not {"x", "y", "z"} <= {p for p, _ in props}:
-            raise expected("vertex properties x, y and z", ", ".join(p for p, _ in props) or "none", path)
+        need += count * (2 * len(props) if fmt == "ascii" else sum(b for _, b, _ in props))
+        if name == "vertex" and count and not {"x", "y", "z"} <= {p for p, _, _ in props}:
+            raise expected("vertex properties x, y and z", ", ".join(p for p, _, _ in props) or "none",
+                           path)
     if need > body:
         counts = ", ".join(f"{count:,} {name}" for name, count, _ in elements)
         raise expected(f"at least {need:,} bytes of {fmt} data for {counts}",
                        f"{body:,} bytes after the header", path)
-    return any(name == "face" and count for name, count, _ in elements)
+    return _PlyHeader(fmt, elements, end.end(), len(lines))
 
 
-def _ascii_ply_fault(path: Path) -> None:
+def _ascii_ply_fault(path: Path, header: _PlyHeader) -> None:
     """Raise at the first line of an ASCII PLY's body that is not one element's numbers (a comma,
     a word, a list shorter than its count); return if there is none, or the file is binary."""
-    with path.open("rb") as f:
-        head = f.read(MAX_PLY_HEADER)
-    end = re.search(rb"(^|\n)end_header[ \t]*\r?\n", head)
-    header = head[: end.end()].decode("latin-1").splitlines() if end else []
-    if not any(line.split()[:2] == ["format", "ascii"] for line in header):
+    if header.fmt != "ascii":
         return
-    elements: list[tuple[str, int, list[tuple[str, bool]]]] = []  # name, count, (property, is a list)
-    for line in header:
-        words = line.split()
-        if words[:1] == ["element"]:
-            elements.append((words[1], int(words[2]), []))
-        elif words[:1] == ["property"] and elements:
-            elements[-1][2].append((words[-1], words[1] == "list"))
     with path.open("rb") as f:
-        f.seek(end.end())  # type: ignore[union-attr]  # a header with no end_header was refused
-        rows = iter(enumerate(f, len(header) + 1))
-        for name, count, props in elements:
-            what = f"{name} ({' '.join(p for p, _ in props)})"
+        f.seek(header.body)
+        rows = iter(enumerate(f, header.lines + 1))
+        for name, count, props in header.elements:
+            what = f"{name} ({' '.join(p for p, _, _ in props)})"
             for _ in range(count):
                 number, raw = next(rows, (None, b""))
                 if number is None:
@@ -358,7 +363,7 @@ def _ascii_ply_fault(path: Path) -> None:
                     raise expected(f"numbers for a {what}", describe(text),
                                    path, number) from None
                 want, at = 0, 0
-                for _, is_list in props:
+                for _, _, is_list in props:
                     if is_list and at < len(values):
                         items = values[at]
                         if not math.isfinite(items) or items != int(items) or items < 0:

@@ -172,7 +172,8 @@ class _Handler(BaseHTTPRequestHandler):
         except OSError as err:  # a name too long for the file system, say: answered, not dropped
             from fishgen.errors import too_long
 
-            message = too_long(err) or f"cannot {method} {self.path[:100]}: {err.strerror or err}"
+            where = urlsplit(self.path).path[:100]       # not the query: it holds the token
+            message = too_long(err) or f"cannot {method} {where}: {err.strerror or err}"
             response = Response.of_json({"error": message}, HTTPStatus.UNPROCESSABLE_ENTITY)
         except Exception as err:  # a bug: the page hears of it, and the server goes on
             self.server.bugs[:] = [*self.server.bugs[-15:], err]
