@@ -190,7 +190,12 @@ print(sorted(m for m in set(sys.modules) - before if m.split(".")[0] in ("fishge
     assert run.stdout.strip() == "[]"
 
 
-def many_builds(shipped, count: int):
+#: Builds in the interrupted batches: enough that a run is still going when its fifth record is
+#: written (about 25 a second on 2 cores), few enough that the run finishing it stays short.
+MANY = 48
+
+
+def many_builds(shipped, count: int = MANY):
     """``count`` builds of one species to different names: every output has the same bytes."""
     manifest = shipped / "params" / "many.toml"
     manifest.write_text('out = "../out/many"\n' + "".join(
@@ -216,7 +221,7 @@ def start_batch_until_recorded(manifest: Path, out: Path, jobs: int = 5) -> subp
 
 @pytest.mark.parametrize("signum,status", [(signal.SIGTERM, 143), (signal.SIGINT, 130), (signal.SIGKILL, -9)])
 def test_a_batch_killed_midway_leaves_whole_files_and_the_next_run_finishes_it(shipped, signum, status):
-    manifest, out = many_builds(shipped, 120)
+    manifest, out = many_builds(shipped)
     assert run_cli("build", manifest.parent / "bonybream.txt", "-o", shipped / "one.glb").returncode == 0
     whole = hashes(shipped)["one.glb"]
     proc = start_batch_until_recorded(manifest, out)
@@ -228,7 +233,7 @@ def test_a_batch_killed_midway_leaves_whole_files_and_the_next_run_finishes_it(s
         assert stderr.endswith("fishgen: interrupted\n") and "Traceback" not in stderr
     time.sleep(1.0 if signum == signal.SIGKILL else 0)  # orphaned workers finish their one job each
     outputs = hashes(out)
-    assert 5 <= len(outputs) < 120
+    assert 5 <= len(outputs) < MANY
     assert set(outputs.values()) == {whole}  # no partial file
     done = record(out)
     assert all(entry["outputs"][name] == outputs[name] for name, entry in done.items())  # consistent
@@ -238,7 +243,7 @@ def test_a_batch_killed_midway_leaves_whole_files_and_the_next_run_finishes_it(s
     assert again.returncode == 0, again.stderr
     found = statuses(again.stdout)
     assert {n for n, s in found.items() if s == "skipped"} == set(done)
-    assert set(found) == {f"fish{i:03d}.glb" for i in range(120)}
+    assert set(found) == {f"fish{i:03d}.glb" for i in range(MANY)}
     assert set(hashes(out).values()) == {whole}
 
 
@@ -270,7 +275,7 @@ def helper(pid: int, batch_pid: int) -> bool:
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers through /proc")
 def test_a_killed_worker_is_replaced_and_its_jobs_are_tried_again(shipped):
-    manifest, out = many_builds(shipped, 120)
+    manifest, out = many_builds(shipped)
     proc = start_batch_until_recorded(manifest, out)
     workers = [pid for pid in descendants(proc.pid) if not helper(pid, proc.pid)]
     assert workers, "no worker found"
@@ -278,7 +283,7 @@ def test_a_killed_worker_is_replaced_and_its_jobs_are_tried_again(shipped):
     stdout, stderr = proc.communicate(timeout=120)
     assert proc.returncode == 0 and stderr == "", stderr
     outputs = hashes(out)
-    assert len(outputs) == 120 and len(set(outputs.values())) == 1  # every file built, and whole
+    assert len(outputs) == MANY and len(set(outputs.values())) == 1  # every file built, and whole
     assert set(record(out)) == set(outputs)
     again = batch(manifest, "-j", "2")
     assert again.returncode == 0 and set(statuses(again.stdout).values()) == {"skipped"}
