@@ -99,7 +99,7 @@ COMMAND = Command(
     Examples:
       fishgen fly --mode thick
       fishgen fly params/clouds/table_4_4.awn --size 1024x768
-      fishgen fly --mode medium --headless --timeout 10 --report out/fly.json
+      fishgen fly --mode medium --headless --timeout 5 --report out/fly.json
       fishgen fly out/sky.glb out/reef.glb --headless --report out/fly.csv
     """,
     options=FlyOptions,
