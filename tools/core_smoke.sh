@@ -9,6 +9,9 @@ trap 'rm -rf "$work"' EXIT
 # no pip of its own (ensurepip took 5 s of the suite's time): this pip installs into it, and compiles
 # nothing ahead (byte-compiling all of numpy and scipy took 5 of the install's 13 s; the commands
 # compile what they import)
+# nor does the environment stop the commands from keeping what they compile (PYTHONDONTWRITEBYTECODE
+# had each of them compile numpy, scipy and trimesh from source again: 40 s, not 27)
+unset PYTHONDONTWRITEBYTECODE
 python -m venv --without-pip "$work/venv"
 python -m pip --python "$work/venv/bin/python" install -q --no-compile --disable-pip-version-check "$root"
 fishgen="$work/venv/bin/fishgen"

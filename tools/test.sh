@@ -22,6 +22,10 @@ if [ ${#missing[@]} -gt 0 ]; then
   fi
 fi
 
+# Bytecode is cached as Python does by default: where the environment forbids it, every one of the
+# suite's hundreds of Python processes (CLI runs, batch and fuzz workers, the core install's
+# commands) compiled every module it imports from source again.
+unset PYTHONDONTWRITEBYTECODE
 python -m pip install -q --disable-pip-version-check -e ".[test]"
 npm ci --no-audit --no-fund --loglevel=error
 # The whole suite, lint, types and the core-install smoke test included (tests/test_house.py), on
