@@ -12,11 +12,17 @@ missing=()
 for pkg in "${APT_PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")
 done
+# The three installs wait mostly on the network, so they run side by side (apt's and pip's
+# downloads had taken turns); each one's failure stops the run with its own output.
+logs=$(mktemp -d)
+trap 'rm -rf "$logs"' EXIT
+apt_pid=""
 if [ ${#missing[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ]; then
     echo "installing system packages: ${missing[*]}"
-    apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
+        apt-get install -y -qq --no-install-recommends "${missing[@]}"; } >"$logs/apt" 2>&1 &
+    apt_pid=$!
   else
     echo "warning: missing system packages (${missing[*]}); run as root or install them" >&2
   fi
@@ -26,8 +32,14 @@ fi
 # suite's hundreds of Python processes (CLI runs, batch and fuzz workers, the core install's
 # commands) compiled every module it imports from source again.
 unset PYTHONDONTWRITEBYTECODE
-python -m pip install -q --disable-pip-version-check -e ".[test]"
+python -m pip install -q --disable-pip-version-check -e ".[test]" >"$logs/pip" 2>&1 &
+pip_pid=$!
 npm ci --no-audit --no-fund --loglevel=error
+wait "$pip_pid" || { cat "$logs/pip" >&2; echo "tools/test.sh: pip install failed" >&2; exit 1; }
+cat "$logs/pip"
+if [ -n "$apt_pid" ]; then
+  wait "$apt_pid" || { cat "$logs/apt" >&2; echo "tools/test.sh: apt-get install failed" >&2; exit 1; }
+fi
 # The whole suite, lint, types and the core-install smoke test included (tests/test_house.py), on
 # every core (pytest-xdist; tests sharing a built asset, a browser page or a server stay on one
 # worker: tests/conftest.py), with the 20 slowest printed and the suite's wall time last.
