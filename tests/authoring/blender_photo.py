@@ -13,8 +13,9 @@ from __future__ import annotations
 import json
 import subprocess
 import tempfile
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -230,11 +231,25 @@ class Fitted:
     triangles: float | None = None
 
 
-def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: bool = True,
-               skip: dict[str, str] | None = None, lens: bool = True) -> list[Fitted]:
-    """``fishgen texture --fit-shape`` of every photo (name -> :func:`photograph`'s record) on every
-    base (name -> species) but the one it was shaped from (``skip``: photo -> base), told the
-    photo's ``--focal-length`` when ``lens`` (as a camera's EXIF tells it)."""
+@dataclass(frozen=True)
+class FitRun:
+    """One ``fishgen texture --fit-shape`` of a photo on a base (:func:`fit_one`): its row, the
+    command's result, the species file written (beside its textures), the rebuilt species, the shot
+    it is photographed side-on with, and the photo's true silhouette levelled by the command."""
+    key: str
+    row: Fitted
+    result: Any = field(repr=False)
+    out: Path
+    rebuilt: Any = field(repr=False)
+    shot: Shot
+    level: np.ndarray = field(repr=False)
+
+
+def fit_one(name: str, rec: dict, base_name: str, base: Any, folder: Path, lens: bool = True) -> FitRun:
+    """``fishgen texture --fit-shape`` of the photo ``name`` (:func:`photograph`'s record) on
+    ``base``, into ``folder/name/base_name.txt``, told the photo's ``--focal-length`` when ``lens``
+    (as a camera's EXIF tells it); the rebuilt fish filled from the photo's camera, side-on, by
+    :func:`raster_mask` against the photo's true silhouette."""
     import time
 
     from PIL import Image
@@ -245,39 +260,50 @@ def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: boo
     from fishgen.errors import FishgenError
     from fishgen.species.parser import load_species
 
-    rows, fits = [], {}
-    for name, rec in records.items():
-        truth = read_mask(Path(rec["mask"]))
-        shot = Shot(**rec["shot"])
-        options = TextureOptions(fit_shape=True, **({"focal_length": shot.lens} if lens else {}))
-        for base_name, base in bases.items():
-            if (skip or {}).get(name) == base_name:
-                continue
-            out = folder / name / f"{base_name}.txt"
-            out.parent.mkdir(parents=True, exist_ok=True)
-            notes: list[str] = []
-            start = time.perf_counter()
-            try:
-                result = make_texture(rec["photo"], base, out, options, notes.append)
-            except FishgenError as err:   # the photo's own silhouette failed: the documented escape
-                notes = [f"needs --mask ({err.message})"]
-                mask = folder / name / "mask.png"
-                Image.fromarray(truth).save(mask)
-                result = make_texture(rec["photo"], base, out, replace(options, mask=mask), notes.append)
-            seconds = time.perf_counter() - start
-            rebuilt = load_species(out)
-            level = result.frame.level(truth)
-            scene = build_fish(rebuilt)
-            camera = camera_for(rest_triangles(scene).reshape(-1, 3), shot.side_on())
-            raster = silhouette_iou(level, raster_mask(scene, camera))
-            key = f"{name}--{base_name}"
-            fits[key] = (rebuilt, shot)
-            rows.append((key, Fitted(name, base_name, result.fitted, result.iou, raster, None, tuple(notes),
-                                     seconds), level))
-    masks = fitted_masks(fits, folder / "blender") if blender else {}
-    return [replace(row, blender=silhouette_iou(level, masks[key][0]),
-                    triangles=silhouette_iou(level, masks[key][1])) if key in masks else row
-            for key, row, level in rows]
+    truth = read_mask(Path(rec["mask"]))
+    shot = Shot(**rec["shot"])
+    options = TextureOptions(fit_shape=True, **({"focal_length": shot.lens} if lens else {}))
+    out = folder / name / f"{base_name}.txt"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    notes: list[str] = []
+    start = time.perf_counter()
+    try:
+        result = make_texture(rec["photo"], base, out, options, notes.append)
+    except FishgenError as err:   # the photo's own silhouette failed: the documented escape
+        notes = [f"needs --mask ({err.message})"]
+        mask = folder / name / "mask.png"
+        Image.fromarray(truth).save(mask)
+        result = make_texture(rec["photo"], base, out, replace(options, mask=mask), notes.append)
+    seconds = time.perf_counter() - start
+    rebuilt = load_species(out)
+    level = result.frame.level(truth)
+    scene = build_fish(rebuilt)
+    camera = camera_for(rest_triangles(scene).reshape(-1, 3), shot.side_on())
+    raster = silhouette_iou(level, raster_mask(scene, camera))
+    row = Fitted(name, base_name, result.fitted, result.iou, raster, None, tuple(notes), seconds)
+    return FitRun(f"{name}--{base_name}", row, result, out, rebuilt, shot, level)
+
+
+def photographed(runs: list[FitRun], folder: Path) -> list[Fitted]:
+    """Each run's row with the rebuilt fish photographed side-on by Blender (:func:`fitted_masks`)
+    against the photo's true silhouette: as the file shows it and every triangle of it."""
+    from fishgen.authoring.photo.compare import silhouette_iou
+
+    masks = fitted_masks({run.key: (run.rebuilt, run.shot) for run in runs}, folder)
+    return [replace(run.row, blender=silhouette_iou(run.level, masks[run.key][0]),
+                    triangles=silhouette_iou(run.level, masks[run.key][1])) for run in runs]
+
+
+def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: bool = True,
+               skip: dict[str, str] | None = None, lens: bool = True) -> list[Fitted]:
+    """``fishgen texture --fit-shape`` of every photo (name -> :func:`photograph`'s record) on every
+    base (name -> species) but the one it was shaped from (``skip``: photo -> base), told the
+    photo's ``--focal-length`` when ``lens`` (as a camera's EXIF tells it): :func:`fit_one` each,
+    then, with ``blender``, :func:`photographed`."""
+    runs = [fit_one(name, rec, base_name, base, folder, lens)
+            for name, rec in records.items() for base_name, base in bases.items()
+            if (skip or {}).get(name) != base_name]
+    return photographed(runs, folder / "blender") if blender else [run.row for run in runs]
 
 
 #: The lenses photos are taken with (mm on a 36 mm sensor: a normal lens to a short telephoto). A

@@ -30,6 +30,23 @@ def _bases(names):
     return {n: load_species(PARAMS / f"{n}.txt") for n in names}
 
 
+@pytest.fixture(scope="module")
+def fitted(tmp_path_factory):
+    """``fitted(photo, base, lens=True)``: :func:`.blender_photo.fit_one` of a committed photo on a
+    shipped base, told the photo's focal length when ``lens``, made once for the module (a fit
+    takes 5-10 s, and several tests here hold the same one to different things)."""
+    runs: dict[tuple[str, str, bool], bp.FitRun] = {}
+
+    def fit(photo: str, base: str, lens: bool = True) -> bp.FitRun:
+        if (photo, base, lens) not in runs:
+            folder = tmp_path_factory.mktemp(f"fit-{photo}-{base}-{'lens' if lens else 'blind'}")
+            runs[photo, base, lens] = bp.fit_one(photo, bp.fixture_records()[photo], base,
+                                                 _bases([base])[base], folder, lens)
+        return runs[photo, base, lens]
+
+    return fit
+
+
 def test_fixtures_are_whole():
     """Each committed photo has its true silhouette and the shot it was taken with."""
     records = bp.fixture_records()
@@ -59,12 +76,11 @@ def test_rasteriser_agrees_with_the_committed_blender_masks(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("photo, base", FITS)
-def test_fit_of_a_blender_photo_holds_on_another_base(tmp_path, gl_available, photo, base):
+def test_fit_of_a_blender_photo_holds_on_another_base(gl_available, fitted, photo, base):
     """--fit-shape on a base the fish was not shaped from: the rebuilt fish, projected side-on with
     the photo's lens and framing, overlaps the photo's true silhouette (levelled by the command)
     with IoU >= 0.85, and the command's own figure is not kinder than that by more than 0.06."""
-    rows = bp.fit_photos({photo: bp.fixture_records()[photo]}, _bases([base]), tmp_path, blender=False)
-    (row,) = rows
+    row = fitted(photo, base).row
     assert row.kept, row.notes
     assert row.raster >= TARGET, f"{photo} on {base}: IoU {row.raster:.3f} (the command says {row.own:.3f})"
     assert row.own is not None and row.own - row.raster <= 0.06
@@ -87,10 +103,10 @@ def test_blender_covers_what_the_rasteriser_fills(tmp_path):
 
 @pytest.mark.slow
 @needs_blender
-def test_fit_photographed_again_by_blender(tmp_path, gl_available):
-    """The whole measure in Blender: a committed photo fitted on another base, the fitted species
-    built as a glb and photographed by Blender with the photo's lens, IoU >= 0.85."""
-    (row,) = bp.fit_photos({"long": bp.fixture_records()["long"]}, _bases(["bonybream"]), tmp_path)
+def test_fit_photographed_again_by_blender(tmp_path, gl_available, fitted):
+    """The whole measure in Blender: a committed photo fitted on another base (the fit above), the
+    fitted species built as a glb and photographed by Blender with the photo's lens, IoU >= 0.85."""
+    (row,) = bp.photographed([fitted("long", "bonybream")], tmp_path)
     assert row.blender is not None and row.blender >= TARGET, row
     assert abs(row.blender - row.raster) <= 0.03
 
@@ -102,23 +118,20 @@ def test_fixtures_folder_is_small():
 
 
 @pytest.mark.slow
-def test_focal_length_fits_for_the_photo_s_perspective_and_repeats_byte_for_byte(tmp_path, gl_available):
+def test_focal_length_fits_for_the_photo_s_perspective(gl_available, fitted):
     """A 50 mm photo fitted told its focal length: the fish from the photo's camera is no less like
-    the photo than a fit that assumed no perspective, and the same inputs write the same bytes."""
+    the photo than a fit that assumed no perspective. (That the same inputs write the same bytes is
+    held by the faint-edges-and-faded-pixels test below, on this photo told its lens.)"""
     rec = bp.fixture_records()["long"]
     assert rec["shot"]["lens"] == 50.0
-    told = bp.fit_photos({"long": rec}, _bases(["threadfingoldie"]), tmp_path / "a", blender=False)[0]
-    bp.fit_photos({"long": rec}, _bases(["threadfingoldie"]), tmp_path / "b", blender=False)
-    blind = bp.fit_photos({"long": rec}, _bases(["threadfingoldie"]), tmp_path / "c", blender=False,
-                          lens=False)[0]
+    told = fitted("long", "threadfingoldie").row
+    blind = fitted("long", "threadfingoldie", lens=False).row
     assert told.kept and told.raster >= TARGET, told
     assert told.own is not None and told.own - told.raster <= 0.06, told
     assert told.raster >= blind.raster - 0.005, (told, blind)
-    for name in ("threadfingoldie.txt", "threadfingoldie.png", "threadfingoldie_mask.png"):
-        assert (tmp_path / "a" / "long" / name).read_bytes() == (tmp_path / "b" / "long" / name).read_bytes()
 
 
-def test_told_the_lens_a_fit_over_water_keeps_the_faint_fin_tips_in_its_mask(tmp_path, gl_available):
+def test_told_the_lens_a_fit_over_water_keeps_the_faint_fin_tips_in_its_mask(gl_available, fitted):
     """Over a backdrop the fit reaches the silhouette's faint edges (a translucent fin's last
     pixels), and told the lens its fins take their texture where the render from the photo's camera
     shows them, out to those edges: its mask texture is cut with them, or it trims the very tips
@@ -128,24 +141,22 @@ def test_told_the_lens_a_fit_over_water_keeps_the_faint_fin_tips_in_its_mask(tmp
     from scipy import ndimage
 
     from fishgen.authoring.photo.image import MEASURE_SIDE, load_photo, working_copy
-    from fishgen.authoring.photo.run import TextureOptions, make_texture
     from fishgen.authoring.photo.silhouette import faint_edges, silhouette
 
     rec = bp.fixture_records()["long"]
+    assert rec["shot"]["lens"] == 50.0
     photo = working_copy(load_photo(rec["photo"]), MEASURE_SIDE)
     sil = silhouette(photo)
     faint = faint_edges(photo, sil.mask)
     assert sil.source == "background model" and faint.sum() > 20
-    base = _bases(["bonybream"])["bonybream"]
-    for lens in (rec["shot"]["lens"], None):
-        out = tmp_path / f"lens-{lens}" / "fish.txt"
-        notes: list[str] = []
-        result = make_texture(rec["photo"], base, out, TextureOptions(fit_shape=True, focal_length=lens),
-                              notes.append)
-        assert result.fitted
+    for lens in (True, False):   # --focal-length 50, and none
+        run = fitted("long", "bonybream", lens)
+        notes = run.row.notes
+        assert run.result.fitted
+        assert not any(n.startswith("needs --mask") for n in notes), notes   # its own silhouette
         # its bare figure is its own: nothing to say of doubts taken together (the next test)
         assert not [n for n in notes if "with both" in n], notes
-        mask = np.asarray(ImageOps.flip(Image.open(out.with_name("fish_mask.png")))) >= 128
+        mask = np.asarray(ImageOps.flip(Image.open(run.out.with_name("bonybream_mask.png")))) >= 128
         assert mask.shape == sil.mask.shape and mask[sil.mask].all()
         # a fitted fish's mask also widens the outline's 1-px threads (test_photo_roundtrip)
         cut = sil.mask | faint if lens else sil.mask
@@ -154,12 +165,13 @@ def test_told_the_lens_a_fit_over_water_keeps_the_faint_fin_tips_in_its_mask(tmp
 
 
 def test_a_fit_that_leans_on_the_faint_edges_and_faded_pixels_together_is_said_so(tmp_path, gl_available,
-                                                                                  monkeypatch):
+                                                                                  fitted, monkeypatch):
     """Fitted to the silhouette with its faint edges, the rebuilt fish may score a little less against
     the bare silhouette and a little less at half coverage, neither alone under 0.85; both together
     can be (605 in Blender: 0.894 by its own figure, 0.857 bare, 0.874 at half, 0.840 in Blender).
     Then one line says so, with each figure; where the bare figure is the fitted one, it is silent
-    (the same fit unpatched, in the test above)."""
+    (the same fit unpatched, in the test above). What is said changes nothing written: the files are
+    the unpatched fit's byte for byte, as the same inputs always write the same bytes."""
     from fishgen.authoring.photo import run as run_module
     from fishgen.authoring.photo.image import MEASURE_SIDE, load_photo, working_copy
     from fishgen.authoring.photo.run import TextureOptions, make_texture
@@ -179,9 +191,13 @@ def test_a_fit_that_leans_on_the_faint_edges_and_faded_pixels_together_is_said_s
 
     monkeypatch.setattr(run_module, "_iou_with", iou_with)
     notes: list[str] = []
-    result = make_texture(rec["photo"], base, tmp_path / "fish.txt", options, notes.append)
+    result = make_texture(rec["photo"], base, tmp_path / "bonybream.txt", options, notes.append)
     said = [n for n in notes if "with both" in n]
     assert result.fitted and result.iou is not None and result.iou >= 0.9, notes
     assert len(said) == 1 and "\n" not in said[0], notes
     assert said[0].startswith(f"silhouette IoU {result.iou:.3f}, but 0."), said
     assert "give --mask" in said[0], said
+    unpatched = fitted("long", "bonybream")
+    assert not any(n.startswith("needs --mask") for n in unpatched.row.notes), unpatched.row.notes
+    for name in ("bonybream.txt", "bonybream.png", "bonybream_mask.png"):
+        assert (tmp_path / name).read_bytes() == unpatched.out.with_name(name).read_bytes(), name
