@@ -46,37 +46,54 @@ def test_fit_is_kept_only_when_it_matches_better(tmp_path, gl_available, photos)
         assert fitted.species.scale[1] / fitted.species.scale[0] > bream.scale[1] / bream.scale[0]
 
 
+@pytest.fixture(scope="module")
+def goldie_fitted(tmp_path_factory, photos):
+    """``goldie_fitted(base_name)``: (result, notes, species file) of ``texture --fit-shape`` of the
+    goldie's photo on a shipped base, made once for the module (two tests hold the Centroberyx fit)."""
+    made: dict[str, tuple] = {}
+
+    def fitted(base_name: str) -> tuple:
+        if base_name not in made:
+            folder = tmp_path_factory.mktemp(f"goldie-on-{base_name}")
+            _, photo = photos["threadfingoldie"]
+            photo.save(folder / "p.png")
+            notes: list[str] = []
+            result = make_texture(folder / "p.png", load_species(PARAMS / f"{base_name}.txt"),
+                                  folder / "new.txt", TextureOptions(fit_shape=True), notes.append)
+            made[base_name] = (result, notes, folder / "new.txt")
+        return made[base_name]
+
+    return fitted
+
+
 @pytest.mark.parametrize("base_name", SHIPPED)
-def test_threadfin_goldie_fits_on_every_base(tmp_path, gl_available, photos, base_name):
+def test_threadfin_goldie_fits_on_every_base(gl_available, goldie_fitted, base_name):
     """Issue 25's case: the slender goldie with its tall dorsal, long pelvic and forked tail, on
     every shipped base, comes back with IoU >= 0.85 (0.53-0.97 before), whole."""
     from fishgen.authoring.photo.checks import fit_problems
 
-    _, photo = photos["threadfingoldie"]
-    photo.save(tmp_path / "p.png")
-    base = load_species(PARAMS / f"{base_name}.txt")
-    notes: list[str] = []
-    result = make_texture(tmp_path / "p.png", base, tmp_path / "new.txt", TextureOptions(fit_shape=True),
-                          notes.append)
+    result, notes, out = goldie_fitted(base_name)
     assert result.iou is not None and result.iou >= 0.85, f"{base_name}: IoU {result.iou:.3f}; {notes}"
     if result.fitted:
         fit = result.shape_fit
-        assert fit_problems(load_species(tmp_path / "new.txt"), fit.work, fit.placement) == []
+        assert fit_problems(load_species(out), fit.work, fit.placement) == []
     assert not any("try --fit-shape" in n for n in notes)
 
 
-def test_a_kept_fit_is_cut_by_its_mask_on_a_base_that_blends_its_fins(tmp_path, gl_available, photos):
+def test_a_kept_fit_is_cut_by_its_mask_on_a_base_that_blends_its_fins(tmp_path, gl_available, photos,
+                                                                     goldie_fitted):
     """Centroberyx blends its fins (alpha 0.6). A fitted fin's straight edges only approach the
     photographed fin, and blended, its thin tips fade under half coverage in other renderers (703
     on Centroberyx in Blender: 0.812 as shown, 0.901 every triangle): a kept fit is written masked,
-    its fins cut by the mask of the photo's outline. Without --fit-shape the base's way stays."""
+    its fins cut by the mask of the photo's outline (the goldie's fit above). Without --fit-shape
+    the base's way stays."""
     _, photo = photos["threadfingoldie"]
     photo.save(tmp_path / "p.png")
     base = load_species(PARAMS / "centroberyx.txt")
     assert not base.masked
-    fitted = make_texture(tmp_path / "p.png", base, tmp_path / "fit.txt", TextureOptions(fit_shape=True))
+    fitted, _, out = goldie_fitted("centroberyx")
     assert fitted.fitted
-    assert load_species(tmp_path / "fit.txt").masked
+    assert load_species(out).masked
     make_texture(tmp_path / "p.png", base, tmp_path / "plain.txt")
     assert not load_species(tmp_path / "plain.txt").masked
 
@@ -146,6 +163,7 @@ def test_a_poor_fit_is_tried_at_other_levels(tmp_path, gl_available, photos, mon
     that well, and the best is kept (its frame turned with it) and named in a note."""
     from fishgen.authoring.photo import fit as fit_module
     from fishgen.authoring.photo import run as run_module
+    from fishgen.authoring.photo.frame import fish_frame
 
     species, photo = photos["pineapplefish"]
     photo.save(tmp_path / "p.png")
@@ -153,10 +171,13 @@ def test_a_poor_fit_is_tried_at_other_levels(tmp_path, gl_available, photos, mon
     turns: list[float] = []
     shapes: list[tuple] = []
 
+    angles: list[float] = []
+
     def recorded(base, mask, sections_fixed=False, turn=0.0):
         turns.append(turn)
         fit = real(base, mask, sections_fixed, turn)
         shapes.append((fit.species.shape_params, fit.species.scale))
+        angles.append(fit.frame.angle)
         return fit
 
     # as the renders would measure a turned fish: poor at its measured level, good 4 degrees on
@@ -174,7 +195,9 @@ def test_a_poor_fit_is_tried_at_other_levels(tmp_path, gl_available, photos, mon
                           notes.append)
     assert turns == [0.0, 4.0]          # 0.90 is good enough: no more levels tried
     assert result.fitted and result.shape_fit.turn == 4.0
-    assert abs(result.frame.angle - real(species, photo.rgba[:, :, 3] >= 64).frame.angle - 4.0) < 1e-6
+    # its frame is the measured level's (the first fit's) turned 4 degrees on
+    assert abs(angles[0] - fish_frame(photo.rgba[:, :, 3] >= 64).angle) < 1e-6
+    assert abs(result.frame.angle - angles[0] - 4.0) < 1e-6 and abs(angles[1] - angles[0] - 4.0) < 1e-6
     assert any("turned +4 degrees" in n for n in notes)
 
 
