@@ -16,7 +16,8 @@ from tests.conftest import PARAMS
 #: The fits CI holds to the target: each committed photo on bases it was not shaped from.
 TARGET = 0.85
 FITS = [("sampled_303", "centroberyx"), ("long", "bonybream"), ("deep-tail", "centroberyx")]
-"""long on ThreadfinGoldie is held by the focal-length test, which fits it twice anyway.
+"""long on ThreadfinGoldie (0.942, told the lens; 0.928 not) is as near the target as long on
+BonyBream (0.940; 0.924), whose fits, told the lens and not, the other tests here hold too.
 sampled_303 on PineappleFish (0.857; 0.849 until the fit took the silhouette's faint edges, the
 translucent caudal lobes' thin tips) tries every level of the fish and takes a minute: it is left
 to `python benchmarks/texture.py --blender`, and the photo is held here on Centroberyx."""
@@ -120,12 +121,12 @@ def test_fixtures_folder_is_small():
 @pytest.mark.slow
 def test_focal_length_fits_for_the_photo_s_perspective(gl_available, fitted):
     """A 50 mm photo fitted told its focal length: the fish from the photo's camera is no less like
-    the photo than a fit that assumed no perspective. (That the same inputs write the same bytes is
-    held by the faint-edges-and-faded-pixels test below, on this photo told its lens.)"""
+    the photo than a fit that assumed no perspective (the two fits the next test reads; 0.940 and
+    0.924 measured). That the same inputs write the same bytes is held by the test after it."""
     rec = bp.fixture_records()["long"]
     assert rec["shot"]["lens"] == 50.0
-    told = fitted("long", "threadfingoldie").row
-    blind = fitted("long", "threadfingoldie", lens=False).row
+    told = fitted("long", "bonybream").row
+    blind = fitted("long", "bonybream", lens=False).row
     assert told.kept and told.raster >= TARGET, told
     assert told.own is not None and told.own - told.raster <= 0.06, told
     assert told.raster >= blind.raster - 0.005, (told, blind)
