@@ -118,9 +118,10 @@ def test_large_photo_is_measured_on_a_smaller_copy(tmp_path, gl_available):
     from fishgen.authoring.photo.run import TextureOptions
 
     species = load_species(ph.PARAMS_DIR / "pineapplefish.txt")
-    photo = ph.on_background(ph.render_photo(species, (2600, 1300)), (180, 190, 200), (180, 190, 200))
+    shot = ph.render_photo(species, (2600, 1300))
+    photo = ph.on_background(shot, (180, 190, 200), (180, 190, 200))
     photo.save(tmp_path / "big.png")
-    hand_made = ((ph.render_photo(species, (2600, 1300)).rgba[:, :, 3] >= 128) * 255).astype("uint8")
+    hand_made = ((shot.rgba[:, :, 3] >= 128) * 255).astype("uint8")
     Image.fromarray(hand_made).save(tmp_path / "mask.png")
     make_texture(tmp_path / "big.png", species, tmp_path / "new.txt",
                  TextureOptions(mask=tmp_path / "mask.png"))
