@@ -48,20 +48,21 @@ def test_fit_is_kept_only_when_it_matches_better(tmp_path, gl_available, photos)
 
 @pytest.fixture(scope="module")
 def goldie_fitted(tmp_path_factory, photos):
-    """``goldie_fitted(base_name)``: (result, notes, species file) of ``texture --fit-shape`` of the
-    goldie's photo on a shipped base, made once for the module (two tests hold the Centroberyx fit)."""
-    made: dict[str, tuple] = {}
+    """``goldie_fitted(base_name, fit_shape=True)``: (result, notes, species file) of ``texture``
+    (``--fit-shape``) of the goldie's photo on a shipped base, made once for the module (tests
+    here hold the same runs to different things)."""
+    made: dict[tuple[str, bool], tuple] = {}
 
-    def fitted(base_name: str) -> tuple:
-        if base_name not in made:
-            folder = tmp_path_factory.mktemp(f"goldie-on-{base_name}")
+    def fitted(base_name: str, fit_shape: bool = True) -> tuple:
+        if (base_name, fit_shape) not in made:
+            folder = tmp_path_factory.mktemp(f"goldie-on-{base_name}{'-fit' if fit_shape else ''}")
             _, photo = photos["threadfingoldie"]
             photo.save(folder / "p.png")
             notes: list[str] = []
             result = make_texture(folder / "p.png", load_species(PARAMS / f"{base_name}.txt"),
-                                  folder / "new.txt", TextureOptions(fit_shape=True), notes.append)
-            made[base_name] = (result, notes, folder / "new.txt")
-        return made[base_name]
+                                  folder / "new.txt", TextureOptions(fit_shape=fit_shape), notes.append)
+            made[base_name, fit_shape] = (result, notes, folder / "new.txt")
+        return made[base_name, fit_shape]
 
     return fitted
 
@@ -80,34 +81,37 @@ def test_threadfin_goldie_fits_on_every_base(gl_available, goldie_fitted, base_n
     assert not any("try --fit-shape" in n for n in notes)
 
 
-def test_a_kept_fit_is_cut_by_its_mask_on_a_base_that_blends_its_fins(tmp_path, gl_available, photos,
-                                                                     goldie_fitted):
+def test_a_kept_fit_is_cut_by_its_mask_on_a_base_that_blends_its_fins(gl_available, goldie_fitted):
     """Centroberyx blends its fins (alpha 0.6). A fitted fin's straight edges only approach the
     photographed fin, and blended, its thin tips fade under half coverage in other renderers (703
     on Centroberyx in Blender: 0.812 as shown, 0.901 every triangle): a kept fit is written masked,
     its fins cut by the mask of the photo's outline (the goldie's fit above). Without --fit-shape
-    the base's way stays."""
-    _, photo = photos["threadfingoldie"]
-    photo.save(tmp_path / "p.png")
+    the base's way stays (the run the advice test below reads)."""
     base = load_species(PARAMS / "centroberyx.txt")
     assert not base.masked
     fitted, _, out = goldie_fitted("centroberyx")
     assert fitted.fitted
     assert load_species(out).masked
-    make_texture(tmp_path / "p.png", base, tmp_path / "plain.txt")
-    assert not load_species(tmp_path / "plain.txt").masked
+    _, _, plain = goldie_fitted("centroberyx", fit_shape=False)
+    assert not load_species(plain).masked
 
 
-def test_more_sections_when_the_base_cannot_hold_the_fish(gl_available, photos):
+def test_more_sections_when_the_base_cannot_hold_the_fish(gl_available, photos, goldie_fitted):
     """The pineapple fish's 8 BodySections cannot place the goldie's fins: the fit uses more and
-    says so; with the sections fixed (--body-sections given) it keeps them."""
+    says so (the goldie's fit on it above); with the sections fixed (--body-sections given) it
+    keeps them."""
     from fishgen.authoring.photo.fit import fit_species
 
     _, photo = photos["threadfingoldie"]
     base = load_species(PARAMS / "pineapplefish.txt")
-    fit = fit_species(base, photo.rgba[:, :, 3] >= 64)
+    result, notes, out = goldie_fitted("pineapplefish")
+    fit = result.shape_fit
+    assert base.body_sections == 8 and fit.turn == 0.0
     assert fit.species.body_sections > base.body_sections
     assert any(n.startswith("BodySections 8 -> ") for n in fit.notes)
+    # kept, the file written holds them too, and the command says so
+    assert result.fitted and load_species(out).body_sections == fit.species.body_sections
+    assert any(n.startswith("note: BodySections 8 -> ") for n in notes)
     fixed = fit_species(base, photo.rgba[:, :, 3] >= 64, sections_fixed=True)
     assert fixed.species.body_sections == 8
 
@@ -201,14 +205,12 @@ def test_a_poor_fit_is_tried_at_other_levels(tmp_path, gl_available, photos, mon
     assert any("turned +4 degrees" in n for n in notes)
 
 
-def test_plain_texture_advises_fit_shape_below_085(tmp_path, gl_available, photos):
-    """A goldie photo on BonyBream's geometry looks nothing like the goldie: the command measures it
-    and suggests --fit-shape in one line; on its own geometry it says nothing."""
+def test_plain_texture_advises_fit_shape_below_085(tmp_path, gl_available, photos, goldie_fitted):
+    """A goldie photo on Centroberyx's geometry looks nothing like the goldie (0.499): the command
+    measures it and suggests --fit-shape in one line; on its own geometry it says nothing."""
     _, photo = photos["threadfingoldie"]
     photo.save(tmp_path / "p.png")
-    notes: list[str] = []
-    result = make_texture(tmp_path / "p.png", load_species(PARAMS / "bonybream.txt"), tmp_path / "a.txt",
-                          on_note=notes.append)
+    result, notes, _ = goldie_fitted("centroberyx", fit_shape=False)
     assert result.iou is not None and result.iou < 0.85
     (advice,) = [n for n in notes if "--fit-shape" in n]
     assert advice.startswith(f"silhouette IoU {result.iou:.3f}") and "\n" not in advice

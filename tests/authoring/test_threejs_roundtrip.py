@@ -26,8 +26,13 @@ def camera(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def three_photos(camera, photos):
-    return {name: (sp, camera.photo(sp)) for name, (sp, _) in photos.items()}
+def three_photos(camera):
+    """species name -> (species, its photo by three.js), for each shipped species."""
+    from fishgen.species.parser import load_species
+    from tests.conftest import PARAMS
+
+    species = {name: load_species(PARAMS / f"{name}.txt") for name in SHIPPED}
+    return {name: (sp, camera.photo(sp)) for name, sp in species.items()}
 
 
 @pytest.mark.parametrize("name", SHIPPED)
@@ -53,11 +58,13 @@ def test_unseen_fish_lit_and_turned_fits_any_base(tmp_path, gl_available, camera
     from fishgen.authoring.photo.checks import fit_problems
     from fishgen.authoring.photo.run import TextureOptions, make_texture
     from fishgen.species.parser import load_species
-    from tests.authoring.subjects import write_subjects
+    from tests.authoring.subjects import SAMPLED, variants, write_subjects
     from tests.authoring.threejs import lit_photo
     from tests.conftest import PARAMS
 
-    species = write_subjects(tmp_path / "subjects")[subject]
+    seeds = tuple(seed for seed in SAMPLED if f"sampled_{seed}" == subject)   # this subject alone
+    species = write_subjects(tmp_path / "subjects", seeds,
+                             {k: v for k, v in variants().items() if k == subject})[subject]
     photo, truth = lit_photo(camera, species, "lit")
     photo.save(tmp_path / "photo.png")
     result = make_texture(tmp_path / "photo.png", load_species(PARAMS / f"{base_name}.txt"),
