@@ -326,26 +326,34 @@ class Renderer:
         """The frame last drawn, resolved and read back: (H, W, 4) uint8 RGBA, straight alpha."""
         return unpremultiply(self._resolved())
 
-    def coverage(self, scene: Scene, camera: Camera, t: float | None = None) -> np.ndarray:
+    def coverage(self, scene: Scene, camera: Camera, t: float | None = None,
+                 size: tuple[int, int] | None = None) -> np.ndarray:
         """(H, W) uint8 alpha of ``scene`` drawn on a transparent background: ``render``'s alpha
         channel, without straightening the colours (a third of a small frame's time), for a caller
-        that measures only a silhouette."""
-        self.draw(scene, camera, self.posed(scene, t), (0.0, 0.0, 0.0, 0.0))
-        return np.ascontiguousarray(self._resolved()[:, :, 3])
+        that measures only a silhouette. ``size``: (W, H) of a smaller frame, drawn in the
+        framebuffer's corner as a renderer of that size draws it (one renderer, and its uploads,
+        serving frames of several sizes)."""
+        self.draw(scene, camera, self.posed(scene, t), (0.0, 0.0, 0.0, 0.0), size=size)
+        return np.ascontiguousarray(self._resolved(size)[:, :, 3])
 
-    def _resolved(self) -> np.ndarray:
-        """The frame last drawn, resolved: (H, W, 4) uint8 RGBA as drawn (premultiplied), top row first."""
+    def _resolved(self, size: tuple[int, int] | None = None) -> np.ndarray:
+        """The frame last drawn, resolved: (H, W, 4) uint8 RGBA as drawn (premultiplied), top row first
+        (``size``: of the frame drawn in the corner)."""
+        width, height = size or (self.width, self.height)
         self.ctx.copy_framebuffer(self.resolved, self.msaa)
-        raw = self.resolved.read(components=4, alignment=1, dtype=self.colour)
+        raw = self.resolved.read(viewport=(0, 0, width, height), components=4, alignment=1,
+                                 dtype=self.colour)
         if self.colour == "f1":
-            return np.frombuffer(raw, np.uint8).reshape(self.height, self.width, 4)[::-1]
+            return np.frombuffer(raw, np.uint8).reshape(height, width, 4)[::-1]
         values = np.clip(np.frombuffer(raw, np.float16), 0, 1)
         values *= np.float16(255)
-        return np.rint(values, out=values).astype(np.uint8).reshape(self.height, self.width, 4)[::-1]
+        return np.rint(values, out=values).astype(np.uint8).reshape(height, width, 4)[::-1]
 
     def draw(self, scene: Scene, camera: Camera, frame: tuple[Pose, list],
-             background: tuple[float, float, float, float], clip: str | None = None) -> None:
-        """Issue the GL commands of one frame posed by ``posed``; ``finish`` reads it back."""
+             background: tuple[float, float, float, float], clip: str | None = None,
+             size: tuple[int, int] | None = None) -> None:
+        """Issue the GL commands of one frame posed by ``posed``; ``finish`` reads it back. ``size``:
+        (W, H) of a smaller frame, drawn in the framebuffer's lower-left corner."""
         import moderngl
 
         ctx = self.ctx
@@ -353,6 +361,10 @@ class Renderer:
         posed, vertices = frame
         view, proj = camera.view(), camera.projection()
         viewproj = proj @ view
+        if size is not None and (size[0] > self.width or size[1] > self.height):
+            raise ValueError(f"a {size[0]}x{size[1]} frame does not fit a {self.width}x{self.height} "
+                             "renderer")
+        self.msaa.viewport = (0, 0, *(size or (self.width, self.height)))
         self.msaa.use()
         r, g, b, a = background
         ctx.clear(r * a, g * a, b * a, a)  # premultiplied, like everything drawn

@@ -219,27 +219,28 @@ def test_a_fish_near_the_line_at_half_coverage_is_said_so(tmp_path, gl_available
 def test_a_fish_that_falls_with_every_sample_alpha_tested_is_said_so(
         tmp_path, gl_available, photos, monkeypatch):
     """The half-coverage figure is also counted with every sample alpha-tested
-    (compare.half_covered), as Blender counts it, and the worst of its grids is the one said: a
-    fish that loses its back half there is said to, one line with both figures."""
+    (compare.half_covered_grids), as Blender counts it, and the worst of its grids is the one said:
+    a fish that loses its back half there is said to, one line with both figures."""
     from fishgen.authoring.photo import compare
 
     species, photo = photos["centroberyx"]
     path = tmp_path / "photo.png"
     photo.save(path, "PNG")
-    real = compare.half_covered
-    grids = []
+    real = compare.half_covered_grids
+    asked = []
 
-    def back_half_trimmed(species, width, height, distance=None, grid=4):
-        grids.append(grid)
-        covered = real(species, width, height, distance, grid)
-        if grid == max(compare.SAMPLE_GRIDS):   # only one grid: the worst of them is said
-            cols = np.flatnonzero(covered.any(axis=0))
-            covered[:, (cols[0] + cols[-1]) // 2:] = False
-        return covered
+    def back_half_trimmed(species, width, height, distance=None, grids=compare.SAMPLE_GRIDS):
+        asked.extend(grids)
+        out = real(species, width, height, distance, grids)
+        for grid, covered in zip(grids, out, strict=True):
+            if grid == max(compare.SAMPLE_GRIDS):   # only one grid: the worst of them is said
+                cols = np.flatnonzero(covered.any(axis=0))
+                covered[:, (cols[0] + cols[-1]) // 2:] = False
+        return out
 
-    monkeypatch.setattr(compare, "half_covered", back_half_trimmed)
+    monkeypatch.setattr(compare, "half_covered_grids", back_half_trimmed)
     _said(path, species, tmp_path / "b.txt", "at least half", "another renderer")
-    assert sorted(grids) == sorted(compare.SAMPLE_GRIDS)
+    assert sorted(asked) == sorted(compare.SAMPLE_GRIDS)
 
 
 def test_half_coverage_counts_a_masked_tip_as_blender_does(gl_available):

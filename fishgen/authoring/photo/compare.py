@@ -53,18 +53,27 @@ def half_covered(species: Species, width: int, height: int, distance: float | No
     pixel by whichever samples it crosses. Where such a tip sets the box the IoU crops to, the two
     part: 1502 on BonyBream (Blender's photo, 50 mm) 0.882 counted at half by :func:`render_side`,
     0.846 here, 0.847 in Blender, whose render of the file stops its dorsal's tip 4 px lower."""
+    (covered,) = half_covered_grids(species, width, height, distance, (grid,))
+    return covered
+
+
+def half_covered_grids(species: Species, width: int, height: int, distance: float | None = None,
+                       grids: tuple[int, ...] = SAMPLE_GRIDS) -> list[np.ndarray]:
+    """:func:`half_covered` at each of ``grids``: the fish built once, and drawn by one renderer
+    as large as the finest grid needs, each coarser grid's frame in its corner."""
     from fishgen.assembly.fish import build_fish
     from fishgen.preview.render import Renderer
 
     scene = build_fish(species)
     camera = side_camera(scene, width, height, distance)
-    renderer = Renderer(width * grid, height * grid, samples=1)
+    finest = max(grids)
+    renderer = Renderer(width * finest, height * finest, samples=1)
     try:
-        alpha = renderer.coverage(scene, camera)
+        alphas = [renderer.coverage(scene, camera, size=(width * grid, height * grid)) for grid in grids]
     finally:
         renderer.release()
-    share = alpha.reshape(height, grid, width, grid).mean(axis=(1, 3), dtype=np.float32)
-    return share >= 127.5
+    return [alpha.reshape(height, grid, width, grid).mean(axis=(1, 3), dtype=np.float32) >= 127.5
+            for alpha, grid in zip(alphas, grids, strict=True)]
 
 
 def side_camera(scene: Any, width: int, height: int, distance: float | None = None) -> Any:

@@ -513,14 +513,13 @@ def _rebuilt(candidate: _Candidate, out: Path) -> Iterator[Species]:
 def _half_covered_ious(photo: Photo, candidate: _Candidate, out: Path,
                        distance: float | None = None) -> list[float]:
     """The candidate rebuilt from its files, counted where it covers a pixel at least half with
-    every sample alpha-tested (:func:`.compare.half_covered`) at each of
+    every sample alpha-tested (:func:`.compare.half_covered_grids`) at each of
     :data:`.compare.SAMPLE_GRIDS`, and its silhouette IoU with the photo's fish at each."""
-    from fishgen.authoring.photo.compare import SAMPLE_GRIDS, half_covered, silhouette_iou
+    from fishgen.authoring.photo.compare import SAMPLE_GRIDS, half_covered_grids, silhouette_iou
 
     with _rebuilt(candidate, out) as rebuilt:
-        return [silhouette_iou(candidate.measured.frame_mask,
-                               half_covered(rebuilt, *_render_size(photo), distance, grid))
-                for grid in SAMPLE_GRIDS]
+        return [silhouette_iou(candidate.measured.frame_mask, covered)
+                for covered in half_covered_grids(rebuilt, *_render_size(photo), distance, SAMPLE_GRIDS)]
 
 
 def _iou_with(candidate: _Candidate, mask: np.ndarray, render: np.ndarray) -> float:
