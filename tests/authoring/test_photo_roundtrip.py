@@ -43,19 +43,21 @@ _SAID: dict[tuple[str, str], tuple[Path, list[str]]] = {}
 """(species, kind) -> (the folder of its photo.png and what it wrote, the notes it gave)."""
 
 
-def made(tmp_path, photos, name: str, kind: str) -> tuple:
-    """``run_round_trip`` of the shipped species ``name``'s photo as ``kind`` makes it, run once."""
+def made(tmp_path_factory, photos, name: str, kind: str) -> tuple:
+    """``run_round_trip`` of the shipped species ``name``'s photo as ``kind`` makes it, run once
+    (in a folder of the session's, which outlasts the test that made it)."""
     if (name, kind) not in _MADE:
         species, clean = photos[name]
+        folder = tmp_path_factory.mktemp(f"round-trip-{name}-{kind}")
         notes: list[str] = []
-        _MADE[name, kind] = run_round_trip(tmp_path, species, ph.KINDS[kind](clean), on_note=notes.append)
-        _SAID[name, kind] = (tmp_path, notes)
+        _MADE[name, kind] = run_round_trip(folder, species, ph.KINDS[kind](clean), on_note=notes.append)
+        _SAID[name, kind] = (folder, notes)
     return _MADE[name, kind]
 
 
-def said(tmp_path, photos, name: str, kind: str) -> tuple[Path, list[str]]:
+def said(tmp_path_factory, photos, name: str, kind: str) -> tuple[Path, list[str]]:
     """:func:`made`'s folder (its photo.png, new.txt and textures) and the notes it gave."""
-    made(tmp_path, photos, name, kind)
+    made(tmp_path_factory, photos, name, kind)
     return _SAID[name, kind]
 
 
@@ -77,8 +79,8 @@ def test_the_cases_cover_every_species_and_kind():
 
 
 @pytest.mark.parametrize(("name", "kind"), CASES)
-def test_round_trip_points(tmp_path, gl_available, photos, name, kind):
-    result, rebuilt, body, fins = made(tmp_path, photos, name, kind)
+def test_round_trip_points(tmp_path_factory, gl_available, photos, name, kind):
+    result, rebuilt, body, fins = made(tmp_path_factory, photos, name, kind)
     assert result.mirrored == (kind == "mirrored")
     assert body.max() <= BODY_TOLERANCE, f"{name}/{kind}: body point off by {body.max():.4f}"
     worst = max(fins, key=lambda n: fins[n])
@@ -87,19 +89,19 @@ def test_round_trip_points(tmp_path, gl_available, photos, name, kind):
 
 
 @pytest.mark.parametrize(("name", "kind"), [(n, k) for n, k in CASES if k in SILHOUETTE_KINDS])
-def test_round_trip_silhouette(tmp_path, gl_available, photos, name, kind):
+def test_round_trip_silhouette(tmp_path_factory, gl_available, photos, name, kind):
     """The rebuilt fish, rendered as the photo was, against the photo's fish turned level."""
-    result, rebuilt, _, _ = made(tmp_path, photos, name, kind)
+    result, rebuilt, _, _ = made(tmp_path_factory, photos, name, kind)
     iou = silhouette_iou(result.level_mask, ph.rendered_mask(rebuilt))
     assert iou >= SAME_BASE_IOU, f"{name}/{kind}: IoU {iou:.3f}"
 
 
-def test_texture_is_the_photo_upside_down(tmp_path, gl_available, photos):
+def test_texture_is_the_photo_upside_down(tmp_path_factory, gl_available, photos):
     """The texture of the transparent round trip above (the photo as rendered)."""
     from PIL import Image
 
     _, photo = photos["centroberyx"]
-    folder, _ = said(tmp_path, photos, "centroberyx", "transparent")
+    folder, _ = said(tmp_path_factory, photos, "centroberyx", "transparent")
     stored = np.asarray(Image.open(folder / "new.png").convert("RGB")).astype(int)
     mask = np.asarray(Image.open(folder / "new_mask.png").convert("L"))[::-1] >= 128
     fish = photo.rgba[:, :, 3] >= 64
@@ -132,8 +134,8 @@ def test_large_photo_is_measured_on_a_smaller_copy(tmp_path, gl_available):
     assert Image.open(tmp_path / "new_mask.png").size == (2600, 1300)
 
 
-def test_a_fish_that_matches_only_without_its_faint_edges_is_said_so(tmp_path, gl_available, photos,
-                                                                     monkeypatch):
+def test_a_fish_that_matches_only_without_its_faint_edges_is_said_so(tmp_path, tmp_path_factory, gl_available,
+                                                                     photos, monkeypatch):
     """Where the photo's faint edges (thin fin tips the silhouette left out) would take the rebuilt
     fish under 0.85, the command says so in one line with both figures; with none, it is silent."""
     from fishgen.authoring.photo import silhouette as sil
@@ -141,7 +143,7 @@ def test_a_fish_that_matches_only_without_its_faint_edges_is_said_so(tmp_path, g
     # the plain round trip above: Centroberyx's translucent fins over a backdrop leave faint edges
     # (626 px), too few to take the rebuilt fish under 0.85
     species, _ = photos["centroberyx"]
-    folder, notes = said(tmp_path, photos, "centroberyx", "plain")
+    folder, notes = said(tmp_path_factory, photos, "centroberyx", "plain")
     _quiet(notes, "faint")
     path = folder / "photo.png"
 
@@ -175,15 +177,15 @@ def _said(path, species, out, key: str, hint: str | None) -> None:
     assert said[0].startswith(f"silhouette IoU {result.iou:.3f}, but 0.") and hint in said[0], said
 
 
-def test_a_fish_that_matches_only_by_its_faded_pixels_is_said_so(tmp_path, gl_available, photos,
-                                                                  monkeypatch):
+def test_a_fish_that_matches_only_by_its_faded_pixels_is_said_so(tmp_path, tmp_path_factory, gl_available,
+                                                                  photos, monkeypatch):
     """Where the rebuilt fish matches the photo at a quarter of a pixel covered but not at a half
     (its thin or translucent fin parts: another renderer's coverage counts half), the command says
     so in one line with both figures; a fish drawn solid is silent."""
     from fishgen.authoring.photo import run as run_module
 
     species, _ = photos["centroberyx"]
-    folder, notes = said(tmp_path, photos, "centroberyx", "transparent")   # the photo as rendered
+    folder, notes = said(tmp_path_factory, photos, "centroberyx", "transparent")   # the photo as rendered
     _quiet(notes, "at least half")
     path = folder / "photo.png"
 
