@@ -67,12 +67,23 @@ function allTextures(root) {
   return out;
 }
 
+// Loads under way: three.js's loaders (TextureLoader's ImageLoader among them) tell the default
+// LoadingManager when each starts and when it ends, loaded or failed; an image is handed to its
+// texture before its end is told.
+let pending = 0;
+const manager = THREE.DefaultLoadingManager;
+const itemStart = manager.itemStart, itemEnd = manager.itemEnd;
+manager.itemStart = (url) => { pending += 1; itemStart(url); };
+manager.itemEnd = (url) => { pending -= 1; itemEnd(url); };
+
 // MTLLoader/TextureLoader fill texture.image asynchronously: wait until every
-// texture has arrived (or give up, which the Python side reports as a failure).
+// texture has arrived, or every load has ended with one still missing (a 404), or
+// give up; the Python side reports a missing texture as a failure.
 async function texturesSettled(root) {
   const start = performance.now();
   while (performance.now() - start < TEXTURE_WAIT_MS) {
     if (allTextures(root).every((t) => t.image && t.image.width > 0)) return true;
+    if (pending === 0) return false;
     await new Promise((r) => setTimeout(r, 20));
   }
   return false;

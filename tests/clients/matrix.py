@@ -634,12 +634,16 @@ class HarnessPage(LocalBrowser):
         out += [f"outside request {u}" for u in self.outside]
         return out
 
-    def _clear(self) -> None:
-        """Forget what was recorded, once every request the page made has ended: a response that came
-        after the last check (a broken asset's 404, under load) would otherwise count against the next."""
+    def _settle(self) -> None:
+        """Wait (up to 10 s) until every request the page made has ended, its response recorded."""
         deadline = time.monotonic() + 10
         while self.inflight and time.monotonic() < deadline:
             self.page.wait_for_timeout(20)
+
+    def _clear(self) -> None:
+        """Forget what was recorded, once every request the page made has ended: a response that came
+        after the last check (a broken asset's 404, under load) would otherwise count against the next."""
+        self._settle()
         self.console.clear()
         self.requests.clear()
         self.outside.clear()
@@ -664,6 +668,7 @@ class ThreeClient(HarnessPage):
         if loader == "ply" and asset.fmt.kind == "cloud":  # what an app must ask for to keep them
             options = {"customProperties": {"radius": ["radius"], "density": ["density"]}}
         result = self.page.evaluate("([l, u, o]) => window.inspectAsset(l, u, o)", [loader, url, options])
+        self._settle()  # a texture's 404 may end the harness's wait for it before Playwright is told
         self.page.wait_for_timeout(50)  # let late console messages and responses land
         expect("error" not in result, f"loader error: {result.get('error')}")
         problems = self._problems()
