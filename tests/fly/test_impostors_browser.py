@@ -150,12 +150,9 @@ def redness(picture: np.ndarray, at) -> float:
 
 
 @pytest.mark.parametrize("scale", [0.5, 1.0])
-def test_a_glb_inside_a_cloud_is_hidden_by_the_particles_in_front_of_it_only(scale):
+def test_a_glb_inside_a_cloud_is_hidden_by_the_particles_in_front_of_it_only(table, scale):
     scene, _ = cube_files_scene([TABLE])
-    page, session = open_page(prepare_assets([TABLE])[0])
-    u = cloud(page)
-    page.close()
-    session.close()
+    u = cloud(table)                # where the page places Table 4.4 drawn alone, at its own scale
     c, r = np.array(u["centre"]), u["radius"]
     # the cloud is a card about 13 x 7 x 3: a box at its front face, one at its back, one in front of it all
     places = {"front": c + [-0.25 * r, 0, 1.2], "back": c + [0.25 * r, 0, -1.2],
@@ -180,12 +177,21 @@ def test_a_glb_inside_a_cloud_is_hidden_by_the_particles_in_front_of_it_only(sca
         session.close()
 
 
-def test_a_still_frame_with_impostors_matches_direct_drawing_on_ten_views_of_the_thick_sky():
+#: Of the ten seeded views of the thick sky (``sky_views(AREA, ALTITUDE, 10, seed=0)``), the four
+#: that show the most clouds as impostors (33-69 of 120; the others 5-30) and the one whose pictures
+#: differ most (SSIM 0.995, mean absolute difference 0.83; the others 0.18-0.82): measured with the
+#: ten, each a second of software GL.
+HARD_SKY_VIEWS = (0, 1, 3, 5, 6)
+
+
+def test_a_still_frame_with_impostors_matches_direct_drawing_on_the_hardest_views_of_the_thick_sky():
+    """The five hardest of ten seeded views from among its clouds (each a second of software GL)."""
     assets, _ = prepare_assets([], mode="thick")
     page, session = open_page(assets)
     try:
         shown = 0
-        for view in pictures.sky_views(AREA, ALTITUDE, 10, seed=0):
+        views = pictures.sky_views(AREA, ALTITUDE, 10, seed=0)
+        for view in (views[k] for k in HARD_SKY_VIEWS):
             direct, impostor, modes = pictures.both(page, view)
             shown += sum(m["mode"] == "impostor" for m in modes)
             assert pictures.ssim(direct, impostor) >= 0.95 and pictures.mean_abs(direct, impostor) <= 2.0
