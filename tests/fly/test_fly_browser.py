@@ -31,7 +31,7 @@ def thin_sky(tmp_path_factory):
 
 def test_a_cube_file_flown_headless_reports_its_particles_and_frames(tmp_path, cli):
     report = tmp_path / "r.json"
-    run = cli("fly", PARAMS / "clouds" / "table_4_4.awn", "--headless", "--timeout", "1", "--warmup", "0.5",
+    run = cli("fly", PARAMS / "clouds" / "table_4_4.awn", "--headless", "--timeout", "1", "--warmup", "0.1",
               "--report", report)
     assert run.returncode == 0, run.stderr
     r = json.loads(report.read_text())
@@ -74,7 +74,7 @@ def test_a_mode_alone_flies_a_sky_of_that_mode_and_reports_it_per_second_in_csv(
     """`fly --mode thin` with no file flies the thin sky (20,000 particles in 16 clouds); its CSV
     report has a row per second flown. (A sky's .glb is flown from a file below, in a page.)"""
     report = tmp_path / "r.csv"
-    run = cli("fly", "--mode", "thin", "--headless", "--timeout", "2", "--warmup", "0.5", "--size", "640x480",
+    run = cli("fly", "--mode", "thin", "--headless", "--timeout", "2", "--warmup", "0.1", "--size", "640x480",
               "--report", report)
     assert run.returncode == 0, run.stderr
     assert "20,000 particles in 16 clouds" in run.stdout, run.stdout
@@ -93,7 +93,7 @@ def test_a_texture_cloud_flies_with_its_billboards_drawn(tmp_path):
     from fishgen.fly.headless import run_headless
 
     assets, _ = prepare_assets([PARAMS / "clouds" / "sky.awa"])
-    session = FlySession(assets, FlyConfig(timeout=1, warmup=0.5, path="still", report=True))
+    session = FlySession(assets, FlyConfig(timeout=1, warmup=0.1, path="still", report=True))
     close_browser()  # fishgen's own Playwright runs in this thread now
     run_headless(session, screenshot=tmp_path / "fly.png")
     assert session.report["scene"]["billboards"] > 0 and session.report["frames"] > 0
@@ -144,7 +144,7 @@ def served_sky(thin_sky):
     """The thin sky served for interactive flights (no path: the keys steer), every cloud drawn
     directly (impostors: tests/fly/test_impostors_browser.py)."""
     assets, _ = prepare_assets([thin_sky[0]])
-    session = FlySession(assets, FlyConfig(size=(640, 480), warmup=0.5, impostors=False))
+    session = FlySession(assets, FlyConfig(size=(640, 480), warmup=0.1, impostors=False))
     session.serve_in_background()
     yield session
     session.close()
@@ -233,7 +233,7 @@ def test_with_a_timeout_the_page_reports_writes_the_file_and_stops_serving(tmp_p
     notes: list[str] = []
     lines: list[str] = []
 
-    options = FlyOptions(timeout=1.5, warmup=0.5, report=report)
+    options = FlyOptions(timeout=1.5, warmup=0.1, report=report)
     events = Events(note=notes.append, line=lambda text, _: lines.append(text))
     made = fly((thin_sky[0],), None, options, events)
     assert made.lines[0].startswith("http://127.0.0.1:") and made.written == ()
