@@ -282,26 +282,38 @@ class BabylonEngine:
 
 
 def godot_play(path: Path, clips: dict[str, np.ndarray], folder: Path,
-               compress: bool = True) -> dict[str, Played]:
+               compress: tuple[bool, ...] = (True,)) -> dict[bool, dict[str, Played]]:
     """Godot 3 (godot3-server): ``path`` imported into a fresh project under ``folder``, each clip played
     by its AnimationPlayer (engine/godot_engine.gd), and every surface posed with what Godot left:
     its imported blend shapes mixed by the player's weights as Godot's blend shape modes say, then
     skinned by the player's bone poses times the skin's binds (linear blend, as Godot's shader does).
     Godot's front faces are clockwise, so its triangles are turned back to glTF's order here.
-    ``compress``: the scene importer's `meshes/compress` (Godot's default, on: normals in bytes)."""
-    from tests.clients.godot import GODOT, _env, import_project, new_project
+    ``compress``: the scene importer's `meshes/compress` settings to play the file under (Godot's
+    default, on: normals in bytes), each a copy of the file with its own .import, all imported in one
+    run of Godot; the clips as played, by setting."""
+    from tests.clients.godot import GODOT, import_project, new_project
 
     if GODOT is None:
         raise RuntimeError("no godot3-server")
     project = new_project(folder, HERE / "godot_engine.gd", "fishgen_pose.gd")
-    shutil.copy(path, project / path.name)
-    if not compress:   # the import dock's Meshes > Compress, as its .import file keeps it
-        (project / f"{path.name}.import").write_text(
-            f'[remap]\n\nimporter="scene"\ntype="PackedScene"\n\n[deps]\n\nsource_file="res://{path.name}"\n\n'
-            '[params]\n\nmeshes/compress=false\n')
-    (project / "fishgen_pose.json").write_text(json.dumps(
-        {"file": f"res://{path.name}", "clips": {k: [float(t) for t in v] for k, v in clips.items()}}))
+    names = {c: f"{path.stem}{'' if c else '_uncompressed'}{path.suffix}" for c in compress}
+    for c, name in names.items():
+        shutil.copy(path, project / name)
+        if not c:   # the import dock's Meshes > Compress, as its .import file keeps it
+            (project / f"{name}.import").write_text(
+                f'[remap]\n\nimporter="scene"\ntype="PackedScene"\n\n[deps]\n\nsource_file="res://{name}"\n\n'
+                '[params]\n\nmeshes/compress=false\n')
     import_project(project, folder)
+    return {c: _godot_pose(project, folder, name, clips) for c, name in names.items()}
+
+
+def _godot_pose(project: Path, folder: Path, name: str, clips: dict[str, np.ndarray]) -> dict[str, Played]:
+    """res://``name`` (imported) played by engine/godot_engine.gd, each clip at its times."""
+    from tests.clients.godot import GODOT, _env
+
+    assert GODOT is not None
+    (project / "fishgen_pose.json").write_text(json.dumps(
+        {"file": f"res://{name}", "clips": {k: [float(t) for t in v] for k, v in clips.items()}}))
     run = subprocess.run([GODOT, "--path", str(project), "-s", "res://fishgen_pose.gd"],
                          capture_output=True, text=True, env=_env(folder), timeout=600)
     line = next((x for x in run.stdout.splitlines() if x.startswith("FISHGEN_POSE ")), None)
