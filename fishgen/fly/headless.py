@@ -119,7 +119,7 @@ def run_headless(session: FlySession, *, webgl: str = "swiftshader", chromium: s
                         raise FishgenError(f"expected the page to fly, found an error: {found}")
                     if time.monotonic() > limit:
                         raise SystemFailure(f"the page did not report within {allowed:.0f} s")
-                    page.wait_for_timeout(500)   # lets Playwright deliver the page's events; runs no script
+                    page.wait_for_timeout(100)   # lets Playwright deliver the page's events; runs no script
                 version = browser.version
                 if screenshot is not None:
                     from fishgen.atomic import write_bytes
