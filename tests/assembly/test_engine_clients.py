@@ -28,30 +28,44 @@ CLIPS = ("swim", "idle", "turn_left", "turn_right", "burst")
 NORMAL_LIMIT = 5.0
 
 
+@pytest.fixture(scope="module")
+def engine_folder(tmp_path_factory):
+    """Where both layouts of the fish are written (merged/fish.glb, parts/fish.glb): one page of each
+    browser client serves them both."""
+    return tmp_path_factory.mktemp("engine")
+
+
 @pytest.fixture(scope="module", params=[True, False], ids=["merged", "parts"])
-def fish(request, tmp_path_factory):
+def fish(request, engine_folder):
+    """The fish, and the folder of its fish.glb (under :func:`engine_folder`)."""
     made = make_fish(load_species(PARAMS / "bonybream.txt"), lods=LODS, merge=request.param, clips=CLIPS)
-    folder = tmp_path_factory.mktemp("engine")
+    folder = engine_folder / ("merged" if request.param else "parts")
+    folder.mkdir(exist_ok=True)
     export(made.scene, folder / "fish.glb")
     return made, folder
 
 
+def _file(fish) -> str:
+    """The fish's .glb as the browser clients ask for it (under :func:`engine_folder`)."""
+    return f"{fish[1].name}/fish.glb"
+
+
 @pytest.fixture(scope="module")
-def three(fish):
+def three(engine_folder):
     reason = three_unavailable()
     if reason:
         pytest.skip(reason)
-    client = ec.ThreeEngine(fish[1])
+    client = ec.ThreeEngine(engine_folder)
     yield client
     client.close()
 
 
 @pytest.fixture(scope="module")
-def babylon(fish):
+def babylon(engine_folder):
     reason = babylon_unavailable()
     if reason:
         pytest.skip(reason)
-    client = ec.BabylonEngine(fish[1])
+    client = ec.BabylonEngine(engine_folder)
     yield client
     client.close()
 
@@ -107,7 +121,7 @@ def test_three_js_plays_each_clip_as_fishgen_poses_it(fish, three, clip):
     probes = ec.probes(scene)
     times = _times(scene, clip)
     ours = ec.fishgen_play(scene, clip, times, probes.all())
-    theirs = three.play("fish.glb", clip, times, probes.all())
+    theirs = three.play(_file(fish), clip, times, probes.all())
     assert [c["name"] for c in three.last["clips"]] == list(CLIPS)
     assert len(theirs.meshes) == (2 if made.facts.merged else 9)            # the finest level only
     a, b = _measures(probes, ours.probes, times), _measures(probes, theirs.probes, times)
@@ -124,7 +138,7 @@ def test_bent_bodies_are_shaded_bent_in_three_js_and_in_fishgen(fish, three, cli
     times = _between_keys(made.scene, clip)
     worst = {}
     for who, played in (("fishgen", ec.fishgen_play(made.scene, clip, times, np.zeros((0, 3)))),
-                        ("three.js", three.play("fish.glb", clip, times, np.zeros((0, 3))))):
+                        ("three.js", three.play(_file(fish), clip, times, np.zeros((0, 3))))):
         worst.update({(who, name): v for name, v in ec.worst_normal_error(played).items()})
     print(clip, {k: f"{v:.2f}" for k, v in worst.items()})
     assert max(worst.values()) < NORMAL_LIMIT
@@ -134,7 +148,7 @@ def test_bent_bodies_are_shaded_bent_in_three_js_and_in_fishgen(fish, three, cli
 def test_babylon_js_shades_bent_bodies_bent(fish, babylon, clip):
     """Babylon's own CPU morphing and skinning of the finest level (getPositionData/getNormalsData)."""
     made, _ = fish
-    played = babylon.play("fish.glb", clip, _between_keys(made.scene, clip))
+    played = babylon.play(_file(fish), clip, _between_keys(made.scene, clip))
     assert len(played.meshes) == (2 if made.facts.merged else 9)
     worst = ec.worst_normal_error(played)
     print(clip, {k: f"{v:.2f}" for k, v in worst.items()})
