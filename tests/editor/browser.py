@@ -26,21 +26,36 @@ def chromium():
         close_browser()
 
 
+def serve_editor(file: Path, *args: str) -> tuple[subprocess.Popen, str]:
+    """`fishgen edit FILE --no-open --port 0 ARGS...` started: the process and the page's address."""
+    proc = subprocess.Popen([sys.executable, "-u", "-m", "fishgen", "edit", str(file), "--no-open",
+                             "--port", "0", *args], cwd=ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    lines: queue.Queue = queue.Queue()
+    threading.Thread(target=lambda: [lines.put(line) for line in proc.stdout], daemon=True).start()
+    try:
+        return proc, lines.get(timeout=60).strip()
+    except queue.Empty:
+        proc.kill()
+        raise RuntimeError(f"fishgen edit printed no address: {proc.stderr.read()}") from None
+
+
+def stop(proc: subprocess.Popen) -> None:
+    """End a :func:`serve_editor` process (killed if it has not ended 10 s after being asked)."""
+    proc.terminate()
+    try:
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
+
 class EditorPage:
     """`fishgen edit FILE --no-open --port 0 ARGS...` and its page, loaded and ready."""
 
     def __init__(self, browser, file: Path, *args: str, viewport=(1280, 800)):
         self.file = Path(file)
-        self.proc = subprocess.Popen([sys.executable, "-u", "-m", "fishgen", "edit", str(file), "--no-open",
-                                      "--port", "0", *args], cwd=ROOT, stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, text=True)
-        lines: queue.Queue = queue.Queue()
-        threading.Thread(target=lambda: [lines.put(line) for line in self.proc.stdout], daemon=True).start()
-        try:
-            self.url = lines.get(timeout=60).strip()
-        except queue.Empty:
-            self.proc.kill()
-            raise RuntimeError(f"fishgen edit printed no address: {self.proc.stderr.read()}") from None
+        self.proc, self.url = serve_editor(file, *args)
         self.errors: list[str] = []
         self.dialogs: list[str] = []
         self.page = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
@@ -76,9 +91,4 @@ class EditorPage:
         try:
             self.page.close()
         finally:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
+            stop(self.proc)

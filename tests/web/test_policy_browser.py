@@ -75,14 +75,14 @@ def test_the_fly_page_runs_under_its_policy_when_served():
 
 
 def test_the_editor_page_runs_under_its_policy_when_served():
-    from tests.editor.browser import EditorPage
+    from tests.editor.browser import serve_editor, stop
 
-    editor = EditorPage(shared_browser(), PARAMS / "clouds" / "table_4_4.awn")
+    proc, url = serve_editor(PARAMS / "clouds" / "table_4_4.awn")
     page = new_page()
     try:
-        page.goto(editor.url)
+        page.goto(url)
         check(page, "window.fishgenEditor && (fishgenEditor.ready || fishgenEditor.error)")
         assert page.evaluate("fishgenEditor.error") is None
     finally:
         page.close()
-        editor.close()
+        stop(proc)
