@@ -233,7 +233,7 @@ def test_with_a_timeout_the_page_reports_writes_the_file_and_stops_serving(tmp_p
     notes: list[str] = []
     lines: list[str] = []
 
-    options = FlyOptions(timeout=1.5, warmup=0.1, report=report)
+    options = FlyOptions(timeout=1, warmup=0.1, report=report)
     events = Events(note=notes.append, line=lambda text, _: lines.append(text))
     made = fly((thin_sky[0],), None, options, events)
     assert made.lines[0].startswith("http://127.0.0.1:") and made.written == ()
