@@ -77,11 +77,16 @@ def difference(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(a - b)[subject].mean())
 
 
-def pose(tab, t: float) -> np.ndarray:
-    """Show the clip at ``t`` seconds; the canvas as RGB."""
+def show(tab, t: float) -> None:
+    """Show the clip at ``t`` seconds, drawn."""
     tab.fill("#time", str(t))
     tab.dispatch_event("#time", "input")
     frames(tab, 3)
+
+
+def pose(tab, t: float) -> np.ndarray:
+    """Show the clip at ``t`` seconds; the canvas as RGB."""
+    show(tab, t)
     shot = tab.locator("#view").screenshot()
     return np.asarray(Image.open(io.BytesIO(shot)).convert("RGB"), np.float32)
 
@@ -91,7 +96,7 @@ def drawn(asset, query="", instancing=True) -> dict:
     counts, and its draw calls; the page showed no error."""
     tab, problems = open_view(asset, query, instancing)
     try:
-        pose(tab, 1.0)
+        show(tab, 1.0)
         state = tab.evaluate("({...window.fishgenViewer.instanced, counts: window.fishgenViewer.counts, "
                              "calls: window.fishgenViewer.calls})")
         assert problems == []
@@ -140,7 +145,7 @@ def test_fish_stand_where_the_files_tracks_put_them(schools):
     tab, _ = open_view(schools["small"])
     try:
         for t in (0.0, 1.7, 4.9):
-            pose(tab, t)
+            show(tab, t)
             (drawn,) = tab.evaluate("window.fishgenViewer.instances()")
             assert drawn["species"] == "bonybream" and len(drawn["fish"]) == 12
             expected = np.array([sample(moves[name], t) for name in drawn["fish"]])
