@@ -35,7 +35,7 @@ def check(page, loaded: str) -> None:
     deadline = time.monotonic() + LOAD_MS / 1000
     while not page.evaluate(loaded):
         assert time.monotonic() < deadline, f"not loaded: {loaded}"
-        page.wait_for_timeout(100)
+        page.wait_for_timeout(25)
     page.evaluate("() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
     assert page.evaluate("window.violations") == []
     assert page.evaluate(INJECT) is False
