@@ -435,6 +435,10 @@ state.view = () => camera;
 state.setSun = ( direction ) => { cloudUniforms.cloudSun.value.fromArray( direction ).normalize(); };
 // The picture drawn now, as a PNG data URL (drawn again and read in one task, so it is whole).
 state.capture = () => { resize(); update(); draw(); return canvas.toDataURL( 'image/png' ); };
+// Hold the page's own loop (true) or let it run again: a test or benchmarks/fly.py's pictures that
+// draws each frame with capture() keeps the software renderer from drawing the scene again meanwhile.
+let held = false;
+state.hold = ( on ) => { held = !! on; };
 
 // -- moving: Pakawan's keys, the mouse, or a seeded path ----------------------------------------
 const keys = new Set();
@@ -557,6 +561,7 @@ const frames = [];   // [ms since measuring began, frame interval ms, particles,
 let hudAt = 0;
 
 function frame() {
+	if ( held ) { last = null; requestAnimationFrame( frame ); return; }
 	const now = performance.now();
 	if ( started === null ) started = now;
 	const dt = last === null ? 0 : Math.min( 0.1, ( now - last ) / 1000 );
