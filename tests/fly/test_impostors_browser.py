@@ -23,12 +23,14 @@ SIZE = (640, 480)
 
 
 def open_page(assets, **config):
-    """A still page of ``assets`` in the shared Chromium, loaded: (page, session)."""
+    """A still page of ``assets`` in the shared Chromium, loaded, its own loop held (each frame a test
+    looks at is drawn by ``capture``): (page, session)."""
     session = FlySession(assets, FlyConfig(size=SIZE, warmup=0.1, path="still", **config))
     session.serve_in_background()
     page = shared_browser().new_page(viewport={"width": SIZE[0], "height": SIZE[1]})
     page.goto(session.url())
     page.wait_for_function("window.fishgenFly.loaded", timeout=180_000)
+    page.evaluate("window.fishgenFly.hold(true)")
     return page, session
 
 
