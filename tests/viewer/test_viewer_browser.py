@@ -120,20 +120,6 @@ def test_fish_loads_plays_scrubs_and_toggles_wireframe(browser, served, viewer_a
         page.close()
 
 
-def test_cloud_shows_its_particles(browser, served, viewer_assets):
-    page, problems, requests = _open(browser, served(viewer_assets["cloud"]))
-    try:
-        state = page.evaluate("window.fishgenViewer")
-        assert state["counts"] == {"vertices": 0, "triangles": 0, "particles": viewer_assets["particles"]}
-        assert state["clips"] == [] and page.locator("#play").is_disabled()
-        frames(page)
-        _assert_not_blank(_canvas(page))
-        assert problems == []
-        _assert_offline(requests)
-    finally:
-        page.close()
-
-
 @pytest.fixture(scope="module")
 def cli_clouds(tmp_path_factory):
     """Table 4.4 through the real `fishgen clouds`, as points and as billboards, with the count it prints."""
@@ -148,14 +134,16 @@ def cli_clouds(tmp_path_factory):
 
 
 @pytest.mark.parametrize("form", ["billboards", "points"])
-def test_cloud_from_the_cli_shows_the_particle_count_it_printed(browser, served, cli_clouds, form):
-    # A billboard cloud is a mesh of one textured quad per particle: its quads are the particles.
+def test_cloud_from_the_cli_shows_its_particles_and_the_count_it_printed(browser, served, cli_clouds, form):
+    """The cloud drawn, its particles counted as `fishgen clouds` printed them, and no clip to play.
+    A billboard cloud is a mesh of one textured quad per particle: its quads are the particles."""
     asset, particles = cli_clouds[form]
     assert particles > 0
     page, problems, requests = _open(browser, served(asset))
     try:
         expected = {"vertices": 0, "triangles": 0, "particles": particles}
         assert page.evaluate("window.fishgenViewer.counts") == expected
+        assert page.evaluate("window.fishgenViewer.clips") == [] and page.locator("#play").is_disabled()
         assert page.locator("#counts").inner_text() == f"0 vertices · 0 triangles · {particles} particles"
         frames(page)
         _assert_not_blank(_canvas(page))
