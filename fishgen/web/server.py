@@ -90,6 +90,10 @@ class Refused(Exception):
 Route = Callable[[Request], Response]
 
 
+POLL = 0.05
+"""Seconds between a serving loop's looks for a shutdown: a wake-up at 20 Hz costs nothing measurable."""
+
+
 class LocalServer(ThreadingHTTPServer):
     """Loopback, Host-checked, token-checked routes: ``{("GET", "/"): page, ("POST", "/api/save"): save}``."""
 
@@ -108,6 +112,11 @@ class LocalServer(ThreadingHTTPServer):
 
     def handle_error(self, request, client_address) -> None:  # a dropped client is not news
         pass
+
+    def serve_forever(self, poll_interval: float = POLL) -> None:
+        """Serve until :meth:`shutdown`, which returns within ``poll_interval`` (http.server's 0.5 s
+        was how late a fly-through's report stopped its server, and each served test ended)."""
+        super().serve_forever(poll_interval)
 
     @property
     def port(self) -> int:
