@@ -17,6 +17,7 @@ from __future__ import annotations
 import hmac
 import json
 import secrets
+import socket
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -37,6 +38,9 @@ server from 175 to 626 MB)."""
 QUEUE = 64
 """Connections the kernel holds for the server to accept (http.server's 5 made a burst of page
 requests wait for SYN retries of a second each)."""
+READ_DEADLINE = 60.0
+"""Seconds a request may take to arrive whole: TIMEOUT bounds each read, so a client trickling a
+byte every few seconds held a thread for ever."""
 
 
 @dataclass(frozen=True)
@@ -108,6 +112,7 @@ class LocalServer(ThreadingHTTPServer):
         self.token = token or secrets.token_urlsafe(24)
         self.in_flight = threading.BoundedSemaphore(MAX_IN_FLIGHT)
         self.bugs: list[BaseException] = []   # errors answered with a 500, the last few (for a harness)
+        self.read_deadline = READ_DEADLINE
         super().__init__((HOST, port), _Handler)
 
     def handle_error(self, request, client_address) -> None:  # a dropped client is not news
@@ -140,6 +145,20 @@ class _Handler(BaseHTTPRequestHandler):
     def setup(self) -> None:
         super().setup()
         self.connection.settimeout(self.server.timeout_seconds)  # a slow sender is cut off
+        # and a trickling one: past the deadline its reads end, and what it sent is refused as short
+        self._deadline = threading.Timer(self.server.read_deadline, self._stop_reading)
+        self._deadline.daemon = True
+        self._deadline.start()
+
+    def _stop_reading(self) -> None:
+        try:
+            self.connection.shutdown(socket.SHUT_RD)
+        except OSError:   # already closed
+            pass
+
+    def finish(self) -> None:
+        self._deadline.cancel()
+        super().finish()
 
     def log_message(self, format, *args):  # one line per request would bury the URL
         pass
@@ -244,4 +263,9 @@ class _Handler(BaseHTTPRequestHandler):
         if size > self.server.max_body:
             raise Refused(HTTPStatus.REQUEST_ENTITY_TOO_LARGE,
                           f"expected a body of at most {self.server.max_body:,} bytes, found {size:,}")
-        return self.rfile.read(size)
+        body = self.rfile.read(size)
+        self._deadline.cancel()
+        if len(body) < size:
+            raise Refused(HTTPStatus.BAD_REQUEST, f"expected a body of {size:,} bytes, found {len(body):,} "
+                          "before the request's time ran out")
+        return body

@@ -117,6 +117,31 @@ def test_a_slow_client_is_cut_off(server):
     assert ask(server, token=server.token)[0] == 200  # and the server goes on
 
 
+def test_a_client_trickling_its_request_is_cut_off_at_the_deadline(server):
+    """Each read within the time-out, the request never whole: its reads end at the deadline."""
+    server.read_deadline = 1.0
+    request = f"GET /?token={server.token} HTTP/1.1\r\nHost: 127.0.0.1:{server.port}\r\nX-Slow: ".encode()
+    with socket.create_connection(("127.0.0.1", server.port)) as sock:
+        sock.settimeout(0.05)
+        start = time.monotonic()
+        answer = b""
+        for byte in request + b"a" * 100:
+            try:
+                sock.sendall(bytes([byte]))
+                answer += sock.recv(1000)
+            except TimeoutError:
+                continue
+            except OSError:        # reset: the server has gone from this connection
+                break
+            if time.monotonic() - start > 8 or (answer and not answer.startswith(b"HTTP/1.0 200")):
+                break
+            time.sleep(0.25)       # within the 1 s time-out of each read
+        took = time.monotonic() - start
+    assert took < 4, f"still connected after {took:.1f} s"
+    assert not answer.startswith(b"HTTP/1.0 200")
+    assert ask(server, token=server.token)[0] == 200  # and the server goes on
+
+
 def test_an_integer_past_pythons_digit_limit_is_a_400_not_a_dropped_connection(server):
     """Python's int-digit limit raises a plain ValueError, which the JSON check let through: the
     connection closed with no answer (QA pass 15)."""
