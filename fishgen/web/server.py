@@ -7,9 +7,8 @@
   ``X-Fishgen-Token`` header that the pages' own requests send), compared in constant time: another
   local user's or another site's guess is refused.
 - Request bodies are capped before they are read, at most MAX_IN_FLIGHT are taken at once (a
-  busy server answers 503), and a client that sends nothing for TIMEOUT seconds is cut off (one
-  that trickles a byte at a time is not: it holds a thread, which idles, and the pending
-  connections queue behind QUEUE).
+  busy server answers 503), and a client that sends nothing for TIMEOUT seconds, or has not sent
+  its whole request in READ_DEADLINE, is cut off; pending connections queue behind QUEUE.
 - It serves only the routes a command gives it: no folder, no directory listing, no file by name.
 """
 from __future__ import annotations
