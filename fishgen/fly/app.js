@@ -435,8 +435,8 @@ state.view = () => camera;
 state.setSun = ( direction ) => { cloudUniforms.cloudSun.value.fromArray( direction ).normalize(); };
 // The picture drawn now, as a PNG data URL (drawn again and read in one task, so it is whole).
 state.capture = () => { resize(); update(); draw(); return canvas.toDataURL( 'image/png' ); };
-// Hold the page's own loop (true) or let it run again: a test or benchmarks/fly.py's pictures that
-// draws each frame with capture() keeps the software renderer from drawing the scene again meanwhile.
+// Hold the page's own loop (true) or let it run again: a caller that draws each frame it reads with
+// capture() (the tests' impostor pages) keeps the software renderer from drawing the scene meanwhile.
 let held = false;
 state.hold = ( on ) => { held = !! on; };
 

@@ -122,7 +122,8 @@ def test_fixtures_folder_is_small():
 def test_focal_length_fits_for_the_photo_s_perspective(gl_available, fitted):
     """A 50 mm photo fitted told its focal length: the fish from the photo's camera is no less like
     the photo than a fit that assumed no perspective (the two fits the next test reads; 0.940 and
-    0.924 measured). That the same inputs write the same bytes is held by the test after it."""
+    0.924 measured). That the same inputs write the same bytes is held by
+    test_a_fit_that_leans_on_the_faint_edges_and_faded_pixels_together_is_said_so."""
     rec = bp.fixture_records()["long"]
     assert rec["shot"]["lens"] == 50.0
     told = fitted("long", "bonybream").row
@@ -190,6 +191,7 @@ def test_a_fit_that_leans_on_the_faint_edges_and_faded_pixels_together_is_said_s
         hold more of its outline."""
         return real(candidate, mask, render) - (lower if np.array_equal(mask, bare) else 0.0)
 
+    unpatched = fitted("long", "bonybream")   # the module's shared fit, made (if not yet) before the patch
     monkeypatch.setattr(run_module, "_iou_with", iou_with)
     notes: list[str] = []
     result = make_texture(rec["photo"], base, tmp_path / "bonybream.txt", options, notes.append)
@@ -198,7 +200,6 @@ def test_a_fit_that_leans_on_the_faint_edges_and_faded_pixels_together_is_said_s
     assert len(said) == 1 and "\n" not in said[0], notes
     assert said[0].startswith(f"silhouette IoU {result.iou:.3f}, but 0."), said
     assert "give --mask" in said[0], said
-    unpatched = fitted("long", "bonybream")
     assert not any(n.startswith("needs --mask") for n in unpatched.row.notes), unpatched.row.notes
     for name in ("bonybream.txt", "bonybream.png", "bonybream_mask.png"):
         assert (tmp_path / name).read_bytes() == unpatched.out.with_name(name).read_bytes(), name

@@ -137,7 +137,8 @@ def test_large_photo_is_measured_on_a_smaller_copy(tmp_path, gl_available):
 def test_a_fish_that_matches_only_without_its_faint_edges_is_said_so(tmp_path, tmp_path_factory, gl_available,
                                                                      photos, monkeypatch):
     """Where the photo's faint edges (thin fin tips the silhouette left out) would take the rebuilt
-    fish under 0.85, the command says so in one line with both figures; with none, it is silent."""
+    fish under 0.85, the command says so in one line with both figures; where they would not, it is
+    silent."""
     from fishgen.authoring.photo import silhouette as sil
 
     # the plain round trip above: Centroberyx's translucent fins over a backdrop leave faint edges
@@ -253,7 +254,13 @@ def test_half_coverage_counts_a_masked_tip_as_blender_does(gl_available):
     Blender did, and the multisampled render at half coverage does not."""
     from PIL import Image
 
-    from fishgen.authoring.photo.compare import HALF_ALPHA, SAMPLE_GRIDS, half_covered, render_side
+    from fishgen.authoring.photo.compare import (
+        HALF_ALPHA,
+        SAMPLE_GRIDS,
+        half_covered,
+        half_covered_grids,
+        render_side,
+    )
 
     folder = Path(__file__).resolve().parents[1] / "fixtures" / "blender_fits"
     species = load_species(folder / "bonybream.txt")
@@ -263,6 +270,12 @@ def test_half_coverage_counts_a_masked_tip_as_blender_does(gl_available):
     assert silhouette_iou(blender, multisampled) < 0.96
     for grid in SAMPLE_GRIDS:
         assert silhouette_iou(blender, half_covered(species, 640, 360, distance, grid)) > 0.98, grid
+    # the command draws every grid with one renderer, the coarser in a corner of the finer one's frame:
+    # the same masks, bit for bit, as a renderer of each grid's own size
+    for grids in (SAMPLE_GRIDS, SAMPLE_GRIDS[::-1]):
+        together = half_covered_grids(species, 640, 360, distance, grids)
+        assert all(np.array_equal(mask, half_covered(species, 640, 360, distance, grid))
+                   for mask, grid in zip(together, grids, strict=True)), grids
 
 
 def test_a_thin_thread_of_the_outline_stays_in_the_mask_texture():

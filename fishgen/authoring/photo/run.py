@@ -358,7 +358,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         from fishgen.authoring.photo.compare import HALF_ALPHA, silhouette_iou
 
         # at half coverage by the multisampled render, and by one that alpha-tests every sample
-        # (compare.half_covered) at two grids of samples: the worst, since any of them may be
+        # (compare.half_covered_grids) at two grids of samples: the worst, since any of them may be
         # another renderer's (1502 on BonyBream: 0.882, 0.846; Blender 0.847)
         faded = min(silhouette_iou(chosen.measured.frame_mask, shown[0][:, :, 3] >= HALF_ALPHA),
                     *_half_covered_ious(photo, chosen, out, distance))
