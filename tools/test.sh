@@ -21,7 +21,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ]; then
     echo "installing system packages: ${missing[*]}"
     { apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
-        apt-get install -y -qq --no-install-recommends "${missing[@]}"; } >"$logs/apt" 2>&1 &
+        apt-get install -y -qq --no-install-recommends "${missing[@]}"; } >/dev/null 2>"$logs/apt" &
     apt_pid=$!
   else
     echo "warning: missing system packages (${missing[*]}); run as root or install them" >&2
@@ -34,11 +34,18 @@ fi
 unset PYTHONDONTWRITEBYTECODE
 python -m pip install -q --disable-pip-version-check -e ".[test]" >"$logs/pip" 2>&1 &
 pip_pid=$!
-npm ci --no-audit --no-fund --loglevel=error
-wait "$pip_pid" || { cat "$logs/pip" >&2; echo "tools/test.sh: pip install failed" >&2; exit 1; }
-cat "$logs/pip"
+# every install is waited for, whichever fails, so none is left running and each says what it said
+failed=()
+npm ci --no-audit --no-fund --loglevel=error || failed+=(npm)
+wait "$pip_pid" || failed+=(pip)
+cat "$logs/pip" >&2
 if [ -n "$apt_pid" ]; then
-  wait "$apt_pid" || { cat "$logs/apt" >&2; echo "tools/test.sh: apt-get install failed" >&2; exit 1; }
+  wait "$apt_pid" || failed+=(apt-get)
+  cat "$logs/apt" >&2
+fi
+if [ ${#failed[@]} -gt 0 ]; then
+  echo "tools/test.sh: the install failed: ${failed[*]}" >&2
+  exit 1
 fi
 # The whole suite, lint, types and the core-install smoke test included (tests/test_house.py), on
 # every core (pytest-xdist; tests sharing a built asset, a browser page or a server stay on one

@@ -192,7 +192,7 @@ print(sorted(m for m in set(sys.modules) - before if m.split(".")[0] in ("fishge
 
 #: Builds in the interrupted batches: enough that a run is still going when its fifth record is
 #: written (about 25 a second on 2 cores), few enough that the run finishing it stays short.
-MANY = 48
+MANY = 64
 
 
 def many_builds(shipped, count: int = MANY):
