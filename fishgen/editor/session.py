@@ -144,7 +144,7 @@ class Session:
                               "on disk since (by another program); open it again, or save under another name")
             write_bytes(path, data)
         return Response.of_json({"saved": name, "particles": parsed.total, "cubes": len(parsed.cubes),
-                                 "bytes": len(data), "stamp": hashlib.sha256(data).hexdigest(),
+                                 "bytes": len(data), "stamp": _digest(data),
                                  **self._lists(path)})
 
     def fill(self, request: Request) -> Response:
@@ -207,11 +207,16 @@ def fill_glb(cube_file: CubeFile, mode: str, seed: int, lighting: Lighting) -> t
 
 
 def _stamp(path: Path) -> str | None:
-    """The SHA-256 of the file's bytes, or None where there is none."""
+    """The file's :func:`_digest`, or None where there is none."""
     try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
+        return _digest(path.read_bytes())
     except (FileNotFoundError, NotADirectoryError):
         return None
+
+
+def _digest(data: bytes) -> str:
+    """What the page sends back with a save: the SHA-256 of the bytes it read or last wrote."""
+    return hashlib.sha256(data).hexdigest()
 
 
 def _shown(folder: Path) -> str:

@@ -265,6 +265,5 @@ class _Handler(BaseHTTPRequestHandler):
         body = self.rfile.read(size)
         self._deadline.cancel()
         if len(body) < size:
-            raise Refused(HTTPStatus.BAD_REQUEST, f"expected a body of {size:,} bytes, found {len(body):,} "
-                          "before the request's time ran out")
+            raise Refused(HTTPStatus.BAD_REQUEST, f"expected a body of {size:,} bytes, found {len(body):,}")
         return body
