@@ -21,7 +21,7 @@ weighted sums by ``np.bincount``.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -35,19 +35,60 @@ TOLERANCE = 0.04
 
 def coarsen(cloud: Cloud, ratio: float) -> Cloud:
     """``cloud`` with about ``len(cloud) / ratio`` particles (at least 1), merged by grid cell."""
+    merged = merge_particles(cloud.centers, cloud.radii, cloud.density, ratio, _texture_group(cloud))
+    if merged is None:
+        return cloud
+    light = None
+    colors = cloud.colors[merged.first]
+    if cloud.light is not None and cloud.lighting is not None:
+        from fishgen.clouds.light import lit_colors
+
+        light = merged.mean(cloud.light).astype(np.float32)
+        colors = lit_colors(light, cloud.lighting)
+    return replace(cloud, centers=merged.centers, radii=merged.radii, density=merged.density,
+                   colors=colors, cube_index=cloud.cube_index[merged.first], light=light)
+
+
+@dataclass(frozen=True)
+class Merged:
+    """Particles merged by grid cell: what each merged particle keeps (float32), each cell's first
+    particle (``first``, for what is taken, not averaged) and the cell of each input particle."""
+
+    centers: np.ndarray
+    radii: np.ndarray
+    density: np.ndarray
+    first: np.ndarray
+    inverse: np.ndarray
+    mass: np.ndarray       # per input particle: density x radius^2, the weight of its values
+    weight: np.ndarray     # per merged particle: its mass, 1 where it is 0 (a safe divisor)
+    spread: np.ndarray     # per merged particle: its positions' variance per axis over their mean
+                           # sprite width squared; under 1 they overlapped, far over it lay apart
+
+    def mean(self, values: np.ndarray) -> np.ndarray:
+        """Per merged particle, the mass-weighted mean of ``values`` (one row per input particle;
+        float64)."""
+        count = len(self.weight)
+        if values.ndim == 1:
+            return np.bincount(self.inverse, self.mass * values, minlength=count) / self.weight
+        return np.stack([self.mean(values[:, k]) for k in range(values.shape[1])], axis=1)
+
+
+def merge_particles(centers: np.ndarray, radii: np.ndarray, density: np.ndarray, ratio: float,
+                    group: np.ndarray | None = None) -> Merged | None:
+    """About ``len(centers) / ratio`` particles (at least 1) merged by grid cell from these (only
+    particles of one ``group`` share a cell); None when that would merge nothing."""
     if not ratio >= 1:
         raise ValueError(f"ratio must be 1 or more, not {ratio}")
-    n = len(cloud)
+    n = len(centers)
     target = max(1, int(round(n / ratio)))
     if n == 0 or target >= n:
-        return cloud
-    columns = [np.ascontiguousarray(cloud.centers[:, k], np.float64) for k in range(3)]
-    group = _texture_group(cloud)
+        return None
+    columns = [np.ascontiguousarray(centers[:, k], np.float64) for k in range(3)]
     lo = np.array([c.min() for c in columns])
     span = np.array([c.max() for c in columns]) - lo
     extent = float(span.max())
     if not extent > 0:  # every particle at one point: one particle
-        return _merge(cloud, columns, np.zeros(n, np.intp), 1, np.zeros(1, np.intp))
+        return _merge(columns, radii, density, np.zeros(n, np.intp), 1, np.zeros(1, np.intp))
     # the occupied cells fall as the cell grows, about as its size to a power between -3 (a solid
     # cloud) and -1 (a sheet): secant steps on log(count) against log(cell), from a solid guess
     cell = float(np.prod(np.maximum(span, extent * 1e-3)) / target) ** (1 / 3)
@@ -67,7 +108,7 @@ def coarsen(cloud: Cloud, ratio: float) -> Cloud:
         cell *= (target / count) ** (1 / slope)
     assert best is not None
     inverse, count, first = best
-    return _merge(cloud, columns, inverse, count, first)
+    return _merge(columns, radii, density, inverse, count, first)
 
 
 def _texture_group(cloud: Cloud) -> np.ndarray | None:
@@ -96,10 +137,10 @@ def _cells(columns: list[np.ndarray], lo: np.ndarray, span: np.ndarray, cell: fl
     return inverse.ravel(), len(unique), first
 
 
-def _merge(cloud: Cloud, columns: list[np.ndarray], inverse: np.ndarray, count: int,
-           first: np.ndarray) -> Cloud:
-    r = cloud.radii.astype(np.float64)
-    mass = cloud.density.astype(np.float64) * r * r
+def _merge(columns: list[np.ndarray], radii: np.ndarray, density: np.ndarray, inverse: np.ndarray,
+           count: int, first: np.ndarray) -> Merged:
+    r = radii.astype(np.float64)
+    mass = density.astype(np.float64) * r * r
     weight = np.bincount(inverse, mass, minlength=count)
     safe = np.where(weight > 0, weight, 1.0)
     mean = [np.bincount(inverse, mass * c, minlength=count) / safe for c in columns]
@@ -108,14 +149,8 @@ def _merge(cloud: Cloud, columns: list[np.ndarray], inverse: np.ndarray, count: 
     variance = np.maximum(spread, 0) / 3             # per axis
     width2 = np.bincount(inverse, mass * (SIGMA * r) ** 2, minlength=count) / safe
     radius = np.sqrt(width2 + variance) / SIGMA
-    density = np.minimum(1.0, weight / np.maximum(radius * radius, np.finfo(np.float64).tiny))
-    light = None
-    colors = cloud.colors[first]
-    if cloud.light is not None and cloud.lighting is not None:
-        from fishgen.clouds.light import lit_colors
-
-        light = (np.bincount(inverse, mass * cloud.light, minlength=count) / safe).astype(np.float32)
-        colors = lit_colors(light, cloud.lighting)
-    return replace(cloud, centers=np.stack(mean, axis=1).astype(np.float32), radii=radius.astype(np.float32),
-                   density=np.maximum(density, np.finfo(np.float32).tiny).astype(np.float32),
-                   colors=colors, cube_index=cloud.cube_index[first], light=light)
+    merged = np.minimum(1.0, weight / np.maximum(radius * radius, np.finfo(np.float64).tiny))
+    return Merged(centers=np.stack(mean, axis=1).astype(np.float32), radii=radius.astype(np.float32),
+                  density=np.maximum(merged, np.finfo(np.float32).tiny).astype(np.float32),
+                  first=first, inverse=inverse, mass=mass, weight=safe,
+                  spread=variance / np.maximum(width2, np.finfo(np.float64).tiny))

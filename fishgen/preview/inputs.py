@@ -7,7 +7,7 @@ from typing import Any
 
 from fishgen.errors import FishgenError
 from fishgen.exchange.registry import formats, input_format
-from fishgen.scene.model import Scene
+from fishgen.scene.model import Primitive, Scene
 
 
 def input_formats():
@@ -32,29 +32,107 @@ def load_input(path: str | os.PathLike, *, textures_dir: str | os.PathLike | Non
 
 
 def thin_particles(scene: Scene, most: int | None = None) -> str | None:
-    """Keep at most ``most`` (``PREVIEW_PARTICLES``) of the scene's particles, every k-th of each
-    point set, as a cube file is filled with at most that many: a 10^7-particle PLY drawn whole took
-    over 8 minutes of CPU and 4.4 GB. The kept ones keep their size (widened to cover as much of the
-    picture, they cost as much to draw as all of them). Returns what the preview then says, or None."""
+    """Draw at most ``most`` (``PREVIEW_PARTICLES``) of the scene's particles: a 10^7-particle PLY
+    drawn whole took over 8 minutes of CPU and 4.4 GB. Each drawn point set is merged by grid cell
+    as a cloud's lower level of detail is (``fishgen.clouds.lod``): fewer, wider particles that
+    keep its cover, optical mass, light and colour, so the picture looks like the whole. Keeping
+    every k-th particle instead let the eye through to the grey inside of a dense cloud: a thick
+    sky came out 28-64 sRGB levels darker than drawn whole (docs/decisions.md). A set that moves
+    (morph targets, a skin) keeps every k-th particle. Returns what the preview then says, or None."""
+    from fishgen.clouds.lod import TOLERANCE
+    from fishgen.clouds.pipeline import PREVIEW_PARTICLES
+
+    most = PREVIEW_PARTICLES if most is None else most
+    drawn = [prim for _, prim in scene.drawn() if prim.mode == "POINTS"]
+    total = sum(prim.vertex_count for prim in drawn)
+    if total <= most:
+        return None
+    # a few % under the cap: a merge lands within its tolerance of the count asked for
+    ratio = total / most * (1 + TOLERANCE)
+    step = -(-total // most)
+    ids = {id(prim) for prim in drawn}
+    thinned: dict[int, Primitive] = {}
+    for mesh in scene.meshes:
+        for k, prim in enumerate(mesh.primitives):
+            if id(prim) in ids:
+                if id(prim) not in thinned:
+                    thinned[id(prim)] = _merged(prim, ratio) or _every(prim, step)
+                mesh.primitives[k] = thinned[id(prim)]
+    kept = sum(thinned[id(prim)].vertex_count for prim in drawn)
+    return f"previewing its {total:,} particles as {kept:,}"
+
+
+def _every(prim: Primitive, step: int) -> Primitive:
+    """Every ``step``-th particle, each at its own size; copies, not views, so the whole set is let go
+    (260 MB at 10^7)."""
     from dataclasses import replace
 
     import numpy as np
 
-    from fishgen.clouds.pipeline import PREVIEW_PARTICLES
+    attributes = {name: np.ascontiguousarray(values[::step]) for name, values in prim.attributes.items()}
+    targets = [{name: np.ascontiguousarray(v[::step]) for name, v in t.items()} for t in prim.targets]
+    return replace(prim, attributes=attributes, targets=targets)
 
-    most = PREVIEW_PARTICLES if most is None else most
-    sets = [(mesh, k) for mesh in scene.meshes for k, prim in enumerate(mesh.primitives)
-            if prim.mode == "POINTS"]
-    total = sum(mesh.primitives[k].vertex_count for mesh, k in sets)
-    if total <= most:
+
+SAMPLED = 8
+"""A set is merged from at most this many times the particles it is merged into."""
+MERGES = 4
+"""Most merges of one set: each further one (a lower level of the one before) shrinks what it draws."""
+APART = 1.0
+"""A cell whose particles lie farther apart than this (``Merged.spread``) keeps its first particle as
+it is: merging dots that do not overlap would draw one wide blob over the gaps between them."""
+
+
+def _merged(prim: Primitive, ratio: float) -> Primitive | None:
+    """The set merged by grid cell into about ``vertex_count / ratio`` particles, or None for a set
+    that moves. Where a cell's particles overlap they become one (as a cloud's lower level: light and
+    colour are weighted means, other data its first particle's); where they lie apart its first
+    particle stands for them, as every k-th would. Merged again while it draws more than every k-th
+    particle would."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    from fishgen.clouds.lod import TOLERANCE, merge_particles
+    from fishgen.numeric import to_linear_float
+    from fishgen.preview.render import point_radii
+
+    a = prim.attributes
+    if prim.targets or "JOINTS_0" in a or "WEIGHTS_0" in a:
         return None
-    step = -(-total // most)
-    kept = 0
-    for mesh, k in sets:
-        prim = mesh.primitives[k]
-        # copies, not views: the whole set is let go (260 MB at 10^7)
-        attributes = {name: np.ascontiguousarray(values[::step]) for name, values in prim.attributes.items()}
-        targets = [{name: np.ascontiguousarray(v[::step]) for name, v in t.items()} for t in prim.targets]
-        mesh.primitives[k] = replace(prim, attributes=attributes, targets=targets)
-        kept += mesh.primitives[k].vertex_count
-    return f"previewing {kept:,} of its {total:,} particles"
+    tiny = np.finfo(np.float32).tiny
+    radii = np.maximum(point_radii(prim), tiny)
+    density = (np.ones(prim.vertex_count, np.float32) if "_DENSITY" not in a else
+               np.clip(np.nan_to_num(np.asarray(a["_DENSITY"], np.float32).ravel()), tiny, 1))
+    # what every k-th particle would draw: a CPU draws pixels, and merged particles are wider
+    budget = float(np.square(radii, dtype=np.float64).sum()) / ratio
+    # a huge set is merged from an even sample of it (sorting 10^7 cell keys took 6 s), each sampled
+    # particle standing for k: its optical mass (density x radius^2) counted k times
+    k = max(1, int(ratio // SAMPLED))
+    values: dict[str, np.ndarray] = {name: v[::k] for name, v in a.items()}
+    values.update(POSITION=np.asarray(a["POSITION"][::k], np.float32), _RADIUS=radii[::k],
+                  _DENSITY=density[::k])
+    if "COLOR_0" in values:
+        values["COLOR_0"] = to_linear_float(values["COLOR_0"])
+    if "_LIGHT" in values:
+        values["_LIGHT"] = np.clip(np.nan_to_num(np.asarray(values["_LIGHT"], np.float32).ravel()), 0, 1)
+    stands = np.full(len(values["POSITION"]), np.float32(k))
+    step = ratio / k
+    for _ in range(MERGES):
+        merged = merge_particles(values["POSITION"], values["_RADIUS"], values["_DENSITY"] * stands,
+                                 max(1.0, step))
+        if merged is None:
+            break
+        apart = merged.spread > APART
+        kept = {name: v[merged.first] for name, v in values.items()}
+        made = {name: merged.mean(v).astype(np.float32) for name, v in values.items()
+                if name in ("COLOR_0", "_LIGHT")}
+        made.update(POSITION=merged.centers, _RADIUS=merged.radii, _DENSITY=merged.density)
+        values = {name: np.where(apart.reshape(-1, *([1] * (v.ndim - 1))), v, made.get(name, v))
+                  for name, v in kept.items()}
+        stands = np.ones(len(apart), np.float32)  # what was sampled is merged or kept alone now
+        # merged again, as a cloud's next lower level is, until it draws no more than the budget
+        step = float(np.square(values["_RADIUS"], dtype=np.float64).sum()) / budget * (1 + TOLERANCE)
+        if step <= 1 + TOLERANCE:
+            break
+    return replace(prim, attributes={name: np.ascontiguousarray(v) for name, v in values.items()})

@@ -487,12 +487,7 @@ def particles(scene: Scene, node: int, prim: Primitive,
     centers, _ = deformed(scene, node, prim, posed)
     m = posed.matrix(node)
     a = prim.attributes
-    if "_RADIUS" in a:
-        radii = np.asarray(a["_RADIUS"], np.float32).ravel()
-    else:
-        span = np.ptp(prim.positions, axis=0) if prim.vertex_count else np.ones(3)
-        radii = np.full(prim.vertex_count, POINT_SIZE_FRACTION * float(np.linalg.norm(span)), np.float32)
-    radii = radii * float(np.cbrt(abs(np.linalg.det(m[:3, :3]))))
+    radii = point_radii(prim) * float(np.cbrt(abs(np.linalg.det(m[:3, :3]))))
     rgba = (np.ones((prim.vertex_count, 4), np.float32) if "COLOR_0" not in a
             else to_linear_float(a["COLOR_0"]))
     material = scene.materials[prim.material] if prim.material is not None else DEFAULT_MATERIAL
@@ -500,6 +495,15 @@ def particles(scene: Scene, node: int, prim: Primitive,
     if "_DENSITY" in a:
         rgba[:, 3] *= np.clip(np.asarray(a["_DENSITY"], np.float32).ravel(), 0, 1)
     return centers, radii, rgba
+
+
+def point_radii(prim: Primitive) -> np.ndarray:
+    """Each particle's radius in its mesh's frame: ``_RADIUS``, else a small fraction of the set's
+    extent (float32)."""
+    if "_RADIUS" in prim.attributes:
+        return np.asarray(prim.attributes["_RADIUS"], np.float32).ravel()
+    span = np.ptp(prim.positions, axis=0) if prim.vertex_count else np.ones(3)
+    return np.full(prim.vertex_count, POINT_SIZE_FRACTION * float(np.linalg.norm(span)), np.float32)
 
 
 def _light(prim: Primitive) -> np.ndarray:

@@ -18,12 +18,106 @@ def _points(n: int) -> Scene:
     return scene
 
 
-def test_every_kth_particle_is_kept_at_its_own_size():
+def test_particles_that_lie_apart_are_kept_at_their_own_size():
+    """Merging dots that do not overlap would draw one wide blob over the gaps between them."""
     scene = _points(25)
-    assert thin_particles(scene, most=10) == "previewing 9 of its 25 particles"
+    assert thin_particles(scene, most=10) == "previewing its 25 particles as 9"
+    (prim,) = scene.meshes[0].primitives
+    assert set(prim.positions[:, 0].tolist()) <= set(range(0, 75, 3))
+    np.testing.assert_array_equal(prim.attributes["_RADIUS"], 0.5)
+
+
+def _blob(n: int = 4000) -> Scene:
+    rng = np.random.default_rng(3)
+    scene = Scene(name="blob")
+    prim = Primitive({"POSITION": rng.normal(0, 1, (n, 3)).astype(np.float32),
+                      "_RADIUS": rng.uniform(0.5, 1.5, n).astype(np.float32),
+                      "_DENSITY": rng.uniform(0.001, 0.01, n).astype(np.float32),
+                      "_LIGHT": rng.uniform(0, 1, n).astype(np.float32),
+                      "COLOR_0": rng.integers(0, 256, (n, 4)).astype(np.uint8)}, mode="POINTS")
+    scene.add_node(Node(name="p", mesh=scene.add_mesh(Mesh("p", [prim]))))
+    return scene
+
+
+def _mass(prim: Primitive) -> np.ndarray:
+    r = prim.attributes["_RADIUS"].astype(np.float64)
+    return prim.attributes["_DENSITY"] * r * r
+
+
+def test_overlapping_particles_merge_keeping_their_optical_mass_light_and_colour():
+    scene = _blob()
+    before = scene.meshes[0].primitives[0]
+    note = thin_particles(scene, most=400)
+    after = scene.meshes[0].primitives[0]
+    assert note == f"previewing its 4,000 particles as {after.vertex_count:,}"
+    assert after.vertex_count <= 400
+    assert after.attributes["_RADIUS"].mean() > before.attributes["_RADIUS"].mean()   # wider, fewer
+    m0, m1 = _mass(before), _mass(after)
+    np.testing.assert_allclose(m1.sum(), m0.sum(), rtol=1e-5)
+    np.testing.assert_allclose((m1 * after.attributes["_LIGHT"]).sum() / m1.sum(),
+                               (m0 * before.attributes["_LIGHT"]).sum() / m0.sum(), rtol=1e-5)
+    rgba = before.attributes["COLOR_0"] / np.float32(255)
+    np.testing.assert_allclose((m1[:, None] * after.attributes["COLOR_0"]).sum(axis=0) / m1.sum(),
+                               (m0[:, None] * rgba).sum(axis=0) / m0.sum(), rtol=1e-5)
+
+
+def test_a_thinned_dense_cloud_looks_like_the_whole_cloud():
+    """Every k-th particle let the eye through to a dense cloud's grey inside (a thick sky came out
+    up to 13 sRGB levels darker): merged, the picture stays near the whole cloud's from every side."""
+    from dataclasses import replace
+
+    from fishgen.clouds.scene import cloud_scene
+    from fishgen.preview.inputs import _every
+    from fishgen.preview.pipeline import frame_scene
+    from fishgen.preview.render import Renderer
+
+    model = load_cubes(PARAMS / "clouds" / "table_4_4.awn")
+    model = replace(model, cubes=tuple(replace(c, particles=c.particles * 32) for c in model.cubes))
+    cloud = light_cloud(fill_cloud(model, seed=0))
+    renderer = Renderer(128, 96, fine_blending=True)
+    sky = np.array([140, 173, 204], np.float64)
+
+    def look(scene: Scene, view: str) -> np.ndarray:
+        camera = frame_scene(scene, view, 128 / 96, [None], None)
+        (image,) = renderer.render_all(scene, [(camera, None)], (0, 0, 0, 0), None)
+        image = image.astype(np.float64)
+        alpha = image[..., 3:] / 255
+        return image[..., :3] * alpha + sky * (1 - alpha)
+
+    merged, every = [], []
+    try:
+        for view in ("top", "side", "three-quarter"):
+            whole = look(cloud_scene(cloud), view)
+            thinned = cloud_scene(cloud)
+            thin_particles(thinned, most=len(cloud) // 10)
+            sparse = cloud_scene(cloud)
+            sparse.meshes[0].primitives[0] = _every(sparse.meshes[0].primitives[0], 10)
+            for errors, scene in ((merged, thinned), (every, sparse)):
+                errors.append(float(np.sqrt(np.mean((look(scene, view) - whole) ** 2))))
+    finally:
+        renderer.release()
+    assert np.mean(merged) <= 7, merged            # sRGB levels, RMS over the picture: 4.9 here
+    assert np.mean(merged) <= 0.7 * np.mean(every), (merged, every)   # every k-th: 10.1
+
+
+def test_only_the_point_sets_a_renderer_draws_are_counted_and_thinned():
+    """A sky's lower levels of detail stand in its second scene: not drawn, not counted."""
+    scene = _points(25)
+    hidden = Primitive({"POSITION": np.zeros((100, 3), np.float32)}, mode="POINTS")
+    scene.add_mesh(Mesh("lod1", [hidden]))
+    assert thin_particles(scene, most=10) == "previewing its 25 particles as 9"
+    assert scene.meshes[1].primitives[0] is hidden
+
+
+def test_a_moving_point_set_keeps_every_kth_particle():
+    scene = _points(25)
+    prim = scene.meshes[0].primitives[0]
+    scene.meshes[0].primitives[0] = Primitive(prim.attributes, mode="POINTS",
+                                              targets=[{"POSITION": np.ones((25, 3), np.float32)}])
+    assert thin_particles(scene, most=10) == "previewing its 25 particles as 9"
     (prim,) = scene.meshes[0].primitives
     np.testing.assert_array_equal(prim.positions[:, 0], np.arange(0, 75, 9))
-    np.testing.assert_array_equal(prim.attributes["_RADIUS"], 0.5)
+    assert len(prim.targets[0]["POSITION"]) == 9
 
 
 def test_a_set_a_preview_can_draw_is_left_alone():
@@ -38,5 +132,6 @@ def test_a_big_ply_cloud_is_previewed_thinned_and_says_so(tmp_path, monkeypatch)
     export_cloud(cloud, tmp_path / "cloud.ply")
     monkeypatch.setattr(pipeline, "PREVIEW_PARTICLES", 100)
     scene = load_input(tmp_path / "cloud.ply")
-    assert scene.note == f"{tmp_path / 'cloud.ply'}: previewing 93 of its 554 particles"
-    assert scene.meshes[0].primitives[0].vertex_count == 93
+    kept = scene.meshes[0].primitives[0].vertex_count
+    assert scene.note == f"{tmp_path / 'cloud.ply'}: previewing its 554 particles as {kept}"
+    assert kept <= 100
