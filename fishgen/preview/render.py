@@ -154,7 +154,11 @@ void main() {
     // The billboard sprite's profile (fishgen.clouds.sprite): a Gaussian of sigma 0.4, 0 at the rim.
     float r2 = dot(v_corner, v_corner);
     if (r2 > 1.0) discard;
-    float a = v_color.a * u_opacity * max((exp(-r2 / 0.32) - 0.04394) / 0.95606, 0.0);
+    float profile = max((exp(-r2 / 0.32) - 0.04394) / 0.95606, 0.0);
+    // past 1, a particle's density counts stacked sprites (a preview's merged particles): as opaque
+    // as that many drawn over each other
+    float a = v_color.a <= 1.0 ? v_color.a * u_opacity * profile
+                               : 1.0 - pow(1.0 - u_opacity * profile, v_color.a);
     f_color = vec4(to_srgb(v_color.rgb) * a, a);
 }
 """
@@ -482,7 +486,7 @@ def particles(scene: Scene, node: int, prim: Primitive,
     """World centres, world radii and linear RGBA of a point set: a soft disc per particle.
 
     ``_RADIUS`` sizes each particle (else a small fraction of the set's extent);
-    ``_DENSITY`` (fishgen clouds) fades the thin edges.
+    ``_DENSITY`` (fishgen clouds) fades the thin edges; past 1 it stands for stacked particles.
     """
     centers, _ = deformed(scene, node, prim, posed)
     m = posed.matrix(node)
@@ -492,17 +496,18 @@ def particles(scene: Scene, node: int, prim: Primitive,
             else to_linear_float(a["COLOR_0"]))
     material = scene.materials[prim.material] if prim.material is not None else DEFAULT_MATERIAL
     rgba = rgba * np.asarray(material.base_color, np.float32)
-    if "_DENSITY" in a:
-        rgba[:, 3] *= np.clip(np.asarray(a["_DENSITY"], np.float32).ravel(), 0, 1)
+    if "_DENSITY" in a:   # past 1: stacked sprites (the shader)
+        rgba[:, 3] *= np.clip(np.asarray(a["_DENSITY"], np.float32).ravel(), 0, None)
     return centers, radii, rgba
 
 
 def point_radii(prim: Primitive) -> np.ndarray:
-    """Each particle's radius in its mesh's frame: ``_RADIUS``, else a small fraction of the set's
-    extent (float32)."""
+    """Each particle's radius in its mesh's frame, as drawn: ``_RADIUS`` (a negative one draws as its
+    size), else a small fraction of the set's extent (float32)."""
     if "_RADIUS" in prim.attributes:
-        return np.asarray(prim.attributes["_RADIUS"], np.float32).ravel()
-    span = np.ptp(prim.positions, axis=0) if prim.vertex_count else np.ones(3)
+        return np.abs(np.asarray(prim.attributes["_RADIUS"], np.float32).ravel())
+    # in float64: a set 1e20 wide squared past float32's range, and its particles became infinite
+    span = np.ptp(prim.positions.astype(np.float64), axis=0) if prim.vertex_count else np.ones(3)
     return np.full(prim.vertex_count, POINT_SIZE_FRACTION * float(np.linalg.norm(span)), np.float32)
 
 

@@ -100,6 +100,62 @@ def test_a_thinned_dense_cloud_looks_like_the_whole_cloud():
     assert np.mean(merged) <= 0.7 * np.mean(every), (merged, every)   # every k-th: 10.1
 
 
+def _picture(scene: Scene, size: int = 64) -> np.ndarray:
+    """The scene drawn from its side by the preview's renderer, over a transparent background (RGBA)."""
+    from fishgen.preview.pipeline import frame_scene
+    from fishgen.preview.render import Renderer
+
+    renderer = Renderer(size, size, fine_blending=True)
+    try:
+        (image,) = renderer.render_all(scene, [(frame_scene(scene, "side", 1.0), None)], (0, 0, 0, 0), None)
+    finally:
+        renderer.release()
+    return image.astype(np.float64)
+
+
+def test_a_density_past_1_draws_as_that_many_stacked_particles():
+    """How a merged stack keeps its opacity: one particle of density 3 is three drawn on each other."""
+    def particles(density: float, n: int) -> Scene:
+        scene = Scene(name="stack")
+        prim = Primitive({"POSITION": np.zeros((n, 3), np.float32), "_RADIUS": np.ones(n, np.float32),
+                          "_DENSITY": np.full(n, density, np.float32)}, mode="POINTS")
+        scene.add_node(Node(name="p", mesh=scene.add_mesh(Mesh("p", [prim]))))
+        return scene
+
+    one, three = _picture(particles(3.0, 1)), _picture(particles(1.0, 3))
+    assert np.abs(one[..., 3] - three[..., 3]).max() <= 2
+    assert one[..., 3].max() > _picture(particles(1.0, 1))[..., 3].max() + 20
+
+
+def test_coincident_particles_merged_stay_as_opaque_as_their_stack():
+    """20,000 points on one spot drew a faint disc once merged (density capped at 1), an opaque one whole."""
+    scene = Scene(name="spot")
+    n = 20_000
+    prim = Primitive({"POSITION": np.zeros((n, 3), np.float32), "_RADIUS": np.full(n, 0.3, np.float32)},
+                     mode="POINTS")
+    scene.add_node(Node(name="p", mesh=scene.add_mesh(Mesh("p", [prim]))))
+    whole = _picture(scene)
+    thin_particles(scene, most=1_000)
+    assert scene.meshes[0].primitives[0].vertex_count == 1
+    assert np.abs(_picture(scene)[..., 3] - whole[..., 3]).mean() < 8
+
+
+def test_negative_and_unstated_radii_are_drawn_at_their_size():
+    """A negative radius draws as its size, merged or not; a set 1e20 wide with no radii got infinite
+    ones (its extent squared past float32)."""
+    from fishgen.preview.render import point_radii
+
+    scene = _blob()
+    prim = scene.meshes[0].primitives[0]
+    prim.attributes["_RADIUS"] = -prim.attributes["_RADIUS"]
+    whole = _picture(scene)
+    thin_particles(scene, most=400)
+    assert (scene.meshes[0].primitives[0].attributes["_RADIUS"] > 0).all()
+    assert abs((_picture(scene)[..., 3] > 0).mean() - (whole[..., 3] > 0).mean()) < 0.05
+    wide = Primitive({"POSITION": np.array([[-1e20, 0, 0], [1e20, 0, 0]], np.float32)}, mode="POINTS")
+    assert np.isfinite(point_radii(wide)).all()
+
+
 def test_only_the_point_sets_a_renderer_draws_are_counted_and_thinned():
     """A sky's lower levels of detail stand in its second scene: not drawn, not counted."""
     scene = _points(25)
