@@ -113,6 +113,13 @@ def _primitive(data: Decoder, prim: dict, where: str) -> Primitive | None:
         indices = _triangles(flat, mode)
     targets = [{name: data.accessor(index).astype(np.float32) for name, index in target.items()}
                for target in prim.get("targets", [])]
+    if _MODES[mode] == "POINTS" and "indices" in prim:
+        # indexed points draw the vertices they name, once each time they are named
+        flat = data.accessor(prim["indices"]).ravel().astype(np.intp)
+        if len(flat) and int(flat.max()) >= n:
+            raise expected(f"vertex indices below {n} at {where}", str(int(flat.max())))
+        attributes = {name: a[flat] for name, a in attributes.items()}
+        targets = [{name: t[flat] for name, t in target.items()} for target in targets]
     return Primitive(attributes, indices, prim.get("material"), _MODES[mode], targets)
 
 

@@ -25,6 +25,10 @@ def load_input(path: str | os.PathLike, *, textures_dir: str | os.PathLike | Non
     if not path.is_file():
         raise FishgenError("expected an existing file, found none", path)
     scene = fmt.read(path, textures_dir=textures_dir, seed=seed, lighting=lighting)
+    if not any(prim.vertex_count for _, prim in scene.drawn()):
+        # lines, empty meshes, nodes without meshes: the picture was blank, and nothing said why
+        raise FishgenError("expected triangles or points to draw (a preview draws no lines), found none",
+                           path)
     note = thin_particles(scene)
     if note:
         scene.note = f"{path}: {note}"

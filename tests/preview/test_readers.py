@@ -103,3 +103,39 @@ def test_gltf_missing_its_bin_names_the_file(assets, tmp_path):
     shutil.copy(assets["fish.gltf"], tmp_path / "lonely.gltf")
     with pytest.raises(FishgenError, match="fish.bin"):
         load_input(tmp_path / "lonely.gltf")
+
+
+def _points_gltf(path, mode: int, indices: list[int] | None):
+    """A .gltf of four points on the x axis (an embedded buffer), drawn in ``mode``, maybe indexed."""
+    import base64
+    import json
+
+    blob = np.arange(12, dtype=np.float32).reshape(4, 3) * np.float32([1, 0, 0])
+    data = blob.tobytes()
+    prim: dict = {"attributes": {"POSITION": 0}, "mode": mode}
+    accessors = [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+                  "min": [0, 0, 0], "max": [9, 0, 0]}]
+    views = [{"buffer": 0, "byteLength": 48}]
+    if indices is not None:
+        data += np.array(indices, np.uint16).tobytes() + b"\0" * (len(indices) % 2 * 2)
+        views.append({"buffer": 0, "byteOffset": 48, "byteLength": 2 * len(indices)})
+        accessors.append({"bufferView": 1, "componentType": 5123, "count": len(indices), "type": "SCALAR"})
+        prim["indices"] = 1
+    doc = {"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "scene": 0, "nodes": [{"mesh": 0}],
+           "meshes": [{"primitives": [prim]}], "accessors": accessors, "bufferViews": views,
+           "buffers": [{"byteLength": len(data),
+                        "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}]}
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def test_indexed_points_draw_only_the_vertices_they_name(tmp_path):
+    """glTF draws an indexed primitive's indices, not its vertices: all were drawn (a QA pass)."""
+    (points,) = point_sets(load_input(_points_gltf(tmp_path / "indexed.gltf", 0, [1, 3])))
+    np.testing.assert_array_equal(points[0][:, 0], [3, 9])
+
+
+def test_an_asset_with_nothing_to_draw_is_an_error_not_a_blank_picture(tmp_path):
+    with pytest.raises(FishgenError, match=r"lines.gltf: expected triangles or points to draw "
+                                           r"\(a preview draws no lines\), found none$"):
+        load_input(_points_gltf(tmp_path / "lines.gltf", 1, None))
