@@ -103,7 +103,7 @@ def _read(path: Path) -> Scene:
         header = _check_ply_header(path)
         try:
             if not header.faces:
-                return _point_set(path)
+                return _point_set(path, header)
             loaded = trimesh.load(str(path), process=False, resolver=resolver)
         except FishgenError:
             raise
@@ -114,7 +114,7 @@ def _read(path: Path) -> Scene:
     scene = Scene(name=path.stem, source=str(path))
     for k, geom in enumerate(geoms):
         if isinstance(geom, trimesh.PointCloud):
-            prim = _points(geom.vertices, geom.metadata, path)
+            prim = _points(geom.vertices, geom.metadata, path, None if obj else header)
         elif isinstance(geom, trimesh.Trimesh) and len(geom.faces):
             prim = _mesh(geom, alpha, path, scene)
         else:
@@ -334,11 +334,34 @@ def _check_ply_header(path: Path) -> _PlyHeader:
         if name == "vertex" and count and not {"x", "y", "z"} <= {p for p, _, _ in props}:
             raise expected("vertex properties x, y and z", ", ".join(p for p, _, _ in props) or "none",
                            path)
+    header = _PlyHeader(fmt, elements, end.end(), len(lines))
     if need > body:
+        _ascii_ply_short(path, header)    # an ASCII file says so at the line it ends
         counts = ", ".join(f"{count:,} {name}" for name, count, _ in elements)
         raise expected(f"at least {need:,} bytes of {fmt} data for {counts}",
                        f"{body:,} bytes after the header", path)
-    return _PlyHeader(fmt, elements, end.end(), len(lines))
+    return header
+
+
+def _ascii_ply_short(path: Path, header: _PlyHeader) -> None:
+    """Raise at the line where an ASCII PLY's body ends short of its elements' rows (one a line),
+    counting lines, not reading numbers; return if it holds them all, or the file is binary."""
+    if header.fmt != "ascii":
+        return
+    lines, tail = 0, b""
+    with path.open("rb") as f:
+        f.seek(header.body)
+        while block := f.read(1 << 20):
+            lines += block.count(b"\n")
+            tail = block[-1:]
+    lines += tail not in (b"", b"\n")        # a last line without its newline
+    before = 0
+    for name, count, props in header.elements:
+        if lines < before + count:
+            what = f"{name} ({' '.join(p for p, _, _ in props)})"
+            raise expected(f"{count:,} rows of {what}", f"the file ending after {lines - before:,}", path,
+                           header.lines + lines + 1)
+        before += count
 
 
 def _ascii_ply_fault(path: Path, header: _PlyHeader) -> None:
@@ -377,7 +400,7 @@ def _ascii_ply_fault(path: Path, header: _PlyHeader) -> None:
                                    path, number)
 
 
-def _finite(positions: np.ndarray, path: Path) -> None:
+def _finite(positions: np.ndarray, path: Path, header: _PlyHeader | None = None) -> None:
     """Vertices of three finite coordinates each: what the scene model and every pose assume."""
     if positions.ndim != 2 or positions.shape[1] != 3:
         found = positions.shape[1] if positions.ndim == 2 else positions.ndim
@@ -385,7 +408,20 @@ def _finite(positions: np.ndarray, path: Path) -> None:
                        path)
     if len(positions) and not np.isfinite(positions).all():
         bad = int(np.argmax(~np.isfinite(positions).all(axis=1)))
-        raise expected("finite vertex coordinates", f"{positions[bad].tolist()} at vertex {bad + 1}", path)
+        raise expected("finite vertex coordinates", f"{positions[bad].tolist()} at vertex {bad + 1}", path,
+                       _vertex_line(header, bad))
+
+
+def _vertex_line(header: _PlyHeader | None, index: int) -> int | None:
+    """The line of an ASCII PLY's vertex ``index`` (from 0), one element row a line; None for binary."""
+    if header is None or header.fmt != "ascii":
+        return None
+    before = 0
+    for name, count, _ in header.elements:
+        if name == "vertex":
+            return header.lines + 1 + before + index
+        before += count
+    return None
 
 
 def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path, scene: Scene) -> Primitive:
@@ -440,7 +476,7 @@ def _check_size(image, path: Path) -> None:
                        f"{width}x{height}", path)
 
 
-def _point_set(path: Path) -> Scene:
+def _point_set(path: Path, header: _PlyHeader | None = None) -> Scene:
     """A PLY of vertices alone, parsed by trimesh's PLY reader without its point cloud: building
     one (its colour visuals) took 10 of a 10^7-particle cloud's 13.5 s."""
     from trimesh.exchange.ply import load_ply
@@ -451,18 +487,20 @@ def _point_set(path: Path) -> Scene:
         raise FishgenError("expected triangles or points, found an empty asset", path)
     scene = Scene(name=path.stem, source=str(path))
     name = f"{path.stem}0"
-    prim = _points(loaded["vertices"], loaded.get("metadata", {}), path)
+    prim = _points(loaded["vertices"], loaded.get("metadata", {}), path, header)
     scene.add_node(Node(name=name, mesh=scene.add_mesh(Mesh(name, [prim]))))
     return scene
 
 
-def _points(vertices, metadata: dict, path: Path) -> Primitive:
+def _points(vertices, metadata: dict, path: Path, header: _PlyHeader | None = None) -> Primitive:
     positions = np.asarray(vertices, np.float32)
-    _finite(positions, path)
+    _finite(positions, path, header)
     columns = _ply_columns(metadata.get("_ply_raw", {}).get("vertex", {}).get("data"))
     for name in ("radius", "red", "green", "blue", "density"):
         if name in columns and columns[name].dtype.kind == "f" and not np.isfinite(columns[name]).all():
-            raise expected(f"finite {name} values", "NaN or infinity", path)
+            bad = int(np.argmax(~np.isfinite(columns[name])))
+            raise expected(f"finite {name} values", f"{columns[name][bad]} at vertex {bad + 1}", path,
+                           _vertex_line(header, bad))
     attributes = {"POSITION": positions}
     if "radius" in columns:
         attributes["_RADIUS"] = columns["radius"].astype(np.float32)

@@ -139,3 +139,23 @@ def test_an_asset_with_nothing_to_draw_is_an_error_not_a_blank_picture(tmp_path)
     with pytest.raises(FishgenError, match=r"lines.gltf: expected triangles or points to draw "
                                            r"\(a preview draws no lines\), found none$"):
         load_input(_points_gltf(tmp_path / "lines.gltf", 1, None))
+
+
+_ASCII_HEAD = ("ply\nformat ascii 1.0\nelement vertex 3\n"
+               "property float x\nproperty float y\nproperty float z\n")
+
+
+@pytest.mark.parametrize("text, message", [
+    (_ASCII_HEAD + "end_header\n0 0 0\n1 1 1\n", r"short.ply:10: expected 3 rows of vertex \(x y z\), "
+                                                 r"found the file ending after 2$"),
+    (_ASCII_HEAD + "property float radius\nend_header\n0 0 0 0.5\n1 1 1 nan\n2 2 2 0.5\n",
+     r"short.ply:10: expected finite radius values, found nan at vertex 2$"),
+    (_ASCII_HEAD + "end_header\n0 0 0\n1 inf 1\n2 2 2\n",
+     r"short.ply:9: expected finite vertex coordinates, found \[1.0, inf, 1.0\] at vertex 2$"),
+])
+def test_an_ascii_ply_is_faulted_at_its_line(tmp_path, text, message):
+    """A QA pass: a short file was said in bytes after the header, a NaN radius at no line."""
+    path = tmp_path / "short.ply"
+    path.write_text(text)
+    with pytest.raises(FishgenError, match=message):
+        load_input(path)
