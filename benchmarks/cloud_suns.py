@@ -32,6 +32,8 @@ def main() -> None:
     parser.add_argument("--highest", type=float, default=1e5)
     parser.add_argument("--queries", type=int, default=400)
     parser.add_argument("--added", action="store_true", help="also seeds 20-99 (tuned on, small clouds)")
+    parser.add_argument("--seeds", metavar="A-B",
+                        help="only these seeds (a range never run before is a fresh held-out set)")
     parser.add_argument("--timing", action="store_true",
                         help="only time the light of the shipped files and of 2,048 random particles")
     args = parser.parse_args()
@@ -41,6 +43,9 @@ def main() -> None:
         return
     groups = {"tuned (0-9)": TUNED, **({"tuned, added (20-99)": ADDED} if args.added else {}),
               "held out (100-119)": HELD_OUT, "fresh, held out of both rounds (200-219)": FRESH}
+    if args.seeds:
+        first, _, last = args.seeds.partition("-")
+        groups = {f"seeds {args.seeds}": range(int(first), int(last or first) + 1)}
     worst = 1.0
     with tempfile.TemporaryDirectory() as folder:
         for title, seeds in groups.items():
