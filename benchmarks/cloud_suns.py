@@ -13,6 +13,7 @@ round, 200-219 held out of both. Goal: at least 0.8 each.
 from __future__ import annotations
 
 import argparse
+import re
 import statistics
 import sys
 import tempfile
@@ -33,7 +34,8 @@ def main() -> None:
     parser.add_argument("--queries", type=int, default=400)
     parser.add_argument("--added", action="store_true", help="also seeds 20-99 (tuned on, small clouds)")
     parser.add_argument("--seeds", metavar="A-B",
-                        help="only these seeds (a range never run before is a fresh held-out set)")
+                        help="only these seeds, instead of the groups and --added (a range never run "
+                             "before is a fresh held-out set)")
     parser.add_argument("--timing", action="store_true",
                         help="only time the light of the shipped files and of 2,048 random particles")
     args = parser.parse_args()
@@ -44,8 +46,10 @@ def main() -> None:
     groups = {"tuned (0-9)": TUNED, **({"tuned, added (20-99)": ADDED} if args.added else {}),
               "held out (100-119)": HELD_OUT, "fresh, held out of both rounds (200-219)": FRESH}
     if args.seeds:
-        first, _, last = args.seeds.partition("-")
-        groups = {f"seeds {args.seeds}": range(int(first), int(last or first) + 1)}
+        bounds = re.fullmatch(r"(\d+)(?:-(\d+))?", args.seeds)
+        if bounds is None or int(bounds[2] or bounds[1]) < int(bounds[1]):
+            parser.error(f"--seeds: expected A-B with A <= B (or one seed), found {args.seeds!r}")
+        groups = {f"seeds {args.seeds}": range(int(bounds[1]), int(bounds[2] or bounds[1]) + 1)}
     worst = 1.0
     with tempfile.TemporaryDirectory() as folder:
         for title, seeds in groups.items():

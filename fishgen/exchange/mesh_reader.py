@@ -116,7 +116,7 @@ def _read(path: Path) -> Scene:
         if isinstance(geom, trimesh.PointCloud):
             prim = _points(geom.vertices, geom.metadata, path, None if obj else header)
         elif isinstance(geom, trimesh.Trimesh) and len(geom.faces):
-            prim = _mesh(geom, alpha, path, scene)
+            prim = _mesh(geom, alpha, path, scene, None if obj else header)
         else:
             continue
         name = str(geom.metadata.get("name") or f"{path.stem}{k}")
@@ -424,9 +424,10 @@ def _vertex_line(header: _PlyHeader | None, index: int) -> int | None:
     return None
 
 
-def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path, scene: Scene) -> Primitive:
+def _mesh(geom, alpha: dict[str, tuple[str, float]], path: Path, scene: Scene,
+          header: _PlyHeader | None = None) -> Primitive:
     positions = np.asarray(geom.vertices, np.float32)
-    _finite(positions, path)
+    _finite(positions, path, header)
     faces = np.asarray(geom.faces)
     if faces.min() < 0 or faces.max() >= len(positions):  # checked before anything indexes with them
         bad = int(faces.max()) if faces.max() >= len(positions) else int(faces.min())

@@ -131,14 +131,15 @@ POINT_VS = """
 uniform mat4 u_view, u_proj;
 uniform vec3 u_eye;
 in vec2 in_corner;
-in vec3 in_center; in float in_radius; in vec4 in_color; in float in_light;
-out vec2 v_corner; out vec4 v_color;
+in vec3 in_center; in float in_radius; in vec4 in_color; in float in_light; in float in_stack;
+out vec2 v_corner; out vec4 v_color; out float v_stack;
 """ + _SECOND_PASS + """
 void main() {
     vec4 c = u_view * vec4(in_center, 1.0);
     c.xy += in_corner * in_radius;   // camera-facing quad of the particle's world radius
     v_corner = in_corner;
     v_color = in_color;
+    v_stack = in_stack;
     if (u_cloud && in_light >= 0.0) v_color.rgb = scattered(in_light, in_center, u_eye);
     gl_Position = u_proj * c;
 }
@@ -147,18 +148,17 @@ void main() {
 POINT_FS = """
 #version 330
 uniform float u_opacity;
-in vec2 v_corner; in vec4 v_color;
+in vec2 v_corner; in vec4 v_color; in float v_stack;
 out vec4 f_color;
 """ + _SRGB + """
 void main() {
     // The billboard sprite's profile (fishgen.clouds.sprite): a Gaussian of sigma 0.4, 0 at the rim.
     float r2 = dot(v_corner, v_corner);
     if (r2 > 1.0) discard;
-    float profile = max((exp(-r2 / 0.32) - 0.04394) / 0.95606, 0.0);
-    // past 1, a particle's density counts stacked sprites (a preview's merged particles): as opaque
-    // as that many drawn over each other
-    float a = v_color.a <= 1.0 ? v_color.a * u_opacity * profile
-                               : 1.0 - pow(1.0 - u_opacity * profile, v_color.a);
+    float a = v_color.a * u_opacity * max((exp(-r2 / 0.32) - 0.04394) / 0.95606, 0.0);
+    // a density past 1 counts stacked sprites (a preview's merged particles): as opaque as that many
+    // drawn over each other
+    if (v_stack > 1.0) a = 1.0 - pow(1.0 - a, v_stack);
     f_color = vec4(to_srgb(v_color.rgb) * a, a);
 }
 """
@@ -455,15 +455,17 @@ class Renderer:
             self._points[id(scene)] = held = (weakref.ref(scene), drawn)
         for node, prim in held[1]:
             c, r, col = particles(scene, node, prim, posed)
-            parts.append((c, r, col, _light(prim)))
+            parts.append((c, r, col, _light(prim), stacks(prim)))
         if not parts:
             return
         c = np.concatenate([p[0] for p in parts]).astype(np.float32)
         r = np.concatenate([p[1] for p in parts]).astype(np.float32)
         col = np.concatenate([p[2] for p in parts]).astype(np.float32)
         light = np.concatenate([p[3] for p in parts]).astype(np.float32)
+        stack = np.concatenate([p[4] for p in parts]).astype(np.float32)
         order = np.argsort((c @ view[2, :3]) + view[2, 3], kind="stable")  # back to front: "over"
-        inst = np.hstack([c[order], r[order, None], col[order], light[order, None]]).astype(np.float32)
+        inst = np.hstack([c[order], r[order, None], col[order], light[order, None],
+                          stack[order, None]]).astype(np.float32)
         buf = self.ctx.buffer(inst.tobytes())
         prog = self.point_prog
         prog["u_view"].write(view.T.astype("f4").tobytes())
@@ -471,8 +473,8 @@ class Renderer:
         prog["u_eye"].value = tuple(eye)
         prog["u_opacity"].value = PARTICLE_OPACITY
         vao = self.ctx.vertex_array(prog, [(self.corner_buf, "2f", "in_corner"),
-                                           (buf, "3f 1f 4f 1f/i", "in_center", "in_radius", "in_color",
-                                            "in_light")])
+                                           (buf, "3f 1f 4f 1f 1f/i", "in_center", "in_radius", "in_color",
+                                            "in_light", "in_stack")])
         vao.render(moderngl.TRIANGLE_STRIP, instances=len(inst))
         vao.release()
         buf.release()
@@ -486,7 +488,7 @@ def particles(scene: Scene, node: int, prim: Primitive,
     """World centres, world radii and linear RGBA of a point set: a soft disc per particle.
 
     ``_RADIUS`` sizes each particle (else a small fraction of the set's extent);
-    ``_DENSITY`` (fishgen clouds) fades the thin edges; past 1 it stands for stacked particles.
+    ``_DENSITY`` (fishgen clouds) fades the thin edges; past 1 it stacks (``stacks``).
     """
     centers, _ = deformed(scene, node, prim, posed)
     m = posed.matrix(node)
@@ -496,8 +498,8 @@ def particles(scene: Scene, node: int, prim: Primitive,
             else to_linear_float(a["COLOR_0"]))
     material = scene.materials[prim.material] if prim.material is not None else DEFAULT_MATERIAL
     rgba = rgba * np.asarray(material.base_color, np.float32)
-    if "_DENSITY" in a:   # past 1: stacked sprites (the shader)
-        rgba[:, 3] *= np.clip(np.asarray(a["_DENSITY"], np.float32).ravel(), 0, None)
+    if "_DENSITY" in a:   # past 1: stacked sprites (``stacks``)
+        rgba[:, 3] *= np.clip(np.asarray(a["_DENSITY"], np.float32).ravel(), 0, 1)
     return centers, radii, rgba
 
 
@@ -509,6 +511,15 @@ def point_radii(prim: Primitive) -> np.ndarray:
     # in float64: a set 1e20 wide squared past float32's range, and its particles became infinite
     span = np.ptp(prim.positions.astype(np.float64), axis=0) if prim.vertex_count else np.ones(3)
     return np.full(prim.vertex_count, POINT_SIZE_FRACTION * float(np.linalg.norm(span)), np.float32)
+
+
+def stacks(prim: Primitive) -> np.ndarray:
+    """Per particle, how many sprites it draws stacked: its ``_DENSITY`` past 1 (a preview's merged
+    particle holds that much optical mass over its area), else 1."""
+    if "_DENSITY" not in prim.attributes:
+        return np.ones(prim.vertex_count, np.float32)
+    density = np.nan_to_num(np.asarray(prim.attributes["_DENSITY"], np.float32).ravel())
+    return np.maximum(density, np.float32(1))
 
 
 def _light(prim: Primitive) -> np.ndarray:

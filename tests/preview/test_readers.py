@@ -135,10 +135,11 @@ def test_indexed_points_draw_only_the_vertices_they_name(tmp_path):
     np.testing.assert_array_equal(points[0][:, 0], [3, 9])
 
 
-def test_an_asset_with_nothing_to_draw_is_an_error_not_a_blank_picture(tmp_path):
-    with pytest.raises(FishgenError, match=r"lines.gltf: expected triangles or points to draw "
+@pytest.mark.parametrize("mode, indices", [(1, None), (4, [0, 1])])   # lines; triangles of 2 indices
+def test_an_asset_with_nothing_to_draw_is_an_error_not_a_blank_picture(tmp_path, mode, indices):
+    with pytest.raises(FishgenError, match=r"nothing.gltf: expected triangles or points to draw "
                                            r"\(a preview draws no lines\), found none$"):
-        load_input(_points_gltf(tmp_path / "lines.gltf", 1, None))
+        load_input(_points_gltf(tmp_path / "nothing.gltf", mode, indices))
 
 
 _ASCII_HEAD = ("ply\nformat ascii 1.0\nelement vertex 3\n"
@@ -152,6 +153,9 @@ _ASCII_HEAD = ("ply\nformat ascii 1.0\nelement vertex 3\n"
      r"short.ply:10: expected finite radius values, found nan at vertex 2$"),
     (_ASCII_HEAD + "end_header\n0 0 0\n1 inf 1\n2 2 2\n",
      r"short.ply:9: expected finite vertex coordinates, found \[1.0, inf, 1.0\] at vertex 2$"),
+    (_ASCII_HEAD + "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 nan 1\n"
+     "2 2 2\n3 0 1 2\n",
+     r"short.ply:11: expected finite vertex coordinates, found \[1.0, nan, 1.0\] at vertex 2$"),
 ])
 def test_an_ascii_ply_is_faulted_at_its_line(tmp_path, text, message):
     """A QA pass: a short file was said in bytes after the header, a NaN radius at no line."""
