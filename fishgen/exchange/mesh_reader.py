@@ -486,6 +486,12 @@ def _point_set(path: Path, header: _PlyHeader | None = None) -> Scene:
         loaded = load_ply(handle)
     if not len(loaded.get("vertices", ())):
         raise FishgenError("expected triangles or points, found an empty asset", path)
+    counts = {} if header is None else {name: n for name, n, _ in header.elements}
+    declared = counts.get("vertex")
+    if header is not None and declared is not None and len(loaded["vertices"]) != declared:
+        # an ASCII body of several rows a line read as fewer vertices, silently
+        _ascii_ply_fault(path, header)
+        raise expected(f"{declared:,} vertices, as the header says", f"{len(loaded['vertices']):,}", path)
     scene = Scene(name=path.stem, source=str(path))
     name = f"{path.stem}0"
     prim = _points(loaded["vertices"], loaded.get("metadata", {}), path, header)

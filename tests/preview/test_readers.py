@@ -153,6 +153,8 @@ _ASCII_HEAD = ("ply\nformat ascii 1.0\nelement vertex 3\n"
      r"short.ply:10: expected finite radius values, found nan at vertex 2$"),
     (_ASCII_HEAD + "end_header\n0 0 0\n1 inf 1\n2 2 2\n",
      r"short.ply:9: expected finite vertex coordinates, found \[1.0, inf, 1.0\] at vertex 2$"),
+    (_ASCII_HEAD + "end_header\n0 0 0 1 1 1 2 2 2\n",       # read as 1 vertex, silently
+     r"short.ply:8: expected 3 numbers for a vertex \(x y z\), found 9: '0 0 0 1 1 1 2 2 2'$"),
     (_ASCII_HEAD + "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 nan 1\n"
      "2 2 2\n3 0 1 2\n",
      r"short.ply:11: expected finite vertex coordinates, found \[1.0, nan, 1.0\] at vertex 2$"),
