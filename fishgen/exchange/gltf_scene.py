@@ -105,22 +105,26 @@ def _primitive(data: Decoder, prim: dict, where: str) -> Primitive | None:
             raise expected(f"WEIGHTS_0 of each vertex non-negative and summing to 1 at {where}",
                            f"{np.round(weights[bad], 4).tolist()} at vertex {bad}")
     indices = None
+    named = _indices(data, prim, n, where)
     if _MODES[mode] == "TRIANGLES":
-        flat = (data.accessor(prim["indices"]).ravel().astype(np.uint32) if "indices" in prim
-                else np.arange(n, dtype=np.uint32))
-        if len(flat) and int(flat.max()) >= n:  # the GPU would read past the vertices
-            raise expected(f"vertex indices below {n} at {where}", str(int(flat.max())))
-        indices = _triangles(flat, mode)
+        indices = _triangles(np.arange(n, dtype=np.uint32) if named is None else named, mode)
     targets = [{name: data.accessor(index).astype(np.float32) for name, index in target.items()}
                for target in prim.get("targets", [])]
-    if _MODES[mode] == "POINTS" and "indices" in prim:
+    if _MODES[mode] == "POINTS" and named is not None:
         # indexed points draw the vertices they name, once each time they are named
-        flat = data.accessor(prim["indices"]).ravel().astype(np.intp)
-        if len(flat) and int(flat.max()) >= n:
-            raise expected(f"vertex indices below {n} at {where}", str(int(flat.max())))
-        attributes = {name: a[flat] for name, a in attributes.items()}
-        targets = [{name: t[flat] for name, t in target.items()} for target in targets]
+        attributes = {name: a[named] for name, a in attributes.items()}
+        targets = [{name: t[named] for name, t in target.items()} for target in targets]
     return Primitive(attributes, indices, prim.get("material"), _MODES[mode], targets)
+
+
+def _indices(data: Decoder, prim: dict, n: int, where: str) -> np.ndarray | None:
+    """A primitive's vertex indices (uint32), checked below its ``n`` vertices, or None."""
+    if "indices" not in prim:
+        return None
+    flat = data.accessor(prim["indices"]).ravel().astype(np.uint32)
+    if len(flat) and int(flat.max()) >= n:  # the GPU would read past the vertices
+        raise expected(f"vertex indices below {n} at {where}", str(int(flat.max())))
+    return flat
 
 
 def _triangles(flat: np.ndarray, mode: int) -> np.ndarray:

@@ -486,9 +486,8 @@ def _point_set(path: Path, header: _PlyHeader | None = None) -> Scene:
         loaded = load_ply(handle)
     if not len(loaded.get("vertices", ())):
         raise FishgenError("expected triangles or points, found an empty asset", path)
-    counts = {} if header is None else {name: n for name, n, _ in header.elements}
-    declared = counts.get("vertex")
-    if header is not None and declared is not None and len(loaded["vertices"]) != declared:
+    declared = None if header is None else {name: n for name, n, _ in header.elements}.get("vertex")
+    if header is not None and declared is not None and declared != len(loaded["vertices"]):
         # an ASCII body of several rows a line read as fewer vertices, silently
         _ascii_ply_fault(path, header)
         raise expected(f"{declared:,} vertices, as the header says", f"{len(loaded['vertices']):,}", path)

@@ -43,8 +43,9 @@ def thin_particles(scene: Scene, most: int | None = None) -> str | None:
     as a cloud's lower level of detail is (``fishgen.clouds.lod``): fewer, wider particles that
     keep its cover, optical mass, light and colour, so the picture looks like the whole. Keeping
     every k-th particle instead let the eye through to the grey inside of a dense cloud: the thick
-    sky's picture was RMS 8.5 sRGB levels off the whole one, merged 3.3 (docs/decisions.md). A set that moves
-    (morph targets, a skin) keeps every k-th particle. Returns what the preview then says, or None."""
+    sky's picture was RMS 8.5 sRGB levels off the whole one, merged 3.3 (docs/decisions.md). A set
+    that moves (morph targets, a skin) keeps every k-th particle. Returns what the preview then
+    says, or None."""
     from fishgen.clouds.lod import TOLERANCE
     from fishgen.clouds.pipeline import PREVIEW_PARTICLES
 
@@ -89,10 +90,10 @@ SHRINK = 0.9
 APART = 16.0
 """A cell whose particles lie farther apart than this (``Merged.spread``: their positions' variance
 per axis over their sprites' Gaussian sigma squared, so 4 sigmas, 1.6 radii) keeps its first
-particle as it is: merged,
-dots that do not overlap became one wide blob over the gaps between them. Chosen on fourteen
-assets and checked on three held out (docs/decisions.md): 1 left dense point clouds of small dots
-unmerged (RMS 20 against 10 for 16), 4 fell between, 16 and 64 did the same."""
+particle as it is: merged, dots that do not overlap became one wide blob over the gaps between
+them. Chosen on fourteen assets and checked on three held out (docs/decisions.md): 1 left dense
+point clouds of small dots unmerged (RMS 20 against 10 for 16), 4 fell between, 16 and 64 did
+the same."""
 
 
 def _merged(prim: Primitive, ratio: float) -> Primitive | None:
@@ -137,12 +138,12 @@ def _merged(prim: Primitive, ratio: float) -> Primitive | None:
                                  max(1.0, step))
         if merged is None:
             break
-        widths = np.where(merged.spread > APART, values["_RADIUS"][merged.first], merged.radii)
+        apart = merged.spread > APART
+        widths = np.where(apart, values["_RADIUS"][merged.first], merged.radii)
         drawn = float(np.square(widths, dtype=np.float64).sum())
         if merges and drawn > SHRINK * area:
-            break   # points strung out along a line or a sheet widen as fast as they thin: kept as they were
+            break   # points strung along a line or a sheet widen as fast as they thin: kept as they were
         area = drawn
-        apart = merged.spread > APART
         kept = {name: v[merged.first] for name, v in values.items()}
         made = {name: merged.mean(v).astype(np.float32) for name, v in values.items()
                 if name in ("COLOR_0", "_LIGHT")}
