@@ -140,15 +140,13 @@ def suns_for(rng: np.random.Generator) -> dict[str, tuple[float, float, float]]:
             "axis": axis, "random 1": random_suns(rng, 1)[0], "random 2": random_suns(rng, 1)[0]}
 
 
-def correlations(seed: int, folder, lowest: int = 100, highest: int = 100_000,
-                 queries: int = 300) -> tuple[int, int, dict[str, float]]:
-    """(particles, cubes, {sun: rank correlation}) of the light fishgen bakes on the random cube
-    file of ``seed`` (``lowest`` to ``highest`` particles, log-uniform), written to ``folder``
-    and loaded as a user's would be, against the reference depth of ``queries`` particles."""
+def drawn(seed: int, folder, lowest: int = 100, highest: int = 100_000, queries: int = 300):
+    """(cloud, cube count, query indices, {sun name: sun}) of the random cube file of ``seed``
+    (``lowest`` to ``highest`` particles, log-uniform), written to ``folder`` and loaded and
+    filled as a user's would be."""
     from pathlib import Path
 
-    from fishgen.clouds import Lighting, fill_cloud, load_cubes
-    from fishgen.clouds.light import incident_light
+    from fishgen.clouds import fill_cloud, load_cubes
 
     rng = np.random.default_rng(seed)
     particles = int(round(math.exp(rng.uniform(math.log(lowest), math.log(highest)))))
@@ -157,10 +155,21 @@ def correlations(seed: int, folder, lowest: int = 100, highest: int = 100_000,
     cubes = load_cubes(path)
     cloud = fill_cloud(cubes, seed=seed)
     query = sample(len(cloud), queries, rng)
+    return cloud, len(cubes.cubes), query, suns_for(rng)
+
+
+def correlations(seed: int, folder, lowest: int = 100, highest: int = 100_000,
+                 queries: int = 300) -> tuple[int, int, dict[str, float]]:
+    """(particles, cubes, {sun: rank correlation}) of the light fishgen bakes on the random cube
+    file of ``seed`` (``drawn``), against the reference depth of ``queries`` particles."""
+    from fishgen.clouds import Lighting
+    from fishgen.clouds.light import incident_light
+
+    cloud, cubes, query, suns = drawn(seed, folder, lowest, highest, queries)
     out = {}
-    for name, sun in suns_for(rng).items():
+    for name, sun in suns.items():
         lighting = Lighting(sun=sun)
         light = incident_light(cloud.centers, cloud.radii, cloud.density, lighting)
         tau = optical_depth(cloud.centers, cloud.radii, cloud.density, sun, query, lighting.extinction)
         out[name] = rank_correlation(light[query], tau)
-    return len(cloud), len(cubes.cubes), out
+    return len(cloud), cubes, out
