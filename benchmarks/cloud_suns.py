@@ -5,6 +5,7 @@ baked light with an independent optical depth towards the sun, per random cube f
     python benchmarks/cloud_suns.py --highest 1e4 --queries 300     # the test's files
     python benchmarks/cloud_suns.py --highest 1e4 --queries 300 --added    # and seeds 20-99
     python benchmarks/cloud_suns.py --timing             # the light's time on small clouds, pair by pair
+    python benchmarks/cloud_suns.py --seeds 800-899 --routes    # strung-out clouds: slabs against pairs
 
 The cube files and the reference are tests/clouds/sun_reference.py's (the test's own harness);
 seeds 0-9 (and 20-99) are the ones the lighting was tuned on, 100-119 held out of the first
@@ -38,6 +39,10 @@ def main() -> None:
                              "before is a fresh held-out set)")
     parser.add_argument("--timing", action="store_true",
                         help="only time the light of the shipped files and of 2,048 random particles")
+    parser.add_argument("--routes", action="store_true",
+                        help="only the files and suns past SMALL lit pair by pair (strung out across "
+                             "the rays): their rank and time through the slabs they took before 0.2.8, "
+                             "and pair by pair")
     args = parser.parse_args()
     warnings.simplefilter("ignore")  # the files' declared totals are right; nothing else warns
     if args.timing:
@@ -50,6 +55,9 @@ def main() -> None:
         if bounds is None or int(bounds[2] or bounds[1]) < int(bounds[1]):
             parser.error(f"--seeds: expected A-B with A <= B (or one seed), found {args.seeds!r}")
         groups = {f"seeds {args.seeds}": range(int(bounds[1]), int(bounds[2] or bounds[1]) + 1)}
+    if args.routes:
+        routes(groups, args)
+        return
     worst = 1.0
     with tempfile.TemporaryDirectory() as folder:
         for title, seeds in groups.items():
@@ -68,6 +76,51 @@ def main() -> None:
                 print(f"{name:>10} {min(values):6.3f} {statistics.median(values):6.3f}")
                 worst = min(worst, min(values))
     print(f"\nlowest of all: {worst:.3f} (goal 0.80)")
+
+
+def routes(groups: dict[str, range], args: argparse.Namespace, repeats: int = 3) -> None:
+    """Each file and sun that SMALL < n <= SPARSE lights pair by pair (``_pair_axis``): the rank
+    and median time of its light through the slabs it would otherwise take, and pair by pair."""
+    import numpy as np
+
+    from fishgen.clouds import Lighting
+    from fishgen.clouds import light as light_module
+    from tests.clouds.sun_reference import drawn, optical_depth, rank_correlation
+
+    def run(cloud, lighting, slabs):
+        took = []
+        for _ in range(repeats):
+            start = time.perf_counter()
+            light = light_module.incident_light(cloud.centers, cloud.radii, cloud.density, lighting,
+                                                slabs=slabs)
+            took.append(time.perf_counter() - start)
+        return light, statistics.median(took) * 1e3
+
+    print(f"{'seed':>5} {'particles':>9} {'cubes':>5} {'sun':>9}  slabs: rank    ms  pairs: rank    ms")
+    changed = 0
+    with tempfile.TemporaryDirectory() as folder:
+        for seeds in groups.values():
+            for seed in seeds:
+                cloud, cubes, query, suns = drawn(seed, folder, int(args.lowest), int(args.highest),
+                                                  args.queries)
+                n = len(cloud)
+                if not light_module.SMALL < n <= light_module.SPARSE:
+                    continue
+                for name, sun in suns.items():
+                    lighting = Lighting(sun=sun)
+                    frame = light_module._frame(np.array(lighting.sun_unit, np.float64))
+                    if light_module._pair_axis(cloud.centers, cloud.radii, frame,
+                                               light_module._middle(cloud.centers)) is None:
+                        continue
+                    changed += 1
+                    tau = optical_depth(cloud.centers, cloud.radii, cloud.density, sun, query,
+                                        lighting.extinction)
+                    slabs, slab_ms = run(cloud, lighting, light_module.slab_count(n))
+                    pairs, pair_ms = run(cloud, lighting, None)
+                    print(f"{seed:>5} {n:>9,} {cubes:>5} {name:>9}  {rank_correlation(slabs[query], tau):11.3f}"
+                          f" {slab_ms:5.0f}  {rank_correlation(pairs[query], tau):11.3f} {pair_ms:5.0f}",
+                          flush=True)
+    print(f"\n{changed} file-and-sun pairs lit pair by pair past SMALL")
 
 
 def timing(repeats: int = 15) -> None:

@@ -18,8 +18,9 @@ particle's optical depth across the rays is a Gaussian of width ``sigma = SIGMA 
 (``peak_optical_depth``).
 
 A small cloud needs no grid: each particle's light comes from every other particle's
-Gaussian, each shading it as far as it lies nearer the sun (``_pairs``). A big one goes
-through a grid across the sun's rays (a deep shadow map) in *slabs* along the sun axis,
+Gaussian, each shading it as far as it lies nearer the sun (``_pairs``). So does a bigger one
+strung out across the sun's rays, whose pairs within reach are as few as a small cloud's. A big
+one goes through a grid across the sun's rays (a deep shadow map) in *slabs* along the sun axis,
 nearest the sun first, its footprints cut at ``CUT`` sigma: up to ``SLABS`` slabs of
 about equal count, splatted as points into a few width classes, each blurred with its
 own Gaussian (separable, mass-preserving); its particles are visited in memory order,
@@ -50,6 +51,10 @@ its face, a sigma sunward, slabs of hundreds of particles (one per 2,048, at lea
 0.92."""
 SMALL = 2048
 """Up to this many particles a cloud is lit pair by pair (``_pairs``), with no grid."""
+SPARSE = 16384
+"""Up to this many particles a cloud is also lit pair by pair when its pairs within reach across
+the rays are no more than a cloud of SMALL particles can have (``_pair_axis``): a cloud strung out
+across the sun's rays, whose grid cells are too wide for its particles."""
 REACH = 8.0
 """In a small cloud a particle shades the others within REACH x its sigma of its centre across the
 sun's rays, and those less than that farther from the sun: beyond, its Gaussian is under e^-32 of
@@ -94,6 +99,11 @@ face: read at the face, the shipped tables' mean light at 2,049 particles was 1.
 at 2,048 (10-20x the reference's with scattering off); 0.3 sigma gave 0.84-0.95x, 0.4 gives
 0.97-1.10x, 0.5 1.10-1.25x. It used to fade out by 8,192 particles, to keep the rank against the
 optical depth at the centre; the reference now takes it at the face, as the colour does."""
+
+
+def slab_count(n: int) -> int:
+    """How many slabs a big cloud of ``n`` particles goes through by default."""
+    return min(n, SLABS, max(FEW_SLABS, n // SLAB_PARTICLES))
 
 
 def slab_lead(n: int) -> float:
@@ -215,7 +225,8 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
 
     ``centers`` (N, 3), ``radii`` (N,) and ``density`` (N,) as in :class:`fishgen.clouds.Cloud`.
     ``slabs``: go through that many slabs (at most N), whatever the size; by default a cloud of up
-    to SMALL particles is lit pair by pair, a bigger one through FEW_SLABS to SLABS slabs.
+    to SMALL particles is lit pair by pair, and so is one of up to SPARSE whose pairs are as few
+    (``_pair_axis``); a bigger one through FEW_SLABS to SLABS slabs.
     ``grid_cells``: at most that many cells along a side of the slabs' light map (default GRID).
     A sky, far wider than its clouds, needs more (fishgen.sky.light).
     ``share``: the share of its optical depth every particle casts (default ``depth_share`` of
@@ -229,23 +240,23 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     if share is None:
         share = depth_share(centers, radii, density, lighting)
     share = float(share)
-    small = n <= SMALL and slabs is None
     frame = _frame(np.array(lighting.sun_unit, np.float64))   # rows: sun, across a, across b
     middle = _middle(centers)
+    axis = (None if slabs is not None else 0 if n <= SMALL
+            else _pair_axis(centers, radii, frame, middle) if n <= SPARSE else None)
     forward = _F32(lighting.forward_fraction)
-    if small:
+    if axis is not None:
         _pairs(centers, radii, density, frame, middle, lighting.extinction, lighting.forward_fraction, light,
-               share)
+               share, axis=axis)
     else:
-        count = (min(n, SLABS, max(FEW_SLABS, n // SLAB_PARTICLES)) if slabs is None
-                 else max(1, min(n, int(slabs))))
+        count = slab_count(n) if slabs is None else max(1, min(n, int(slabs)))
         light = _slabs(centers, radii, density, frame, middle, count, lighting.extinction, forward, light,
                        grid_cells, lead=slab_lead(n), share=share)
     return light
 
 
 def _pairs(centers, radii, density, frame, middle, extinction: float, forward: float, light,
-           share: float = 1.0) -> None:
+           share: float = 1.0, axis: int = 0) -> None:
     """A small cloud, pair by pair: each particle's light from every other particle's Gaussian.
 
     Particle j's optical depth on the ray from particle i's centre towards the sun is its
@@ -262,14 +273,16 @@ def _pairs(centers, radii, density, frame, middle, extinction: float, forward: f
     depth e(d), of which the same share Phi counts (as the slabs take half their own slab's).
     So with scattering off the light is exactly ``light_of_depth(tau)``.
 
-    No grid: the particles sorted across the rays, each block of them weighed against those
-    within REACH of the widest sigma across the rays; every sum runs in that order, so the
-    input's order changes nothing.
+    No grid: the particles sorted along ``axis`` across the rays (a or b), each block of them
+    weighed against those within REACH of the widest sigma along it; every sum runs in that order,
+    so the input's order changes nothing.
     """
     n = len(centers)
     p = centers.astype(np.float64) - middle
     x, y, z = p.T
     depth, a, b = (x * row[0] + y * row[1] + z * row[2] for row in frame)    # written out: no BLAS
+    if axis:
+        a, b = b, a
     order = np.lexsort((depth, b, a))
     depth, a, b = depth[order], a[order], b[order]
     sigma = radii[order].astype(np.float64) * SIGMA
@@ -305,6 +318,26 @@ def _pairs(centers, radii, density, frame, middle, extinction: float, forward: f
         shade *= _normal_cdf(along[i, j])
         tau[start:stop] = np.bincount(i, shade, minlength=stop - start)
     light[order] = light_of_depth(tau.astype(_F32))
+
+
+def _pair_axis(centers, radii, frame, middle) -> int | None:
+    """The axis across the rays (0: a, 1: b) along which ``_pairs`` would weigh the fewest pairs of
+    this cloud, if they are at most SMALL x SMALL (what a cloud of SMALL particles may cost); else
+    None. The same windows as ``_pairs``, counted, not weighed: two sorts."""
+    n = len(centers)
+    x, y, z = (centers.astype(np.float64) - middle).T
+    reach = REACH * SIGMA * float(radii.max())
+    rows = max(1, PAIRS // n)
+    starts = np.arange(0, n, rows)
+    stops = np.minimum(starts + rows, n)
+    work = []
+    for row in frame[1:]:
+        across = np.sort(x * row[0] + y * row[1] + z * row[2])      # as ``_pairs`` writes it
+        first = np.searchsorted(across, across[starts] - reach, "left")
+        last = np.searchsorted(across, across[stops - 1] + reach, "right")
+        work.append(int(((stops - starts) * (last - first)).sum()))
+    best = int(np.argmin(work))
+    return best if work[best] <= SMALL * SMALL else None
 
 
 def _normal_cdf(z: np.ndarray) -> np.ndarray:

@@ -40,3 +40,17 @@ def test_a_dense_cloud_keeps_its_order_where_e_to_the_minus_tau_is_zero(tmp_path
     assert (particles, cubes) == (26_002, 1)
     low = {sun: round(value, 3) for sun, value in got.items() if value < GOAL}
     assert not low, low
+
+
+def test_a_file_strung_out_just_past_small_is_lit_as_a_small_one(tmp_path):
+    """Seed 671 drawn up to 10^5 particles (``benchmarks/cloud_suns.py --seeds 600-699``): 2,059
+    particles, eleven past SMALL, in 19 cubes strung out over 320 units across a sun from -y.
+    Through 32 slabs, whose grid cells were twice its median particle's sigma, it ranked 0.812
+    (0.828 through 128); its pairs within reach are as few as a small cloud's, so it is lit pair
+    by pair (0.998)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        particles, cubes, got = correlations(671, tmp_path, highest=100_000)
+    assert (particles, cubes) == (2_059, 19)
+    low = {sun: round(value, 3) for sun, value in got.items() if value < 0.95}
+    assert not low, low
