@@ -117,9 +117,9 @@ def routes(groups: dict[str, range], args: argparse.Namespace, repeats: int = 3)
                                         lighting.extinction)
                     slabs, slab_ms = run(cloud, lighting, light_module.slab_count(n))
                     pairs, pair_ms = run(cloud, lighting, None)
-                    print(f"{seed:>5} {n:>9,} {cubes:>5} {name:>9}  {rank_correlation(slabs[query], tau):11.3f}"
-                          f" {slab_ms:5.0f}  {rank_correlation(pairs[query], tau):11.3f} {pair_ms:5.0f}",
-                          flush=True)
+                    before, now = (rank_correlation(light[query], tau) for light in (slabs, pairs))
+                    print(f"{seed:>5} {n:>9,} {cubes:>5} {name:>9}  {before:11.3f} {slab_ms:5.0f}  "
+                          f"{now:11.3f} {pair_ms:5.0f}", flush=True)
     print(f"\n{changed} file-and-sun pairs lit pair by pair past SMALL")
 
 
