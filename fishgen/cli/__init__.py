@@ -82,6 +82,7 @@ def main(argv: list[str] | None = None) -> None:
     from fishgen.errors import FishgenError
 
     args = sys.argv[1:] if argv is None else list(argv)
+    _printable_streams()
     # Known before parsing, so that even an unknown option's error comes out as JSON.
     reset(json_errors="--json" in (args[: args.index("--")] if "--" in args else args))
     signal.signal(signal.SIGTERM, _interrupt)
@@ -119,6 +120,16 @@ def main(argv: list[str] | None = None) -> None:
         long = too_long(err)
         where = f"{err.filename}: " if err.filename and long is None else ""
         _fail(f"fishgen: {where}{long or err.strerror or err}", 1, err.filename, kind="os")
+
+
+def _printable_streams() -> None:
+    """Print what the terminal's encoding cannot show as escapes (``f\\xefsh.glb``), as Python's
+    stderr already does: a file name in a summary line once ended a build whose file had landed in
+    a traceback and exit 1 (``PYTHONIOENCODING=latin-1``, a name with a ``✓``)."""
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)      # a test's buffer may have none
+        if reconfigure is not None and getattr(stream, "errors", None) == "strict":
+            reconfigure(errors="backslashreplace")
 
 
 def status_of(argv: list[str] | None = None) -> int:

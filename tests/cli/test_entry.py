@@ -42,3 +42,15 @@ def test_a_users_choice_of_huge_pages_stands(value):
 def test_a_setting_numpy_cannot_read_is_not_a_traceback(value):
     # numpy raised ValueError at its import, before any of fishgen's error handling
     assert _huge_pages(value) == "False"
+
+
+def test_a_name_the_terminal_cannot_encode_is_printed_escaped(tmp_path):
+    """The summary line names the output; in a latin-1 terminal a ``✓`` in it was a traceback and
+    exit 1 after the file had landed, so a pipeline threw a good asset away."""
+    out = tmp_path / "fïsh✓.glb"
+    env = {**os.environ, "PYTHONIOENCODING": "latin-1"}
+    done = subprocess.run([sys.executable, "-m", "fishgen", "build", str(ROOT / "params" / "bonybream.txt"),
+                           "-o", str(out)], capture_output=True, cwd=ROOT, env=env)
+    assert done.returncode == 0, done.stderr.decode("latin-1")
+    assert out.exists() and b"Traceback" not in done.stderr
+    assert b"\\u2713.glb: bonybream" in done.stdout
