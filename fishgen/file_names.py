@@ -20,6 +20,21 @@ def too_long(name: str) -> bool:
     return any(len(part.encode("utf-8", "surrogateescape")) > NAME_MAX for part in parts)
 
 
+def name_text(name: str) -> str:
+    """A file name as the text whose UTF-8 bytes (surrogates escaped) are its bytes on disk: what
+    a file that names it (a species file, an OBJ, a PLY's header, a USD layer) writes, in any
+    locale. Where the locale's file names are not UTF-8 (``LC_ALL=C``: the bytes are kept as
+    surrogates; latin-1) the name as Python spells it wrote other bytes, or could not be written."""
+    return os.fsencode(name).decode("utf-8", "surrogateescape")
+
+
+def text_name(text: str) -> str:
+    """The file a text names (its UTF-8 bytes), as the file system spells it: ``name_text``'s
+    inverse. ``spëcies.png`` in a species file is the file ``sp\\udcc3\\udcabcies.png`` where the
+    locale is ASCII; opened as spelled, it was a traceback."""
+    return os.fsdecode(text.encode("utf-8", "surrogateescape"))
+
+
 def ascii_name(text: str, fallback: str) -> str:
     """ASCII letters, digits and ``_`` of ``text`` (a name inside a file), its accents dropped
     rather than the letters that carry them: ``ünï🐟`` is ``uni``; ``fallback`` when none is left."""
@@ -53,7 +68,7 @@ def resolve_texture(name: str, roots: Sequence[Path], file: str, line: int) -> P
     escaped = False
     folder = other = None
     for root in roots:
-        candidate = (root / name).resolve()
+        candidate = (root / text_name(name)).resolve()
         if not candidate.is_relative_to(root):
             escaped = True
             continue

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fishgen.errors import FishgenError, UsageError
-from fishgen.file_names import NAME_MAX, ascii_name, texture_token_problem
+from fishgen.file_names import NAME_MAX, ascii_name, name_text, texture_token_problem
 
 MASK_SUFFIX = "_mask.png"
 
@@ -50,7 +50,8 @@ def texture_names(species_file: str | os.PathLike) -> TextureNames:
     derived pair that is (see the module's text)."""
     path = Path(species_file)
     stem = path.stem
-    why = texture_token_problem(stem + MASK_SUFFIX) or texture_token_problem(stem + ".png")
+    text = name_text(stem)     # as the species file will name them
+    why = texture_token_problem(text + MASK_SUFFIX) or texture_token_problem(text + ".png")
     if why is None:
         return TextureNames(path, stem + ".png", stem + MASK_SUFFIX)
     safe = re.sub(r"[\s/\\\ud800-\udfff]+", "_", stem)
@@ -158,7 +159,7 @@ def sample_files(seed: int, stem: str, textures: TextureNames | None = None) -> 
     names = textures or TextureNames(Path(f"{stem}.txt"), f"{stem}.png", f"{stem}{MASK_SUFFIX}")
     sample = sample_species(seed, stem)
     sp = replace(sample.species, name=stem)
-    text = format_species(sp, names.colour, names.mask)
+    text = format_species(sp, name_text(names.colour), name_text(names.mask))
     file_name = names.species_file.name
     parse_species(text, file_name)   # a sample the parser would refuse is a bug here, not the user's
     colour, mask = texture_files(sp, sample.palette, seed)
@@ -205,4 +206,4 @@ def write_samples(seed: int, count: int, output: Path, folder: bool | None = Non
 
 def species_name(species_file: Path) -> str:
     """The species' name inside its file: ASCII letters, digits and ``_`` of the file's name."""
-    return ascii_name(species_file.stem, "species")
+    return ascii_name(name_text(species_file.stem), "species")

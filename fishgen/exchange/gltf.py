@@ -15,7 +15,6 @@ import json
 import struct
 from pathlib import Path
 from typing import Any
-from urllib.parse import quote
 
 import numpy as np
 
@@ -284,14 +283,14 @@ def write_glb(scene: Scene, path: Path) -> list[Path]:
 
 def write_gltf(scene: Scene, path: Path) -> list[Path]:
     """``.gltf`` JSON with the buffer and images as files beside it (URIs percent-encoded)."""
-    from fishgen.exchange.sidefiles import check_shared, image_side_stems
+    from fishgen.exchange.sidefiles import check_shared, image_side_stems, name_uri
 
     stem = path.stem
     stems = image_side_stems(stem, [image.name for image in scene.images])
     names = [f"{side}.{'jpg' if image.mime_type == 'image/jpeg' else 'png'}"
              for side, image in zip(stems, scene.images, strict=True)]
-    doc, buf = build_document(scene, path, image_uri=lambda k: quote(names[k]))
-    doc["buffers"][0] = {"uri": quote(f"{stem}.bin"), **doc["buffers"][0]}
+    doc, buf = build_document(scene, path, image_uri=lambda k: name_uri(names[k]))
+    doc["buffers"][0] = {"uri": name_uri(f"{stem}.bin"), **doc["buffers"][0]}
     files: dict[Path, bytes] = {path: document_json(doc, path),
                                 path.with_name(f"{stem}.bin"): _blob(buf)}
     for name, image in zip(names, scene.images, strict=True):

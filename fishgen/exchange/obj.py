@@ -8,6 +8,7 @@ import numpy as np
 from fishgen.atomic import write_files
 from fishgen.exchange.rest import rest_meshes
 from fishgen.exchange.sidefiles import check_shared, image_side_stems
+from fishgen.file_names import name_text
 from fishgen.scene.model import Scene
 
 
@@ -43,7 +44,8 @@ def write_obj(scene: Scene, path: Path) -> list[Path]:
     mtl_name = f"{stem}.mtl"
     stems = image_side_stems(stem, [image.name for image in scene.images])
     textures = {k: f"{side}.png" for k, side in enumerate(stems)}
-    lines = [f"# fishgen: {scene.name} (rest pose, metres, +Y up, head towards +Z)", f"mtllib {mtl_name}"]
+    lines = [f"# fishgen: {scene.name} (rest pose, metres, +Y up, head towards +Z)",
+             f"mtllib {name_text(mtl_name)}"]
     offset = 0
     for part in rest_meshes(scene):
         uv = part.uvs if part.uvs is not None else np.zeros((len(part.positions), 2))
@@ -61,13 +63,15 @@ def write_obj(scene: Scene, path: Path) -> list[Path]:
         mtl += [f"newmtl {mat.name}", f"Kd {r:.6f} {g:.6f} {b:.6f}", "Ka 0 0 0", "Ks 0.04 0.04 0.04",
                 f"d {a:.6f}", "illum 2"]
         if mat.texture is not None:
-            mtl.append(f"map_Kd {textures[mat.texture]}")
+            mtl.append(f"map_Kd {name_text(textures[mat.texture])}")
             if mat.alpha_mode == "MASK":
                 # A separate greyscale picture: three.js's MTLLoader reads no `-imfchan` option (it
                 # asked for a file named "-imfchan m ...") and every reader takes map_d's grey as alpha.
-                mtl.append(f"map_d {masks[mat.texture]}")
+                mtl.append(f"map_d {name_text(masks[mat.texture])}")
         mtl.append("")
-    files = {path: ("\n".join(lines) + "\n").encode(), path.with_name(mtl_name): "\n".join(mtl).encode()}
+    # the names' bytes are the file system's (name_text), the rest UTF-8
+    files = {path: ("\n".join(lines) + "\n").encode("utf-8", "surrogateescape"),
+             path.with_name(mtl_name): "\n".join(mtl).encode("utf-8", "surrogateescape")}
     for k, name in textures.items():
         files[path.with_name(name)] = scene.images[k].encoded()
     for k, name in masks.items():

@@ -17,6 +17,7 @@ from fishgen.errors import FishgenError
 from fishgen.exchange.particles import only_points, particle_chunks, particle_columns
 from fishgen.exchange.rest import rest_meshes
 from fishgen.exchange.sidefiles import check_shared, image_side_stems
+from fishgen.file_names import name_text
 from fishgen.scene.model import Scene
 
 VERTEX = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("nx", "<f4"), ("ny", "<f4"),
@@ -63,12 +64,14 @@ def _write_mesh(scene: Scene, path: Path) -> list[Path]:
     header = ["ply", "format binary_little_endian 1.0",
               f"comment fishgen {_ascii(scene.name)} rest pose, metres, +Y up"]
     if texture:
-        header.append(f"comment TextureFile {texture}")
+        header.append(f"comment TextureFile {name_text(texture)}")
     header += [f"element vertex {len(vertices)}"] + [f"property float {n}" for n in VERTEX.names or ()]
     header += [f"element face {len(faces)}", "property list uchar int vertex_indices", "end_header", ""]
-    # The header is ASCII but for a texture's file name, which must be the file's own: UTF-8, as
-    # trimesh (and so fishgen's reader) reads it; "pòisson.ply" was a traceback.
-    files = {path: "\n".join(header).encode("utf-8") + vertices.tobytes() + faces.tobytes()}
+    # The header is ASCII but for a texture's file name, which must be the file's own bytes: UTF-8
+    # where the file system's names are, as trimesh (and so fishgen's reader) reads it; "pòisson.ply"
+    # was a traceback.
+    files = {path: "\n".join(header).encode("utf-8", "surrogateescape") + vertices.tobytes()
+             + faces.tobytes()}
     if texture and image is not None:
         files[path.with_name(texture)] = image.encoded()
     check_shared(path, files)

@@ -13,10 +13,23 @@ import re
 import stat
 from collections.abc import Mapping
 from pathlib import Path
-from urllib.parse import quote, unquote
+from urllib.parse import quote, unquote_to_bytes
 
 from fishgen.errors import describe, expected
-from fishgen.file_names import NAME_MAX, too_long
+from fishgen.file_names import NAME_MAX, name_text, text_name, too_long
+
+
+def name_uri(name: str) -> str:
+    """A side file's name as a glTF URI: its bytes on disk, percent-encoded. ``quote(name)``
+    encoded the name as UTF-8 text, so where the locale's file names are not UTF-8 the URI named
+    another file (latin-1) or raised (ASCII, the name's bytes kept as surrogates)."""
+    return quote(os.fsencode(name))
+
+
+def uri_name(uri: str) -> str:
+    """The file name a percent-encoded URI gives, as the file system spells it."""
+    return os.fsdecode(unquote_to_bytes(uri))
+
 
 _SCHEME = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:")
 """``http:``, ``file:``, ``C:`` ... - anything but a plain relative path."""
@@ -36,9 +49,11 @@ def side_file(asset: str | Path, ref: str, *, uri: bool = False, must_exist: boo
     if _SCHEME.match(name) or name.startswith(("/", "~")):
         raise expected("a relative file name inside the asset's folder", describe(ref), asset)
     if uri:
-        name = unquote(name)  # glTF URIs are percent-encoded ("my%20skin.png")
+        name = uri_name(name)  # glTF URIs are percent-encoded ("my%20skin.png")
         if "\0" in name or name.startswith("/"):
             raise expected("a relative file name inside the asset's folder", describe(ref), asset)
+    else:
+        name = text_name(name)  # an OBJ's or PLY's text names a file by its bytes
     if too_long(name):
         raise expected(f"a file name of at most {NAME_MAX} bytes a part", f"{describe(ref)} "
                        f"({len(name.encode('utf-8', 'surrogateescape')):,} bytes)", asset)
@@ -142,7 +157,7 @@ def check_shared(asset: str | os.PathLike, files: Mapping[Path, bytes]) -> None:
             if other not in texts:
                 texts[other] = _head(other)
             if any(form.encode("utf-8", "surrogateescape") in texts[other]
-                   for form in (side.name, quote(side.name))):
+                   for form in (name_text(side.name), name_uri(side.name))):
                 obj = other.with_suffix(".obj")      # an OBJ names its textures in its .mtl
                 other = obj if other.suffix.lower() == ".mtl" and obj.is_file() else other
                 raise UsageError(f"expected side files no other asset names, found {side.name!r}, named by "

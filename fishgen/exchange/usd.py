@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from fishgen.file_names import name_text
 from fishgen.scene.model import Image, Instancer, Material, Scene
 from fishgen.scene.pose import dequantized, pose, sample_many, trs_matrix
 
@@ -35,28 +36,39 @@ DEFAULT_FPS = 30.0
 def write_usd(scene: Scene, path: str | os.PathLike) -> list[Path]:
     """Write ``scene`` as USD in the encoding its extension names; returns the files written."""
     from fishgen.atomic import write_files
+    from fishgen.errors import describe, expected
     from fishgen.exchange.sidefiles import check_shared
 
     path = Path(path)
     suffix = path.suffix.lower()
+    try:
+        name_text(path.name).encode("utf-8")
+    except UnicodeEncodeError:
+        raise expected("a file name whose bytes are UTF-8 (USD names its files in UTF-8)",
+                       describe(path.name), path) from None
     pictures = _Pictures(path.stem)
     with tempfile.TemporaryDirectory(prefix="fishgen-usd-") as work:
+        # ASCII names in the work folder: usd-core takes paths as UTF-8 text, which a name the
+        # locale does not spell in UTF-8 (its bytes kept as surrogates) is not
         folder = Path(work)
-        inner = folder / (path.stem + (".usdc" if suffix == ".usdz" else suffix))
+        inner = folder / ("layer" + (".usdc" if suffix == ".usdz" else suffix))
         stage = _stage(scene, pictures)   # held: the layer is the stage's, a weak handle
         stage.GetRootLayer().Export(str(inner))
-        for name, data in pictures.files.items():
-            (folder / name).write_bytes(data)
         if suffix == ".usdz":
             from pxr import Sdf
 
             package = folder / ("package" + suffix)
             writer = Sdf.ZipFileWriter.CreateNew(str(package))
-            for name in [inner.name, *pictures.files]:  # the layer first: usdz's default layer
+            # the layer first: usdz's default layer
+            entries = [(inner, path.stem + ".usdc")]
+            for k, (name, data) in enumerate(pictures.files.items()):
+                entries.append((folder / f"picture{k}.png", name))
+                entries[-1][0].write_bytes(data)
+            for local, name in entries:
                 # the archive records each file's local time: a fixed one keeps packages identical
                 stamp = time.mktime(PACKAGE_TIME)
-                os.utime(folder / name, (stamp, stamp))
-                writer.AddFile(str(folder / name), name)
+                os.utime(local, (stamp, stamp))
+                writer.AddFile(str(local), name_text(name))
             writer.Save()
             files = {path: package.read_bytes()}
         else:
@@ -69,7 +81,8 @@ def write_usd(scene: Scene, path: str | os.PathLike) -> list[Path]:
 
 @dataclass
 class _Pictures:
-    """The texture files: one per distinct picture, named after the USD file and the image."""
+    """The texture files: one per distinct picture, named after the USD file and the image (as
+    the file system spells them; the layer names them by ``name_text``)."""
 
     stem: str
     files: dict[str, bytes] = field(default_factory=dict)
@@ -379,7 +392,7 @@ def _material(stage, looks, scene: Scene, index: int, pictures: _Pictures):
         texture = UsdShade.Shader.Define(stage, material.GetPath().AppendChild("BaseColor"))
         texture.CreateIdAttr("UsdUVTexture")
         texture.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(
-            Sdf.AssetPath("./" + pictures.name(scene.images[m.texture])))
+            Sdf.AssetPath("./" + name_text(pictures.name(scene.images[m.texture]))))
         texture.CreateInput("sourceColorSpace", Sdf.ValueTypeNames.Token).Set("sRGB")
         texture.CreateInput("wrapS", Sdf.ValueTypeNames.Token).Set("repeat")
         texture.CreateInput("wrapT", Sdf.ValueTypeNames.Token).Set("repeat")

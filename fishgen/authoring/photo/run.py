@@ -464,6 +464,7 @@ def _candidate(photo: Photo, mask: np.ndarray, base: Species, out: Path, options
         pts = replace(pts, **{part: tuple(values)})
     measured = replace(measured, unseen=tuple(n for n in measured.unseen if n not in imported))
     from fishgen.authoring.species_files import species_name, texture_names
+    from fishgen.file_names import name_text
 
     name = species_name(out)
     names = texture_names(out)   # NEW.png and NEW_mask.png, unless a species file cannot name them
@@ -475,7 +476,7 @@ def _candidate(photo: Photo, mask: np.ndarray, base: Species, out: Path, options
     masked = base.masked or fit is not None
     species = replace(base, name=name, textured=True, masked=masked, texture_points=pts,
                       colour_texture=None, mask_texture=None, source=None)
-    text = format_species(species, colour_name, mask_name)
+    text = format_species(species, name_text(colour_name), name_text(mask_name))
     parse_species(text, out)   # what we write must read back (section ranges, counts)
     files = {out: text.encode(), out.with_name(colour_name): textures[0],
              out.with_name(mask_name): textures[1]}
