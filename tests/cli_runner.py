@@ -10,11 +10,19 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def run_cli_process(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+def run_cli_process(*args: str, cwd: Path | None = None,
+                    env: dict[str, str | None] | None = None) -> subprocess.CompletedProcess:
     """Run the real `fishgen` command line in a subprocess: for what only a process shows (the
-    exit status the shell sees, signals, start-up imports)."""
+    exit status the shell sees, signals, start-up imports, its environment: ``env`` sets a
+    variable, or unsets it with None)."""
+    environ = dict(os.environ)
+    for key, value in (env or {}).items():
+        if value is None:
+            environ.pop(key, None)
+        else:
+            environ[key] = value
     return subprocess.run([sys.executable, "-m", "fishgen", *map(str, args)], cwd=cwd or ROOT,
-                          capture_output=True, text=True)
+                          capture_output=True, text=True, env=environ)
 
 
 def run_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:

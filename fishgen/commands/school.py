@@ -216,9 +216,14 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     numbers: dict = {}
     table = ""
     if "metrics" in sides or "plot" in sides:
+        import numpy as np
+
         from fishgen.school.metrics import summary
 
-        per_frame = run.measures(every_frame=True)
+        # to the digits the file keeps, before the means: the measures' sums go through BLAS,
+        # whose kernels (one per CPU family) differ in the last bits, and the summary's full
+        # floats showed it (OPENBLAS_CORETYPE=Zen changed metrics.json; QA pass 17)
+        per_frame = {k: np.round(v, METRIC_DIGITS) for k, v in run.measures(every_frame=True).items()}
         numbers = summary(per_frame, warmup)
     if events.summary:  # else nobody reads the table: only what it prints is measured
         table = run.summary(per_frame or None)
@@ -286,6 +291,10 @@ def _write_all(output: Path, run, sides: dict[str, Path], per_frame: dict, numbe
     return files, sizes
 
 
+METRIC_DIGITS = 6
+"""Decimals a measure keeps in metrics.json, per frame and in the summary."""
+
+
 def _metrics_json(run, per_frame: dict, numbers: dict, warmup: int) -> bytes:
     import json
     import math
@@ -297,12 +306,14 @@ def _metrics_json(run, per_frame: dict, numbers: dict, warmup: int) -> bytes:
         none finite is null, since strict JSON parsers refuse NaN and Infinity."""
         if isinstance(value, dict):
             return {str(k): plain(v) for k, v in value.items()}
+        if isinstance(value, list):
+            return [plain(v) for v in value]
         if isinstance(value, np.ndarray):
-            rounded = np.round(value.astype(float), 6).astype(object)
+            rounded = np.round(value.astype(float), METRIC_DIGITS).astype(object)
             rounded[~np.isfinite(value.astype(float))] = None
             return rounded.tolist()
         if isinstance(value, (np.floating, np.integer, float)):
-            number = float(value)
+            number = round(float(value), METRIC_DIGITS)
             return number if math.isfinite(number) else None
         return value
 

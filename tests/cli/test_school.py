@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import os
+import platform
 import subprocess
 import sys
 
@@ -10,7 +11,7 @@ import numpy as np
 import pygltflib
 import pytest
 
-from tests.conftest import PARAMS, ROOT, assert_valid_gltf, run_cli
+from tests.conftest import PARAMS, ROOT, assert_valid_gltf, run_cli, run_cli_process
 
 
 def test_the_exact_form_writes_a_valid_animated_school(tmp_path):
@@ -400,3 +401,18 @@ def test_prototypes_are_refused_for_an_output_without_them(tmp_path):
         f"fishgen school: expected --prototypes with a USD output (.usdc, .usda, .usdz), found -o "
         f"'{tmp_path / 's.glb'}'\n")
     assert not (tmp_path / "s.glb").exists()
+
+
+@pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"), reason="OpenBLAS's x86-64 kernels")
+def test_metrics_are_the_same_whichever_blas_kernel_sums_them(tmp_path):
+    """The measures' sums go through BLAS, whose kernel follows the CPU: OpenBLAS's for SSE3
+    (Prescott, which any x86-64 runs) changed the summary's last digits."""
+    def metrics(name: str, kernel: str | None) -> bytes:
+        out = tmp_path / f"{name}.json"
+        done = run_cli_process("-q", "school", PARAMS / "bonybream.txt", PARAMS / "threadfingoldie.txt",
+                               "--count", "15", "--frames", "60", "-o", tmp_path / f"{name}.glb",
+                               "--metrics", out, env={"OPENBLAS_CORETYPE": kernel})
+        assert done.returncode == 0, done.stderr
+        return out.read_bytes()
+
+    assert metrics("default", None) == metrics("sse3", "Prescott")
