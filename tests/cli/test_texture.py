@@ -2,6 +2,7 @@
 for unseen fins, and one-line errors (exit 2, no traceback, nothing written) for bad photos."""
 from __future__ import annotations
 
+import platform
 import re
 import struct
 import zlib
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image, ImageDraw, ImageFilter
 
-from tests.conftest import PARAMS, assert_valid_gltf, run_cli
+from tests.conftest import PARAMS, assert_valid_gltf, run_cli, run_cli_process
 
 SMALL = (640, 320)
 
@@ -420,3 +421,18 @@ def test_a_greyscale_photo_that_misfits_says_so_not_that_the_base_is_wrong(tmp_p
         assert "a greyscale photo" in r.stderr and "give --mask" in r.stderr and "--fit-shape" not in r.stderr
     else:   # a renderer that draws this fish apart from its water: nothing to advise
         assert "greyscale" not in r.stderr
+
+
+@pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"), reason="OpenBLAS's x86-64 kernels")
+def test_the_species_file_is_the_same_whichever_blas_kernel_maps_the_points(tmp_path):
+    """The texture points pass through products BLAS computes, whose kernel follows the CPU:
+    OpenBLAS's for SSE3 (Prescott, which any x86-64 runs) changed one point's last bit."""
+    def species(folder: str, kernel: str | None) -> bytes:
+        out = tmp_path / folder / "fish.txt"
+        out.parent.mkdir()
+        done = run_cli_process("-q", "texture", PARAMS / "photos" / "bonybream-side.png",
+                               "-s", PARAMS / "centroberyx.txt", "-o", out, env={"OPENBLAS_CORETYPE": kernel})
+        assert done.returncode == 0, done.stderr
+        return out.read_bytes()
+
+    assert species("default", None) == species("sse3", "Prescott")

@@ -155,6 +155,10 @@ def _on_fish(points: np.ndarray, mask: np.ndarray) -> np.ndarray:
     return out
 
 
+UV_DECIMALS = 9
+"""Decimals a measured texture point keeps."""
+
+
 def measure(photo: Photo, base: Species, mask: np.ndarray, spacing: str = "projected",
             fit: Any = None, level_by: Species | None = None,
             seen_from: tuple[float, tuple[int, int]] | None = None) -> Measured:
@@ -165,6 +169,9 @@ def measure(photo: Photo, base: Species, mask: np.ndarray, spacing: str = "proje
 
     def uv(frame_pts: np.ndarray) -> tuple[tuple[float, float], ...]:
         p = np.clip(a.frame.to_photo(frame_pts.reshape(-1, 2)) / size, 0.0, 1.0)
+        # to UV_DECIMALS (1e-5 of a pixel of a 10,000-pixel photo): the products go through BLAS,
+        # whose kernel follows the CPU, and a last bit of one point changed the species file
+        p = np.round(p, UV_DECIMALS)
         return tuple((float(u), float(v)) for u, v in p)
 
     parts: dict[str, tuple[tuple[float, float], ...]] = {"body": uv(a.body)}
