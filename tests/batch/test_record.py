@@ -1,6 +1,7 @@
 """Incremental runs: a job runs again exactly when a file it reads, its options or its output changed."""
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -95,3 +96,24 @@ def test_changed_options_rebuild_the_job_and_a_damaged_record_rebuilds_everythin
     (out / ".fishgen-batch.json").write_text("{not json")
     assert rebuilt(batch(manifest, "-j", "2")) == ALL
     assert set(record(out)) == ALL
+
+
+def test_a_job_built_with_other_library_versions_runs_again(tmp_path):
+    """Pillow 10.4 and 13.0 drew one random species' texture 15 pixels apart: a record holding
+    fishgen's version alone kept the old picture after an upgrade."""
+    from fishgen.batch.record import library_versions
+
+    (tmp_path / "cube.awn").write_bytes((ROOT / "params" / "clouds" / "table_4_3.awn").read_bytes())
+    manifest = tmp_path / "assets.toml"
+    manifest.write_text('out = "out"\n\n[[clouds]]\ninput = "cube.awn"\noutput = "cloud.ply"\n')
+    out = tmp_path / "out"
+    assert statuses(batch(manifest).stdout) == {"cloud.ply": "built"}
+    entry = record(out)["cloud.ply"]
+    assert entry["libraries"] == library_versions() and "numpy" in entry["libraries"]
+    assert statuses(batch(manifest).stdout) == {"cloud.ply": "skipped"}
+    whole = json.loads((out / ".fishgen-batch.json").read_text())
+    whole["jobs"]["cloud.ply"]["libraries"]["numpy"] = "1.0"
+    (out / ".fishgen-batch.json").write_text(json.dumps(whole))
+    again = batch(manifest, "--verbose")
+    assert statuses(again.stdout) == {"cloud.ply": "built"}
+    assert f"numpy 1.0 built it, this is {library_versions()['numpy']}" in again.stdout
