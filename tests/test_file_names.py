@@ -26,16 +26,17 @@ def test_a_name_is_written_by_its_bytes_and_read_back_as_the_same_file():
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="a locale whose file names are not UTF-8")
 def test_an_ascii_locale_writes_the_same_files_for_a_name_that_is_not_ascii(tmp_path):
-    """``LC_ALL=C`` (Python's coercion off): the .gltf's URIs and the OBJ's, PLY's, USD's and
-    species file's names were a traceback (surrogates), the species file named its textures
-    ``f_sh.png``, and a species file naming ``spëcies.png`` could not be read. Now every file's
-    bytes are those a UTF-8 locale writes."""
+    """``LC_ALL=C`` (Python's coercion off): the .gltf's URIs, the OBJ's, PLY's, USD's and species
+    file's names and the viewer's page were a traceback (surrogates), the species file named its
+    textures ``f_sh.png``, and a species file naming ``spëcies.png`` could not be read. Now every
+    file's bytes are those a UTF-8 locale writes."""
     def run(env: dict[str, str], folder: Path) -> dict[str, bytes]:
         folder.mkdir()
         species = folder / "spëcies.txt"
         commands = [["species", "--random", "--seed", "3", "-o", str(species)],
                     *(["build", str(species), "-o", str(folder / f"fïsh.{ext}")]
-                      for ext in ("gltf", "obj", "ply", "usdz"))]
+                      for ext in ("gltf", "obj", "ply", "usdz")),
+                    ["view", "--no-serve", str(folder / "fïsh.gltf"), "-o", str(folder / "vïew.html")]]
         for args in commands:
             done = subprocess.run([sys.executable, "-m", "fishgen", "-q", *args], capture_output=True,
                                   cwd=ROOT, env={**os.environ, **env})

@@ -19,6 +19,7 @@ from pathlib import Path
 from fishgen.clouds.lighting import Lighting
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES
 from fishgen.errors import FishgenError, UsageError
+from fishgen.file_names import name_text
 
 MAX_ASSET_BYTES = 1 << 30
 """Most bytes of glb the page is handed (a browser tab holds about this much; a thick sky is 41 MB)."""
@@ -74,10 +75,10 @@ def prepare_assets(inputs: Sequence[str | os.PathLike], *, mode: str | None = No
     elif cubes:
         scene, files = cube_files_scene(cubes, seed=seed, lighting=lighting, textures_dir=textures_dir,
                                         max_particles=max_particles)
-        out.append(Asset(", ".join(p.name for p in cubes), glb_bytes(scene), "cubes"))
+        out.append(Asset(", ".join(name_text(p.name) for p in cubes), glb_bytes(scene), "cubes"))
         read += files
     for path in assets:
-        out.append(Asset(path.name, _glb(path), "glb"))
+        out.append(Asset(name_text(path.name), _glb(path), "glb"))   # shown on the page, as text
         read.append(path)
     return out, read
 

@@ -16,6 +16,7 @@ from urllib.parse import unquote
 from fishgen.errors import FishgenError
 from fishgen.exchange.registry import FORMATS, formats
 from fishgen.exchange.sidefiles import map_file_name, mtl_libraries, side_file
+from fishgen.file_names import name_text
 from fishgen.viewer import MAX_EMBED_BYTES
 from fishgen.web.page import page_html
 
@@ -87,15 +88,16 @@ def build_page(asset: str | Path, background: str = "#8cadcc", *, instancing: bo
     # Parse it as `fishgen preview` does: a truncated or garbage asset is refused, not embedded.
     FORMATS[kind].read(asset)
     extra, mtl = sidecars(asset)
-    files = {asset.name: asset, **extra}
+    main = name_text(asset.name)      # the page names it as text, whatever the locale
+    files = {main: asset, **extra}
     total = sum(p.stat().st_size for p in files.values())
     if total > MAX_EMBED_BYTES:
         raise FishgenError(f"expected at most {MAX_EMBED_BYTES >> 20} MiB to embed in a page, "
                            f"found {total / 2**20:.0f} MiB", asset)
-    payload = {"main": asset.name, "kind": kind, "mtl": mtl, "background": background,
+    payload = {"main": main, "kind": kind, "mtl": mtl, "background": background,
                "instancing": instancing,
                "files": {name: base64.b64encode(p.read_bytes()).decode("ascii") for name, p in files.items()}}
-    return page_html("viewer", asset.name, ("fishgen-asset", payload))
+    return page_html("viewer", main, ("fishgen-asset", payload))
 
 
 def write_page(asset: str | Path, page: str | Path | None = None, background: str = "#8cadcc", *,

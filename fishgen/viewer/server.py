@@ -11,8 +11,9 @@ import os
 import stat
 from http import HTTPStatus
 from pathlib import Path
-from urllib.parse import quote
+from urllib.parse import unquote
 
+from fishgen.exchange.sidefiles import name_uri
 from fishgen.viewer import MAX_EMBED_BYTES
 from fishgen.web.server import LocalServer, Refused, Request, Response
 
@@ -41,9 +42,11 @@ def make_server(page: Path, port: int) -> LocalServer:
     def no_icon(request: Request) -> Response:  # the page's icon is inline; a stray ask gets nothing
         return Response(HTTPStatus.NO_CONTENT)
 
-    routes = {("GET", "/"): serve, ("GET", "/" + page.name): serve, ("GET", "/favicon.ico"): no_icon}
+    # the route is the name a browser asks for: its bytes, percent-decoded as UTF-8 text
+    routes = {("GET", "/"): serve, ("GET", "/" + unquote(name_uri(page.name))): serve,
+              ("GET", "/favicon.ico"): no_icon}
     return LocalServer(routes, port)
 
 
 def url_of(server: LocalServer, page: Path) -> str:
-    return server.url("/" + quote(Path(page).name))
+    return server.url("/" + name_uri(Path(page).name))
