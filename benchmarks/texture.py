@@ -255,7 +255,9 @@ def blender() -> None:
 
 
 if __name__ == "__main__":
-    if "--blender" in sys.argv:
+    if "-h" in sys.argv or "--help" in sys.argv:     # it read no option it did not know: say them
+        print(__doc__)
+    elif "--blender" in sys.argv:
         blender()
     elif "--photographs" in sys.argv:
         photographs()
