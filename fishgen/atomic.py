@@ -476,7 +476,7 @@ def _commit(staged: list[tuple[str, Path]]) -> None:
                 backup = _beside(target, ".old") if len(staged) > 1 and target.is_file() else None
                 undo.append((tmp, backup, target))
                 if backup is not None:
-                    os.replace(target, backup)
+                    _keep(target, backup)
                 try:
                     os.replace(tmp, target)
                 except OSError as err:
@@ -488,7 +488,7 @@ def _commit(staged: list[tuple[str, Path]]) -> None:
                 try:  # every step tried: one that fails must not leave the others undone
                     if backup is not None:
                         if os.path.lexists(backup):
-                            os.replace(backup, target)
+                            _put_back(backup, target)
                     elif len(staged) > 1 and not os.path.lexists(tmp) and target.is_file():
                         os.unlink(target)  # new in this set, and the set does not land
                 except OSError:
@@ -508,6 +508,31 @@ def _commit(staged: list[tuple[str, Path]]) -> None:
                 _discard(backup)
     for _, target in staged:
         _log.info("wrote %s", target)
+
+
+def _keep(target: Path, backup: str) -> None:
+    """Keep ``target`` at ``backup`` for a rollback: a second link to it, so that ``target`` is
+    never missing while its set lands (renamed aside, it was gone for a reader between two renames);
+    renamed aside where the file system has no hard links."""
+    try:
+        os.link(target, backup, follow_symlinks=False)    # a symlink kept as the link it is
+    except (OSError, NotImplementedError):
+        os.replace(target, backup)
+
+
+def _put_back(backup: str, target: Path) -> None:
+    """``target`` as ``_keep`` kept it. Where its new file never landed, the backup is a second link
+    to ``target`` itself, and a rename of one link over another of the same file does nothing
+    (POSIX): the backup is only removed."""
+    try:
+        kept, now = os.lstat(backup), os.lstat(target)
+        same = (kept.st_dev, kept.st_ino) == (now.st_dev, now.st_ino)
+    except FileNotFoundError:
+        same = False
+    if same:
+        os.unlink(backup)
+    else:
+        os.replace(backup, target)
 
 
 def write_bytes(path: str | os.PathLike, data: bytes) -> None:

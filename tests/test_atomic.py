@@ -66,6 +66,31 @@ def test_failed_rename_restores_earlier_targets(tmp_path, monkeypatch):
     assert a.read_bytes() == b"old a" and b.read_bytes() == b"old b" and leftovers(tmp_path) == []
 
 
+@pytest.mark.parametrize("links", [True, False], ids=["hard links", "no hard links"])
+def test_a_set_lands_with_no_moment_its_earlier_files_are_missing(tmp_path, monkeypatch, links):
+    """A reader between two renames of a set found no file: each earlier file was renamed aside
+    before its new one came. It is linked aside now, and renamed only where links are refused
+    (then a rollback still puts it back)."""
+    a, b = tmp_path / "x.gltf", tmp_path / "x.bin"
+    a.write_bytes(b"old a")
+    b.write_bytes(b"old b")
+    real, missing = os.replace, []
+
+    def watched(src, dst):
+        missing.extend(str(t) for t in (a, b) if not t.exists())
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", watched)
+    if not links:
+        def refused(*args, **kwargs):
+            raise OSError(1, "Operation not permitted")
+
+        monkeypatch.setattr(os, "link", refused)
+    write_files({a: b"new a", b: b"new b"})
+    assert a.read_bytes() == b"new a" and b.read_bytes() == b"new b" and leftovers(tmp_path) == []
+    assert missing == ([] if links else [str(a), str(b)])
+
+
 def test_a_failed_set_leaves_no_folder_it_made_even_after_some_renames(tmp_path, monkeypatch):
     a, b = tmp_path / "new" / "a.gltf", tmp_path / "new" / "b.bin"
     real = os.replace
