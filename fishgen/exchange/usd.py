@@ -62,8 +62,9 @@ def write_usd(scene: Scene, path: str | os.PathLike) -> list[Path]:
             # the layer first: usdz's default layer
             entries = [(inner, path.stem + ".usdc")]
             for k, (name, data) in enumerate(pictures.files.items()):
-                entries.append((folder / f"picture{k}.png", name))
-                entries[-1][0].write_bytes(data)
+                local = folder / f"picture{k}.png"
+                local.write_bytes(data)
+                entries.append((local, name))
             for local, name in entries:
                 # the archive records each file's local time: a fixed one keeps packages identical
                 stamp = time.mktime(PACKAGE_TIME)

@@ -6,7 +6,9 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import os
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -374,3 +376,13 @@ def test_a_school_to_usd_says_what_its_prototypes_leave_out(tmp_path):
     assert usd.stdout.splitlines()[0].endswith("(USDC holds no levels of detail or compact keys) (+1 file)")
     glb = run_cli(*args, "-o", tmp_path / "s.glb")
     assert glb.returncode == 0 and "holds no" not in glb.stdout
+
+
+@pytest.mark.skipif(os.name != "posix" or sys.platform == "darwin", reason="a file name that is not UTF-8")
+def test_a_name_whose_bytes_are_not_utf8_is_refused_in_one_line(tmp_path):
+    """USD names its files in UTF-8 text; a latin-1 byte in the name (``caf\\xe9``) was a traceback
+    inside usd-core."""
+    out = tmp_path / "caf\udce9.usda"        # the byte 0xE9, as Python spells it
+    result = run_cli("build", BONYBREAM, "-o", out)
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "expected a file name whose bytes are UTF-8" in result.stderr and list(tmp_path.iterdir()) == []
