@@ -81,9 +81,17 @@ def gl_available():
 _STARTED = pytest.StashKey[float]()
 #: Session fixtures cheap enough that sharing them is no reason to keep their tests together.
 _CHEAP_SHARED = {"gl_available", "tmp_path_factory", "worker_id", "testrun_uid"}
-#: Modules run first (their groups go to the workers before anything else): each is one long
-#: stretch (the README's examples in order; the fuzz run) that would otherwise end the run alone.
-_FIRST = ("tests/test_readme.py", "tests/fuzz/test_fuzz.py")
+#: Modules whose long stretches go to the workers first, longest first (seconds on 2 busy cores): a
+#: group or test that starts late ends the run alone while the other core idles (the core install,
+#: 18-22 s, had started last). The rest follow in groups, most tests first, and single tests last,
+#: which fill in the end. tools/test.sh passes --no-loadscope-reorder so pytest-xdist keeps this
+#: order (it would sort by test count alone, and the README's one 55-s test came after every group).
+_FIRST = ("tests/authoring/test_fit.py",          # the goldie fits' group, 77 s
+          "tests/test_readme.py",                 # the README's examples in order, 55 s
+          "tests/authoring/test_blender_photos.py", "tests/authoring/test_threejs_roundtrip.py",
+          "tests/web/test_schools_browser.py",    # 34-37 s each
+          "tests/test_house.py",                  # the core install, 18-22 s
+          "tests/fuzz/test_fuzz.py")
 
 
 @pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups
@@ -113,11 +121,23 @@ def pytest_collection_modifyitems(config, items):
         keys[id(item)] = mine
         for key in mine[1:]:
             parent[root(key)] = root(mine[0])
+    groups: dict[str, int] = {}
     for item in items:
         mine = keys[id(item)]
         if mine and not item.get_closest_marker("xdist_group"):
             item.add_marker(pytest.mark.xdist_group(root(mine[0])))
-    items.sort(key=lambda item: not item.nodeid.startswith(_FIRST))
+        marker = item.get_closest_marker("xdist_group")
+        if marker is not None:
+            name = marker.args[0] if marker.args else marker.kwargs.get("name", "")
+            groups[name] = groups.get(name, 0) + 1
+
+    def order(item) -> tuple[int, int]:
+        first = next((k for k, module in enumerate(_FIRST) if item.nodeid.startswith(module)), len(_FIRST))
+        marker = item.get_closest_marker("xdist_group")
+        size = groups.get(marker.args[0] if marker.args else marker.kwargs.get("name", "")) if marker else 1
+        return first, -(size or 1)
+
+    items.sort(key=order)     # stable: tests keep their order within a group and among equals
 
 
 def pytest_sessionstart(session):

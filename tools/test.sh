@@ -52,6 +52,6 @@ fi
 # worker: tests/conftest.py), with the 20 slowest printed and the suite's wall time last.
 start=$(date +%s)
 status=0
-python -m pytest -n "${FISHGEN_TEST_WORKERS:-auto}" --dist loadgroup --durations=20 "$@" || status=$?
+python -m pytest -n "${FISHGEN_TEST_WORKERS:-auto}" --dist loadgroup --no-loadscope-reorder --durations=20 "$@" || status=$?
 echo "test suite: $(( $(date +%s) - start )) s wall on $(nproc) cores (pytest exit $status)"
 exit $status
