@@ -144,6 +144,52 @@ def pytest_sessionstart(session):
     session.config.stash[_STARTED] = time.time()
 
 
+#: With FISHGEN_SUITE_TIMELINE=folder, each worker writes when each test starts and ends there, and
+#: the machine's CPU counters at its first and last test: `python tools/suite_timeline.py folder`.
+_TIMELINE = os.environ.get("FISHGEN_SUITE_TIMELINE")
+_timeline: list = []
+
+
+def _record(**event) -> None:
+    if not _timeline:
+        folder = Path(_TIMELINE or ".")
+        folder.mkdir(parents=True, exist_ok=True)
+        _timeline.append(open(folder / f"{os.environ.get('PYTEST_XDIST_WORKER', 'main')}.jsonl", "a",
+                              encoding="utf-8"))
+        _record(cpu=_cpu_counters())
+    _timeline[0].write(json.dumps(event) + "\n")
+    _timeline[0].flush()
+
+
+def _cpu_counters() -> list[int]:
+    try:
+        with open("/proc/stat", encoding="ascii") as stat:
+            return [int(v) for v in stat.readline().split()[1:]]
+    except OSError:
+        return []
+
+
+if _TIMELINE:
+    def pytest_runtest_logstart(nodeid, location):
+        if not _controller():
+            _record(event="start", id=nodeid, t=time.time())
+
+    def pytest_runtest_logfinish(nodeid, location):
+        if not _controller():
+            _record(event="end", id=nodeid, t=time.time())
+
+_CONFIG: list = []
+
+
+def pytest_configure(config):
+    _CONFIG.append(config)
+
+
+def _controller() -> bool:
+    """Whether this process is pytest-xdist's controller, which hears every worker's tests too."""
+    return bool(_CONFIG) and _CONFIG[-1].pluginmanager.has_plugin("dsession")
+
+
 def pytest_terminal_summary(terminalreporter, config):
     """The client matrix's table, when this session's tests (on whichever worker) wrote it."""
     started = config.stash.get(_STARTED, None)
@@ -154,6 +200,9 @@ def pytest_terminal_summary(terminalreporter, config):
 
 
 def pytest_sessionfinish(session, exitstatus):
+    if _timeline:
+        _record(cpu=_cpu_counters())
+        _timeline.pop().close()
     shared = sys.modules.get("tests.browser")
     if shared is not None:
         shared.close()

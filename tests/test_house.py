@@ -48,3 +48,39 @@ def test_benchmarks_and_tools_take_harness_code_not_tests():
                           if name.startswith("tests.")
                           and name.rsplit(".", 1)[-1].startswith(("test_", "conftest"))]
     assert found == []
+
+
+def test_the_suite_timeline_says_where_the_time_goes(tmp_path):
+    """FISHGEN_SUITE_TIMELINE records each test's start and end on each worker, and
+    tools/suite_timeline.py reports the workers' spans, the tail, the machine's idle share and the
+    longest groups, modules and tests."""
+    import os
+
+    folder = tmp_path / "timeline"
+    env = {**os.environ, "FISHGEN_SUITE_TIMELINE": str(folder)}
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-n", "2",
+                           "tests/test_tomlfile.py"], cwd=ROOT, capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert sorted(p.name for p in folder.iterdir()) == ["gw0.jsonl", "gw1.jsonl"]
+    said = _run(sys.executable, "tools/suite_timeline.py", str(folder), "--top", "3")
+    assert said.returncode == 0, said.stderr
+    lines = said.stdout.splitlines()
+    counted = sum(int(line.split()[1]) for line in lines if line.startswith("gw"))
+    assert counted == 5 and any(line.startswith("tail: ") for line in lines)
+    assert any(line.startswith("machine idle over the run: ") for line in lines)
+    assert lines[-4] == "longest tests:" and "tests/test_tomlfile.py::" in lines[-3]
+
+
+def test_the_suite_timeline_report_counts_groups_and_the_tail():
+    sys.path.insert(0, str(ROOT / "tools"))
+    try:
+        from suite_timeline import Test, report
+    finally:
+        sys.path.remove(str(ROOT / "tools"))
+    tests = [Test("gw0", "a.py::x@g", 0.0, 3.0), Test("gw0", "a.py::y@g", 3.0, 4.0),
+             Test("gw1", "b.py::z", 0.0, 10.0)]
+    text = report(tests, [[0, 0, 0, 50, 0], [60, 0, 20, 70, 10]], top=2)
+    assert "gw0: 2 tests, 4.0 s in tests, last ended at 4.0 s" in text
+    assert "tail: the last worker ended 6.0 s after the first" in text
+    assert "machine idle over the run: 27.3 %" in text     # (20 idle + 10 iowait) / 110
+    assert "     10.0 s  b.py::z\n      4.0 s  g\n" in text
