@@ -145,7 +145,8 @@ def pytest_sessionstart(session):
 
 
 #: With FISHGEN_SUITE_TIMELINE=folder, each worker writes when each test starts and ends there, and
-#: the machine's CPU counters at its first and last test: `python tools/suite_timeline.py folder`.
+#: the machine's CPU counters at its first and last test (replacing an earlier run's file there):
+#: `python tools/suite_timeline.py folder`.
 _TIMELINE = os.environ.get("FISHGEN_SUITE_TIMELINE")
 _timeline: list = []
 
@@ -154,7 +155,7 @@ def _record(**event) -> None:
     if not _timeline:
         folder = Path(_TIMELINE or ".")
         folder.mkdir(parents=True, exist_ok=True)
-        _timeline.append(open(folder / f"{os.environ.get('PYTEST_XDIST_WORKER', 'main')}.jsonl", "a",
+        _timeline.append(open(folder / f"{os.environ.get('PYTEST_XDIST_WORKER', 'main')}.jsonl", "w",
                               encoding="utf-8"))
         _record(cpu=_cpu_counters())
     _timeline[0].write(json.dumps(event) + "\n")
