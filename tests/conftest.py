@@ -148,6 +148,13 @@ def pytest_sessionstart(session):
 #: the machine's CPU counters at its first and last test (replacing an earlier run's file there):
 #: `python tools/suite_timeline.py folder`.
 _TIMELINE = os.environ.get("FISHGEN_SUITE_TIMELINE")
+if _TIMELINE:
+    # The run that was given the folder (or its pytest-xdist workers, its children) records; a
+    # pytest some test starts inherits the variable and records nothing (it had truncated the
+    # worker's own file).
+    _OWNER = os.environ.setdefault("FISHGEN_SUITE_TIMELINE_OWNER", str(os.getpid()))
+    if str(os.getppid() if os.environ.get("PYTEST_XDIST_WORKER") else os.getpid()) != _OWNER:
+        _TIMELINE = None
 _timeline: list = []
 
 

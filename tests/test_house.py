@@ -57,7 +57,9 @@ def test_the_suite_timeline_says_where_the_time_goes(tmp_path):
     import os
 
     folder = tmp_path / "timeline"
-    env = {**os.environ, "FISHGEN_SUITE_TIMELINE": str(folder)}
+    inherited = ("PYTEST_XDIST_WORKER", "FISHGEN_SUITE_TIMELINE_OWNER")
+    env = {k: v for k, v in os.environ.items() if k not in inherited}
+    env["FISHGEN_SUITE_TIMELINE"] = str(folder)
     for _ in range(2):      # a second run into the folder replaces the first's timeline
         done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-n", "2",
                                "tests/test_tomlfile.py"], cwd=ROOT, capture_output=True, text=True, env=env)
@@ -70,6 +72,20 @@ def test_the_suite_timeline_says_where_the_time_goes(tmp_path):
     assert counted == 5 and any(line.startswith("tail: ") for line in lines)
     assert any(line.startswith("machine idle over the run: ") for line in lines)
     assert lines[-4] == "longest tests:" and "tests/test_tomlfile.py::" in lines[-3]
+
+
+def test_a_pytest_a_test_starts_records_nothing_in_the_suites_timeline(tmp_path):
+    """A test that runs pytest again (the preview's softpipe run) inherits the variable: that run
+    must not write into the folder, where it had truncated its worker's own file."""
+    import os
+
+    folder = tmp_path / "timeline"
+    env = {k: v for k, v in os.environ.items() if k != "PYTEST_XDIST_WORKER"}
+    env.update(FISHGEN_SUITE_TIMELINE=str(folder), FISHGEN_SUITE_TIMELINE_OWNER="1")  # not this run's
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:xdist",
+                           "tests/test_tomlfile.py"], cwd=ROOT, capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert not folder.exists()
 
 
 def test_the_suite_timeline_report_counts_groups_and_the_tail():
@@ -85,3 +101,11 @@ def test_the_suite_timeline_report_counts_groups_and_the_tail():
     assert "tail: the last worker ended 6.0 s after the first" in text
     assert "machine idle over the run: 27.3 %" in text     # (20 idle + 10 iowait) / 110
     assert "     10.0 s  b.py::z\n      4.0 s  g\n" in text
+
+
+def test_a_damaged_timeline_is_one_line_naming_its_file_and_line(tmp_path):
+    (tmp_path / "gw0.jsonl").write_text('{"cpu": [1, 2]}\n\0\0{"event": "start"\n', encoding="utf-8")
+    said = _run(sys.executable, "tools/suite_timeline.py", str(tmp_path))
+    assert said.returncode == 2 and said.stdout == ""
+    assert said.stderr.startswith(f"{tmp_path / 'gw0.jsonl'}:2: expected one JSON event a line, found ")
+    assert said.stderr.count("\n") == 1

@@ -46,8 +46,12 @@ def read(folder: Path) -> tuple[list[Test], list[list[int]]]:
     counters: list[list[int]] = []
     for log in sorted(folder.glob("*.jsonl")):
         started: dict[str, float] = {}
-        for line in log.read_text(encoding="utf-8").splitlines():
-            event = json.loads(line)
+        for number, line in enumerate(log.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
+            try:
+                event = json.loads(line)
+            except ValueError:
+                found = line[:40]
+                raise ValueError(f"{log}:{number}: expected one JSON event a line, found {found!r}") from None
             if "cpu" in event:
                 counters.append(event["cpu"])
             elif event["event"] == "start":
@@ -100,7 +104,12 @@ def main(argv: list[str] | None = None) -> int:
     if not args.folder.is_dir():
         print(f"{args.folder}: expected the timeline's folder, found none", file=sys.stderr)
         return 2
-    print(report(*read(args.folder), top=args.top))
+    try:
+        tests, counters = read(args.folder)
+    except ValueError as err:
+        print(err, file=sys.stderr)
+        return 2
+    print(report(tests, counters, top=args.top))
     return 0
 
 
