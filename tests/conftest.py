@@ -7,6 +7,7 @@ import shutil
 import subprocess
 import sys
 import time
+from collections import Counter
 from pathlib import Path
 
 import pytest
@@ -121,27 +122,32 @@ def pytest_collection_modifyitems(config, items):
         keys[id(item)] = mine
         for key in mine[1:]:
             parent[root(key)] = root(mine[0])
-    groups: dict[str, int] = {}
     for item in items:
         mine = keys[id(item)]
         if mine and not item.get_closest_marker("xdist_group"):
             item.add_marker(pytest.mark.xdist_group(root(mine[0])))
-        marker = item.get_closest_marker("xdist_group")
-        if marker is not None:
-            name = marker.args[0] if marker.args else marker.kwargs.get("name", "")
-            groups[name] = groups.get(name, 0) + 1
+    group = {id(item): _group(item) for item in items}
+    sizes = Counter(group.values())
 
     def order(item) -> tuple[int, int]:
         first = next((k for k, module in enumerate(_FIRST) if item.nodeid.startswith(module)), len(_FIRST))
-        marker = item.get_closest_marker("xdist_group")
-        size = groups.get(marker.args[0] if marker.args else marker.kwargs.get("name", "")) if marker else 1
-        return first, -(size or 1)
+        name = group[id(item)]
+        return first, -(sizes[name] if name is not None else 1)
 
     items.sort(key=order)     # stable: tests keep their order within a group and among equals
 
 
+def _group(item) -> str | None:
+    """The item's pytest-xdist group, or None."""
+    marker = item.get_closest_marker("xdist_group")
+    return None if marker is None else str(marker.args[0] if marker.args else marker.kwargs.get("name", ""))
+
+
 def pytest_sessionstart(session):
     session.config.stash[_STARTED] = time.time()
+    global _TIMELINE
+    if session.config.pluginmanager.has_plugin("dsession"):
+        _TIMELINE = None    # pytest-xdist's controller hears every worker's tests too: they record
 
 
 #: With FISHGEN_SUITE_TIMELINE=folder, each worker writes when each test starts and ends there, and
@@ -160,7 +166,7 @@ _timeline: list = []
 
 def _record(**event) -> None:
     if not _timeline:
-        folder = Path(_TIMELINE or ".")
+        folder = Path(str(_TIMELINE))
         folder.mkdir(parents=True, exist_ok=True)
         _timeline.append(open(folder / f"{os.environ.get('PYTEST_XDIST_WORKER', 'main')}.jsonl", "w",
                               encoding="utf-8"))
@@ -177,25 +183,14 @@ def _cpu_counters() -> list[int]:
         return []
 
 
-if _TIMELINE:
-    def pytest_runtest_logstart(nodeid, location):
-        if not _controller():
-            _record(event="start", id=nodeid, t=time.time())
-
-    def pytest_runtest_logfinish(nodeid, location):
-        if not _controller():
-            _record(event="end", id=nodeid, t=time.time())
-
-_CONFIG: list = []
+def pytest_runtest_logstart(nodeid, location):
+    if _TIMELINE:
+        _record(event="start", id=nodeid, t=time.time())
 
 
-def pytest_configure(config):
-    _CONFIG.append(config)
-
-
-def _controller() -> bool:
-    """Whether this process is pytest-xdist's controller, which hears every worker's tests too."""
-    return bool(_CONFIG) and _CONFIG[-1].pluginmanager.has_plugin("dsession")
+def pytest_runtest_logfinish(nodeid, location):
+    if _TIMELINE:
+        _record(event="end", id=nodeid, t=time.time())
 
 
 def pytest_terminal_summary(terminalreporter, config):

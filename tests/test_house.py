@@ -4,6 +4,7 @@ its types check (mypy), and the core install alone, without the test extra, runs
 after another before it."""
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
@@ -54,8 +55,6 @@ def test_the_suite_timeline_says_where_the_time_goes(tmp_path):
     """FISHGEN_SUITE_TIMELINE records each test's start and end on each worker, and
     tools/suite_timeline.py reports the workers' spans, the tail, the machine's idle share and the
     longest groups, modules and tests."""
-    import os
-
     folder = tmp_path / "timeline"
     inherited = ("PYTEST_XDIST_WORKER", "FISHGEN_SUITE_TIMELINE_OWNER")
     env = {k: v for k, v in os.environ.items() if k not in inherited}
@@ -77,8 +76,6 @@ def test_the_suite_timeline_says_where_the_time_goes(tmp_path):
 def test_a_pytest_a_test_starts_records_nothing_in_the_suites_timeline(tmp_path):
     """A test that runs pytest again (the preview's softpipe run) inherits the variable: that run
     must not write into the folder, where it had truncated its worker's own file."""
-    import os
-
     folder = tmp_path / "timeline"
     env = {k: v for k, v in os.environ.items() if k != "PYTEST_XDIST_WORKER"}
     env.update(FISHGEN_SUITE_TIMELINE=str(folder), FISHGEN_SUITE_TIMELINE_OWNER="1")  # not this run's
@@ -104,8 +101,9 @@ def test_the_suite_timeline_report_counts_groups_and_the_tail():
 
 
 def test_a_damaged_timeline_is_one_line_naming_its_file_and_line(tmp_path):
-    (tmp_path / "gw0.jsonl").write_text('{"cpu": [1, 2]}\n\0\0{"event": "start"\n', encoding="utf-8")
-    said = _run(sys.executable, "tools/suite_timeline.py", str(tmp_path))
-    assert said.returncode == 2 and said.stdout == ""
-    assert said.stderr.startswith(f"{tmp_path / 'gw0.jsonl'}:2: expected one JSON event a line, found ")
-    assert said.stderr.count("\n") == 1
+    for damage in ('\0\0{"event": "start"', '{"event": "start"}', '[1, 2]'):   # cut, no id, no event
+        (tmp_path / "gw0.jsonl").write_text(f'{{"cpu": [1, 2]}}\n{damage}\n', encoding="utf-8")
+        said = _run(sys.executable, "tools/suite_timeline.py", str(tmp_path))
+        assert said.returncode == 2 and said.stdout == "", damage
+        assert said.stderr.startswith(f"{tmp_path / 'gw0.jsonl'}:2: expected one JSON event a line, found ")
+        assert said.stderr.count("\n") == 1

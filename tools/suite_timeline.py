@@ -49,15 +49,15 @@ def read(folder: Path) -> tuple[list[Test], list[list[int]]]:
         for number, line in enumerate(log.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
             try:
                 event = json.loads(line)
-            except ValueError:
+                if "cpu" in event:
+                    counters.append([int(v) for v in event["cpu"]])
+                elif event["event"] == "start":
+                    started[event["id"]] = float(event["t"])
+                elif event["id"] in started:
+                    tests.append(Test(log.stem, event["id"], started.pop(event["id"]), float(event["t"])))
+            except (ValueError, KeyError, TypeError):
                 found = line[:40]
                 raise ValueError(f"{log}:{number}: expected one JSON event a line, found {found!r}") from None
-            if "cpu" in event:
-                counters.append(event["cpu"])
-            elif event["event"] == "start":
-                started[event["id"]] = event["t"]
-            elif event["id"] in started:
-                tests.append(Test(log.stem, event["id"], started.pop(event["id"]), event["t"]))
     return tests, counters
 
 
