@@ -13,6 +13,8 @@ The framebuffer holds premultiplied alpha, so a transparent background works.
 """
 from __future__ import annotations
 
+import os
+import threading
 import weakref
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -199,40 +201,53 @@ class Renderer:
         none, each pixel one sample, its masked materials' alpha tested at its centre)."""
         import moderngl
 
-        try:
-            # the stubs type ``**settings`` as dicts; the backend is a string
-            self.ctx: Any = moderngl.create_context(standalone=True, backend="egl")  # type: ignore[arg-type]
-        except Exception as err:  # no libEGL / no Mesa driver on this machine
-            raise FishgenError(
-                "expected an OpenGL 3.3 context from EGL (Debian: apt-get install libegl1 "
-                f"libgl1-mesa-dri), found none ({err})") from None
+        self._gl = gl = _gl_for_thread()
+        self.ctx: Any = gl.ctx
+        self.mesh_prog: Any = gl.mesh_prog
+        self.point_prog: Any = gl.point_prog
+        self.corner_buf = gl.corner_buf
         self.width, self.height = width, height
         samples = min(samples, self.ctx.max_samples) if samples > 1 else 0
         self.colour = "f2" if fine_blending else "f1"
-        try:
-            self.msaa = self.ctx.framebuffer(
-                color_attachments=[self.ctx.renderbuffer((width, height), 4, samples=samples,
-                                                         dtype=self.colour)],
-                depth_attachment=self.ctx.depth_renderbuffer((width, height), samples=samples))
-            self.resolved = self.ctx.framebuffer(
-                color_attachments=[self.ctx.renderbuffer((width, height), 4, dtype=self.colour)])
-        except moderngl.Error as err:  # out of memory: the driver leaves the framebuffer incomplete
-            self.ctx.release()
-            colour = 8 if fine_blending else 4
-            need = width * height * (colour + 4) * max(samples, 1) + width * height * colour
-            # past the estimate (preview.memory): the system's refusal, as an out-of-memory error is
-            raise SystemFailure(f"out of memory for a {width}x{height} framebuffer ({need / 2**20:,.0f} MiB "
-                                f"with {samples}x anti-aliasing): the driver could not make one ({err})"
-                                ) from None
-        self.mesh_prog: Any = self.ctx.program(vertex_shader=MESH_VS, fragment_shader=MESH_FS)
-        self.point_prog: Any = self.ctx.program(vertex_shader=POINT_VS, fragment_shader=POINT_FS)
-        corners = np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32)
-        self.corner_buf = self.ctx.buffer(corners.tobytes())
+        self._own: list[Any] = []   # framebuffers: what release() frees besides the uploads
         # Caches by id(scene), each entry holding a weak reference to its scene: a scene freed and
         # another made at the same address must not find the first one's buffers (it drew the old cloud).
         self._uploaded: dict[int, tuple[weakref.ref, Poser, list[_GpuMesh]]] = {}
         self._textures: dict[tuple[int, int], tuple[weakref.ref, Any]] = {}
         self._points: dict[int, tuple[weakref.ref, list[tuple[int, Primitive]]]] = {}
+        try:
+            colour = self._keep(self.ctx.renderbuffer((width, height), 4, samples=samples, dtype=self.colour))
+            depth = self._keep(self.ctx.depth_renderbuffer((width, height), samples=samples))
+            self.msaa = self._keep(self.ctx.framebuffer(color_attachments=[colour], depth_attachment=depth))
+            plain = self._keep(self.ctx.renderbuffer((width, height), 4, dtype=self.colour))
+            self.resolved = self._keep(self.ctx.framebuffer(color_attachments=[plain]))
+        except moderngl.Error as err:  # out of memory: the driver leaves the framebuffer incomplete
+            self.release()
+            colour_bytes = 8 if fine_blending else 4
+            need = width * height * (colour_bytes + 4) * max(samples, 1) + width * height * colour_bytes
+            # past the estimate (preview.memory): the system's refusal, as an out-of-memory error is
+            raise SystemFailure(f"out of memory for a {width}x{height} framebuffer ({need / 2**20:,.0f} MiB "
+                                f"with {samples}x anti-aliasing): the driver could not make one ({err})"
+                                ) from None
+
+    def _keep(self, thing: Any) -> Any:
+        self._own.append(thing)
+        return thing
+
+    def _forget_dead(self) -> None:
+        """Free the uploads of scenes gone since they were drawn: a fit draws hundreds of fish through
+        one renderer, and the context outlives it."""
+        for key, (ref, _, meshes) in list(self._uploaded.items()):
+            if ref() is None:
+                del self._uploaded[key]
+                _free(meshes)
+        for tkey, (ref, tex) in list(self._textures.items()):
+            if ref() is None:
+                del self._textures[tkey]
+                tex.release()
+        for key, (ref, _) in list(self._points.items()):
+            if ref() is None:
+                del self._points[key]
 
     # -- uploads -------------------------------------------------------------
     def _texture(self, scene: Scene, index: int) -> Any:
@@ -261,6 +276,9 @@ class Renderer:
         held = self._uploaded.get(key)
         if held is not None and held[0]() is scene and held[1].active is scene.clip(clip):
             return held[1], held[2]
+        self._forget_dead()
+        if key in self._uploaded:  # the same scene posed by another clip: drawn again from its rest
+            _free(self._uploaded.pop(key)[2])
         out: list[_GpuMesh] = []
         poser = poser_for(scene, clip)
         for index, batch in enumerate(poser.batches):
@@ -316,6 +334,7 @@ class Renderer:
 
     def posed(self, scene: Scene, t: float | None, clip: str | None = None) -> tuple[Pose, list]:
         """Every batch of ``scene`` posed at ``t``: the CPU's share of a frame."""
+        self._gl.use()
         poser, meshes = self._upload(scene, clip)
         posed, worlds = poser.frame(t)
         out = []
@@ -344,6 +363,7 @@ class Renderer:
         """The frame last drawn, resolved: (H, W, 4) uint8 RGBA as drawn (premultiplied), top row first
         (``size``: of the frame drawn in the corner)."""
         width, height = size or (self.width, self.height)
+        self._gl.use()
         self.ctx.copy_framebuffer(self.resolved, self.msaa)
         raw = self.resolved.read(viewport=(0, 0, width, height), components=4, alignment=1,
                                  dtype=self.colour)
@@ -361,6 +381,7 @@ class Renderer:
         import moderngl
 
         ctx = self.ctx
+        self._gl.use()
         _, meshes = self._upload(scene, clip)
         posed, vertices = frame
         view, proj = camera.view(), camera.projection()
@@ -480,7 +501,76 @@ class Renderer:
         buf.release()
 
     def release(self) -> None:
-        self.ctx.release()
+        """Free the framebuffers and every upload; the thread's context and programs stay for the
+        next renderer (:func:`_gl_for_thread`)."""
+        self._gl.use()
+        for _, _, meshes in self._uploaded.values():
+            _free(meshes)
+        for _, tex in self._textures.values():
+            tex.release()
+        self._uploaded.clear()
+        self._textures.clear()
+        self._points.clear()
+        for thing in reversed(self._own):
+            thing.release()
+        self._own.clear()
+        self._gl.done()
+
+
+def _free(meshes: list[_GpuMesh]) -> None:
+    for m in meshes:   # not the texture: the renderer's texture cache holds it
+        for thing in (m.vao, m.vbo, m.static, m.ibo):
+            thing.release()
+
+
+class _Gl:
+    """A headless GL context and the programs compiled in it. A new context costs about 15 ms, and
+    its first frame about 110 ms more while llvmpipe compiles the shaders; a photo fit makes a
+    renderer for each of its measures, a test worker hundreds."""
+
+    def __init__(self, kept: bool):
+        import moderngl
+
+        try:
+            # the stubs type ``**settings`` as dicts; the backend is a string
+            self.ctx: Any = moderngl.create_context(standalone=True, backend="egl")  # type: ignore[arg-type]
+        except Exception as err:  # no libEGL / no Mesa driver on this machine
+            raise FishgenError(
+                "expected an OpenGL 3.3 context from EGL (Debian: apt-get install libegl1 "
+                f"libgl1-mesa-dri), found none ({err})") from None
+        self.kept, self.pid = kept, os.getpid()
+        self.mesh_prog = self.ctx.program(vertex_shader=MESH_VS, fragment_shader=MESH_FS)
+        self.point_prog = self.ctx.program(vertex_shader=POINT_VS, fragment_shader=POINT_FS)
+        corners = np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32)
+        self.corner_buf = self.ctx.buffer(corners.tobytes())
+
+    def use(self) -> None:
+        """Make the context current: another context made in this thread since (a probe's) took over."""
+        self.ctx.__enter__()
+
+    def done(self) -> None:
+        """A renderer is done with it: a context of its own goes, a kept one stays."""
+        if not self.kept:
+            self.ctx.release()
+
+
+_MAIN_GL: list[_Gl] = []
+"""The main thread's kept context, in the process that made it."""
+
+
+def _gl_for_thread() -> _Gl:
+    """The main thread keeps one context for every renderer it makes, one after another. Another
+    thread gets a context of its own, freed with its renderer: a thread's end would leave a kept one
+    current nowhere, never freed. A forked child makes its own; its parent's copy is not its to use
+    (nor can it draw at all: Mesa's rasteriser threads stay in the parent, and its first draw hangs,
+    as it did before contexts were kept; no fishgen process pool draws)."""
+    if threading.current_thread() is not threading.main_thread():
+        return _Gl(kept=False)
+    if not _MAIN_GL or _MAIN_GL[-1].pid != os.getpid():
+        _MAIN_GL.append(_Gl(kept=True))   # a forked parent's stays listed: freeing it is not ours
+    gl = _MAIN_GL[-1]
+    gl.use()
+    return gl
 
 
 def particles(scene: Scene, node: int, prim: Primitive,

@@ -1,0 +1,117 @@
+"""The renderer's GL context: one kept for a thread's renderers, and what each renderer frees."""
+from __future__ import annotations
+
+import gc
+import threading
+
+import numpy as np
+import pytest
+
+from fishgen.authoring.photo.compare import side_camera
+from fishgen.preview.render import Renderer
+from tests.conftest import PARAMS
+
+pytestmark = pytest.mark.usefixtures("gl_available")
+
+
+@pytest.fixture(scope="module")
+def species():
+    from fishgen.species.parser import load_species
+
+    return load_species(PARAMS / "bonybream.txt")
+
+
+def drawn(renderer: Renderer, species, size=(96, 48)) -> np.ndarray:
+    from fishgen.assembly.fish import build_fish
+
+    scene = build_fish(species)
+    return renderer.render(scene, side_camera(scene, *size), None, (0.0, 0.0, 0.0, 0.0))
+
+
+def released(thing) -> bool:
+    return type(thing.mglo).__name__ == "InvalidObject"
+
+
+def gpu_objects(renderer: Renderer) -> list:
+    meshes = [m for _, _, held in renderer._uploaded.values() for m in held]
+    return ([thing for m in meshes for thing in (m.vao, m.vbo, m.static, m.ibo)]
+            + [tex for _, tex in renderer._textures.values()])
+
+
+def test_renderers_made_one_after_another_share_one_context_and_draw_as_a_new_context_does(species):
+    first = Renderer(96, 48)
+    try:
+        picture = drawn(first, species)
+    finally:
+        first.release()
+    second = Renderer(200, 100, samples=1)   # another size and sampling: the same context
+    try:
+        assert second.ctx is first.ctx and not released(second.ctx)
+    finally:
+        second.release()
+    third = Renderer(96, 48)
+    try:
+        again = drawn(third, species)
+    finally:
+        third.release()
+    elsewhere: list[np.ndarray] = []
+
+    def on_a_thread() -> None:
+        # another thread's renderer has a context of its own, made fresh, and freed with it
+        renderer = Renderer(96, 48)
+        try:
+            assert renderer.ctx is not first.ctx
+            elsewhere.append(drawn(renderer, species))
+        finally:
+            renderer.release()
+        assert released(renderer.ctx)
+
+    thread = threading.Thread(target=on_a_thread)
+    thread.start()
+    thread.join()
+    assert picture[..., 3].any()
+    np.testing.assert_array_equal(again, picture)
+    np.testing.assert_array_equal(elsewhere[0], picture)
+
+
+def test_a_released_renderer_frees_its_uploads_and_framebuffers_but_not_the_context(species):
+    renderer = Renderer(96, 48)
+    drawn(renderer, species)
+    held = gpu_objects(renderer) + [renderer.msaa, renderer.resolved]
+    assert len(held) > 2 and not any(map(released, held))
+    renderer.release()
+    assert all(map(released, held))
+    assert not released(renderer.ctx) and not released(renderer.mesh_prog)
+
+
+def test_a_scene_gone_is_freed_when_the_next_one_is_uploaded(species):
+    from fishgen.assembly.fish import build_fish
+
+    renderer = Renderer(96, 48)
+    try:
+        drawn(renderer, species)   # its scene is gone when drawn() returns
+        gone = gpu_objects(renderer)
+        gc.collect()
+        assert not any(map(released, gone))   # until another scene is uploaded
+        scene = build_fish(species)
+        renderer.render(scene, side_camera(scene, 96, 48), None, (0.0, 0.0, 0.0, 0.0))
+        assert all(map(released, gone))
+        assert list(renderer._uploaded) == [id(scene)]
+    finally:
+        renderer.release()
+
+
+def test_a_context_made_between_two_draws_does_not_take_the_renderer_s_place(species):
+    import moderngl
+
+    renderer = Renderer(96, 48)
+    try:
+        before = drawn(renderer, species)
+        moderngl.create_context(standalone=True, backend="egl").release()   # as a GL probe does
+        probe = moderngl.create_context(standalone=True, backend="egl")     # ... and one left current
+        try:
+            np.testing.assert_array_equal(drawn(renderer, species), before)
+        finally:
+            probe.release()
+    finally:
+        renderer.release()
