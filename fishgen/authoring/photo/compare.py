@@ -24,8 +24,9 @@ others did not, and its render was a third of the check's cost."""
 def render_side(species: Species, width: int, height: int, distance: float | None = None,
                 renderer: Any = None, coverage: bool = False) -> np.ndarray:
     """(H, W, 4) uint8 left-side render on a transparent background, head left: orthographic, or
-    in the perspective of a camera ``distance`` fish lengths away. ``renderer``: one to reuse (a
-    new one costs about 0.4 s). ``coverage``: only the (H, W) alpha, the silhouette's measure."""
+    in the perspective of a camera ``distance`` fish lengths away. ``renderer``: one to reuse,
+    with its uploads (a new one shares the thread's GL context: only its framebuffers are new).
+    ``coverage``: only the (H, W) alpha, the silhouette's measure."""
     from fishgen.assembly.fish import build_fish
     from fishgen.preview.render import Renderer
 
