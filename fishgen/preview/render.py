@@ -13,12 +13,15 @@ The framebuffer holds premultiplied alpha, so a transparent background works.
 """
 from __future__ import annotations
 
+import ctypes
+import functools
 import os
 import threading
 import weakref
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar, cast
 
 import numpy as np
 
@@ -184,8 +187,22 @@ class _GpuMesh:
     computed_normals: bool   # the file has none: made from the posed triangles each frame
 
 
+_Method = TypeVar("_Method", bound=Callable[..., Any])
+
+
+def _in_context(method: _Method) -> _Method:
+    """The renderer's GL context current through ``method`` (:meth:`_Gl.current`)."""
+    @functools.wraps(method)
+    def run(self: Renderer, *args: Any, **kwargs: Any) -> Any:
+        with self._gl.current():
+            return method(self, *args, **kwargs)
+    return cast(_Method, run)
+
+
 class Renderer:
-    """One headless GL context and framebuffer, reused for every image of a run."""
+    """A framebuffer, reused for every image of a run, and the uploads of what it draws, on its
+    thread's headless GL context (:func:`_gl_for_thread`). Use it in the thread that made it, and
+    release it (or use it as a context manager)."""
 
     sort_triangles = True
     """Draw a transparent mesh's triangles farthest first (off: in file order, as three.js does)."""
@@ -199,8 +216,6 @@ class Renderer:
         a smooth cloud; 16 bits cost 28 bytes a pixel more at 4x multisampling, so only a scene
         with particles (points or billboards) asks for it. ``samples``: multisamples a pixel (1:
         none, each pixel one sample, its masked materials' alpha tested at its centre)."""
-        import moderngl
-
         self._gl = gl = _gl_for_thread()
         self.ctx: Any = gl.ctx
         self.mesh_prog: Any = gl.mesh_prog
@@ -215,6 +230,18 @@ class Renderer:
         self._uploaded: dict[int, tuple[weakref.ref, Poser, list[_GpuMesh]]] = {}
         self._textures: dict[tuple[int, int], tuple[weakref.ref, Any]] = {}
         self._points: dict[int, tuple[weakref.ref, list[tuple[int, Primitive]]]] = {}
+        self._framebuffers(width, height, samples, fine_blending)
+
+    def __enter__(self) -> Renderer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.release()
+
+    @_in_context
+    def _framebuffers(self, width: int, height: int, samples: int, fine_blending: bool) -> None:
+        import moderngl
+
         try:
             colour = self._keep(self.ctx.renderbuffer((width, height), 4, samples=samples, dtype=self.colour))
             depth = self._keep(self.ctx.depth_renderbuffer((width, height), samples=samples))
@@ -327,14 +354,18 @@ class Renderer:
             if waiting:
                 yield self.finish()
             self.draw(scene, camera, posed, background, clip)
-            self.resolved.use()  # binding another framebuffer hands the frame to Mesa's threads
+            self._hand_over()
             waiting = True
         if waiting:
             yield self.finish()
 
+    @_in_context
+    def _hand_over(self) -> None:
+        self.resolved.use()  # binding another framebuffer hands the frame to Mesa's threads
+
+    @_in_context
     def posed(self, scene: Scene, t: float | None, clip: str | None = None) -> tuple[Pose, list]:
         """Every batch of ``scene`` posed at ``t``: the CPU's share of a frame."""
-        self._gl.use()
         poser, meshes = self._upload(scene, clip)
         posed, worlds = poser.frame(t)
         out = []
@@ -359,11 +390,11 @@ class Renderer:
         self.draw(scene, camera, self.posed(scene, t), (0.0, 0.0, 0.0, 0.0), size=size)
         return np.ascontiguousarray(self._resolved(size)[:, :, 3])
 
+    @_in_context
     def _resolved(self, size: tuple[int, int] | None = None) -> np.ndarray:
         """The frame last drawn, resolved: (H, W, 4) uint8 RGBA as drawn (premultiplied), top row first
         (``size``: of the frame drawn in the corner)."""
         width, height = size or (self.width, self.height)
-        self._gl.use()
         self.ctx.copy_framebuffer(self.resolved, self.msaa)
         raw = self.resolved.read(viewport=(0, 0, width, height), components=4, alignment=1,
                                  dtype=self.colour)
@@ -373,6 +404,7 @@ class Renderer:
         values *= np.float16(255)
         return np.rint(values, out=values).astype(np.uint8).reshape(height, width, 4)[::-1]
 
+    @_in_context
     def draw(self, scene: Scene, camera: Camera, frame: tuple[Pose, list],
              background: tuple[float, float, float, float], clip: str | None = None,
              size: tuple[int, int] | None = None) -> None:
@@ -381,7 +413,6 @@ class Renderer:
         import moderngl
 
         ctx = self.ctx
-        self._gl.use()
         _, meshes = self._upload(scene, clip)
         posed, vertices = frame
         view, proj = camera.view(), camera.projection()
@@ -503,17 +534,17 @@ class Renderer:
     def release(self) -> None:
         """Free the framebuffers and every upload; the thread's context and programs stay for the
         next renderer (:func:`_gl_for_thread`)."""
-        self._gl.use()
-        for _, _, meshes in self._uploaded.values():
-            _free(meshes)
-        for _, tex in self._textures.values():
-            tex.release()
-        self._uploaded.clear()
-        self._textures.clear()
-        self._points.clear()
-        for thing in reversed(self._own):
-            thing.release()
-        self._own.clear()
+        with self._gl.current():
+            for _, _, meshes in self._uploaded.values():
+                _free(meshes)
+            for _, tex in self._textures.values():
+                tex.release()
+            self._uploaded.clear()
+            self._textures.clear()
+            self._points.clear()
+            for thing in reversed(self._own):
+                thing.release()
+            self._own.clear()
         self._gl.done()
 
 
@@ -531,6 +562,11 @@ class _Gl:
     def __init__(self, kept: bool):
         import moderngl
 
+        if _DREW and os.getpid() not in _DREW:
+            raise FishgenError(
+                "expected to draw in a process not forked from one that drew: Mesa's rasteriser "
+                "stayed with the parent, and a first draw here hangs (start the process with "
+                "multiprocessing's spawn or forkserver), found a fork")
         try:
             # the stubs type ``**settings`` as dicts; the backend is a string
             self.ctx: Any = moderngl.create_context(standalone=True, backend="egl")  # type: ignore[arg-type]
@@ -538,39 +574,90 @@ class _Gl:
             raise FishgenError(
                 "expected an OpenGL 3.3 context from EGL (Debian: apt-get install libegl1 "
                 f"libgl1-mesa-dri), found none ({err})") from None
-        self.kept, self.pid = kept, os.getpid()
+        _DREW.append(os.getpid())
+        self.kept, self.pid, self.thread = kept, os.getpid(), threading.get_ident()
+        self.handle = _egl_current()   # made current by its making
         self.mesh_prog = self.ctx.program(vertex_shader=MESH_VS, fragment_shader=MESH_FS)
         self.point_prog = self.ctx.program(vertex_shader=POINT_VS, fragment_shader=POINT_FS)
         corners = np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32)
         self.corner_buf = self.ctx.buffer(corners.tobytes())
 
-    def use(self) -> None:
-        """Make the context current: another context made in this thread since (a probe's) took over."""
+    @contextmanager
+    def current(self) -> Iterator[None]:
+        """The context current for a renderer's work. A context the caller had current is current
+        again after: its GL calls (a buffer's release by its name) must not reach this one's."""
+        if threading.get_ident() != self.thread:
+            raise RuntimeError("a fishgen Renderer draws only in the thread that made it: make one "
+                               "in this thread")
+        before = _egl_state()
+        if before is not None and before[3] == self.handle:
+            yield
+            return
         self.ctx.__enter__()
+        try:
+            yield
+        finally:
+            if before is not None and before[3]:   # the caller's context, current again
+                _EGL[0].eglMakeCurrent(*before)
 
     def done(self) -> None:
         """A renderer is done with it: a context of its own goes, a kept one stays."""
-        if not self.kept:
-            self.ctx.release()
+        if self.kept:
+            return
+        self.ctx.release()
+        if _egl_current() in (0, self.handle):
+            # the thread's own EGL state, 3 MB a thread that drew otherwise
+            _egl().eglReleaseThread()
 
 
 _MAIN_GL: list[_Gl] = []
-"""The main thread's kept context, in the process that made it."""
+"""The main thread's kept context."""
+_DREW: list[int] = []
+"""The processes that made a context here: this one, or the one it was forked from."""
+_EGL: list[Any] = []
+
+
+def _egl() -> Any:
+    """libEGL, as glcontext loads it (None: not by that name)."""
+    if not _EGL:
+        try:
+            lib: Any = ctypes.CDLL(os.environ.get("GLCONTEXT_LINUX_LIBEGL") or "libEGL.so.1")
+        except OSError:
+            _EGL.append(None)
+            return None
+        for name in ("eglGetCurrentContext", "eglGetCurrentDisplay", "eglGetCurrentSurface"):
+            getattr(lib, name).restype = ctypes.c_void_p
+        lib.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
+        _EGL.append(lib)
+    return _EGL[0]
+
+
+def _egl_state() -> tuple[int | None, ...] | None:
+    """What is current in this thread, as eglMakeCurrent takes it back: display, draw and read
+    surfaces, context (glcontext's own exit makes nothing current, not what was)."""
+    lib = _egl()
+    if lib is None:
+        return None
+    return (lib.eglGetCurrentDisplay(), lib.eglGetCurrentSurface(0x3059),   # EGL_DRAW
+            lib.eglGetCurrentSurface(0x305A), lib.eglGetCurrentContext())   # EGL_READ
+
+
+def _egl_current() -> int:
+    """The EGL context current in this thread (0: none; -1: libEGL not found by that name)."""
+    state = _egl_state()
+    return -1 if state is None else state[3] or 0
 
 
 def _gl_for_thread() -> _Gl:
-    """The main thread keeps one context for every renderer it makes, one after another. Another
-    thread gets a context of its own, freed with its renderer: a thread's end would leave a kept one
-    current nowhere, never freed. A forked child makes its own; its parent's copy is not its to use
-    (nor can it draw at all: Mesa's rasteriser threads stay in the parent, and its first draw hangs,
-    as it did before contexts were kept; no fishgen process pool draws)."""
+    """The main thread keeps one context for every renderer it makes. Another thread gets a context
+    of its own, freed with its renderer: a thread's end would leave a kept one current nowhere,
+    never freed. A process forked after drawing cannot draw (:class:`_Gl`); no fishgen process pool
+    draws."""
     if threading.current_thread() is not threading.main_thread():
         return _Gl(kept=False)
-    if not _MAIN_GL or _MAIN_GL[-1].pid != os.getpid():
-        _MAIN_GL.append(_Gl(kept=True))   # a forked parent's stays listed: freeing it is not ours
-    gl = _MAIN_GL[-1]
-    gl.use()
-    return gl
+    if not _MAIN_GL or _MAIN_GL[-1].pid != os.getpid():   # a forked parent's is not this one's
+        _MAIN_GL.append(_Gl(kept=True))
+    return _MAIN_GL[-1]
 
 
 def particles(scene: Scene, node: int, prim: Primitive,

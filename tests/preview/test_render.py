@@ -2,6 +2,9 @@
 from __future__ import annotations
 
 import gc
+import os
+import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -115,3 +118,88 @@ def test_a_context_made_between_two_draws_does_not_take_the_renderer_s_place(spe
             probe.release()
     finally:
         renderer.release()
+
+
+def test_the_context_a_caller_had_current_is_current_again_after_a_render(species):
+    """A library user's own GL work goes on in their context: a render must not leave fishgen's
+    current, where the user's next calls (releasing a buffer by its name) would reach fishgen's."""
+    import moderngl
+
+    renderer = Renderer(96, 48)
+    try:
+        before = drawn(renderer, species)
+        mine = moderngl.create_context(standalone=True, backend="egl")
+        try:
+            frame = mine.simple_framebuffer((4, 4))
+            buffers = [mine.buffer(reserve=64) for _ in range(4)]   # names 1, 2, ...: as fishgen's
+            drawn(renderer, species)
+            frame.use()
+            mine.clear(0.0, 0.0, 1.0, 1.0)
+            assert frame.read(components=4)[:4] == bytes([0, 0, 255, 255])   # my blue, in my frame
+            for buffer in buffers:
+                buffer.release()
+            np.testing.assert_array_equal(drawn(renderer, species), before)
+        finally:
+            mine.release()
+    finally:
+        renderer.release()
+
+
+def test_a_renderer_is_used_in_the_thread_that_made_it():
+    renderer = Renderer(16, 16)
+    failed: list[BaseException] = []
+
+    def elsewhere() -> None:
+        try:
+            renderer.finish()
+        except BaseException as err:  # noqa: BLE001 - what the thread met is the test's
+            failed.append(err)
+
+    try:
+        thread = threading.Thread(target=elsewhere)
+        thread.start()
+        thread.join()
+    finally:
+        renderer.release()
+    assert isinstance(failed[0], RuntimeError) and "thread that made it" in str(failed[0])
+
+
+def test_threads_that_draw_and_end_leave_no_gl_state_behind(species):
+    def resident_mib() -> float:
+        return int(open("/proc/self/statm").read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+    def once() -> None:
+        with Renderer(96, 48) as renderer:
+            drawn(renderer, species)
+
+    once_on_a_thread = [threading.Thread(target=once) for _ in range(21)]
+    once_on_a_thread[0].start()
+    once_on_a_thread[0].join()
+    start = resident_mib()
+    for thread in once_on_a_thread[1:]:
+        thread.start()
+        thread.join()
+    # each thread's EGL state had stayed: 7.5 MiB a thread here
+    assert resident_mib() - start < 20 * 2
+
+
+def test_a_process_forked_after_drawing_is_refused_in_one_line_not_hung():
+    code = """if True:
+        import multiprocessing, sys
+        from fishgen.errors import FishgenError
+        from fishgen.preview.render import Renderer
+
+        def child(_):
+            try:
+                Renderer(16, 16).release()
+            except FishgenError as err:
+                return str(err)
+            return "drew"
+
+        Renderer(16, 16).finish()
+        with multiprocessing.get_context("fork").Pool(1) as pool:
+            print(pool.map_async(child, [0]).get(60)[0])
+    """
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("expected to draw in a process not forked from one that drew")
