@@ -112,7 +112,9 @@ class Size(click.ParamType):
     def convert(self, value, param, ctx):
         import re
 
-        if isinstance(value, tuple):
+        if isinstance(value, tuple):   # click's converted value, or a Python caller's (W, H)
+            if not (len(value) == 2 and all(_whole(v) and self.low <= v <= self.high for v in value)):
+                self.fail(f"expected {self.what}, found {value!r}", param, ctx)
             return value
         m = re.fullmatch(r"\s*(\d{1,6})\s*[xX×]\s*(\d{1,6})\s*", str(value))
         if not m or not all(self.low <= int(v) <= self.high for v in m.groups()):
@@ -131,7 +133,10 @@ class Colour(click.ParamType):
                      else "a colour (#8cadcc, white) or transparent")
 
     def convert(self, value, param, ctx):
-        if isinstance(value, tuple):
+        if isinstance(value, tuple):   # click's converted value, or a Python caller's RGBA
+            if not (len(value) == 4 and all(_whole(v) and 0 <= v <= 255 for v in value)
+                    and not (self.opaque and value[3] != 255)):
+                self.fail(f"expected {self.what} (or four whole numbers 0-255), found {value!r}", param, ctx)
             return value
         from PIL import ImageColor
 
@@ -199,6 +204,10 @@ class Names(click.ParamType):
         if not names or any(n not in self.choices for n in names) or len(set(names)) != len(names):
             self.fail(f"expected {self.what}, found {value!r}", param, ctx)
         return names
+
+
+def _whole(value: Any) -> bool:
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool)
 
 
 def _finite_number(value: Any) -> bool:
@@ -416,6 +425,52 @@ def check_value(spec: Option, value: Any, fail: Callable[[str], FishgenError]) -
         except click.BadParameter:
             raise fail(what(spec)) from None
     return tuple(converted) if spec.multiple else converted[0]
+
+
+def check_record(options: Any) -> None:
+    """A Python caller's options record, each value checked by its declaration as the command line
+    and manifests check theirs (theirs are checked on the way in; a record made in Python is not):
+    a UsageError naming the field and its option."""
+    from fishgen.errors import UsageError
+
+    for f in fields(options):
+        value = getattr(options, f.name)
+        if GROUP in f.metadata:
+            check_record(value)
+            continue
+        spec, default = f.metadata.get(OPTION), field_default(f)
+        if spec is None or value is default or (type(value) is type(default) and value == default):
+            continue
+        items = value if spec.multiple and isinstance(value, (tuple, list)) else [value]
+        ok = value is not None and (not spec.multiple or isinstance(value, (tuple, list)))
+        for item in items if ok else ():
+            if spec.flag:
+                ok = isinstance(item, bool)
+            else:
+                try:   # a whole number declared: 2.5 is not 2 (click's int() would make it so)
+                    ok = _same(spec.type.convert(item, None, None), item)
+                except click.BadParameter:
+                    ok = False
+            if not ok:
+                value = item
+                break
+        if not ok:
+            raise UsageError(f"expected options.{f.name} (--{long_name(f)}) to be {what(spec)}, "
+                             f"found {value!r}")
+
+
+def _same(converted: Any, given: Any) -> bool:
+    """Whether a converted value is the given one: numbers equal, sequences item by item (a path
+    given as text and converted to a Path is the same)."""
+    if isinstance(converted, bool) or isinstance(given, bool):   # only flags are true or false
+        return converted is given
+    if isinstance(converted, numbers.Real) and isinstance(given, numbers.Real):
+        return converted == given
+    if isinstance(converted, (tuple, list)) and isinstance(given, (tuple, list)):
+        return len(converted) == len(given) and all(map(_same, converted, given))
+    if given is None or converted is None:
+        return given is converted
+    return True
 
 
 def manifest_options(record: type) -> dict[str, tuple[Field, Option]]:

@@ -82,6 +82,30 @@ class Command:
     # options that cannot go together, or with the output (-o): a UsageError, for the use case and
     # for a manifest's job before any job runs
 
+    def given(self, inputs: Any, options: Any) -> tuple[Any, ...]:
+        """A Python caller's inputs and options, checked as the command line checks its own: the
+        options record of this command, each value as declared; the inputs a list (one path stands
+        for a list of one), as many as the command takes."""
+        from fishgen.errors import UsageError
+        from fishgen.options import check_record
+
+        if not isinstance(options, self.options):
+            raise UsageError(f"expected options to be a {self.options.__name__}, found "
+                             f"{type(options).__name__}")
+        check_record(options)
+        spec = self.inputs or Inputs("INPUT", required=False)
+        if isinstance(inputs, (str, os.PathLike)):
+            inputs = [inputs]
+        try:
+            items = tuple(Path(p) if spec.path else str(p) for p in inputs)
+        except TypeError:
+            raise UsageError(f"expected the inputs as a list of {spec.metavar}, found {inputs!r}") from None
+        if not items and spec.required:
+            raise UsageError(f"expected {'one or more' if spec.many else 'one'} {spec.metavar}, found none")
+        if len(items) > 1 and not spec.many:
+            raise UsageError(f"expected one {spec.metavar}, found {len(items)}")
+        return items
+
     @property
     def holds(self) -> tuple[str, ...]:
         """What the command's output format must hold (nothing when it writes no -o)."""

@@ -135,7 +135,7 @@ def _manifest(source: Path, out: Path | None):
 def batch(inputs: Sequence[Path], output: None, options: BatchOptions = BatchOptions(),
           events: Events = QUIET) -> Made:
     """Run every job that is not up to date; each finished job is told through ``events``."""
-    inputs = tuple(Path(p) for p in inputs)
+    inputs = COMMAND.given(inputs, options)
     import time
 
     from fishgen.batch import RecordNotSaved, run_batch

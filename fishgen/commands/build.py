@@ -80,7 +80,7 @@ def build(inputs: Sequence[Path], output: str | os.PathLike | None,
           events: Events = QUIET) -> Made:
     """Build each species file into a fish asset; with several inputs, a bad one is reported
     through ``events.failed`` and the others are built."""
-    inputs = tuple(Path(p) for p in inputs)
+    inputs = COMMAND.given(inputs, options)
     from fishgen.assembly.fish import fish_of
     from fishgen.atomic import protecting
     from fishgen.commands.paths import check_inputs, check_targets, targets

@@ -126,6 +126,7 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
            events: Events = QUIET) -> Made:
     """Fill every cube file, light them together (so clouds shadow each other) and write them as one
     scene; input i is filled with seed + i. A texture cloud (.awa) becomes textured billboards."""
+    inputs = COMMAND.given(inputs, options)
     from fishgen.clouds.pipeline import cloud_textures, cube_clouds, read_cube_files
     from fishgen.commands.paths import check_inputs, check_targets
     from fishgen.errors import UsageError, plural

@@ -58,6 +58,7 @@ def edit(inputs: Sequence[Path], output: str | os.PathLike | None = None,
     """Check FILE (a bad existing file is its one-line error), bind the editor's server and open the
     browser; the caller serves the server (``Made.server``) until Ctrl-C. The first summary line is
     the page's address."""
+    inputs = COMMAND.given(inputs, options)
     from fishgen.commands.paths import check_inputs
     from fishgen.editor.session import Session
     from fishgen.errors import FishgenError, SystemFailure

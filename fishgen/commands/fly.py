@@ -112,6 +112,7 @@ def fly(inputs: Sequence[Path], output: str | os.PathLike | None = None, options
         events: Events = QUIET) -> Made:
     """Headless: fly, wait for the report, write it; else bind the page's server (the caller serves it
     until Ctrl-C, or until the page reports at its time-out)."""
+    inputs = COMMAND.given(inputs, options)
     from fishgen.commands.paths import check_targets, suffix_of
     from fishgen.errors import UsageError
     from fishgen.fly.report import SUFFIXES, full_report, summary, write_report

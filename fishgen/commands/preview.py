@@ -81,7 +81,7 @@ def preview(inputs: Sequence[Path], output: str | os.PathLike,
             options: PreviewCommandOptions = PreviewCommandOptions(),
             events: Events = QUIET) -> Made:
     """Render the inputs to one image or loop."""
-    inputs = tuple(Path(p) for p in inputs)
+    inputs = COMMAND.given(inputs, options)
     output = Path(output)
     from fishgen.atomic import protecting
     from fishgen.commands.paths import check_inputs, check_targets, read_beside

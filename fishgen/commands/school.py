@@ -151,7 +151,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
            events: Events = QUIET) -> Made:
     """Simulate, bake and write the school; the side outputs (tracks, metrics, plot) are written
     only when the glb was, and every target is checked before the simulation starts."""
-    inputs = tuple(Path(p) for p in inputs)
+    inputs = COMMAND.given(inputs, options)
     output = Path(output)
     from fishgen.commands.paths import check_inputs, check_targets, needs, read_beside, suffix_of
     from fishgen.errors import UsageError, either, plural

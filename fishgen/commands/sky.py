@@ -107,6 +107,7 @@ class SkyFacts:
 def sky(inputs: Sequence[Path], output: str | os.PathLike, options: SkyOptions = SkyOptions(),
         events: Events = QUIET) -> Made:
     """Build the sky and write it atomically; the summary says its clouds, particles and size."""
+    inputs = COMMAND.given(inputs, options)
     from fishgen.commands.paths import check_inputs, check_targets, read_beside
     from fishgen.errors import UsageError
     from fishgen.exchange import export

@@ -55,6 +55,7 @@ COMMAND = Command(
 def species(inputs: Sequence[Path], output: str | os.PathLike, options: SpeciesOptions = SpeciesOptions(),
             events: Events = QUIET) -> Made:
     """Sample ``count`` species from ``seed`` on and write them: every file of every species, or none."""
+    inputs = COMMAND.given(inputs, options)
     from fishgen.authoring.species_files import write_samples
     from fishgen.commands.paths import names_folder
     from fishgen.errors import UsageError

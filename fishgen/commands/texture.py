@@ -76,7 +76,7 @@ COMMAND = Command(
 def texture(inputs: Sequence[Path], output: str | os.PathLike, options: TextureCommandOptions,
             events: Events = QUIET) -> Made:
     """Measure the photo and write the new species, its texture and mask (and the extras asked)."""
-    inputs = tuple(Path(p) for p in inputs)
+    inputs = COMMAND.given(inputs, options)
     output = Path(output)
     from fishgen.authoring.photo.run import FITS, TextureOptions, check_out, make_texture
     from fishgen.authoring.species_files import check_texture_names, texture_names

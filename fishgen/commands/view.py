@@ -50,7 +50,7 @@ def view(inputs: Sequence[Path], output: str | os.PathLike | None,
          options: ViewOptions = ViewOptions(),
          events: Events = QUIET) -> Made:
     """Write the page; unless ``no_serve``, also bind its server (the caller serves it)."""
-    inputs = tuple(Path(p) for p in inputs)
+    inputs = COMMAND.given(inputs, options)
     output = Path(output) if output is not None else None
     from fishgen.errors import SystemFailure
     from fishgen.viewer.page import write_page

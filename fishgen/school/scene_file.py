@@ -113,7 +113,9 @@ class Box(click.ParamType):
 
     def convert(self, value, param, ctx):
         if isinstance(value, (tuple, list)):  # a scene file's [[x0, y0, z0], [x1, y1, z1]]
-            items = [v for corner in value for v in (corner if isinstance(corner, list) else [corner])]
+            # or its own (lo, hi) from the command line, or a Python caller's
+            items = [v for corner in value
+                     for v in (corner if isinstance(corner, (list, tuple)) else [corner])]
         else:
             items = str(value).replace(" ", "").split(",")
         try:

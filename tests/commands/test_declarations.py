@@ -7,6 +7,7 @@ from click.testing import CliRunner
 
 from fishgen.commands import MODULES, Made, command
 from tests.commands import toy
+from tests.conftest import PARAMS
 
 
 @pytest.fixture
@@ -121,3 +122,70 @@ def test_the_library_function_is_what_the_cli_and_a_batch_job_run():
         declared = command(name)
         assert declared.function().__name__ == name
         assert declared.function().__annotations__["return"] in ("Made", Made)
+
+
+# A Python caller's values, each outside what the option's declaration takes (the command line
+# refuses each): they had reached the work as tracebacks (a count of -1 compared a complex number,
+# a size of -1 x 100 said the framebuffer was out of memory) or were written as given (2.5 fish).
+_BAD = [("preview", "size", (-1, 100)), ("preview", "size", (100.5, 100)), ("preview", "fps", 0),
+        ("preview", "background", (300, 0, 0, 255)), ("preview", "columns", -3),
+        ("school", "count", -1), ("school", "count", 2.5), ("school", "frames", -5),
+        ("texture", "body_sections", 1), ("texture", "focal_length", -1.0),
+        ("sky", "area", (-400.0, 400.0)), ("sky", "mode", "bogus"), ("sky", "noise", -5.0),
+        ("species", "seed", -1), ("clouds", "max_particles", -1), ("clouds", "seed", True),
+        ("view", "background", None)]
+
+
+@pytest.mark.parametrize(("name", "field", "value"), _BAD, ids=[f"{n}-{f}-{v}" for n, f, v in _BAD])
+def test_a_python_caller_s_option_is_checked_by_its_declaration_before_any_work(name, field, value,
+                                                                                 tmp_path):
+    from dataclasses import fields
+
+    from fishgen.errors import UsageError
+
+    declared = command(name)
+    record = declared.options
+    assert field in {f.name for f in fields(record)}, f"{record.__name__} has no {field}"
+    try:
+        options = record(**{field: value})
+    except TypeError:   # a record with a required field (texture's base species)
+        options = record(**{field: value, "species": PARAMS / "bonybream.txt"})
+    with pytest.raises(UsageError) as caught:
+        declared.function()([PARAMS / "bonybream.txt"], tmp_path / "out.glb", options)
+    assert str(caught.value).startswith(f"expected options.{field} (--{field.replace('_', '-')}) to be ")
+    assert str(caught.value).endswith(f", found {value!r}")
+    assert not list(tmp_path.iterdir())
+
+
+def test_every_option_s_own_value_from_the_command_line_passes_the_library_check():
+    """The command line's values reach the function converted; each type takes its own output back
+    (the school's --bounds, a pair of corners, had been refused)."""
+    from fishgen.commands.school import SchoolOptions
+    from fishgen.options import check_record
+
+    check_record(SchoolOptions(bounds=((-3.0, -1.0, -3.0), (3.0, 1.0, 3.0))))
+    for name in MODULES:
+        record = command(name).options
+        try:
+            check_record(record())
+        except TypeError:   # texture's required base species
+            pass
+
+
+def test_a_python_caller_s_inputs_may_be_one_path_and_are_counted_as_the_command_line_counts():
+    from fishgen.commands.batch import batch
+    from fishgen.commands.build import build
+    from fishgen.errors import UsageError
+
+    with pytest.raises(UsageError, match=r"^expected one or more SPECIES_FILE\.\.\., found none$"):
+        build([], None)
+    with pytest.raises(UsageError, match=r"^expected one MANIFEST\.toml\|DIR, found 2$"):
+        batch(["a.toml", "b.toml"], None)
+    with pytest.raises(UsageError, match=r"^expected the inputs as a list of SPECIES_FILE\.\.\., found 7$"):
+        build(7, None)   # type: ignore[arg-type]
+    with pytest.raises(UsageError, match=r"^expected options to be a BuildOptions, found dict$"):
+        build(["x.txt"], None, {"fps": 30})   # type: ignore[arg-type]
+    from fishgen.commands import command as declaration
+
+    assert declaration("build").given(str(PARAMS / "bonybream.txt"), declaration("build").options()) == (
+        PARAMS / "bonybream.txt",)
