@@ -14,6 +14,7 @@ redrawn in batches while outside the cube (Figure 4.2).
 from __future__ import annotations
 
 import math
+import numbers
 import os
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -45,14 +46,21 @@ def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
     # a library caller's arguments get the command line's kind of error, not numpy's
     if method not in METHODS:
         raise FishgenError(f"expected a fill method of {' or '.join(METHODS)}, found {method!r}")
-    if int(seed) < 0:
-        raise FishgenError(f"expected a seed of 0 or more, found {seed}")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise FishgenError(f"expected a seed as a whole number of 0 or more, found {seed!r}")
     if np.shape(offset) != (3,):
         shown = ", ".join(f"{v:g}" if isinstance(v, (int, float)) else repr(v)
                           for v in np.ravel(offset).tolist())
         raise FishgenError(f"expected an offset of three numbers (x, y, z), found ({shown})")
     cubes = cube_file.cubes
     counts = np.array([c.particles for c in cubes], np.int64)
+    if (counts < 0).any():   # a CubeFile made in Python; the parser refuses these
+        bad = cubes[int(np.argmax(counts < 0))]
+        raise FishgenError(f"expected a cube of 0 or more particles, found {bad.particles}",
+                           cube_file.path or None, bad.line or None)
+    from fishgen.clouds.memory import check_fits
+
+    check_fits(int(counts.sum()), ".npy")   # before the arrays: the parser's cap is the caller's to skip
     size = np.array([c.size for c in cubes], np.float64).reshape(-1, 3)
     centre = np.array([c.centre for c in cubes], np.float64).reshape(-1, 3)
     centre = centre + np.asarray(offset, np.float64).reshape(1, 3)

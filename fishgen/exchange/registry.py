@@ -137,7 +137,7 @@ def detect(path: str | os.PathLike) -> Format | None:
 
 def output_format(path: str | os.PathLike, holding: Iterable[str] = (), what: str = "output") -> Format:
     """The writable format ``path``'s extension names, able to hold ``holding``; else a one-line error."""
-    need = list(holding)
+    need = [holding] if isinstance(holding, str) else list(holding)   # "meshes" is one need, not six
     usable = formats(writable=True, holding=need)
     fmt = by_extension(path)
     if fmt is None or fmt.writer is None:
@@ -149,9 +149,10 @@ def output_format(path: str | os.PathLike, holding: Iterable[str] = (), what: st
                            path)
     missing = [k for k in need if k not in fmt.holds]
     if missing:  # before the package: installing usd-core would not make a .usdc hold a cloud
+        instead = f"use {' or '.join(extensions(usable))} instead" if usable else "no format holds them"
         raise FishgenError(f"expected a format that holds {' and '.join(missing)}, found "
-                           f"{fmt.extensions[0]} ({fmt.description}), which would lose them; use "
-                           f"{' or '.join(extensions(usable))} instead", path)
+                           f"{fmt.extensions[0]} ({fmt.description}), which would lose them; {instead}",
+                           path)
     if fmt.extra is not None:
         from fishgen.extras import needs
 

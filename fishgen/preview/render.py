@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import ctypes
 import functools
+import numbers
 import os
 import threading
 import weakref
@@ -216,6 +217,10 @@ class Renderer:
         a smooth cloud; 16 bits cost 28 bytes a pixel more at 4x multisampling, so only a scene
         with particles (points or billboards) asks for it. ``samples``: multisamples a pixel (1:
         none, each pixel one sample, its masked materials' alpha tested at its centre)."""
+        if not all(isinstance(n, numbers.Integral) and 0 < n <= 2**15 for n in (width, height)):
+            raise ValueError(f"expected a renderer's width and height as whole numbers from 1 to 32768, "
+                             f"found {width!r} x {height!r}")
+        width, height = int(width), int(height)
         self._gl = gl = _gl_for_thread()
         self.ctx: Any = gl.ctx
         self.mesh_prog: Any = gl.mesh_prog

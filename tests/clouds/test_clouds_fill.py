@@ -154,10 +154,23 @@ def test_bad_method_seed_and_offset_are_said_as_the_command_line_says_them():
     """A library caller's offset of two numbers was numpy's "cannot reshape array of size 2"."""
     with pytest.raises(FishgenError, match="expected a fill method of paper or uniform, found 'gaussian'"):
         fill_cloud(one_cube(10), method="gaussian")
-    with pytest.raises(FishgenError, match="expected a seed of 0 or more, found -1"):
+    with pytest.raises(FishgenError, match="expected a seed as a whole number of 0 or more, found -1"):
         fill_cloud(one_cube(10), seed=-1)
     with pytest.raises(FishgenError, match=r"an offset of three numbers \(x, y, z\), found \(1, 2\)"):
         fill_cloud(one_cube(10), offset=(1, 2))
+    with pytest.raises(FishgenError, match=r"expected a seed as a whole number of 0 or more, found 1\.5"):
+        fill_cloud(one_cube(10), seed=1.5)   # type: ignore[arg-type]
+
+
+def test_a_cube_file_made_in_python_is_checked_before_its_arrays_are_made():
+    """The parser refuses these; a CubeFile made in Python reached numpy (its raw errors, or a
+    MemoryError after gigabytes were taken)."""
+    from fishgen.errors import UsageError
+
+    with pytest.raises(FishgenError, match=r"^test: expected a cube of 0 or more particles, found -5$"):
+        fill_cloud(one_cube(-5))
+    with pytest.raises(UsageError, match=r"expected a cloud that fits in .*, found 1,000,000,000,000 "):
+        fill_cloud(one_cube(10**12))
 
 
 def test_phase_shift_is_eq_4_5_to_4_7_as_decided():

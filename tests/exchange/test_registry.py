@@ -46,6 +46,12 @@ def test_a_format_that_cannot_hold_what_is_asked_says_what_is_lost_and_what_to_u
                                "use .glb or .gltf or .usdc or .usda or .usdz instead")
     with pytest.raises(FishgenError, match="an input of `fishgen clouds`"):
         output_format("sky.awn", [POINTS])
+    # one need given as text is one need (it was six letters), and none that no format holds is
+    # offered (it was "use  instead")
+    with pytest.raises(FishgenError, match=r"holds node animation, found \.obj .*; use \.glb or"):
+        output_format("school.obj", NODE_ANIMATION)
+    with pytest.raises(FishgenError, match=r"holds nothing-at-all, found \.glb .*; no format holds them$"):
+        output_format("x.glb", ["nothing-at-all"])
 
 
 def test_summary_names_what_a_rest_pose_format_drops(tmp_path):

@@ -203,3 +203,9 @@ def test_a_process_forked_after_drawing_is_refused_in_one_line_not_hung():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("expected to draw in a process not forked from one that drew")
+
+
+@pytest.mark.parametrize("size", [(-5, 10), (0, 16), (16.5, 16), (10**6, 16)])
+def test_a_renderer_of_no_size_or_an_absurd_one_is_refused_before_any_gl(size):
+    with pytest.raises(ValueError, match=r"^expected a renderer's width and height as whole numbers from 1 "):
+        Renderer(*size)   # -5 x 10 had been "out of memory for a -5x10 framebuffer (-0 MiB ...)"
