@@ -430,7 +430,8 @@ def check_value(spec: Option, value: Any, fail: Callable[[str], FishgenError]) -
 def check_record(options: Any) -> None:
     """A Python caller's options record, each value checked by its declaration as the command line
     and manifests check theirs (theirs are checked on the way in; a record made in Python is not):
-    a UsageError naming the field and its option."""
+    a UsageError naming the field and its option. Not :func:`check_value`: a Python value comes as
+    Python types (a tuple, a Path), not as TOML's."""
     from fishgen.errors import UsageError
 
     for f in fields(options):
@@ -441,22 +442,27 @@ def check_record(options: Any) -> None:
         spec, default = f.metadata.get(OPTION), field_default(f)
         if spec is None or value is default or (type(value) is type(default) and value == default):
             continue
-        items = value if spec.multiple and isinstance(value, (tuple, list)) else [value]
-        ok = value is not None and (not spec.multiple or isinstance(value, (tuple, list)))
-        for item in items if ok else ():
-            if spec.flag:
-                ok = isinstance(item, bool)
-            else:
-                try:   # a whole number declared: 2.5 is not 2 (click's int() would make it so)
-                    ok = _same(spec.type.convert(item, None, None), item)
-                except click.BadParameter:
-                    ok = False
-            if not ok:
-                value = item
-                break
-        if not ok:
+        if not _fits(spec, value):
             raise UsageError(f"expected options.{f.name} (--{long_name(f)}) to be {what(spec)}, "
                              f"found {value!r}")
+
+
+def _fits(spec: Option, value: Any) -> bool:
+    """Whether ``value`` is one its option's type takes as it is (a whole number stays whole:
+    click's int() would make 2.5 two)."""
+    if value is None or (spec.multiple and not isinstance(value, (tuple, list))):
+        return False
+    for item in value if spec.multiple else [value]:
+        if spec.flag:
+            if not isinstance(item, bool):
+                return False
+            continue
+        try:
+            if not _same(spec.type.convert(item, None, None), item):
+                return False
+        except click.BadParameter:
+            return False
+    return True
 
 
 def _same(converted: Any, given: Any) -> bool:
@@ -468,8 +474,6 @@ def _same(converted: Any, given: Any) -> bool:
         return converted == given
     if isinstance(converted, (tuple, list)) and isinstance(given, (tuple, list)):
         return len(converted) == len(given) and all(map(_same, converted, given))
-    if given is None or converted is None:
-        return given is converted
     return True
 
 

@@ -579,7 +579,7 @@ class _Gl:
             raise FishgenError(
                 "expected an OpenGL 3.3 context from EGL (Debian: apt-get install libegl1 "
                 f"libgl1-mesa-dri), found none ({err})") from None
-        _DREW.append(os.getpid())
+        _DREW.add(os.getpid())
         self.kept, self.pid, self.thread = kept, os.getpid(), threading.get_ident()
         self.handle = _egl_current()   # made current by its making
         self.mesh_prog = self.ctx.program(vertex_shader=MESH_VS, fragment_shader=MESH_FS)
@@ -603,7 +603,7 @@ class _Gl:
             yield
         finally:
             if before is not None and before[3]:   # the caller's context, current again
-                _EGL[0].eglMakeCurrent(*before)
+                _egl().eglMakeCurrent(*before)
 
     def done(self) -> None:
         """A renderer is done with it: a context of its own goes, a kept one stays."""
@@ -617,7 +617,7 @@ class _Gl:
 
 _MAIN_GL: list[_Gl] = []
 """The main thread's kept context."""
-_DREW: list[int] = []
+_DREW: set[int] = set()
 """The processes that made a context here: this one, or the one it was forked from."""
 _EGL: list[Any] = []
 
