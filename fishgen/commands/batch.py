@@ -222,14 +222,18 @@ def _job_reads(manifest: Manifest) -> list[tuple[Job, list[Path]]]:
     from fishgen.exchange.registry import FORMATS
 
     found = []
+    # a manifest often builds one input many times (variants, LODs): each is read once
+    beside: dict[tuple, list[Path]] = {}
     for job in manifest.jobs:
-        read = list(job.inputs)
-        try:
-            kinds = check_inputs(job.inputs, job.kind, list(FORMATS.values()), default=FORMATS["species"])
-            read += read_beside(job.inputs, kinds, getattr(job.options, "textures", None))
-        except FishgenError:
-            pass
-        found.append((job, read))
+        textures = getattr(job.options, "textures", None)
+        key = (tuple(job.inputs), job.kind, textures)
+        if key not in beside:
+            try:
+                kinds = check_inputs(job.inputs, job.kind, list(FORMATS.values()), default=FORMATS["species"])
+                beside[key] = read_beside(job.inputs, kinds, textures)
+            except FishgenError:
+                beside[key] = []
+        found.append((job, [*job.inputs, *beside[key]]))
     return found
 
 
