@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+import threading
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 
@@ -76,8 +77,13 @@ def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
                 density=np.empty(n, _F32), colors=np.full((n, 3), UNLIT, np.uint8),
                 cube_index=cube_index, cube_bounds=np.stack([lo, hi], axis=1), textures=textures)
 
+    kept = threading.local()  # each worker thread's scratch, reused from chunk to chunk
+
     def work(start: int) -> None:
-        _fill_chunk(out, tables, start, min(start + CHUNK, n), int(seed), method)
+        scratch = getattr(kept, "scratch", None)
+        if scratch is None:
+            scratch = kept.scratch = _Scratch(min(CHUNK, n))
+        _fill_chunk(out, tables, start, min(start + CHUNK, n), int(seed), method, scratch)
 
     starts = range(0, n, CHUNK)
     threads = 1 if len(starts) <= 1 else min(workers or os.cpu_count() or 1, len(starts))
@@ -176,21 +182,42 @@ def _round_inward(bound: np.ndarray, up: bool) -> np.ndarray:
     return np.where(wrong, np.nextafter(b32, _F32(np.inf if up else -np.inf)), b32)
 
 
-def _fill_chunk(out: Cloud, t: _Tables, start: int, stop: int, seed: int, method: str) -> None:
+class _Scratch:
+    """One worker thread's buffers for chunks of up to ``m`` particles. A fill's arithmetic is a
+    few nanoseconds a particle, and on a VM the first touch of a fresh page costs about as much a
+    byte: made anew for each step, the temporaries' pages cost more than the steps did."""
+
+    def __init__(self, m: int):
+        draws = m + m // 3 + 16   # the first round's over-draw, the largest
+        self.draws = np.empty(3 * draws, _F32)
+        self.rows = np.empty((5, draws), _F32)
+        self.mask = np.empty(draws, np.bool_)
+        self.offsets = np.empty(3 * m, _F32)
+        self.u = np.empty((2, m), _F32)
+
+
+def _fill_chunk(out: Cloud, t: _Tables, start: int, stop: int, seed: int, method: str,
+                scratch: _Scratch | None = None) -> None:
     m = stop - start
+    work = scratch or _Scratch(m)
     rng = np.random.default_rng([seed, start // CHUNK])
     idx = out.cube_index[start:stop]
-    s = _paper_offsets(rng, m) if method == "paper" else _uniform_offsets(rng, m)
+    s = _paper_offsets(rng, m, work) if method == "paper" else _uniform_offsets(rng, m, work.offsets)
 
     # Particles are sorted by cube, so a chunk is a few runs of equal cube index: each run is
     # placed with its cube's numbers as scalars, an axis at a time into the (m, 3) centres (no
     # per-particle copies of the tables, no transposed copy of the whole chunk).
     first, last = int(idx[0]), int(idx[-1])
     ends = [0, m] if first == last else [0, *np.cumsum(np.bincount(idx - first, minlength=last - first + 1))]
-    u = _F32(1) - rng.random(m, dtype=_F32)  # (0, 1]: a radius is never 0
+    u, sine = work.u[0, :m], work.u[1, :m]
+    rng.random(m, dtype=_F32, out=u)
+    np.subtract(_F32(1), u, out=u)  # (0, 1]: a radius is never 0
     if method == "paper":
         # eq. 4.9-4.12 in units of the cube's maximum radius, renormalised into (0, 1].
-        u = (u + _HALF_PI * np.sin(u)) / _RADIUS_NORM
+        np.sin(u, out=sine)
+        sine *= _HALF_PI
+        u += sine
+        u /= _RADIUS_NORM
     centers, radii = out.centers[start:stop], out.radii[start:stop]
     for cube, (a, b) in enumerate(zip(ends[:-1], ends[1:], strict=True), start=first):
         if a == b:
@@ -212,51 +239,62 @@ def _fill_chunk(out: Cloud, t: _Tables, start: int, stop: int, seed: int, method
     np.exp(density, out=density)
 
 
-def _uniform_offsets(rng: np.random.Generator, m: int) -> np.ndarray:
-    s = rng.random((3, m), dtype=_F32)
+def _uniform_offsets(rng: np.random.Generator, m: int, into: np.ndarray | None = None) -> np.ndarray:
+    """(3, m) uniform draws in [-1, 1), drawn into the start of the flat float32 ``into``."""
+    s = rng.random((3, m), dtype=_F32, out=None if into is None else into[:3 * m].reshape(3, m))
     s *= _F32(2)
     s -= _F32(1)
     return s
 
 
-def _paper_offsets(rng: np.random.Generator, m: int) -> np.ndarray:
+def _paper_offsets(rng: np.random.Generator, m: int, work: _Scratch) -> np.ndarray:
     """(3, m) normalised positions: eq. 4.2-4.7 draws, rejected and redrawn in batches."""
-    out = np.empty((3, m), _F32)
+    out = work.offsets[:3 * m].reshape(3, m)
     filled = 0
     for _ in range(MAX_ROUNDS):
         need = m - filled
         if need == 0:
             return out
-        s = _uniform_offsets(rng, need + need // 3 + 16)  # over-draw for the ~23 % rejected
-        _phase_shift(s)
-        worst = np.abs(s[0])
-        np.maximum(worst, np.abs(s[1]), out=worst)
-        np.maximum(worst, np.abs(s[2]), out=worst)
-        keep = s.compress(worst <= 1, axis=1)[:, :need]
-        out[:, filled:filled + keep.shape[1]] = keep
-        filled += keep.shape[1]
+        d = need + need // 3 + 16  # over-draw for the ~23 % rejected
+        s = _uniform_offsets(rng, d, work.draws)
+        rows = work.rows[:, :d]
+        _phase_shift(s, rows)
+        worst, other = rows[0], rows[1]
+        np.abs(s[0], out=worst)
+        np.maximum(worst, np.abs(s[1], out=other), out=worst)
+        np.maximum(worst, np.abs(s[2], out=other), out=worst)
+        inside = np.less_equal(worst, 1, out=work.mask[:d])
+        kept = int(np.count_nonzero(inside))
+        take = min(kept, need)
+        for axis in range(3):
+            row = rows[1 + axis, :kept]
+            np.compress(inside, s[axis], out=row)
+            out[axis, filled:filled + take] = row[:take]
+        filled += take
     if filled < m:  # cannot happen with CLUMP as set: acceptance is ~77 %
         raise RuntimeError("rejection sampling did not converge")
     return out
 
 
-def _phase_shift(s: np.ndarray) -> None:
-    """Eq. 4.5-4.7 in place, with phase angle theta = pi*s so a cube spans one period.
+def _phase_shift(s: np.ndarray, rows: np.ndarray | None = None) -> None:
+    """Eq. 4.5-4.7 in place, with phase angle theta = pi*s so a cube spans one period; ``rows``:
+    five rows as long as ``s`` for the temporaries.
 
     Algebraically x += k*(pi/2 sin(theta_y/2) + pi sin(P_x theta_z/2)), with the
     constants folded and in-place ufuncs: this is the hot loop, and every extra
     pass over the batch costs about as much as a sine.
     """
     x, y, z = s
+    if rows is None:
+        rows = np.empty((5, x.shape[0]), x.dtype)
+    half_theta_z, z_term, tmp, sine_y, sine_x = rows
     k = CLUMP / math.pi                              # eq. 4.7, scaled to the cube
-    half_theta_z = z * _HALF_PI
-    z_term = half_theta_z * _HALF_PI                 # multiplies sin(theta/2) in eq. 4.6's argument
-    tmp = np.empty_like(x)
-    sines = []
-    for source in (y, x):                            # both before either coordinate moves
-        sine = np.multiply(source, _HALF_PI)
-        sines.append(np.sin(sine, out=sine))         # eq. 4.5: P = pi/2 sin(0.5 theta_other)
-    for moved, sine in zip((x, y), sines, strict=True):
+    np.multiply(z, _HALF_PI, out=half_theta_z)
+    np.multiply(half_theta_z, _HALF_PI, out=z_term)  # multiplies sin(theta/2) in eq. 4.6's argument
+    for source, sine in ((y, sine_y), (x, sine_x)):  # both before either coordinate moves
+        np.multiply(source, _HALF_PI, out=sine)
+        np.sin(sine, out=sine)                       # eq. 4.5: P = pi/2 sin(0.5 theta_other)
+    for moved, sine in ((x, sine_y), (y, sine_x)):
         np.multiply(sine, z_term, out=tmp)           # P * theta_z / 2
         np.sin(tmp, out=tmp)
         tmp *= _F32(k * math.pi)                     # eq. 4.6 (for y: P_y as meant, not P_x)
