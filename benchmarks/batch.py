@@ -102,7 +102,7 @@ def main() -> None:
     top = statistics.median(ceiling)
     print(f"  the machine's ceiling: two -j 1 batches at once did twice the work {top:.2f}x as fast as "
           f"one, median of the {len(ceiling)} pairs ({ceiling[0]:.2f} to {ceiling[-1]:.2f}); -j 2 reached "
-          f"{ratio / top:.0%} of it")
+          f"{statistics.median(pairs) / top:.0%} of it by pairs")
     print(f"  rerun with nothing changed, {args.jobs} jobs: {statistics.median(unchanged):.3f} s median of "
           f"{len(unchanged)} (target: under 1 s)")
 
