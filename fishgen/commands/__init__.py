@@ -193,10 +193,11 @@ def run(cmd: Command, inputs: tuple[Path, ...], output: str | os.PathLike | None
     _folders_there(options)
     with protecting(inputs):
         made = cmd.function()(inputs, output, options, events)
-    from fishgen.exchange.client_limits import notes
+    if cmd.output is not None:  # a batch writes through its jobs' runs, and each said its own
+        from fishgen.exchange.client_limits import notes
 
-    for note in notes(made.written):    # what a client will not read or play of it
-        events.note(note)
+        for note in notes(made.written):    # what a client will not read or play of it
+            events.note(note)
     return made
 
 

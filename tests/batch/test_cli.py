@@ -285,3 +285,15 @@ def test_a_batch_whose_reader_has_gone_runs_every_job(tmp_path, shipped):
     result = closed_stdout("batch", shipped / "params" / "assets.toml", "--out", tmp_path / "out", "-j", "1")
     assert result.returncode == 0 and result.stderr == "", result.stderr
     assert len([p for p in (tmp_path / "out").rglob("*.glb")]) >= 9
+
+
+def test_a_jobs_warning_is_said_once(shipped):
+    """A school over Godot 3's 1,024 animated weights is said once: by its job as it ran, and not
+    again after the batch, from the batch's own list of what it wrote (it was, twice a job)."""
+    manifest = shipped / "params" / "m.toml"
+    manifest.write_text('out = "../out"\n[[school]]\ninput = "bonybream.txt"\noutput = "s.glb"\n'
+                        'count = 150\nframes = 10\n')
+    run = batch(manifest, "-j", "1", "--quiet")
+    assert run.returncode == 0, run.stderr
+    lines = run.stderr.splitlines()
+    assert len(lines) == 1 and "s.glb: animates 5,400 blend-shape weights; Godot 3 plays at most" in lines[0]
