@@ -6,6 +6,7 @@ declaration, its work from the use-case function, and this module only turns the
 """
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager, nullcontext
@@ -139,16 +140,41 @@ class TerminalEvents:
 
     @contextmanager
     def progress(self, label: str, total: int) -> Iterator[Progress]:
-        if not (sys.stderr.isatty() and verbosity() == 1) or total <= 0:
+        width = _bar_width(label) if watched() and total > 0 else None
+        if width is None:
             yield Progress()
             return
-        bar = click.progressbar(length=total, label=label, file=sys.stderr)
+        bar = click.progressbar(length=total, label=label, file=sys.stderr, width=width)
         self.bars.append(bar)
         try:
             with bar:
                 yield _Bar(bar)
         finally:
             self.bars.pop()
+
+
+def watched() -> bool:
+    """Whether a person watches the command: stderr is a terminal that can redraw a line, not --quiet
+    or --verbose, and not a CI runner (some give their jobs a pseudo-terminal)."""
+    return (sys.stderr.isatty() and verbosity() == 1 and os.environ.get("TERM") != "dumb"
+            and os.environ.get("CI", "").strip().lower() in ("", "0", "false", "no"))
+
+
+BAR_WIDTH = 36
+_AROUND_BAR = len("  []  100%  00:00:00") + 1
+"""Columns of click's bar line besides its label and bar (percent and ETA), and one spare: a line
+that reaches the last column wraps on some terminals, and every redraw then starts a new row."""
+
+
+def _bar_width(label: str) -> int | None:
+    """The bar's width, so that its whole line fits the terminal; None when even a short bar
+    would not (a bar that wraps is drawn again on a new row at every step)."""
+    try:
+        columns = os.get_terminal_size(sys.stderr.fileno()).columns
+    except (OSError, ValueError, AttributeError):  # not a real terminal (a test's stand-in)
+        columns = 80
+    width = min(BAR_WIDTH, columns - len(label) - _AROUND_BAR)
+    return width if width >= 4 else None
 
 
 class _Bar(Progress):

@@ -2,6 +2,8 @@
 on the bar's line (the school's and the preview's bars are tested with them)."""
 from __future__ import annotations
 
+import pytest
+
 from fishgen.commands import Events
 from fishgen.commands.build import build
 from fishgen.commands.species import SpeciesOptions, species
@@ -66,6 +68,7 @@ def test_a_note_during_a_bar_takes_the_bar_s_line_and_the_bar_is_drawn_again_bel
 
 def test_click_s_own_bar_is_drawn_again_at_once_below_a_note(monkeypatch):
     """With click's progress bar itself (the redraw clears what click remembers it drew last)."""
+    _a_person_watches(monkeypatch)
     import io
     import sys
 
@@ -84,3 +87,77 @@ def test_click_s_own_bar_is_drawn_again_at_once_below_a_note(monkeypatch):
         assert "fitting" in err.getvalue().split("hello\n", 1)[1]     # before the next step
         bar.update(3)
     assert "\n\n" not in err.getvalue() and err.getvalue().count("hello") == 1
+
+
+class _Terminal:
+    """stderr as a terminal of ``columns`` columns."""
+
+    def __init__(self, columns: int = 80):
+        import io
+
+        self.text = io.StringIO()
+        self.columns = columns
+
+    def isatty(self) -> bool:
+        return True
+
+    def fileno(self) -> int:
+        return 2
+
+    def write(self, text: str) -> int:
+        return self.text.write(text)
+
+    def flush(self) -> None:
+        pass
+
+
+def _a_person_watches(monkeypatch, columns: int = 80) -> _Terminal:
+    import os
+    import sys
+
+    terminal = _Terminal(columns)
+    monkeypatch.setattr(sys, "stderr", terminal)
+    monkeypatch.setattr(os, "get_terminal_size", lambda fd=1: os.terminal_size((columns, 24)))
+    monkeypatch.delenv("CI", raising=False)
+    monkeypatch.setenv("TERM", "xterm")
+    return terminal
+
+
+def _drawn(terminal: _Terminal, label: str = "simulating", total: int = 50) -> list[str]:
+    """Every line the bar drew, its redraws apart (each starts with a carriage return)."""
+    import re
+
+    from fishgen.cli.adapter import TerminalEvents
+
+    with TerminalEvents("school").progress(label, total) as bar:
+        for _ in range(total):
+            bar.update(1)
+    text = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", terminal.text.getvalue())   # cursor hiding
+    return [line for line in re.split(r"[\r\n]", text) if line.strip()]
+
+
+@pytest.mark.parametrize("columns", [40, 60, 80, 200])
+def test_the_bar_s_line_fits_the_terminal_so_each_step_redraws_it_in_place(monkeypatch, columns):
+    """A bar 36 wide made a line of 56-66 columns: on a narrower terminal every redraw wrapped onto
+    a new row (124 rows of a 40-column terminal for one school, QA pass 21)."""
+    lines = _drawn(_a_person_watches(monkeypatch, columns))
+    assert lines and all(len(line) < columns for line in lines)
+    assert "100%" in lines[-1]
+
+
+def test_no_bar_where_even_a_short_one_would_not_fit(monkeypatch):
+    assert _drawn(_a_person_watches(monkeypatch, 20)) == []
+
+
+@pytest.mark.parametrize("variable, value", [("CI", "true"), ("CI", "1"), ("TERM", "dumb")])
+def test_no_bar_in_ci_or_on_a_terminal_that_cannot_redraw_a_line(monkeypatch, variable, value):
+    """Some CI runners give their jobs a pseudo-terminal; a dumb terminal cannot move its cursor."""
+    terminal = _a_person_watches(monkeypatch)
+    monkeypatch.setenv(variable, value)
+    assert _drawn(terminal) == [] and terminal.text.getvalue() == ""
+
+
+def test_a_bar_when_ci_is_set_to_false(monkeypatch):
+    terminal = _a_person_watches(monkeypatch)
+    monkeypatch.setenv("CI", "false")
+    assert _drawn(terminal)
