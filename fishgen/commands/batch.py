@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 class BatchOptions:
     out: Path | None = option(OUT_FOLDER, "Folder for the outputs and the record (.fishgen-batch.json). "
                               "Required with DIR.", shown_default="the manifest's `out`, else ./out",
-                              metavar="DIRECTORY")
+                              metavar="DIRECTORY", short="-o")   # -o, as every other command's output
     jobs: int | None = option(click.IntRange(1, 1024), "Jobs at once, each in its own process (1: in this "
                               "process).", shown_default="the number of cores", short="-j")
     force: bool = option(click.BOOL, "Rebuild every job, even those the record says are up to date.", False,

@@ -297,3 +297,13 @@ def test_a_jobs_warning_is_said_once(shipped):
     assert run.returncode == 0, run.stderr
     lines = run.stderr.splitlines()
     assert len(lines) == 1 and "s.glb: animates 5,400 blend-shape weights; Godot 3 plays at most" in lines[0]
+
+
+def test_o_names_the_out_folder_as_every_other_command_s_output_does(tmp_path):
+    """`fishgen batch m.toml -o DIR` was "No such option '-o'" with no hint (QA pass 21)."""
+    (tmp_path / "c.awn").write_text("20\n1\n20, 2,2,2, 0,0,0, 0.5\n")
+    manifest = tmp_path / "m.toml"
+    manifest.write_text('[[clouds]]\ninput = "c.awn"\noutput = "c.ply"\n')
+    run = batch(manifest, "-o", tmp_path / "there", "-j", "1")
+    assert run.returncode == 0, run.stderr
+    assert (tmp_path / "there" / "c.ply").is_file() and not (tmp_path / "out").exists()
