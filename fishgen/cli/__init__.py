@@ -42,6 +42,16 @@ class LazyGroup(click.Group):
         cmd = command(name)
         return add_common_options(click_command(cmd))  # --quiet, --verbose, --json: every command, once
 
+    def resolve_command(self, ctx, args):
+        name = args[0] if args else ""
+        if name not in MODULES and not name.startswith("-"):
+            import difflib
+
+            near = difflib.get_close_matches(name, MODULES, n=1)    # as click suggests options
+            if near:
+                ctx.fail(f"No such command {name!r}. Did you mean {near[0]!r}?")
+        return super().resolve_command(ctx, args)
+
     def format_commands(self, ctx, formatter):
         rows = [(name, command(name).summary) for name in self.list_commands(ctx)]
         with formatter.section("Commands"):
@@ -58,6 +68,9 @@ def cli() -> None:
 
 
 add_common_options(cli, wrap=False)  # `fishgen --json build ...` as well as `fishgen build ... --json`
+
+
+_NO_COMMAND = click.exceptions.NoArgsIsHelpError   # a group given no command (click 8.2+)
 
 
 class Interrupted(BaseException):
@@ -95,6 +108,12 @@ def main(argv: list[str] | None = None) -> None:
     except click.exceptions.Abort:
         interrupts.stopped()
         _fail("fishgen: interrupted", 130, kind="interrupted")  # the shell's ^C ends the line before ours
+    except _NO_COMMAND as err:  # `fishgen` alone: the help, as click prints it (stderr, status 2)
+        if json_errors():
+            _fail("fishgen: expected a command (`fishgen --help` lists them), found none", err.exit_code,
+                  kind="usage")
+        err.show()
+        sys.exit(err.exit_code)
     except click.UsageError as err:  # one line, like every other error (`--help` shows the usage)
         command = err.ctx.command_path if err.ctx is not None else "fishgen"
         if command == "fishgen":

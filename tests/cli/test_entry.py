@@ -54,3 +54,24 @@ def test_a_name_the_terminal_cannot_encode_is_printed_escaped(tmp_path):
     assert done.returncode == 0, done.stderr.decode("latin-1")
     assert out.exists() and b"Traceback" not in done.stderr
     assert b"\\u2713.glb: bonybream" in done.stdout
+
+
+def test_a_mistyped_command_is_one_line_that_names_the_nearest():
+    """Options were suggested; commands were not (QA pass 21)."""
+    from tests.cli_runner import run_cli
+
+    run = run_cli("buidl", "params/bonybream.txt")
+    assert (run.returncode, run.stderr) == (2, "fishgen: No such command 'buidl'. Did you mean 'build'?\n")
+    far = run_cli("zzz")
+    assert (far.returncode, far.stderr) == (2, "fishgen: No such command 'zzz'.\n")
+
+
+def test_fishgen_alone_prints_its_help_as_click_does_not_an_error_line_around_it():
+    """The help came behind an error prefix, `fishgen: Usage: fishgen …` (QA pass 21)."""
+    from tests.cli_runner import run_cli
+
+    run = run_cli()
+    assert run.returncode == 2 and run.stdout == ""
+    assert run.stderr.startswith("Usage: fishgen [OPTIONS] COMMAND [ARGS]...") and "  build " in run.stderr
+    plain = run_cli("--help")
+    assert plain.returncode == 0 and plain.stdout.rstrip() == run.stderr.rstrip()
