@@ -24,7 +24,7 @@ def click_command(cmd: Command) -> click.Command:
     """The click command of ``cmd``: its inputs, ``-o``, and every declared option with its default."""
     params: list[click.Parameter] = []
     if cmd.inputs is not None:
-        kind = click.Path(path_type=Path, exists=cmd.inputs.must_exist) if cmd.inputs.path else None
+        kind = click.Path(path_type=Path) if cmd.inputs.path else None
         params.append(click.Argument(["inputs"], nargs=-1 if cmd.inputs.many else 1,
                                      required=cmd.inputs.required, type=kind, metavar=cmd.inputs.metavar))
     if cmd.output is not None:

@@ -48,7 +48,6 @@ class Inputs:
     metavar: str
     many: bool = True                   # one or more (else exactly one)
     path: bool = True                   # file paths (else plain strings)
-    must_exist: bool = False
     required: bool = True               # False: none at all is allowed (fly --mode)
 
 

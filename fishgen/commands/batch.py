@@ -60,7 +60,7 @@ COMMAND = Command(
     """,
     options=BatchOptions,
     run="fishgen.commands.batch:batch",
-    inputs=Inputs("MANIFEST.toml|DIR", many=False, must_exist=True),
+    inputs=Inputs("MANIFEST.toml|DIR", many=False),
 )
 
 

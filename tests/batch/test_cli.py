@@ -307,3 +307,14 @@ def test_o_names_the_out_folder_as_every_other_command_s_output_does(tmp_path):
     run = batch(manifest, "-o", tmp_path / "there", "-j", "1")
     assert run.returncode == 0, run.stderr
     assert (tmp_path / "there" / "c.ply").is_file() and not (tmp_path / "out").exists()
+
+
+def test_a_missing_manifest_is_a_bad_input_as_every_command_s_missing_input_is(tmp_path):
+    """It was click's own `Invalid value for 'MANIFEST.toml|DIR': Path … does not exist.`, a usage
+    error with no file under --json, where every other command says FILE: … no such file (QA pass 21)."""
+    missing = tmp_path / "nope.toml"
+    run = batch(missing)
+    assert (run.returncode, run.stderr) == (2, f"{missing}: expected a batch manifest or a folder, found no "
+                                               "such file\n")
+    as_json = json.loads(batch(missing, "--json").stderr)
+    assert (as_json["kind"], as_json["file"]) == ("input", str(missing))
