@@ -39,7 +39,8 @@ class FishOptions:
     length: float | None = option(FiniteRange(0.001, 1e4), "Nose-to-tail length in metres.",
                                   shown_default="world scale x scaleX x 0.05 m for the body",
                                   metavar="METRES")
-    fps: float = option(FiniteRange(1, 1000), "Frames per second; fins move step size degrees per frame.",
+    fps: float = option(FiniteRange(1, 1000), "Frames per second of the animation; each fin turns by its "
+                        "species file's step size (degrees) a frame.",
                         30.0)
     swim: str = swim_option("body: a travelling body wave (carangiform, tail-beat frequency from --speed) "
                             "under the fin swings; fins: a rigid body, only the fins move (VRFish's fish).")
@@ -52,7 +53,7 @@ class FishOptions:
                                  shown_default=f"{DEFAULT_SPEED:g}", metavar="BL/S")
     lods: tuple[tuple[int, int], ...] | None = lods_option()
     merge: bool = merge_option()
-    clips: tuple[str, ...] = option(Names(CLIP_NAMES), "Clips to write, each looping but burst: "
+    clips: tuple[str, ...] = option(Names(CLIP_NAMES), "Clips to write (each loops, except burst): "
                                     f"{', '.join(CLIP_NAMES)}.", DEFAULT_CLIPS, metavar="NAME,...")
     compact: bool = compact_option()
 

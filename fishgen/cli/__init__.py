@@ -64,6 +64,13 @@ def cli() -> None:
     """fishgen: procedural fish and cloud assets for games and pipelines.
 
     Run `fishgen COMMAND --help` for the options of each command.
+
+    \b
+    Examples:
+      fishgen build params/bonybream.txt -o out/bonybream.glb
+      fishgen clouds params/clouds/table_4_4.awn -o out/cloud.glb --billboards
+      fishgen school params/bonybream.txt --count 200 -o out/school.glb
+      fishgen batch params/assets.toml -j 2
     """
 
 

@@ -76,8 +76,8 @@ def _options() -> list[click.Option]:
     return [
         click.Option(["-q", "--quiet"], is_flag=True, expose_value=False, is_eager=True,
                      callback=_set("quiet", True),
-                     help="Print nothing on stdout (no summary, no progress); errors still go to stderr. "
-                          "Wins over --verbose.  [default: off]"),
+                     help="Print nothing on stdout (no summary) and draw no progress bar; errors and "
+                          "warnings still go to stderr. Wins over --verbose.  [default: off]"),
         click.Option(["-v", "--verbose"], is_flag=True, expose_value=False, is_eager=True,
                      callback=_set("verbose", True),
                      help="Also print each file written and the time taken, on stderr.  [default: off]"),

@@ -37,6 +37,12 @@ COMMAND = Command(
     orbit with the mouse, play/pause, scrub the timeline, pick a clip, toggle
     wireframe; it shows vertex, triangle and particle counts. It is served on
     127.0.0.1 only (that one page, nothing else in its folder), until Ctrl-C.
+
+    \b
+    Examples:
+      fishgen view out/bonybream.glb
+      fishgen view out/school.glb --no-instancing --port 0
+      fishgen view out/cloud.glb --no-serve -o out/cloud.html --background white
     """,
     options=ViewOptions,
     run="fishgen.commands.view:view",

@@ -282,7 +282,7 @@ register_format(Format("glb", (".glb",), "binary glTF 2.0", _ALL,
 register_format(Format("gltf", (".gltf",), "glTF 2.0 JSON with .bin and images beside it", _ALL,
                        "fishgen.exchange.gltf:write_gltf", "fishgen.exchange.gltf_reader:read_gltf",
                        viewer=True, sides=("{stem}.bin", "{stem}_*.png", "{stem}_*.jpg")))
-register_format(Format("obj", (".obj",), "Wavefront OBJ with .mtl and images (rest pose)",
+register_format(Format("obj", (".obj",), "Wavefront OBJ: a rest-pose mesh with .mtl and images",
                        frozenset({MESHES, TEXTURES}),
                        "fishgen.exchange.obj:write_obj", "fishgen.exchange.mesh_reader:read_mesh_file",
                        viewer=True, sides=("{stem}.mtl", "{stem}_*.png")))

@@ -42,8 +42,8 @@ def test_a_format_that_cannot_hold_what_is_asked_says_what_is_lost_and_what_to_u
     with pytest.raises(FishgenError) as info:
         output_format("school.obj", [MESHES, NODE_ANIMATION])
     assert str(info.value) == ("school.obj: expected a format that holds node animation, found .obj "
-                               "(Wavefront OBJ with .mtl and images (rest pose)), which would lose them; "
-                               "use .glb or .gltf or .usdc or .usda or .usdz instead")
+                               "(Wavefront OBJ: a rest-pose mesh with .mtl and images), which would lose "
+                               "them; use .glb or .gltf or .usdc or .usda or .usdz instead")
     with pytest.raises(FishgenError, match="an input of `fishgen clouds`"):
         output_format("sky.awn", [POINTS])
     # one need given as text is one need (it was six letters), and none that no format holds is
