@@ -172,7 +172,8 @@ def _bar_width(label: str) -> int | None:
     try:
         columns = os.get_terminal_size(sys.stderr.fileno()).columns
     except (OSError, ValueError, AttributeError):  # not a real terminal (a test's stand-in)
-        columns = 80
+        columns = 0
+    columns = columns or 80     # a pseudo-terminal no one sized says 0, as shutil's fallback takes
     width = min(BAR_WIDTH, columns - len(label) - _AROUND_BAR)
     return width if width >= 4 else None
 

@@ -149,6 +149,12 @@ def test_no_bar_where_even_a_short_one_would_not_fit(monkeypatch):
     assert _drawn(_a_person_watches(monkeypatch, 20)) == []
 
 
+def test_a_terminal_of_no_known_width_is_taken_as_80_columns(monkeypatch):
+    """A pseudo-terminal that no one sized (`script` run from a pipe) says 0 columns."""
+    lines = _drawn(_a_person_watches(monkeypatch, 0))
+    assert lines and all(len(line) < 80 for line in lines)
+
+
 @pytest.mark.parametrize("variable, value", [("CI", "true"), ("CI", "1"), ("TERM", "dumb")])
 def test_no_bar_in_ci_or_on_a_terminal_that_cannot_redraw_a_line(monkeypatch, variable, value):
     """Some CI runners give their jobs a pseudo-terminal; a dumb terminal cannot move its cursor."""
