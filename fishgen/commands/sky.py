@@ -127,13 +127,15 @@ def sky(inputs: Sequence[Path], output: str | os.PathLike, options: SkyOptions =
     from fishgen.clouds.memory import check_fits
 
     check_fits(total, output.suffix, options.billboards, sky=True)    # before anything is filled
-    from fishgen.sky.build import build_sky
+    from fishgen.sky.build import build_sky, steps
 
-    built = build_sky(options.mode, seed=options.seed, area=options.area, altitude=options.altitude,
-                      models=models, noise=options.noise, particles=options.particles,
-                      lighting=options.lighting,
-                      shadow_map=options.shadow_map, billboards=options.billboards, lod=options.lod,
-                      textures_dir=options.textures, max_particles=options.max_particles)
+    with events.progress("building the sky", steps(options.mode)) as bar:
+        built = build_sky(options.mode, seed=options.seed, area=options.area, altitude=options.altitude,
+                          models=models, noise=options.noise, particles=options.particles,
+                          lighting=options.lighting,
+                          shadow_map=options.shadow_map, billboards=options.billboards, lod=options.lod,
+                          textures_dir=options.textures, max_particles=options.max_particles,
+                          advance=bar.update)
     written = export(built.scene, output)
     size = sum(p.stat().st_size for p in written)
     sun = ",".join(f"{v:g}" for v in options.lighting.sun)

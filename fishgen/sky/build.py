@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -52,14 +52,21 @@ def load_models(paths: Sequence[str | os.PathLike] = (), *, max_particles: int =
                            raise_with="--max-particles"), files
 
 
+def steps(mode: str) -> int:
+    """How many times :func:`build_sky` advances for a sky of ``mode``: fill, light, level, a cloud."""
+    return 3 * MODES[mode].clouds
+
+
 def build_sky(mode: str = "medium", *, seed: int = 0, area: tuple[float, float] = AREA,
               altitude: tuple[float, float] = ALTITUDE, models: Sequence[str | os.PathLike] = (),
               noise: float = NOISE, particles: int | None = None, lighting: Lighting | None = None,
               shadow_map: str = "cloud", billboards: bool = False, lod: bool = True,
               textures_dir: str | os.PathLike | None = None,
-              max_particles: int = DEFAULT_MAX_PARTICLES) -> Sky:
+              max_particles: int = DEFAULT_MAX_PARTICLES,
+              advance: Callable[[int], None] | None = None) -> Sky:
     """Compose, fill, light and level a sky of ``mode`` (thin, medium, thick) from ``models`` (cube
-    files, .awn or .awa; default: the shipped ones). Same arguments, same scene, bit for bit."""
+    files, .awn or .awa; default: the shipped ones). Same arguments, same scene, bit for bit.
+    ``advance(1)`` as each cloud is filled, lit and levelled: three steps a cloud (``steps``)."""
     from fishgen.clouds.pipeline import cloud_textures
     from fishgen.errors import UsageError
     from fishgen.sky.compose import fill_sky, plan_sky
@@ -81,7 +88,8 @@ def build_sky(mode: str = "medium", *, seed: int = 0, area: tuple[float, float] 
         raise UsageError(f"expected --particles of at least {need:,} for a {mode} sky of {sky_mode.clouds} "
                          f"clouds (one in each cube of every cloud), found {total:,}")
     plan = plan_sky(sky_mode, cubes, seed=seed, area=area, altitude=altitude, particles=total)
-    filled = fill_sky(plan, cubes, noise=noise, max_particles=max_particles)
-    clouds = light_sky(filled, lighting or Lighting(), method=shadow_map)
-    scene, facts = sky_scene(plan, clouds, [p.name for p in files], billboards=billboards, lod=lod)
+    filled = fill_sky(plan, cubes, noise=noise, max_particles=max_particles, advance=advance)
+    clouds = light_sky(filled, lighting or Lighting(), method=shadow_map, advance=advance)
+    scene, facts = sky_scene(plan, clouds, [p.name for p in files], billboards=billboards, lod=lod,
+                             advance=advance)
     return Sky(scene, tuple(facts), mode, seed, tuple(files), cloud_textures(cubes))

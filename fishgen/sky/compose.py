@@ -10,7 +10,7 @@ lighting (:mod:`fishgen.sky.light`) and the scene (:mod:`fishgen.sky.scene`) fol
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -182,10 +182,12 @@ def scaled_model(model: CubeFile, placement: Placement, puff: float) -> CubeFile
 
 
 def fill_sky(plan: SkyPlan, sources: Sequence[CubeFile], *, noise: float = 0.0,
-             max_particles: int = DEFAULT_MAX_PARTICLES) -> list[SkyCloud]:
+             max_particles: int = DEFAULT_MAX_PARTICLES,
+             advance: Callable[[int], None] | None = None) -> list[SkyCloud]:
     """Every cloud of the plan filled in its own frame through the one cloud pipeline
     (:func:`fishgen.clouds.pipeline.cube_clouds`, its placement's seed), with ``noise`` (0 to 0.9)
-    of seeded 3D noise on its radii and densities; the sky lights them (:mod:`fishgen.sky.light`)."""
+    of seeded 3D noise on its radii and densities; the sky lights them (:mod:`fishgen.sky.light`).
+    ``advance(1)`` after each cloud (a progress bar's)."""
     from fishgen.clouds.noise import roughen
     from fishgen.clouds.pipeline import cube_clouds
 
@@ -198,4 +200,6 @@ def fill_sky(plan: SkyPlan, sources: Sequence[CubeFile], *, noise: float = 0.0,
             # features about a third of the cloud's height: bumps on its top, holes in its base
             cloud = roughen(cloud, noise, seed=p.seed, scale=float(hi[1] - lo[1]) / 3)
         out.append(SkyCloud(p, cloud))
+        if advance is not None:
+            advance(1)
     return out

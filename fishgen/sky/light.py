@@ -15,7 +15,7 @@ Cost and difference, measured: ``docs/fly.md`` ("Lighting a sky").
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -30,8 +30,10 @@ CUT = 3.0
 
 
 def light_sky(clouds: Sequence[SkyCloud], lighting: Lighting | None = None, method: str = "cloud",
-              slabs: int | None = 16, grid: int | None = None) -> list[SkyCloud]:
-    """Each cloud lit by one sun, the others casting their shadows on it."""
+              slabs: int | None = 16, grid: int | None = None,
+              advance: Callable[[int], None] | None = None) -> list[SkyCloud]:
+    """Each cloud lit by one sun, the others casting their shadows on it; ``advance(1)`` as each
+    cloud's light is done (all at once with ``method="sky"``)."""
     from fishgen.clouds.light import incident_light, lit_colors
 
     if method not in METHODS:
@@ -48,8 +50,10 @@ def light_sky(clouds: Sequence[SkyCloud], lighting: Lighting | None = None, meth
     if method == "sky":
         light = incident_light(centers.astype(np.float32), radii, density, lighting, grid_cells=grid)
         parts = [light[a:b] for a, b in zip(starts[:-1], starts[1:], strict=True)]
+        if advance is not None:
+            advance(len(parts))
     else:
-        parts = _each_cloud(centers, radii, density, starts, lighting, slabs)
+        parts = _each_cloud(centers, radii, density, starts, lighting, slabs, advance)
     return [replace(c, cloud=replace(c.cloud, light=part, lighting=lighting,
                                      colors=lit_colors(part, lighting)))
             for c, part in zip(clouds, parts, strict=True)]
@@ -60,7 +64,8 @@ SKY_GRID = 96
 
 
 def _each_cloud(centers: np.ndarray, radii: np.ndarray, density: np.ndarray, starts: np.ndarray,
-                lighting: Lighting, slabs: int | None) -> list[np.ndarray]:
+                lighting: Lighting, slabs: int | None,
+                advance: Callable[[int], None] | None = None) -> list[np.ndarray]:
     from fishgen.clouds.light import depth_share, incident_light
 
     sun = np.array(lighting.sun_unit, np.float64)
@@ -108,5 +113,10 @@ def _each_cloud(centers: np.ndarray, radii: np.ndarray, density: np.ndarray, sta
     import os
     from concurrent.futures import ThreadPoolExecutor
 
+    parts = []
     with ThreadPoolExecutor(min(count, os.cpu_count() or 1)) as pool:
-        return list(pool.map(one, range(count)))
+        for part in pool.map(one, range(count)):    # in order, each as soon as it and those before are
+            parts.append(part)
+            if advance is not None:
+                advance(1)
+    return parts

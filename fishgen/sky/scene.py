@@ -20,7 +20,7 @@ sky's plan (``fishgen_sky``).
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -67,8 +67,10 @@ def levels(cloud: Cloud) -> list[Cloud]:
 
 
 def sky_scene(plan: SkyPlan | None, clouds: Sequence[SkyCloud], sources: Sequence[str], *,
-              billboards: bool = False, lod: bool = True) -> tuple[Scene, list[dict[str, Any]]]:
-    """The scene, and per cloud what it holds (name, source, particles at each level).
+              billboards: bool = False, lod: bool = True,
+              advance: Callable[[int], None] | None = None) -> tuple[Scene, list[dict[str, Any]]]:
+    """The scene, and per cloud what it holds (name, source, particles at each level); ``advance(1)``
+    after each cloud's levels.
 
     ``plan``: the sky's, recorded in the scene's extras (None: clouds placed otherwise, no record).
     ``billboards``: particle clouds as crossed-quad billboards (a texture cloud always is).
@@ -103,6 +105,8 @@ def sky_scene(plan: SkyPlan | None, clouds: Sequence[SkyCloud], sources: Sequenc
                 fact[f"lod{k}"] = len(low)
             scene.add_levels(lod0, ids, [*coverage, 0.0], hidden=LEVELS_IN_A_SCENE)
         facts.append(fact)
+        if advance is not None:
+            advance(1)
     if plan is None:
         return scene, facts
     scene.extras[SKY_KEY] = {"mode": plan.mode.name, "seed": plan.seed, "area": list(plan.area),

@@ -205,3 +205,17 @@ def test_help_gives_each_modes_least_particles_as_the_shipped_files_make_it():
     run = run_cli("sky", "--help")
     text = " ".join(run.stdout.split())
     assert "(with the shipped files, thin 368, medium 1,104, thick 2,760)" in text, text
+
+
+@pytest.mark.parametrize("shadow_map", ["cloud", "sky"])
+def test_a_sky_counts_each_cloud_filled_lit_and_levelled_on_one_bar(tmp_path, shadow_map):
+    """A thick sky took 3.5 s, 7 s with 4 million particles, with nothing on the terminal
+    (QA pass 21)."""
+    from fishgen.commands import Events
+    from tests.progress_bars import recorded_bars
+
+    bars, progress = recorded_bars()
+    sky([], tmp_path / "s.glb", SkyOptions(mode="thin", shadow_map=shadow_map), Events(progress=progress))
+    clouds = MODES["thin"].clouds
+    assert [(label, total) for label, total, _ in bars] == [("building the sky", 3 * clouds)]
+    assert sum(bars[0][2]) == 3 * clouds
