@@ -15,7 +15,7 @@ from typing import Any
 
 import click
 
-from fishgen.cli.common import QUIET, VERBOSE, error_line, error_text, say, verbosity
+from fishgen.cli.common import QUIET, VERBOSE, error_line, error_text, say, verbosity, warning_line
 from fishgen.commands import Command, Events, Progress
 from fishgen.options import click_params, from_values
 
@@ -113,7 +113,7 @@ class TerminalEvents:
                       line=self.line)
 
     def note(self, text: str) -> None:
-        self._above_bar(text)
+        self._above_bar(warning_line(text))
 
     def _above_bar(self, text: str) -> None:
         """``text`` on stderr; while a bar is drawn, in the bar's place, and the bar again below it

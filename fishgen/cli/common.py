@@ -65,6 +65,12 @@ def error_line(message: str, status: int, *, file: str | None = None, line: int 
     return json.dumps({"error": message, "file": file, "line": line, "exit": status, "kind": kind, **extra})
 
 
+def warning_line(text: str) -> str:
+    """A warning as the user asked for it: the plain line, or under --json one JSON object, so that
+    every line on stderr parses alike."""
+    return json.dumps({"warning": text}) if json_errors() else text
+
+
 def _set(key: str, value: Any):
     def callback(ctx: click.Context, param: click.Parameter, given: bool) -> None:
         if given:
@@ -83,7 +89,7 @@ def _options() -> list[click.Option]:
                      help="Also print each file written and the time taken, on stderr.  [default: off]"),
         click.Option(["--json"], is_flag=True, expose_value=False, is_eager=True, callback=_set("json", True),
                      help='Print an error as one JSON object on stderr: {"error", "file", "line", "exit", '
-                          '"kind"}.  [default: off]'),
+                          '"kind"}; and each warning as {"warning"}.  [default: off]'),
     ]
 
 

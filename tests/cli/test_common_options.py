@@ -70,6 +70,19 @@ def test_json_errors_of_a_multi_file_build_are_one_object_per_bad_file(tmp_path)
         (str(bad), 1, 2, "input"), (str(tmp_path / "none.txt"), None, 2, "input")]
 
 
+def test_under_json_every_line_on_stderr_is_an_object_warnings_too(tmp_path):
+    """A warning was plain text among the JSON lines: a pipeline parsing stderr tripped on it
+    (QA pass 21)."""
+    bad = tmp_path / "bad.txt"
+    bad.write_text("not a species\n")
+    run = run_cli("build", PARAMS / "bonybream.txt", bad, "-o", f"{tmp_path}/", "--json")
+    school = run_cli("school", PARAMS / "bonybream.txt", "--count", "150", "--frames", "10",
+                     "-o", tmp_path / "s.glb", "--json", "-q")
+    lines = [json.loads(line) for line in (run.stderr + school.stderr).splitlines()]
+    assert [sorted(o) for o in lines] == [["error", "exit", "file", "kind", "line"], ["warning"]]
+    assert "Godot 3 plays at most 1,024" in lines[1]["warning"]
+
+
 def test_version():
     """The version every file records: an editable install's stale metadata said 0.2.0 after 0.2.1."""
     from fishgen import __version__
