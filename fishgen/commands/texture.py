@@ -56,7 +56,7 @@ COMMAND = Command(
 
     \b
     Examples:
-      fishgen texture params/photos/bonybream-side.png -s params/centroberyx.txt -o out/bream.txt
+      fishgen texture params/photos/bonybream-side.png -s params/bonybream.txt -o out/bream.txt
       fishgen texture params/photos/bonybream-side.png -s params/centroberyx.txt -o out/bream.txt \\
         --fit-shape --compare out/cmp.png
     """,
