@@ -91,7 +91,7 @@ def _glb(path: Path) -> bytes:
     from fishgen.exchange.gltf_reader import read_gltf
 
     if not path.is_file():
-        raise FishgenError("expected an existing file, found none", path)
+        raise FishgenError("expected an asset file, found no such file", path)
     size = path.stat().st_size
     if size > MAX_ASSET_BYTES:
         raise FishgenError(f"expected at most {MAX_ASSET_BYTES >> 20} MiB of glTF to fly through, found "

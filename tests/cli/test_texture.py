@@ -122,7 +122,7 @@ def _photos(tmp_path, bream_photo):
             "big.png": "at most 64 megapixels, found 9000 x 9000",
             "notes.png": "expected a photo",
             "tiny.png": "at least 64 pixels a side",
-            "missing.png": "found nothing there"}
+            "missing.png": "found no such file"}
 
 
 def test_bad_photos_get_one_line_errors_and_nothing_is_written(tmp_path, cli, bream_photo):

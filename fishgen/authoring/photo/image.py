@@ -57,7 +57,7 @@ def load_photo(path: str | os.PathLike) -> Photo:
 
     path = Path(path)
     if not path.is_file():
-        raise FishgenError("expected a photo file, found nothing there" if not path.exists()
+        raise FishgenError("expected a photo file, found no such file" if not path.exists()
                            else "expected a photo file, found a folder or special file", path)
     try:
         with warnings.catch_warnings():
