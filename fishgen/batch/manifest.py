@@ -90,7 +90,8 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None,
     path = Path(path)
     file = os.fspath(path)
     if not path.is_file():
-        raise FishgenError("expected a batch manifest or a folder, found no such file", file)
+        raise FishgenError("expected a batch manifest or a folder, found "
+                           + ("a special file" if path.exists() else "no such file"), file)
     if path.stat().st_size > MAX_MANIFEST_BYTES:
         raise FishgenError(f"expected a manifest of at most {MAX_MANIFEST_BYTES:,} bytes, "
                            "found a larger file", file)

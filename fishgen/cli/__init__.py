@@ -44,7 +44,7 @@ class LazyGroup(click.Group):
 
     def resolve_command(self, ctx, args):
         name = args[0] if args else ""
-        if name not in MODULES and not name.startswith("-"):
+        if name not in MODULES and not name.startswith("-") and not ctx.resilient_parsing:
             import difflib
 
             near = difflib.get_close_matches(name, MODULES, n=1)    # as click suggests options
@@ -116,9 +116,6 @@ def main(argv: list[str] | None = None) -> None:
         interrupts.stopped()
         _fail("fishgen: interrupted", 130, kind="interrupted")  # the shell's ^C ends the line before ours
     except _NO_COMMAND as err:  # `fishgen` alone: the help, as click prints it (stderr, status 2)
-        if json_errors():
-            _fail("fishgen: expected a command (`fishgen --help` lists them), found none", err.exit_code,
-                  kind="usage")
         err.show()
         sys.exit(err.exit_code)
     except click.UsageError as err:  # one line, like every other error (`--help` shows the usage)

@@ -15,16 +15,26 @@ from typing import Any
 
 import click
 
-from fishgen.cli.common import QUIET, VERBOSE, error_line, error_text, say, verbosity, warning_line
+from fishgen.cli.common import QUIET, VERBOSE, error_line, error_text, json_errors, note_line, say, verbosity
 from fishgen.commands import Command, Events, Progress
 from fishgen.options import click_params, from_values
+
+
+class InputPath(click.Path):
+    """An input's path, never empty: ``Path("")`` is the working folder, and `batch ""` (a script's
+    unset variable) had batched everything under it."""
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if isinstance(value, str) and not value:
+            self.fail("expected a path, found an empty one", param, ctx)
+        return super().convert(value, param, ctx)
 
 
 def click_command(cmd: Command) -> click.Command:
     """The click command of ``cmd``: its inputs, ``-o``, and every declared option with its default."""
     params: list[click.Parameter] = []
     if cmd.inputs is not None:
-        kind = click.Path(path_type=Path) if cmd.inputs.path else None
+        kind = InputPath(path_type=Path) if cmd.inputs.path else None
         params.append(click.Argument(["inputs"], nargs=-1 if cmd.inputs.many else 1,
                                      required=cmd.inputs.required, type=kind, metavar=cmd.inputs.metavar))
     if cmd.output is not None:
@@ -90,7 +100,8 @@ def _warnings_as_notes(events: TerminalEvents) -> Iterator[None]:
         shown = warnings.showwarning
 
         def show(message, category, filename, lineno, file=None, line=None):
-            if issubclass(category, CubeFileWarning):
+            # under --json every line on stderr is an object: any warning, said as a batch job says it
+            if issubclass(category, CubeFileWarning) or json_errors():
                 events.note(str(message))
             else:
                 shown(message, category, filename, lineno, file, line)
@@ -113,7 +124,7 @@ class TerminalEvents:
                       line=self.line)
 
     def note(self, text: str) -> None:
-        self._above_bar(warning_line(text))
+        self._above_bar(note_line(text))
 
     def _above_bar(self, text: str) -> None:
         """``text`` on stderr; while a bar is drawn, in the bar's place, and the bar again below it
@@ -161,9 +172,10 @@ def watched() -> bool:
 
 
 BAR_WIDTH = 36
-_AROUND_BAR = len("  []  100%  00:00:00") + 1
-"""Columns of click's bar line besides its label and bar (percent and ETA), and one spare: a line
-that reaches the last column wraps on some terminals, and every redraw then starts a new row."""
+_AROUND_BAR = len("  []  100%  10d 00:00:00") + 1
+"""Columns of click's bar line besides its label and bar (percent, and an ETA of up to 12: click
+writes one of a day or more as "1d 00:00:00"), and one spare: a line that reaches the last column
+wraps on some terminals, and every redraw then starts a new row."""
 
 
 def _bar_width(label: str) -> int | None:

@@ -65,10 +65,10 @@ def error_line(message: str, status: int, *, file: str | None = None, line: int 
     return json.dumps({"error": message, "file": file, "line": line, "exit": status, "kind": kind, **extra})
 
 
-def warning_line(text: str) -> str:
-    """A warning as the user asked for it: the plain line, or under --json one JSON object, so that
-    every line on stderr parses alike."""
-    return json.dumps({"warning": text}) if json_errors() else text
+def note_line(text: str) -> str:
+    """A note (a warning, or what a command wrote besides its summary) as the user asked for it: the
+    plain line, or under --json one JSON object, so that every line on stderr parses alike."""
+    return json.dumps({"note": text}) if json_errors() else text
 
 
 def _set(key: str, value: Any):
@@ -89,7 +89,7 @@ def _options() -> list[click.Option]:
                      help="Also print each file written and the time taken, on stderr.  [default: off]"),
         click.Option(["--json"], is_flag=True, expose_value=False, is_eager=True, callback=_set("json", True),
                      help='Print an error as one JSON object on stderr: {"error", "file", "line", "exit", '
-                          '"kind"}; and each warning as {"warning"}.  [default: off]'),
+                          '"kind"}; and each note or warning as {"note"}.  [default: off]'),
     ]
 
 

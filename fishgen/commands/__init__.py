@@ -96,9 +96,12 @@ class Command:
         if isinstance(inputs, (str, os.PathLike)):
             inputs = [inputs]
         try:
-            items = tuple(Path(p) if spec.path else str(p) for p in inputs)
+            given = list(inputs)
+            items = tuple(Path(p) if spec.path else str(p) for p in given)
         except TypeError:
             raise UsageError(f"expected the inputs as a list of {spec.metavar}, found {inputs!r}") from None
+        if spec.path and any(not os.fspath(p) for p in given):     # Path("") is the working folder
+            raise UsageError(f"expected each {spec.metavar} to be a path, found an empty one")
         if not items and spec.required:
             raise UsageError(f"expected {'one or more' if spec.many else 'one'} {spec.metavar}, found none")
         if len(items) > 1 and not spec.many:

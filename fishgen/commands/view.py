@@ -58,7 +58,7 @@ def view(inputs: Sequence[Path], output: str | os.PathLike | None,
     """Write the page; unless ``no_serve``, also bind its server (the caller serves it)."""
     inputs = COMMAND.given(inputs, options)
     output = Path(output) if output is not None else None
-    from fishgen.errors import SystemFailure
+    from fishgen.errors import FishgenError, SystemFailure
     from fishgen.viewer.page import write_page
 
     (asset,) = inputs
@@ -66,6 +66,8 @@ def view(inputs: Sequence[Path], output: str | os.PathLike | None,
     from fishgen.commands.paths import check_targets, suffix_of
     from fishgen.viewer.page import page_path
 
+    if asset.is_dir():   # before its page's name: a folder such as `.` has none to take
+        raise FishgenError("expected a file, found a directory", asset)
     page = output if output is not None else page_path(asset)
     suffix_of(page, PAGES, "a page")  # `-o -` too: a page is a file
     check_targets([page], [asset])

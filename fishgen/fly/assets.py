@@ -91,7 +91,8 @@ def _glb(path: Path) -> bytes:
     from fishgen.exchange.gltf_reader import read_gltf
 
     if not path.is_file():
-        raise FishgenError("expected an asset file, found no such file", path)
+        raise FishgenError("expected an asset file, found " + ("a folder or special file" if path.exists()
+                                                               else "no such file"), path)
     size = path.stat().st_size
     if size > MAX_ASSET_BYTES:
         raise FishgenError(f"expected at most {MAX_ASSET_BYTES >> 20} MiB of glTF to fly through, found "

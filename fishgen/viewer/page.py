@@ -81,7 +81,8 @@ def build_page(asset: str | Path, background: str = "#8cadcc", *, instancing: bo
     if asset.is_dir():
         raise FishgenError("expected a file, found a directory", asset)
     if not asset.is_file():
-        raise FishgenError("expected an asset file, found no such file", asset)
+        raise FishgenError("expected an asset file, found " + ("a special file" if asset.exists()
+                                                               else "no such file"), asset)
     if asset.stat().st_size > MAX_EMBED_BYTES:  # before reading a byte of it
         raise FishgenError(f"expected at most {MAX_EMBED_BYTES >> 20} MiB to embed in a page, "
                            f"found {asset.stat().st_size / 2**20:.0f} MiB", asset)

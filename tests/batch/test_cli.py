@@ -318,3 +318,18 @@ def test_a_missing_manifest_is_a_bad_input_as_every_command_s_missing_input_is(t
                                                "such file\n")
     as_json = json.loads(batch(missing, "--json").stderr)
     assert (as_json["kind"], as_json["file"]) == ("input", str(missing))
+
+
+def test_an_empty_manifest_name_is_a_usage_error_not_the_working_folder(tmp_path):
+    """`Path("")` is the working folder: `batch ""` (a script's unset variable) batched everything
+    under it once click's own check that the manifest exists had gone (a review)."""
+    (tmp_path / "a.txt").write_text("not a species\n")
+    run = batch("", "-o", tmp_path / "out", cwd=tmp_path)
+    assert run.returncode == 2 and run.stderr.startswith("fishgen batch: ") and "empty" in run.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_manifest_that_is_no_regular_file_is_not_said_to_be_missing():
+    run = batch("/dev/null")
+    assert (run.returncode, run.stderr) == (2, "/dev/null: expected a batch manifest or a folder, found a "
+                                               "special file\n")

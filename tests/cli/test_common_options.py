@@ -70,7 +70,7 @@ def test_json_errors_of_a_multi_file_build_are_one_object_per_bad_file(tmp_path)
         (str(bad), 1, 2, "input"), (str(tmp_path / "none.txt"), None, 2, "input")]
 
 
-def test_under_json_every_line_on_stderr_is_an_object_warnings_too(tmp_path):
+def test_under_json_every_line_on_stderr_is_an_object_notes_too(tmp_path):
     """A warning was plain text among the JSON lines: a pipeline parsing stderr tripped on it
     (QA pass 21)."""
     bad = tmp_path / "bad.txt"
@@ -79,8 +79,8 @@ def test_under_json_every_line_on_stderr_is_an_object_warnings_too(tmp_path):
     school = run_cli("school", PARAMS / "bonybream.txt", "--count", "150", "--frames", "10",
                      "-o", tmp_path / "s.glb", "--json", "-q")
     lines = [json.loads(line) for line in (run.stderr + school.stderr).splitlines()]
-    assert [sorted(o) for o in lines] == [["error", "exit", "file", "kind", "line"], ["warning"]]
-    assert "Godot 3 plays at most 1,024" in lines[1]["warning"]
+    assert [sorted(o) for o in lines] == [["error", "exit", "file", "kind", "line"], ["note"]]
+    assert "Godot 3 plays at most 1,024" in lines[1]["note"]
 
 
 def test_version():
@@ -238,3 +238,42 @@ def test_an_empty_path_option_is_a_usage_error(tmp_path, args):
     assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
     assert "expected a file or folder name, found an empty one" in result.stderr
     assert list((tmp_path / "here").iterdir()) == [] and not (tmp_path / "out").exists()
+
+
+def test_under_json_pythons_own_warnings_are_notes_too(tmp_path):
+    """A library's warning (Pillow's on a palette texture) came as Python's two plain lines."""
+    import warnings
+
+    from fishgen.cli.adapter import TerminalEvents, _warnings_as_notes
+    from fishgen.cli.common import reset
+
+    said: list[str] = []
+    events = TerminalEvents("build")
+    events.note = said.append           # type: ignore[method-assign]
+    reset(json_errors=True)
+    try:
+        with _warnings_as_notes(events):
+            warnings.warn("Palette images with Transparency expressed in bytes", UserWarning, stacklevel=1)
+    finally:
+        reset(json_errors=False)
+    assert said == ["Palette images with Transparency expressed in bytes"]
+
+
+@pytest.mark.parametrize("command", ["build", "view", "batch"])
+def test_an_empty_input_path_is_a_usage_error(command):
+    run = run_cli(command, "")
+    assert run.returncode == 2 and run.stderr.count("\n") == 1 and "found an empty one" in run.stderr
+
+
+def test_view_of_a_folder_is_one_line():
+    """`fishgen view .` was a traceback: the page's name was taken from the folder's, which `.` lacks."""
+    run = run_cli("view", ".", "--no-serve")
+    assert (run.returncode, run.stderr) == (2, ".: expected a file, found a directory\n")
+
+
+def test_a_python_caller_s_empty_input_path_is_a_usage_error(tmp_path):
+    from fishgen.commands.batch import BatchOptions, batch
+    from fishgen.errors import UsageError
+
+    with pytest.raises(UsageError, match="found an empty one"):
+        batch("", None, BatchOptions(out=tmp_path))

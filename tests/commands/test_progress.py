@@ -167,3 +167,18 @@ def test_a_bar_when_ci_is_set_to_false(monkeypatch):
     terminal = _a_person_watches(monkeypatch)
     monkeypatch.setenv("CI", "false")
     assert _drawn(terminal)
+
+
+@pytest.mark.parametrize("columns", [50, 60, 80])
+def test_the_line_fits_with_an_eta_of_days_too(monkeypatch, columns):
+    """click writes an ETA of a day or more as "1d 00:00:00", 3-4 columns past "00:00:00" (a review)."""
+    import click
+
+    from fishgen.cli.adapter import _bar_width
+
+    _a_person_watches(monkeypatch, columns)
+    for label in ("simulating", "building the sky"):
+        bar = click.progressbar(length=10_000, label=label, width=_bar_width(label), show_eta=True)
+        bar.pos, bar.eta_known = 1, True
+        monkeypatch.setattr(type(bar), "format_eta", lambda self: "10d 00:00:00")
+        assert len(bar.format_progress_line()) < columns
