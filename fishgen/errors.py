@@ -116,6 +116,14 @@ def expected(what: str, found: str, file=None, line=None) -> FishgenError:
     return FishgenError(f"expected {what}, found {found}", file, line)
 
 
+def not_a_file(what: str, path: str | os.PathLike) -> FishgenError:
+    """``expected WHAT, found …`` for a path that is no regular file: not there, a directory, or a
+    special file (a FIFO, /dev/null), each said as what it is."""
+    found = ("no such file" if not os.path.exists(path) else "a directory" if os.path.isdir(path)
+             else "a special file")
+    return expected(what, found, os.fspath(path))
+
+
 def cannot(action: str, path: str | os.PathLike, err: OSError) -> SystemFailure:
     """An OS error while reading or writing ``path``, with the path always named (a full disk's
     ``OSError`` carries none)."""

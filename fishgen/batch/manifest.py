@@ -29,7 +29,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-from fishgen.errors import FishgenError, UsageError
+from fishgen.errors import FishgenError, UsageError, not_a_file
 from fishgen.exchange.registry import first_shared, output_format
 from fishgen.options import build, check_value, manifest_options
 from fishgen.tomlfile import Where, loads, text_of
@@ -90,8 +90,7 @@ def load_manifest(path: str | os.PathLike, out: str | os.PathLike | None = None,
     path = Path(path)
     file = os.fspath(path)
     if not path.is_file():
-        raise FishgenError("expected a batch manifest or a folder, found "
-                           + ("a special file" if path.exists() else "no such file"), file)
+        raise not_a_file("a batch manifest or a folder", file)
     if path.stat().st_size > MAX_MANIFEST_BYTES:
         raise FishgenError(f"expected a manifest of at most {MAX_MANIFEST_BYTES:,} bytes, "
                            "found a larger file", file)

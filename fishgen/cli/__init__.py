@@ -77,9 +77,6 @@ def cli() -> None:
 add_common_options(cli, wrap=False)  # `fishgen --json build ...` as well as `fishgen build ... --json`
 
 
-_NO_COMMAND = click.exceptions.NoArgsIsHelpError   # a group given no command (click 8.2+)
-
-
 class Interrupted(BaseException):
     """Ctrl-C or SIGTERM. Not a KeyboardInterrupt: click turns that into Abort after printing a
     blank line of its own, and the message would be two lines. Atomic writers still unwind."""
@@ -115,7 +112,7 @@ def main(argv: list[str] | None = None) -> None:
     except click.exceptions.Abort:
         interrupts.stopped()
         _fail("fishgen: interrupted", 130, kind="interrupted")  # the shell's ^C ends the line before ours
-    except _NO_COMMAND as err:  # `fishgen` alone: the help, as click prints it (stderr, status 2)
+    except click.exceptions.NoArgsIsHelpError as err:  # `fishgen` alone: its help, as click prints it
         err.show()
         sys.exit(err.exit_code)
     except click.UsageError as err:  # one line, like every other error (`--help` shows the usage)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from fishgen.clouds.lighting import Lighting
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES
-from fishgen.errors import FishgenError, UsageError
+from fishgen.errors import FishgenError, UsageError, not_a_file
 from fishgen.file_names import name_text
 
 MAX_ASSET_BYTES = 1 << 30
@@ -91,8 +91,7 @@ def _glb(path: Path) -> bytes:
     from fishgen.exchange.gltf_reader import read_gltf
 
     if not path.is_file():
-        raise FishgenError("expected an asset file, found " + ("a folder or special file" if path.exists()
-                                                               else "no such file"), path)
+        raise not_a_file("an asset file", path)
     size = path.stat().st_size
     if size > MAX_ASSET_BYTES:
         raise FishgenError(f"expected at most {MAX_ASSET_BYTES >> 20} MiB of glTF to fly through, found "

@@ -6,7 +6,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, not_a_file
 from fishgen.exchange.registry import formats, input_format
 from fishgen.scene.model import Primitive, Scene
 
@@ -24,8 +24,7 @@ def load_input(path: str | os.PathLike, *, textures_dir: str | os.PathLike | Non
     if path.is_dir():
         raise FishgenError("expected a file, found a directory", path)
     if not path.is_file():
-        raise FishgenError("expected an input file, found " + ("a special file" if path.exists()
-                                                               else "no such file"), path)
+        raise not_a_file("an input file", path)
     scene = fmt.read(path, textures_dir=textures_dir, seed=seed, lighting=lighting)
     if not any(prim.triangle_count or (prim.mode == "POINTS" and prim.vertex_count)
                for _, prim in scene.drawn()):

@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 from urllib.parse import unquote
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, not_a_file
 from fishgen.exchange.registry import FORMATS, formats
 from fishgen.exchange.sidefiles import map_file_name, mtl_libraries, side_file
 from fishgen.file_names import name_text
@@ -81,8 +81,7 @@ def build_page(asset: str | Path, background: str = "#8cadcc", *, instancing: bo
     if asset.is_dir():
         raise FishgenError("expected a file, found a directory", asset)
     if not asset.is_file():
-        raise FishgenError("expected an asset file, found " + ("a special file" if asset.exists()
-                                                               else "no such file"), asset)
+        raise not_a_file("an asset file", asset)
     if asset.stat().st_size > MAX_EMBED_BYTES:  # before reading a byte of it
         raise FishgenError(f"expected at most {MAX_EMBED_BYTES >> 20} MiB to embed in a page, "
                            f"found {asset.stat().st_size / 2**20:.0f} MiB", asset)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fishgen.errors import FishgenError
+from fishgen.errors import FishgenError, not_a_file
 
 #: Largest photo accepted, in pixels (about a 64-megapixel camera frame).
 MAX_PHOTO_PIXELS = 64_000_000
@@ -57,8 +57,7 @@ def load_photo(path: str | os.PathLike) -> Photo:
 
     path = Path(path)
     if not path.is_file():
-        raise FishgenError("expected a photo file, found no such file" if not path.exists()
-                           else "expected a photo file, found a folder or special file", path)
+        raise not_a_file("a photo file", path)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)
