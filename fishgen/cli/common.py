@@ -11,7 +11,8 @@ too, so ``fishgen --json build ...`` works), so a new command gets them for free
   ``{"error": ..., "file": ..., "line": ..., "exit": ..., "kind": ...}``.
 
 A :class:`fishgen.errors.UsageError` from the use-case layer leaves the command as click's own
-usage errors do, so that every bad command line reads ``fishgen COMMAND: ...``.
+usage errors do, so that every bad command line reads ``fishgen COMMAND: ...``; one that names a
+file (an ``-o`` the command cannot write) reads ``FILE: ...``, with the same status and kind.
 """
 from __future__ import annotations
 

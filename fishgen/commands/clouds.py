@@ -63,13 +63,11 @@ def check_options(options: CloudsOptions, output: str | os.PathLike | None = Non
                  if getattr(options.lighting, f.name) != getattr(Lighting(), f.name)]
         raise UsageError(f"expected no lighting options with --no-light, found {', '.join(given)}")
     if options.billboards and output is not None:
-        from fishgen.errors import FishgenError
+        from fishgen.commands.paths import output_at_fault
         from fishgen.exchange.clouds import check_output
 
-        try:
+        with output_at_fault():     # the options' fault, not the file's: a manifest job's line
             check_output(output, billboards=True)
-        except FishgenError as err:     # the options' fault, not the file's: a manifest job's line
-            raise UsageError(err.message, output) from None
     if options.voxel_size is not None and output is not None:
         from fishgen.exchange.clouds import VOLUME_FORMATS
 
@@ -128,7 +126,7 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     scene; input i is filled with seed + i. A texture cloud (.awa) becomes textured billboards."""
     inputs = COMMAND.given(inputs, options)
     from fishgen.clouds.pipeline import cloud_textures, cube_clouds, read_cube_files
-    from fishgen.commands.paths import check_inputs, check_targets
+    from fishgen.commands.paths import check_inputs, check_targets, output_at_fault
     from fishgen.errors import UsageError, plural
     from fishgen.exchange.clouds import VOLUME_FORMATS, check_output, export_cloud
     from fishgen.exchange.registry import FORMATS
@@ -139,7 +137,8 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
                          default=FORMATS["cubes"])
     textured = any(kind is FORMATS["texture cubes"] for kind in kinds)
     billboards = options.billboards or (textured and output.suffix.lower() in (".glb", ".gltf"))
-    check_output(output, billboards)
+    with output_at_fault():
+        check_output(output, billboards)
     check_options(options, output)
     check_targets([output], inputs)
     if options.offset and len(options.offset) != len(inputs):
@@ -151,7 +150,8 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
         events.note(f"{output}: {output.suffix.upper()[1:]} holds no textures; the billboards' centres are "
                     "written as particles")
     check_targets([output], textures)
-    check_output(output, billboards, particles=sum(f.total for f in files))  # a glTF buffer holds 4 GiB
+    with output_at_fault():     # a glTF buffer holds 4 GiB
+        check_output(output, billboards, particles=sum(f.total for f in files))
     from fishgen.clouds.memory import check_fits
 
     check_fits(sum(f.total for f in files), output.suffix, billboards)    # before anything is filled

@@ -7,7 +7,10 @@ The ``-o`` rule, for every command:
 - anything else names a file, whose extension picks the format; several inputs into one file
   is refused, and so is a name with no extension that is not a folder;
 - an output that exists must be a regular file (never a FIFO or ``/dev/null``);
-- no output may be one of the command's inputs.
+- no output may be one of the command's inputs;
+- an output the command cannot write (its extension, a format that would lose what it holds) is a
+  bad command line, exit 2 kind ``usage``, said as ``OUTPUT: expected ..., found ...``
+  (:func:`output_at_fault`).
 
 Optional dependencies a chosen feature needs are checked before any work too (:func:`needs`, from
 :mod:`fishgen.extras`, which the layers below the commands use as well).
@@ -16,7 +19,8 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -72,6 +76,18 @@ def read_beside(inputs: Sequence[Path], kinds: Sequence[Format],
     return found
 
 
+@contextmanager
+def output_at_fault() -> Iterator[None]:
+    """The exchange layer's refusal of an output (a :class:`FishgenError` naming the file, as a
+    library caller gets it) as the command line's: the -o a user typed is at fault, not an input."""
+    try:
+        yield
+    except FishgenError as err:
+        if type(err) is not FishgenError:     # a missing package stays exit 1, kind dependency
+            raise
+        raise UsageError(err.message, err.file, err.line) from None
+
+
 def names_folder(output: str | os.PathLike) -> bool:
     """Whether ``-o`` names a folder: an existing one, or a name ending in ``/``."""
     text = os.fspath(output)
@@ -94,10 +110,12 @@ def targets(inputs: Sequence[Path], given: str | os.PathLike | None, *, fmt: str
         if not output.suffix:
             raise UsageError(f"expected an output file with an extension, or a folder (an existing one, "
                              f"or a name ending in /), found {os.fspath(output)!r}")
-        output_format(output, need)
+        with output_at_fault():
+            output_format(output, need)
         return [output]
     folder = output if output is not None else default_folder
-    output_format(Path(f"x.{fmt}"), need)
+    with output_at_fault():
+        output_format(Path(f"x.{fmt}"), need)
     made: dict[str, Path] = {}
     for path in inputs:
         name = f"{path.stem}.{fmt}"

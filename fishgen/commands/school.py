@@ -153,7 +153,14 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     only when the glb was, and every target is checked before the simulation starts."""
     inputs = COMMAND.given(inputs, options)
     output = Path(output)
-    from fishgen.commands.paths import check_inputs, check_targets, needs, read_beside, suffix_of
+    from fishgen.commands.paths import (
+        check_inputs,
+        check_targets,
+        needs,
+        output_at_fault,
+        read_beside,
+        suffix_of,
+    )
     from fishgen.errors import UsageError, either, plural
     from fishgen.exchange.registry import FORMATS, INSTANCES, MESHES, NODE_ANIMATION, output_format
     from fishgen.school.scene_file import (
@@ -167,7 +174,8 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
         with_options,
     )
 
-    instanced = INSTANCES in output_format(output, [MESHES, NODE_ANIMATION]).holds
+    with output_at_fault():
+        instanced = INSTANCES in output_format(output, [MESHES, NODE_ANIMATION]).holds
     kinds = check_inputs(inputs, "school", [FORMATS["school scene"], FORMATS["species"]],
                          default=FORMATS["species"])
     scene_files = [p for p, kind in zip(inputs, kinds, strict=True) if kind is FORMATS["school scene"]]

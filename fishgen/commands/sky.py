@@ -108,7 +108,7 @@ def sky(inputs: Sequence[Path], output: str | os.PathLike, options: SkyOptions =
         events: Events = QUIET) -> Made:
     """Build the sky and write it atomically; the summary says its clouds, particles and size."""
     inputs = COMMAND.given(inputs, options)
-    from fishgen.commands.paths import check_inputs, check_targets, read_beside
+    from fishgen.commands.paths import check_inputs, check_targets, output_at_fault, read_beside
     from fishgen.errors import UsageError
     from fishgen.exchange import export
     from fishgen.exchange.clouds import check_output
@@ -117,13 +117,14 @@ def sky(inputs: Sequence[Path], output: str | os.PathLike, options: SkyOptions =
     output = Path(output)
     if output.suffix.lower() not in (".glb", ".gltf"):
         raise UsageError(f"expected a .glb or .gltf output (a sky's nodes and levels of detail need glTF), "
-                         f"found {output.suffix or 'no extension'!r}")
+                         f"found {output.suffix or 'no extension'!r}", output)
     models = tuple(Path(p) for p in options.clouds)
     kinds = check_inputs(models, "sky", [FORMATS["cubes"], FORMATS["texture cubes"]],
                          default=FORMATS["cubes"])
     check_targets([output], [*models, *read_beside(models, kinds, options.textures)])
     total = options.particles if options.particles is not None else MODES[options.mode].particles
-    check_output(output, options.billboards, particles=total)
+    with output_at_fault():
+        check_output(output, options.billboards, particles=total)
     from fishgen.clouds.memory import check_fits
 
     check_fits(total, output.suffix, options.billboards, sky=True)    # before anything is filled

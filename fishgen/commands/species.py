@@ -69,7 +69,7 @@ def species(inputs: Sequence[Path], output: str | os.PathLike, options: SpeciesO
                          f"ending in /), found {os.fspath(output)!r}")
     if not folder and path.suffix.lower() != ".txt":
         raise UsageError(f"expected -o to name a species file (.txt) or a folder (an existing one, or a name "
-                         f"ending in /), found {os.fspath(output)!r}")
+                         f"ending in /), found {path.suffix or 'no extension'!r}", path)
     last = options.seed + options.count - 1
     if last > MAX_SEED:  # refused, not wrapped: species_0.txt after the last seed would be a surprise
         raise UsageError(f"expected seeds within 0..2^63-1 (--seed {MAX_SEED - options.count + 1} at most "

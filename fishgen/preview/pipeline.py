@@ -92,7 +92,8 @@ def check_output(out: Path, options: PreviewOptions, inputs: int = 1, particles:
     """
     ext = out.suffix.lower()
     if ext not in OUTPUTS:
-        raise UsageError(f"expected an output ending in {', '.join(OUTPUTS)}, found {out.name!r}")
+        raise UsageError(f"expected an output ending in {', '.join(OUTPUTS)}, "
+                         f"found {out.suffix or 'no extension'!r}", out)
     frames = options.frames
     if frames is not None and not 1 <= frames <= MAX_FRAMES:
         raise UsageError(f"expected --frames from 1 to {MAX_FRAMES}, found {frames}")
@@ -103,7 +104,7 @@ def check_output(out: Path, options: PreviewOptions, inputs: int = 1, particles:
         raise UsageError(f"expected at most {MAX_FRAMES} frames, found {frames} "
                            f"(--duration x --fps); use a shorter --duration or a lower --fps")
     if frames > 1 and ext not in ANIMATED:
-        raise UsageError(f"expected a .gif or .webp output for --frames {frames}, found {out.name!r}")
+        raise UsageError(f"expected a .gif or .webp output for --frames {frames}, found {out.suffix!r}", out)
     if options.view not in VIEWS:
         raise UsageError(f"expected --view {'|'.join(VIEWS)}, found {options.view!r}")
     if ext in (".gif", ".jpg", ".jpeg") and options.background[3] < 255:

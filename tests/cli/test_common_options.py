@@ -47,8 +47,9 @@ def test_quiet_wins_over_verbose_wherever_each_is_given(tmp_path, args):
     (["build", str(PARAMS.parent / "tests" / "fixtures" / "appendix_a_as_printed.txt"), "-o", "{out}"], 2,
      "input", 2),
     (["build", "--no-such-option"], 2, "usage", None),
-    (["clouds", str(PARAMS / "clouds" / "table_4_2.awn"), "-o", "{out}.txt"], 2, "input", None),
-    (["school", str(PARAMS / "bonybream.txt"), "-o", "{out}.obj"], 2, "input", None),
+    # an output the command cannot write is the command line's fault, named as the file
+    (["clouds", str(PARAMS / "clouds" / "table_4_2.awn"), "-o", "{out}.txt"], 2, "usage", None),
+    (["school", str(PARAMS / "bonybream.txt"), "-o", "{out}.obj"], 2, "usage", None),
 ])
 def test_json_errors_are_one_object_with_the_exit_status(tmp_path, args, status, kind, line):
     filled = [a.format(missing=tmp_path / "none.txt", out=tmp_path / "x.glb") for a in args]
@@ -98,10 +99,8 @@ def test_version():
      "expected one --offset per input (1), found 2"),
     (["school", "{fish}", "--count", "100000", "--frames", "100000", "-o", "{out}/s.glb"],
      "expected at most 100,000 fish and 200,000,000 fish x frames"),
-    (["sky", "-o", "{out}/s.ply"], "expected a .glb or .gltf output"),
     (["preview", "{fish}", "--size", "8192x8192", "--frames", "1000", "-o", "{out}/p.gif"],
      "expected at most 1073741824 pixels (2^30)"),
-    (["species", "--random", "-o", "{out}/a.xyz"], "expected -o to name a species file (.txt)"),
     (["fly"], "expected INPUT... (cube files, .awa, .glb) or --mode thin|medium|thick, found neither"),
     (["school", str(PARAMS / "reef.toml"), "{fish}", "-o", "{out}/s.glb"],
      "expected one scene file alone or species files, found 2 inputs"),
@@ -116,6 +115,38 @@ def test_a_usage_error_from_the_command_names_the_command_as_clicks_own_do(tmp_p
     as_json = run_cli("--json", *filled)
     error = json.loads(as_json.stderr)
     assert (error["error"], error["kind"], error["exit"]) == (plain.stderr.strip(), "usage", 2)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("args,output,message", [
+    (["build", "{fish}"], "x.foo", "expected an output ending in .glb, .gltf, .obj, .ply"),
+    (["build", "{fish}"], "x.awn", "found '.awn' (a RekAwan cloud cube file, an input of `fishgen clouds`)"),
+    (["school", "{fish}"], "x.ply", "expected a format that holds"),
+    (["clouds", "{cubes}"], "x.obj", "expected a format that holds points, found .obj"),
+    (["clouds", "{cubes}", "--billboards"], "x.ply", "expected a .glb or .gltf output with --billboards"),
+    (["sky"], "s.ply", "expected a .glb or .gltf output (a sky's nodes and levels of detail need glTF), "
+                       "found '.ply'"),
+    (["preview", "{fish}"], "p.bmp", "expected an output ending in .png, .webp, .gif, .jpg, .jpeg, "
+                                     "found '.bmp'"),
+    (["preview", "{fish}", "--frames", "3"], "p.png", "expected a .gif or .webp output for --frames 3, "
+                                                      "found '.png'"),
+    (["species", "--random"], "a.xyz", "expected -o to name a species file (.txt) or a folder"),
+    (["species", "--random"], "axyz", "found 'no extension'"),
+    (["texture", str(PARAMS / "photos" / "bonybream-side.png"), "-s", "{fish}"], "s.xyz",
+     "expected -o to name a species file (.txt), found '.xyz'"),
+])
+def test_an_output_of_the_wrong_kind_is_named_as_the_file_at_fault(tmp_path, args, output, message):
+    """`build`, `school` and `clouds` named the output as bad input (kind input) while `sky`,
+    `preview`, `species` and `texture` named the command: every one now names the output, as a bad
+    command line (kind usage, exit 2)."""
+    filled = [a.format(fish=PARAMS / "bonybream.txt", cubes=PARAMS / "clouds" / "table_4_3.awn")
+              for a in args]
+    out = tmp_path / output
+    run = run_cli(*filled, "-o", out)
+    assert run.returncode == 2 and run.stderr.startswith(f"{out}: "), run.stderr
+    assert message in run.stderr and run.stderr.count("\n") == 1, run.stderr
+    error = json.loads(run_cli("--json", *filled, "-o", out).stderr)
+    assert (error["file"], error["kind"], error["exit"]) == (str(out), "usage", 2)
     assert list(tmp_path.iterdir()) == []
 
 

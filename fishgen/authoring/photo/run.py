@@ -239,7 +239,8 @@ def check_out(out: str | os.PathLike) -> Path:
     """``out`` as the new species file's path, when it names one (.txt)."""
     out = Path(out)
     if out.suffix.lower() != ".txt":
-        raise UsageError(f"expected -o to name a species file (.txt), found {out.name!r}")
+        raise UsageError(f"expected -o to name a species file (.txt), found {out.suffix or 'no extension'!r}",
+                         out)
     return out
 
 
