@@ -14,10 +14,13 @@ class _Counter(Progress):
     def update(self, n: int) -> None:
         self.updates.append(n)
 
+    def stage(self, label: str) -> None:
+        self.updates.append(label)      # type: ignore[arg-type]  # in order among the counts
+
 
 def recorded_bars() -> tuple[list[tuple[str, int, list[int]]], object]:
     """(bars, progress): pass ``progress`` as ``Events(progress=...)``; ``bars`` then holds each bar
-    opened, as (label, total, every update)."""
+    opened, as (label, total, every update and stage label in order)."""
     bars: list[tuple[str, int, list[int]]] = []
 
     @contextmanager

@@ -193,6 +193,11 @@ def _bar_width(label: str) -> int | None:
 class _Bar(Progress):
     def __init__(self, bar: Any):
         self.bar = bar
+        self.width = len(bar.label)     # the bar's width was fitted to the terminal with this label
 
     def update(self, n: int) -> None:
         self.bar.update(n)
+
+    def stage(self, label: str) -> None:
+        self.bar.label = label[:self.width].ljust(self.width)
+        self.bar.render_progress()

@@ -17,7 +17,7 @@ import math
 import numbers
 import os
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -42,8 +42,10 @@ _TINY = np.finfo(np.float32).smallest_subnormal
 
 
 def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
-               offset: Sequence[float] = (0.0, 0.0, 0.0), workers: int | None = None) -> Cloud:
-    """Fill every cube with its particles; ``offset`` moves the whole cloud in the scene."""
+               offset: Sequence[float] = (0.0, 0.0, 0.0), workers: int | None = None,
+               advance: Callable[[int], None] | None = None) -> Cloud:
+    """Fill every cube with its particles; ``offset`` moves the whole cloud in the scene.
+    ``advance(k)`` as each k particles are placed (a progress bar's), on the calling thread."""
     # a library caller's arguments get the command line's kind of error, not numpy's
     if method not in METHODS:
         raise FishgenError(f"expected a fill method of {' or '.join(METHODS)}, found {method!r}")
@@ -90,9 +92,13 @@ def fill_cloud(cube_file: CubeFile, *, seed: int = 0, method: str = "paper",
     if threads <= 1:
         for start in starts:
             work(start)
+            if advance is not None:
+                advance(min(CHUNK, n - start))
     else:
         with ThreadPoolExecutor(threads) as pool:
-            list(pool.map(work, starts))
+            for start, _ in zip(starts, pool.map(work, starts), strict=True):
+                if advance is not None:
+                    advance(min(CHUNK, n - start))
     return out
 
 

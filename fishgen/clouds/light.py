@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
@@ -177,13 +178,15 @@ holds optical depths in the hundreds at a cell, and in 255ths its sunlit face re
 steps of 1, 0.53, 0.27."""
 
 
-def light_cloud(cloud: Cloud, lighting: Lighting | None = None) -> Cloud:
+def light_cloud(cloud: Cloud, lighting: Lighting | None = None, *,
+                advance: Callable[[int], None] | None = None) -> Cloud:
     """``cloud`` lit by the sun and the sky: its ``light`` per particle and the colours it gives.
 
-    Light a scene after ``merge_clouds``, so its clouds shadow each other.
+    Light a scene after ``merge_clouds``, so its clouds shadow each other. ``advance`` as in
+    :func:`incident_light`.
     """
     lighting = lighting or Lighting()
-    light = incident_light(cloud.centers, cloud.radii, cloud.density, lighting)
+    light = incident_light(cloud.centers, cloud.radii, cloud.density, lighting, advance=advance)
     return replace(cloud, light=light, lighting=lighting, colors=lit_colors(light, lighting))
 
 
@@ -219,7 +222,8 @@ _RGB_WORD = np.dtype({"names": ["rgb"], "formats": ["V3"], "offsets": [0], "item
 
 def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
                    lighting: Lighting | None = None, *, slabs: int | None = None,
-                   grid_cells: int | None = None, share: float | None = None) -> np.ndarray:
+                   grid_cells: int | None = None, share: float | None = None,
+                   advance: Callable[[int], None] | None = None) -> np.ndarray:
     """The fraction of sunlight (0 to 1) reaching each particle's sunward face (FRONT sigma nearer
     the sun than its centre; the slabs read LEAD sigma ahead, which gives the same light), float32.
 
@@ -231,9 +235,12 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     A sky, far wider than its clouds, needs more (fishgen.sky.light).
     ``share``: the share of its optical depth every particle casts (default ``depth_share`` of
     these particles: 1 unless the cloud is more crowded than CROWDING).
+    ``advance(k)``, on the calling thread, as work is done: ``light_steps(N)`` in all (a progress
+    bar's; the light weighs about twice the fill a particle).
     """
     lighting = lighting or Lighting()
     n = len(centers)
+    done = _Done(advance, light_steps(n))
     light = np.zeros(n, _F32)
     if n == 0:
         return light
@@ -251,8 +258,30 @@ def incident_light(centers: np.ndarray, radii: np.ndarray, density: np.ndarray,
     else:
         count = slab_count(n) if slabs is None else max(1, min(n, int(slabs)))
         light = _slabs(centers, radii, density, frame, middle, count, lighting.extinction, forward, light,
-                       grid_cells, lead=slab_lead(n), share=share)
+                       grid_cells, lead=slab_lead(n), share=share, done=done)
+    done.until(1.0)
     return light
+
+
+def light_steps(n: int) -> int:
+    """How far :func:`incident_light` advances for ``n`` particles."""
+    return 2 * n
+
+
+class _Done:
+    """A progress counter fed in whole steps as shares of ``total`` are reached."""
+
+    def __init__(self, advance: Callable[[int], None] | None, total: int):
+        self.advance, self.total, self.given = advance, total, 0
+
+    def until(self, share: float) -> None:
+        """``share`` (0 to 1) of the work is done."""
+        if self.advance is None:
+            return
+        target = min(self.total, int(self.total * share))
+        if target > self.given:
+            self.advance(target - self.given)
+            self.given = target
 
 
 def _pairs(centers, radii, density, frame, middle, extinction: float, forward: float, light,
@@ -363,7 +392,8 @@ def _cdf_table() -> np.ndarray:
 
 
 def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forward, light,
-           grid_cells: int | None, lead: float = 0.0, share: float = 1.0) -> np.ndarray:
+           grid_cells: int | None, lead: float = 0.0, share: float = 1.0,
+           done: _Done | None = None) -> np.ndarray:
     """A big cloud, in ``slabs`` slabs along the sun axis, all read from and splatted into one
     light map.
 
@@ -389,6 +419,7 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
     or, when one group holds every slab, over the across-ray coordinate it has just read (and
     returns that array): fresh pages cost more than the arithmetic on them.
     """
+    done = done or _Done(None, 0)
     n = len(centers)
     spans = _spans(n, CHUNK)
     with ThreadPoolExecutor(WORKERS) as pool:
@@ -405,7 +436,10 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
         own = depth             # each particle's own depth at its centre, once splatted
         if group >= slabs:
             light = a
+        done.until(0.25)        # the projection and the slabs' numbers; then each group's passes
+        groups = -(-slabs // group)
         for first in range(0, slabs, group):
+            begun = 0.25 + 0.75 * (first // group) / groups
             last = min(slabs, first + group)
             place = functools.partial(_place, grid, slab, a, b, first, last, slabs)
             size = (last - first) * CLASSES * cells
@@ -419,6 +453,7 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
             depths = np.concatenate(list(pool.map(grid.blur, (maps[k:k + BLUR_SLABS]
                                                               for k in range(0, last - first, BLUR_SLABS)))))
             del layers
+            done.until(begun + 0.75 * 0.5 / groups)
             before = np.empty_like(depths)
             # depths, not light, down the slabs: a product of light factors reaches 0 in float32
             # after an optical depth of ~100, where a dense cloud's order would be lost
@@ -430,7 +465,8 @@ def _slabs(centers, radii, density, frame, middle, slabs: int, extinction, forwa
             reading = place if lead <= 0 else functools.partial(_place, grid, face, a, b, first, last, slabs)
             read = functools.partial(_read_chunk, grid, reading, own, slab if lead > 0 else None, nearer,
                                      before, depths, light, first)
-            list(pool.map(read, spans))
+            for k, _ in enumerate(pool.map(read, spans)):
+                done.until(begun + 0.75 * (0.5 + 0.5 * (k + 1) / len(spans)) / groups)
     return light
 
 

@@ -117,12 +117,14 @@ class CubeClouds:
 def cube_clouds(models: Sequence[CubeFile], *, seed: int = 0, method: str = "paper",
                 offsets: Sequence[Sequence[float]] = (), most: int | None = None,
                 lighting: Lighting | None = None, light: bool = True,
-                max_particles: int = DEFAULT_MAX_PARTICLES) -> CubeClouds:
+                max_particles: int = DEFAULT_MAX_PARTICLES,
+                advance: Callable[[int], None] | None = None) -> CubeClouds:
     """Fill every cube file (input i with seed + i, at ``offsets[i]``), then light them together.
 
     A file of more than ``most`` particles is filled with every cube's count scaled down alike
     (:func:`scaled`). More than ``max_particles`` in all is refused before anything is allocated.
     ``light=False`` leaves the clouds unlit, for a caller that lights them as a sky (fly, `fishgen sky`).
+    ``advance(k)`` as work is done, ``cloud_steps`` of it in all (a progress bar's).
     """
     from fishgen.clouds.fill import fill_cloud, merge_clouds
     from fishgen.clouds.light import light_cloud
@@ -136,9 +138,18 @@ def cube_clouds(models: Sequence[CubeFile], *, seed: int = 0, method: str = "pap
         files = plural(len(models), "file")
         raise UsageError(f"expected at most {max_particles:,} particles in the scene (raise the limit with "
                          f"--max-particles), found {total:,} in {files}")
-    fills = (fill_cloud(m, seed=seed + i, method=method, offset=place)
+    fills = (fill_cloud(m, seed=seed + i, method=method, offset=place, advance=advance)
              for i, (m, place) in enumerate(zip(filled, places, strict=True)))
     if not light:
         return CubeClouds(models, filled, tuple(fills), None)
     # the files' clouds are dropped once merged: a scene near the limit is not held twice while lit
-    return CubeClouds(models, filled, (), light_cloud(merge_clouds(list(fills)), lighting))
+    return CubeClouds(models, filled, (), light_cloud(merge_clouds(list(fills)), lighting, advance=advance))
+
+
+def cloud_steps(models: Sequence[CubeFile], *, light: bool = True) -> int:
+    """How far :func:`cube_clouds` advances for ``models`` (none scaled down): a step a particle
+    filled, and the light's."""
+    from fishgen.clouds.light import light_steps
+
+    total = sum(m.total for m in models)
+    return total + (light_steps(total) if light else 0)

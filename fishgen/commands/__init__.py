@@ -139,9 +139,13 @@ class Made:
 
 
 class Progress:
-    """A progress bar's counter: ``update(n)`` adds ``n`` done."""
+    """A progress bar's counter: ``update(n)`` adds ``n`` done; ``stage(label)`` names what the
+    command does now, on the same bar (no longer a label than the bar's first)."""
 
     def update(self, n: int) -> None:
+        pass
+
+    def stage(self, label: str) -> None:
         pass
 
 

@@ -125,7 +125,7 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     """Fill every cube file, light them together (so clouds shadow each other) and write them as one
     scene; input i is filled with seed + i. A texture cloud (.awa) becomes textured billboards."""
     inputs = COMMAND.given(inputs, options)
-    from fishgen.clouds.pipeline import cloud_textures, cube_clouds, read_cube_files
+    from fishgen.clouds.pipeline import cloud_steps, cloud_textures, cube_clouds, read_cube_files
     from fishgen.commands.paths import check_inputs, check_targets, output_at_fault
     from fishgen.errors import UsageError, plural
     from fishgen.exchange.clouds import VOLUME_FORMATS, check_output, export_cloud
@@ -166,8 +166,11 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
         except FishgenError as err:     # too fine a --voxel-size: the option's fault, not the output's
             raise UsageError(err.message) from None
     seed = options.seed or 0
-    made = cube_clouds(files, seed=seed, method=options.method, offsets=options.offset,
-                       lighting=options.lighting, light=options.light, max_particles=options.max_particles)
+    with events.progress("filling and lighting" if options.light else "filling",
+                         cloud_steps(files, light=options.light)) as bar:
+        made = cube_clouds(files, seed=seed, method=options.method, offsets=options.offset,
+                           lighting=options.lighting, light=options.light,
+                           max_particles=options.max_particles, advance=bar.update)
     if options.light:
         cloud = made.cloud
         sun = "sun " + ",".join(f"{v:g}" for v in options.lighting.sun)

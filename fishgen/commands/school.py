@@ -210,32 +210,46 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
     from fishgen.school import run_school
 
     steps = scene.frames + preroll_steps(scene)
-    with events.progress("simulating", steps) as bar:
+    # baking and writing weigh about a frame simulated each, a frame (2,000 fish: 0.5 s
+    # simulated, then 0.9 s baked and written that the bar, at 100 %, did not count)
+    with events.progress("simulating", steps + 2 * scene.frames) as bar:
+        simulated = 0
+
+        def step(n: int) -> None:
+            nonlocal simulated
+            bar.update(n)
+            simulated += n
+            if simulated == steps:
+                bar.stage("baking")
+
         run = run_school(scene, fins=options.fins, swim=options.swim, tolerance=options.tolerance,
-                         textures_dir=options.textures, progress=bar.update, lods=options.lods,
+                         textures_dir=options.textures, progress=step, lods=options.lods,
                          merge=options.merge,
                          prototypes=(options.prototypes or PROTOTYPES) if instanced else None)
-    if options.compact:
-        from fishgen.assembly.compact import compact_clips
+        if options.compact:
+            from fishgen.assembly.compact import compact_clips
 
-        compact_clips(run.scene)
-    warmup = run.warmup_frames
-    per_frame: dict = {}
-    numbers: dict = {}
-    table = ""
-    if "metrics" in sides or "plot" in sides:
-        import numpy as np
+            compact_clips(run.scene)
+        bar.update(scene.frames)
+        bar.stage("writing")
+        warmup = run.warmup_frames
+        per_frame: dict = {}
+        numbers: dict = {}
+        table = ""
+        if "metrics" in sides or "plot" in sides:
+            import numpy as np
 
-        from fishgen.school.metrics import summary
+            from fishgen.school.metrics import summary
 
-        # to the digits the file keeps, before the means: the measures' sums go through BLAS,
-        # whose kernels (one per CPU family) differ in the last bits, and the summary's full
-        # floats showed it (OPENBLAS_CORETYPE=Zen changed metrics.json; QA pass 17)
-        per_frame = {k: np.round(v, METRIC_DIGITS) for k, v in run.measures(every_frame=True).items()}
-        numbers = summary(per_frame, warmup)
-    if events.summary:  # else nobody reads the table: only what it prints is measured
-        table = run.summary(per_frame or None)
-    files, sizes = _write_all(output, run, sides, per_frame, numbers, warmup)
+            # to the digits the file keeps, before the means: the measures' sums go through BLAS,
+            # whose kernels (one per CPU family) differ in the last bits, and the summary's full
+            # floats showed it (OPENBLAS_CORETYPE=Zen changed metrics.json; QA pass 17)
+            per_frame = {k: np.round(v, METRIC_DIGITS) for k, v in run.measures(every_frame=True).items()}
+            numbers = summary(per_frame, warmup)
+        if events.summary:  # else nobody reads the table: only what it prints is measured
+            table = run.summary(per_frame or None)
+        files, sizes = _write_all(output, run, sides, per_frame, numbers, warmup)
+        bar.update(scene.frames)
     # said once written: a run that fails keeps its one line
     if scene.warmup is not None and round(scene.warmup * scene.fps) > warmup:
         events.note(f"{output}: a warm-up of {scene.warmup:g} s is as long as the run or longer "

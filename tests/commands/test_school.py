@@ -13,4 +13,5 @@ def test_the_progress_bar_counts_each_step_once_pre_roll_included(tmp_path):
     bars, progress = recorded_bars()
     options = SchoolOptions(count=6, frames=20, model="couzin", preroll=1.0)
     school([PARAMS / "bonybream.txt"], tmp_path / "s.glb", options, Events(progress=progress))
-    assert bars == [("simulating", 50, [1] * 50)]                  # 30 pre-roll steps and 20 frames
+    # 30 pre-roll steps and 20 frames, then the bake and the files, a frame's weight each
+    assert bars == [("simulating", 50 + 2 * 20, [1] * 50 + ["baking", 20, "writing", 20])]
