@@ -119,9 +119,11 @@ def main(argv: list[str] | None = None) -> None:
         command = err.ctx.command_path if err.ctx is not None else "fishgen"
         if command == "fishgen":
             # click says an option given no value in the group's context, not its command's: the
-            # command is found in the arguments, so the line names it as every other usage error does
-            named = next((a for a in args if a in MODULES), None)
-            command = f"fishgen {named}" if named else command
+            # command is found in the arguments, so the line names it as every other usage error does;
+            # not an option typed before the command's name (`fishgen --foo build`): the group's
+            at = next((i for i, a in enumerate(args) if a in MODULES), None)
+            before = getattr(err, "option_name", None) in args[:at] if at is not None else True
+            command = f"fishgen {args[at]}" if at is not None and not before else command
         _fail(f"{command}: {err.format_message()}", err.exit_code, kind="usage")
     except click.ClickException as err:
         if not json_errors():

@@ -193,6 +193,14 @@ def test_an_option_given_no_value_names_its_command(args):
     assert result.stderr.count("\n") == 1
 
 
+@pytest.mark.parametrize("args", [["--foo", "build", "x.txt"], ["-q", "--foo", "school", "x.txt"]])
+def test_an_unknown_option_before_the_command_is_the_group_s(args):
+    """It was named with the command typed after it, `fishgen build: No such option '--foo'`, as an
+    option of build's (QA pass 21)."""
+    result = run_cli(*args)
+    assert result.returncode == 2 and result.stderr == "fishgen: No such option '--foo'.\n", result.stderr
+
+
 @pytest.mark.parametrize("args", [
     ["sky", "--mode", "thin", "--particles", "500"], ["school", "{fish}", "--count", "3", "--frames", "5"],
     ["clouds", "{cubes}"], ["species", "--random"], ["build", "{fish}"],
