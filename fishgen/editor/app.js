@@ -11,11 +11,19 @@ const SUFFIX = { particles: '.awn', texture: '.awa' };
 const HISTORY = 500;              // undo steps kept
 const HANDLE_DIGITS = 1e4;        // values dragged by a handle are rounded to 0.0001 (no snapping)
 const MIN_SIZE = 0.01;            // a handle never scales a cube below this
+const LISTED = 5000;              // cubes named in the Cube list
+// A sum or multiple of decimal steps without binary noise: 0.1 x 3 is 0.30000000000000004 in a
+// double, which the fields showed and the file kept (QA pass 22); 12 digits hold any value typed.
+const tidy = ( v ) => Number( v.toPrecision( 12 ) );
 
 // -- the document ------------------------------------------------------------------------------------
 const doc = { mode: 'particles', cubes: [] };   // what a file holds: cubes {particles, size, centre, radius, texture}
 let name = '';                                 // the file the document was opened from or saved as
 let selected = - 1;
+// The field holding text that is no valid value, kept as typed (and marked) while its cube stays
+// selected, also once it loses the focus: a click on Save had put the old value back and saved it
+// without a word (QA pass 22); now Save refuses while it is there.
+let typedWrong = null;
 let saved = '';                                // the document as last opened or saved (JSON)
 let stamp = null;                              // the file's bytes as last read or written (its hash), or null
 let textures = [];                             // names a .awa file may use
@@ -80,6 +88,7 @@ function step( from, to ) {
 	to.push( snapshot() );
 	restore( from.pop() );
 	lastKey = null;
+	typedWrong = null;
 	changed();
 }
 
@@ -87,7 +96,11 @@ const undoStep = () => step( undo, redo ), redoStep = () => step( redo, undo );
 
 // -- three.js: the workspace ---------------------------------------------------------------------------
 const canvas = $( 'view' );
-const renderer = new THREE.WebGLRenderer( { canvas, antialias: true, preserveDrawingBuffer: true } );
+// without WebGL the workspace draws nothing, but the cubes can still be edited by their numbers,
+// filled and saved (the page says so, and keeps saying it: see `say`)
+let noWebGL = '';
+const renderer = drawing.webglRenderer( { canvas, antialias: true, preserveDrawingBuffer: true }, ( text ) => { noWebGL = text; } )
+	|| drawing.noRenderer( canvas );
 renderer.setPixelRatio( window.devicePixelRatio );
 const scene = new THREE.Scene();
 scene.background = new THREE.Color( 0x7ea3c9 );
@@ -309,7 +322,7 @@ transform.addEventListener( 'objectChange', () => {
 	const c = current(), mesh = transform.object;
 	if ( ! c || ! mesh ) return;
 	const step = snapping();
-	const round = ( v ) => step ? Math.round( v / step ) * step : Math.round( v * HANDLE_DIGITS ) / HANDLE_DIGITS;
+	const round = ( v ) => step ? tidy( Math.round( v / step ) * step ) : Math.round( v * HANDLE_DIGITS ) / HANDLE_DIGITS;
 	const sized = ( v ) => Math.max( Math.abs( round( v ) ), step || MIN_SIZE );
 	// only what the handle moved is rounded (or snapped): the other values stay exactly as they were
 	c.centre = mesh.position.toArray().map( ( v, k ) => v === c.centre[ k ] ? v : round( v ) );
@@ -372,6 +385,7 @@ function toScreen( p ) {
 function select( index ) {
 	selected = index >= 0 && index < doc.cubes.length ? index : - 1;
 	lastKey = null;
+	typedWrong = null;   // choosing a cube (the same one too) shows its values again
 	syncCubes();
 	showCube();
 }
@@ -392,6 +406,8 @@ const FIELDS = {   // input id -> how it reads and writes the selected cube
 function parseField( id, text ) {
 	const f = FIELDS[ id ], label = $( id ).labels[ 0 ].textContent;
 	const v = text.trim() === '' ? NaN : Number( text );
+	// the browser gives no text for what it cannot read as a number (1e309, "1..2")
+	if ( $( id ).validity.badInput ) return { error: `${ label }: expected a number, found something the browser cannot read as one (too large, or not a number)` };
 	if ( ! Number.isFinite( v ) ) return { error: `${ label }: expected a number, found ${ JSON.stringify( text ) }` };
 	if ( f.whole && ( ! Number.isInteger( v ) || v < f.min ) ) return { error: `${ label }: expected a whole number of 0 or more, found ${ text }` };
 	if ( f.above !== undefined && ! ( v > f.above ) ) return { error: `${ label }: expected a number greater than 0, found ${ text }` };
@@ -405,7 +421,8 @@ for ( const id of Object.keys( FIELDS ) ) {
 		if ( ! c ) return;
 		const { value, error } = parseField( id, input.value );
 		input.setAttribute( 'aria-invalid', error ? 'true' : 'false' );
-		if ( error ) { say( error, true ); return; }
+		if ( error ) { typedWrong = input; say( error, true ); return; }
+		if ( typedWrong === input ) typedWrong = null;
 		say( '' );
 		if ( FIELDS[ id ].get( c ) === value ) return;
 		change( () => FIELDS[ id ].set( current(), value ), `${ id }:${ selected }` );
@@ -418,19 +435,26 @@ function showCube() {
 	for ( const [ id, f ] of Object.entries( FIELDS ) ) {
 		const input = $( id );
 		input.disabled = ! c;
-		if ( document.activeElement === input && input.getAttribute( 'aria-invalid' ) === 'true' ) continue;
+		if ( input === typedWrong && c ) continue;
 		if ( document.activeElement !== input || ! c || Number( input.value ) !== f.get( c ) ) input.value = c ? String( f.get( c ) ) : '';
 		input.setAttribute( 'aria-invalid', 'false' );
 	}
 	for ( const id of [ 'delete', 'duplicate', 'scale-all', 'set-texture' ] ) $( id ).disabled = ! c;
 	$( 'delete-all' ).disabled = doc.cubes.length === 0;
 	const list = $( 'cube' );
-	if ( list.options.length !== doc.cubes.length + 1 || list.dataset.version !== String( version ) ) {
+	// the first LISTED cubes, and the selected one past them: a list of 50,000 options took seconds,
+	// and a cube past the end was selected with nothing shown (QA pass 22)
+	const beyond = selected >= LISTED ? String( selected ) : '';
+	if ( list.dataset.version !== String( version ) || list.dataset.beyond !== beyond ) {
 		const noun = doc.mode === 'texture' ? 'billboards' : 'particles';
+		const option = ( c, i ) => new Option( `${ i + 1 }: ${ c.particles } ${ noun } at ${ c.centre.map( ( v ) => Math.round( v * 100 ) / 100 ).join( ', ' ) }`
+			+ ( doc.mode === 'texture' && c.texture ? ` (${ c.texture })` : '' ), String( i ) );
+		const more = doc.cubes.length - LISTED;
+		const rest = more > 0 ? [ Object.assign( new Option( `… ${ more.toLocaleString( 'en' ) } more: click one in the workspace`, '' ), { disabled: true } ) ] : [];
 		list.replaceChildren( new Option( doc.cubes.length ? 'none selected' : 'no cubes', '-1' ),
-			...doc.cubes.slice( 0, 5000 ).map( ( c, i ) => new Option( `${ i + 1 }: ${ c.particles } ${ noun } at ${ c.centre.map( ( v ) => Math.round( v * 100 ) / 100 ).join( ', ' ) }`
-				+ ( doc.mode === 'texture' && c.texture ? ` (${ c.texture })` : '' ), String( i ) ) ) );
+			...doc.cubes.slice( 0, LISTED ).map( option ), ...( beyond ? [ option( doc.cubes[ selected ], selected ) ] : [] ), ...rest );
 		list.dataset.version = String( version );
+		list.dataset.beyond = beyond;
 	}
 	list.value = String( selected );
 	if ( c && c.texture && textures.includes( c.texture ) && document.activeElement !== $( 'texture' ) ) $( 'texture' ).value = c.texture;
@@ -505,9 +529,13 @@ $( 'zoom' ).addEventListener( 'input', () => {
 $( 'reset-view' ).addEventListener( 'click', resetView );
 
 // Handles: move or scale; snapping to a grid step (handles only: typed values stay as typed).
-function snapping() {
+function gridStep() {
 	const step = Number( $( 'grid-step' ).value );
-	return $( 'snap' ).checked && step > 0 && Number.isFinite( step ) ? step : 0;
+	return step > 0 && Number.isFinite( step ) ? step : 0;
+}
+
+function snapping() {
+	return $( 'snap' ).checked ? gridStep() : 0;
 }
 
 function applySnap() {
@@ -750,6 +778,10 @@ function changed() {
 
 // -- messages -----------------------------------------------------------------------------------------
 function say( text, error = false, line = null ) {
+	if ( noWebGL ) {   // every message keeps it: the empty workspace would otherwise go unexplained
+		text = text ? `${ text }; ${ noWebGL }` : `the workspace cannot be drawn: ${ noWebGL }; the cubes can still be edited by their numbers and saved`;
+		error = true;
+	}
 	state.message = text;
 	$( 'message' ).textContent = text;
 	$( 'message' ).className = error ? 'error' : '';
@@ -758,9 +790,10 @@ function say( text, error = false, line = null ) {
 
 class ServerError extends Error {
 
-	constructor( message, line ) {
+	constructor( message, line, status = null ) {
 		super( message );
 		this.line = line;
+		this.status = status;
 	}
 
 }
@@ -779,7 +812,7 @@ async function api( path, body, as = 'json' ) {
 	if ( ! res.ok ) {
 		let answer = {};
 		try { answer = await res.json(); } catch ( err ) { answer = { error: `${ res.status } ${ res.statusText }` }; }
-		throw new ServerError( answer.error || `${ res.status } ${ res.statusText }`, answer.line );
+		throw new ServerError( answer.error || `${ res.status } ${ res.statusText }`, answer.line, res.status );
 	}
 	return as === 'json' ? res.json() : res.arrayBuffer();
 }
@@ -793,6 +826,7 @@ function load( answer, fresh ) {
 	files = answer.files;
 	textures = answer.textures;
 	selected = doc.cubes.length ? 0 : - 1;
+	typedWrong = null;
 	saved = answer.exists ? json() : JSON.stringify( { mode: doc.mode, cubes: [] } );
 	undo.length = redo.length = 0;
 	lastKey = null;
@@ -820,12 +854,28 @@ async function openFile() {
 }
 
 async function saveFile() {
+	// a field still marked wrong holds a value the document does not: saving would say "saved" and
+	// write the last good one (QA pass 22)
+	if ( typedWrong && ! typedWrong.disabled ) {
+		say( `not saved: ${ typedWrong.labels[ 0 ].textContent } holds no valid value (${ JSON.stringify( typedWrong.value ) }); `
+			+ 'correct it, or choose the cube again to drop the typing', true );
+		typedWrong.focus();
+		return;
+	}
 	let target = $( 'file-name' ).value.trim() || name;
 	if ( ! /\.(awn|awa)$/i.test( target ) ) target += SUFFIX[ doc.mode ];
+	// another file of the folder is replaced only when asked (picking it in the list and pressing
+	// Enter wrote over it without a word: QA pass 22); a name not there is written only if still free
+	const other = target !== name;
+	if ( other && files.includes( target ) && ! confirm( `Replace ${ target } with the cubes of ${ name || 'this page' }? Its cubes are lost.` ) ) {
+		say( `not saved: ${ target } kept` );
+		return;
+	}
 	const sent = json();
 	try {
 		const body = { name: target, mode: doc.mode, cubes: doc.cubes };
-		if ( target === name ) body.stamp = stamp;   // refused if another program changed the file since
+		if ( ! other ) body.stamp = stamp;   // refused if another program changed the file since
+		else if ( ! files.includes( target ) ) body.stamp = null;   // refused if one was made since
 		const answer = await api( '/api/save', body );
 		saved = sent;
 		stamp = answer.stamp;
@@ -837,6 +887,13 @@ async function saveFile() {
 		say( `saved ${ name }: ${ answer.particles.toLocaleString( 'en' ) } ${ doc.mode === 'texture' ? 'billboards' : 'particles' } in ${ answer.cubes } cubes` );
 	} catch ( err ) {
 		say( err.message, true, err.line );
+		if ( err.status === 409 ) {   // the folder as it is now: the next Save asks, or writes anew
+			api( '/api/lists' ).then( ( answer ) => {
+				files = answer.files;
+				showLists();
+				if ( target === name && ! files.includes( name ) ) stamp = null;
+			}, () => {} );
+		}
 	}
 }
 
@@ -865,8 +922,12 @@ window.addEventListener( 'keydown', ( e ) => {
 	const move = { arrowleft: [ 0, - 1 ], arrowright: [ 0, 1 ], arrowup: [ 2, - 1 ], arrowdown: [ 2, 1 ], pageup: [ 1, 1 ], pagedown: [ 1, - 1 ] }[ key ];
 	if ( c && move && t === canvas ) {
 		e.preventDefault();
-		const step = snapping() || 0.1;
-		change( () => { current().centre[ move[ 0 ] ] = Math.round( ( current().centre[ move[ 0 ] ] + move[ 1 ] * step ) / step ) * step; } );
+		// by the grid step, as the hint says; onto the grid when snapping
+		const step = gridStep() || 0.1, snap = snapping();
+		change( () => {
+			const moved = current().centre[ move[ 0 ] ] + move[ 1 ] * step;
+			current().centre[ move[ 0 ] ] = tidy( snap ? Math.round( moved / snap ) * snap : moved );
+		} );
 	}
 } );
 

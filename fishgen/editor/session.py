@@ -139,9 +139,9 @@ class Session:
         with self._save_lock:
             # the page says which bytes it read (or last wrote) under this name: another program's
             # change since is refused, not overwritten (QA pass 15: it was lost without a word)
-            if "stamp" in body and _stamp(path) != body["stamp"]:
-                raise Refused(HTTPStatus.CONFLICT, f"expected {name} as this page read it, found it changed "
-                              "on disk since (by another program); open it again, or save under another name")
+            found = _stamp(path)
+            if "stamp" in body and found != body["stamp"]:
+                raise Refused(HTTPStatus.CONFLICT, _conflict(str(name), body["stamp"], found))
             write_bytes(path, data)
         return Response.of_json({"saved": name, "particles": parsed.total, "cubes": len(parsed.cubes),
                                  "bytes": len(data), "stamp": _digest(data),
@@ -206,6 +206,17 @@ def fill_glb(cube_file: CubeFile, mode: str, seed: int, lighting: Lighting) -> t
                  "note": note, "seed": seed, "mode": mode}
 
 
+def _conflict(name: str, expected: str | None, found: str | None) -> str:
+    """Why a save was refused: the file is not as the page last saw it."""
+    if expected is None:     # a name the page saw free (a new file, or another than the one open)
+        return f"expected no file {name} (this page saw none), found one made since; Save again to replace it"
+    if found is None:
+        return (f"expected {name} as this page read it, found it removed since (by another program or "
+                "another page of this editor); Save again to write it anew")
+    return (f"expected {name} as this page read it, found it changed on disk since (by another program or "
+            "another page of this editor); open it again, or save under another name")
+
+
 def _stamp(path: Path) -> str | None:
     """The file's :func:`_digest`, or None where there is none."""
     try:
@@ -220,9 +231,11 @@ def _digest(data: bytes) -> str:
 
 
 def _shown(folder: Path) -> str:
-    """A folder as the page names it: relative to where fishgen runs when inside it."""
+    """A folder as the page names it: relative to where fishgen runs when below it, else whole (the
+    page said "In ." of the folder it runs in)."""
     here = Path.cwd().resolve()
-    return (folder.relative_to(here).as_posix() or ".") if folder.is_relative_to(here) else str(folder)
+    inside = folder.is_relative_to(here) and folder != here
+    return folder.relative_to(here).as_posix() if inside else str(folder)
 
 
 def _member(body: Any, key: str) -> Any:

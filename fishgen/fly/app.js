@@ -23,7 +23,8 @@ const fail = ( err ) => {
 
 // -- renderer, camera ------------------------------------------------------------------------
 const canvas = $( 'view' );
-const renderer = new THREE.WebGLRenderer( { canvas, antialias: false, powerPreference: 'high-performance' } );
+const renderer = drawing.webglRenderer( { canvas, antialias: false, powerPreference: 'high-performance' }, fail );
+if ( renderer === null ) throw new Error( state.error );   // said on the page and to a headless driver
 renderer.setPixelRatio( 1 );   // the report's window size is the drawn size
 const gl = renderer.getContext();
 const scene = new THREE.Scene();
@@ -293,6 +294,8 @@ const drawn = { particles: 0, billboards: 0, clouds: 0, distant: 0, impostors: 0
 const impostors = config.impostors && config.impostors.on ? new Impostors( renderer, scene, {
 	angle: config.impostors.angle, budget: config.impostors.budget, near: config.impostors.near, layer: CLOUDS,
 	draws: IMPOSTOR_DRAWS, twin, sort: ( s, along ) => sortNow( s, along ), uniforms: pixelScale } ) : null;
+
+canvas.addEventListener( 'webglcontextrestored', () => { if ( impostors ) impostors.forget(); } );
 
 // A level's drawable as the impostors draw it: its attributes and material shared, its own index
 // (sorted along the line from the eye to the cloud, drawn a slice a frame), seen by their camera only.
@@ -605,9 +608,11 @@ function hud( now ) {
 	const [ w, h ] = size();
 	$( 'hud' ).textContent = `${ w } × ${ h }   ${ state.time.toFixed( 1 ) } s   ${ state.fps.toFixed( 1 ) } FPS`
 		+ ( measuring === null ? '   (warming up)' : '' );
-	$( 'detail' ).textContent = `${ drawn.particles.toLocaleString( 'en' ) } of ${ counts.particles.toLocaleString( 'en' ) } particles`
+	// particles drawn directly this frame; a cloud shown as an impostor is a picture of its particles
+	$( 'detail' ).textContent = `${ drawn.particles.toLocaleString( 'en' ) } of ${ counts.particles.toLocaleString( 'en' ) } particles drawn`
 		+ ( counts.billboards ? `, ${ drawn.billboards.toLocaleString( 'en' ) } of ${ counts.billboards.toLocaleString( 'en' ) } billboards` : '' )
-		+ ` · ${ drawn.clouds } of ${ counts.clouds } clouds (${ drawn.distant } distant) · speed ${ state.speed }`;
+		+ ` · ${ drawn.clouds } of ${ counts.clouds } clouds (${ drawn.distant } distant`
+		+ ( impostors ? `, ${ impostors.last.impostors } as impostors` : '' ) + `) · speed ${ state.speed }`;
 }
 
 function rendererName() {
@@ -650,10 +655,16 @@ function finish( end ) {
 			particles: fs.length ? fs.reduce( ( a, f ) => a + f[ 2 ], 0 ) / fs.length : 0,
 			billboards: fs.length ? fs.reduce( ( a, f ) => a + f[ 3 ], 0 ) / fs.length : 0 } ) ),
 	};
-	$( 'hud' ).textContent = `${ w } × ${ h }   ${ state.report.seconds.toFixed( 1 ) } s   ${ state.report.fps.median.toFixed( 1 ) } FPS median   (time out)`;
+	const line = `${ w } × ${ h }   ${ state.report.seconds.toFixed( 1 ) } s   ${ state.report.fps.median.toFixed( 1 ) } FPS median`;
+	$( 'hud' ).textContent = `${ line }   (time out)`;
 	const post = config.report ? fetch( 'report', { method: 'POST', headers: { 'X-Fishgen-Token': token, 'Content-Type': 'application/json' },
-		body: JSON.stringify( state.report ) } ).then( ( r ) => { if ( ! r.ok ) throw new Error( `the report was refused (${ r.status })` ); } ) : Promise.resolve();
-	post.then( () => { state.done = true; } ).catch( fail );
+		body: JSON.stringify( state.report ) } ).then( ( r ) => { if ( ! r.ok ) throw new Error( `the report was refused (${ r.status })` ); },
+		() => { throw new Error( 'the report could not be sent: fishgen fly\'s server does not answer (was it stopped?)' ); } )
+		: Promise.resolve();
+	post.then( () => {
+		state.done = true;
+		$( 'hud' ).textContent = `${ line }   (time out: ${ config.report ? 'the report is written, and fishgen fly has stopped' : 'done' })`;
+	} ).catch( fail );
 }
 
 // -- start ---------------------------------------------------------------------------------------

@@ -43,12 +43,17 @@ export class Impostors {
 			fragmentShader: 'uniform sampler2D map; varying vec2 vUv; void main() { gl_FragColor = texture2D( map, vUv ); }',
 		} );
 		this.sun = '';
+		this.epoch = 0;   // pictures of an earlier epoch are never shown (a WebGL context lost since)
 		this.frame = 0;
 		this.stats = { redraws: 0, particles: 0, frames: 0, impostors: 0, direct: 0, textures: 0 };
 		this.last = { redraws: 0, particles: 0, impostors: 0, direct: 0 };
 	}
 
 	setDepthTest( on ) { this.material.depthTest = on; }
+
+	// Every picture is lost with its WebGL context: after a restore each cloud is drawn directly
+	// until it is drawn into a picture again (the clouds stayed away for good: QA pass 22).
+	forget() { this.epoch ++; }
 
 	// The texture's side (log2) a cloud needs: SkyWorks' _GetRequiredLogResolution.
 	logSize( distance, radius, width, height ) {
@@ -76,7 +81,7 @@ export class Impostors {
 	// holds, renderOrder}. `sun`: a key of the sun's uniforms; `camRadius`: the eye's own extent.
 	plan( units, camera, width, height, sun, camRadius ) {
 		this.frame ++;
-		this.sun = sun;   // a picture made under another sun is never shown again
+		this.sun = `${ sun } ${ this.epoch }`;   // a picture made under another sun is never shown again
 		const eye = camera.position, due = [];
 		for ( const u of units ) {
 			const p = u.impostor;

@@ -44,13 +44,25 @@ manager.setURLModifier( ( url ) => {
 } );
 
 const canvas = $( 'view' );
-const renderer = new THREE.WebGLRenderer( { canvas, antialias: true } );
+const renderer = drawing.webglRenderer( { canvas, antialias: true }, fail );
+if ( renderer === null ) throw new Error( state.error );   // said on the page: nothing else can run
 renderer.setPixelRatio( window.devicePixelRatio );
 const scene = new THREE.Scene();
 scene.background = new THREE.Color( embedded.background );
 const camera = new THREE.PerspectiveCamera( 30, 1, 0.01, 1000 );
 const controls = new OrbitControls( camera, canvas );
 controls.enableDamping = true;
+// from the keyboard too, once the view has the focus: arrows pan, Shift+arrows orbit (three's own),
+// + and - zoom (QA pass 22: the camera had no keys and the canvas took no focus)
+controls.listenToKeyEvents( canvas );
+canvas.addEventListener( 'keydown', ( e ) => {
+	const near = { '+': 0.8, '=': 0.8, '-': 1.25, '_': 1.25 }[ e.key ];
+	if ( near === undefined || e.ctrlKey || e.metaKey || e.altKey ) return;
+	e.preventDefault();
+	camera.position.sub( controls.target ).multiplyScalar( near ).add( controls.target );
+	controls.update();
+	redraw();
+} );
 // Same light rig as `fishgen preview`: sun from above-front, weak fill, sky/ground hemisphere.
 scene.add( new THREE.HemisphereLight( 0xc4cdd8, 0x3a3530, 1.6 ) );
 const sun = new THREE.DirectionalLight( 0xfff8eb, 2.2 );
@@ -251,7 +263,8 @@ load().then( ( { root, clips } ) => {
 	redraw();
 	state.counts = count( root );
 	const c = state.counts;
-	$( 'counts' ).textContent = `${ c.vertices } vertices · ${ c.triangles } triangles · ${ c.particles } particles`;
+	const n = ( v ) => v.toLocaleString( 'en' );
+	$( 'counts' ).textContent = `${ n( c.vertices ) } vertices · ${ n( c.triangles ) } triangles · ${ n( c.particles ) } particles`;
 	school = schools.instanceSchools( root, clips, instancing );   // counted above as the file holds them
 	state.instanced = school.info;
 	state.instances = () => schools.instancePositions( school );

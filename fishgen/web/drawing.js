@@ -2,6 +2,32 @@
 // things (particles, billboards) drawn farthest first.
 import * as THREE from 'three';
 
+// The page's WebGL renderer on ``options.canvas``; where the browser gives no WebGL context (it is
+// off, or no GPU and no software rasterizer), null, after ``said( text )`` with why and what to do:
+// a page that threw here was left dead and silent (QA pass 22).
+export function webglRenderer( options, said ) {
+	try {
+		return new THREE.WebGLRenderer( options );
+	} catch ( error ) {
+		said( `this page draws with WebGL, and the browser gave it none (${ error && error.message || error }): `
+			+ 'turn on hardware acceleration (or WebGL) in the browser, or open the page in another one' );
+		return null;
+	}
+}
+
+// A renderer that draws nothing, for a page that has other work than drawing (the editor's cubes
+// by their numbers) where the browser gave no WebGL context.
+export function noRenderer( canvas ) {
+	let ratio = 1;
+	const gl = { readPixels() {}, RGBA: 0, UNSIGNED_BYTE: 0 };
+	return {
+		domElement: canvas, autoClear: true, info: { render: { calls: 0 } },
+		setPixelRatio( r ) { ratio = r; }, getPixelRatio: () => ratio,
+		setSize( w, h ) { canvas.width = Math.floor( w * ratio ); canvas.height = Math.floor( h * ratio ); },
+		render() {}, setRenderTarget() {}, setClearColor() {}, clear() {}, getContext: () => gl,
+	};
+}
+
 // The renderer and camera fitted to the canvas's size in the page; true when they changed.
 export function fitCanvas( renderer, camera, canvas ) {
 	const w = canvas.clientWidth, h = canvas.clientHeight, ratio = renderer.getPixelRatio();

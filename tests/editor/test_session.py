@@ -230,3 +230,21 @@ def test_a_save_over_a_file_another_program_changed_since_is_refused(skies, star
     assert client.post("/api/save", dict(body, stamp=fresh["stamp"])).status == 200
     new = client.post("/api/save", {**SAVE, "name": "brand_new.awn", "stamp": None})   # none there yet
     assert new.status == 200, new.body
+
+
+def test_a_save_refused_says_whether_the_file_was_made_changed_or_removed_since(skies, start_editor):
+    """A name the page saw free is written only if it still is (picking another file of the folder
+    and saving wrote over it without a word: QA pass 22); and a refusal says which of the three
+    happened, not "changed by another program" for each."""
+    path = skies / "table_4_3.awn"
+    client = start_editor(path)
+    doc = client.get("/api/document").json()
+    (skies / "made.awn").write_text("7\n1\n7, 2, 2, 2, 0, 0, 0, 1\n")
+    made = client.post("/api/save", {**SAVE, "name": "made.awn", "stamp": None})
+    assert made.status == 409 and "expected no file made.awn" in made.json()["error"], made.body
+    assert (skies / "made.awn").read_text() == "7\n1\n7, 2, 2, 2, 0, 0, 0, 1\n"
+    path.unlink()
+    body = {"name": "table_4_3.awn", "mode": "particles", "cubes": doc["cubes"], "stamp": doc["stamp"]}
+    removed = client.post("/api/save", body)
+    assert removed.status == 409 and "found it removed since" in removed.json()["error"], removed.body
+    assert client.post("/api/save", dict(body, stamp=None)).status == 200      # Save again: written anew

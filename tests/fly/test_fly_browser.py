@@ -208,6 +208,8 @@ def test_the_overlay_shows_window_size_time_and_fps(page):
     page.wait_for_function("document.querySelector('#hud').innerText.includes('FPS')", timeout=60_000)
     text = page.inner_text("#hud")
     assert text.startswith("640 × 480") and " s " in text and "FPS" in text
+    # particles drawn directly this frame, out of all: a cloud shown as an impostor is a picture
+    assert " particles drawn · " in page.inner_text("#detail")
 
 
 def test_clouds_out_of_view_are_culled_far_ones_levelled_and_the_rest_sorted_back_to_front(page):
@@ -243,6 +245,9 @@ def test_with_a_timeout_the_page_reports_writes_the_file_and_stops_serving(tmp_p
     tab.goto(made.lines[0])
     served.join(timeout=120)
     if not tab.is_closed():
+        # the page says the flight ended with its report written (it said "(time out)" alone: QA 22)
+        tab.wait_for_function("window.fishgenFly.done", timeout=30_000)
+        assert "(time out: the report is written, and fishgen fly has stopped)" in tab.inner_text("#hud")
         tab.close()
     made.server.server_close()
     assert not served.is_alive()                             # Pakawan closed its window at the time-out

@@ -201,3 +201,30 @@ def test_a_still_frame_with_impostors_matches_direct_drawing_on_the_hardest_view
     finally:
         page.close()
         session.close()
+
+
+def test_a_lost_webgl_context_takes_the_pictures_and_the_clouds_come_back_after_it():
+    """After WEBGL_lose_context's loss and restore, fly kept showing the impostors' lost pictures: an
+    empty sky with "1 of 1 clouds" on the HUD, and a measured flight would have reported it (QA pass
+    22). Every picture is now taken as lost: the cloud is drawn directly, then into a picture again."""
+    page, session = open_page(prepare_assets([TABLE])[0])
+    try:
+        u = cloud(page)
+        c, r = np.array(u["centre"]), u["radius"]
+        eye = c + np.array([0.0, 0.0, 4.0 * r])
+        before = capture(page, eye, c, "impostors")
+        assert cloud(page)["mode"] == "impostor"
+        page.evaluate("""() => new Promise(done => {
+            const canvas = document.getElementById('view');
+            const lose = canvas.getContext('webgl2').getExtension('WEBGL_lose_context');
+            canvas.addEventListener('webglcontextrestored', () => done(), { once: true });
+            lose.loseContext();
+            setTimeout(() => lose.restoreContext(), 50);
+        })""")
+        redraws = cloud(page)["redraws"]
+        after = capture(page, eye, c)           # the same view, the pictures kept: none is current now
+        assert cloud(page)["mode"] == "impostor" and cloud(page)["redraws"] == redraws + 1
+        assert pictures.ssim(before, after) >= 0.95 and pictures.mean_abs(before, after) <= 2.0
+    finally:
+        page.close()
+        session.close()

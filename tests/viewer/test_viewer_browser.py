@@ -97,7 +97,7 @@ def test_fish_loads_plays_scrubs_and_toggles_wireframe(browser, served, viewer_a
         expected = load_input(viewer_assets["fish"]).counts()
         assert state["counts"] == expected
         assert state["clips"] == ["swim"] and state["playing"]
-        assert page.locator("#counts").inner_text().startswith(f"{expected['vertices']} vertices")
+        assert page.locator("#counts").inner_text().startswith(f"{expected['vertices']:,} vertices")
         t0 = page.evaluate("window.fishgenViewer.time")
         page.wait_for_function(f"window.fishgenViewer.time != {t0}", timeout=LOAD_TIMEOUT_MS)  # it advances
         img = _canvas(page)
@@ -144,7 +144,7 @@ def test_cloud_from_the_cli_shows_its_particles_and_the_count_it_printed(browser
         expected = {"vertices": 0, "triangles": 0, "particles": particles}
         assert page.evaluate("window.fishgenViewer.counts") == expected
         assert page.evaluate("window.fishgenViewer.clips") == [] and page.locator("#play").is_disabled()
-        assert page.locator("#counts").inner_text() == f"0 vertices · 0 triangles · {particles} particles"
+        assert page.locator("#counts").inner_text() == f"0 vertices · 0 triangles · {particles:,} particles"
         frames(page)
         _assert_not_blank(_canvas(page))
         assert problems == []
@@ -276,6 +276,33 @@ def test_an_obj_named_with_spaces_shows_its_texture(browser, tmp_path):
         background = np.median(img.reshape(-1, 3), axis=0)
         subject = img[np.abs(img - background).max(-1) > 20]
         assert np.ptp(subject, axis=0).max() > 60
+        assert problems == []
+    finally:
+        page.close()
+
+
+def test_the_camera_answers_the_keys_and_every_control_has_a_name(browser, viewer_assets, tmp_path):
+    """The view took no focus and the camera no key, and the clip list and the timeline were named by
+    their tooltips alone (QA pass 22). Once the view has the focus: + and - zoom, arrows pan,
+    Shift+arrows orbit."""
+    from fishgen.viewer.page import write_page
+
+    page, problems, _ = _open(browser, write_page(viewer_assets["fish"], tmp_path / "v.html").as_uri())
+    try:
+        assert page.get_by_role("combobox", name="Animation clip", exact=True).count() == 1
+        assert page.get_by_role("slider", name="Time in the clip", exact=True).count() == 1
+        page.click("#play")                    # paused: only the keys move the picture
+        frames(page)
+        view = page.locator("#view")
+        view.focus()
+        assert page.evaluate("document.activeElement.id") == "view"
+        before = _canvas(page)
+        for key in ("+", "+", "ArrowLeft", "Shift+ArrowUp"):
+            shown = _canvas(page)
+            view.press(key)
+            frames(page, 3)
+            assert np.abs(_canvas(page) - shown).mean() > 0.5, f"{key} left the picture as it was"
+        assert np.abs(_canvas(page) - before).mean() > 1
         assert problems == []
     finally:
         page.close()
