@@ -166,7 +166,7 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
 
     declared_total = _header(rows[0], f"total {noun} count", name)
     if declared_total > max_particles:
-        raise _over_limit(declared_total, max_particles, name, rows[0][0], raise_with)
+        raise over_limit(declared_total, max_particles, name, rows[0][0], raise_with)
     if len(rows) < 2:
         raise expected("the number of cubes on the next line", "the end of the file",
                        name, rows[0][0] + 1)
@@ -192,7 +192,7 @@ def parse_cubes(data: bytes, name: str = "<cubes>", *,
         cube = _cube(line, name, number, textures)
         running += cube.particles
         if running > max_particles:
-            raise _over_limit(running, max_particles, name, number, raise_with)
+            raise over_limit(running, max_particles, name, number, raise_with)
         cubes.append(cube)
 
     total = sum(cube.particles for cube in cubes)
@@ -297,6 +297,7 @@ def _cube(line: str, name: str, number: int, textures: Callable[[str, int], str]
     return Cube(particles, size, centre, radius, number, texture)  # type: ignore[arg-type]
 
 
-def _over_limit(count: int, limit: int, name: str, number: int, raise_with: str | None) -> FishgenError:
+def over_limit(count: int, limit: int, name: str, number: int, raise_with: str | None = None) -> FishgenError:
+    """More particles than ``limit``, said at line ``number`` of ``name``."""
     hint = f" (raise the limit with {raise_with})" if raise_with else ""
     return expected(f"at most {limit:,} particles{hint}", f"{count:,}", name, number)

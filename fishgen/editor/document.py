@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from fishgen.clouds.model import DEFAULT_MAX_PARTICLES, CubeFile
-from fishgen.clouds.parser import MAX_CUBES, parse_cubes
+from fishgen.clouds.parser import MAX_CUBES, over_limit, parse_cubes
 from fishgen.errors import FishgenError, describe, expected
 
 PARTICLES = "particles"
@@ -152,6 +152,13 @@ def read_back(text: str, mode: str, name: str, cubes: Sequence[EditCube], *,
               roots: Sequence[Path] = (), max_particles: int = DEFAULT_MAX_PARTICLES) -> CubeFile:
     """Parse ``text`` as fishgen reads a file called ``name`` (its errors are the parser's, with the
     line), and check it holds exactly ``cubes``."""
+    # the cube whose count takes the file past the limit, at its line (the total on line 1, which the
+    # parser reads first, names no cube the page could select: QA pass 22)
+    running = 0
+    for k, cube in enumerate(cubes):
+        running += int(cube.particles)
+        if running > max_particles:
+            raise over_limit(running, max_particles, name, k + 3)
     resolver = texture_resolver(roots, name) if mode == TEXTURE else None
     parsed = parse_cubes(text.encode("utf-8"), name, max_particles=max_particles, textures=resolver)
     for cube, got in zip(cubes, parsed.cubes, strict=True):
