@@ -253,7 +253,8 @@ def test_a_save_refused_says_whether_the_file_was_made_changed_or_removed_since(
 def test_a_save_past_the_particle_limit_is_refused_at_the_cube_that_crosses_it(skies, start_editor):
     """It was refused at line 1 with the file's total, a line that names no cube (QA pass 22)."""
     client = start_editor(skies / "table_4_3.awn")
-    cubes = [EditCube(10, (1, 1, 1), (0, 0, 0), 1).json(), EditCube(99_999_999_999, (1, 1, 1), (2, 0, 0), 1).json(),
+    cubes = [EditCube(10, (1, 1, 1), (0, 0, 0), 1).json(),
+             EditCube(99_999_999_999, (1, 1, 1), (2, 0, 0), 1).json(),
              EditCube(10, (1, 1, 1), (4, 0, 0), 1).json()]
     answer = client.post("/api/save", {"name": "big.awn", "mode": "particles", "cubes": cubes, "stamp": None})
     assert answer.status == 422, answer.body
