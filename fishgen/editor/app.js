@@ -24,6 +24,7 @@ let selected = - 1;
 // selected, also once it loses the focus: a click on Save had put the old value back and saved it
 // without a word (QA pass 22); now Save refuses while it is there.
 let typedWrong = null;
+let fieldMessage = null;   // the message line as a field's error left it
 let saved = '';                                // the document as last opened or saved (JSON)
 let stamp = null;                              // the file's bytes as last read or written (its hash), or null
 let textures = [];                             // names a .awa file may use
@@ -421,9 +422,9 @@ for ( const id of Object.keys( FIELDS ) ) {
 		if ( ! c ) return;
 		const { value, error } = parseField( id, input.value );
 		input.setAttribute( 'aria-invalid', error ? 'true' : 'false' );
-		if ( error ) { typedWrong = input; say( error, true ); return; }
+		if ( error ) { typedWrong = input; say( error, true ); fieldMessage = state.message; return; }
 		if ( typedWrong === input ) typedWrong = null;
-		say( '' );
+		if ( state.message === fieldMessage ) say( '' );   // a field's own error goes; a save's stays
 		if ( FIELDS[ id ].get( c ) === value ) return;
 		change( () => FIELDS[ id ].set( current(), value ), `${ id }:${ selected }` );
 	} );

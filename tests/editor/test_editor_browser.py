@@ -473,3 +473,18 @@ def test_a_cube_past_the_list_s_first_five_thousand_is_named_when_selected(tmp_p
     ed.page.evaluate("fishgenEditor.select(5001)")
     assert ed.page.locator("#cube option:checked").inner_text().startswith("5002: 1 particles at 5001")
     assert ed.page.locator("#cube option").last.inner_text() == "… 3 more: click one in the workspace"
+
+
+def test_typing_a_valid_value_clears_a_field_s_error_but_not_a_save_s(skies, open_editor):
+    """Any valid keystroke cleared the message line, a save's refusal included (QA pass 22)."""
+    ed = open_editor(skies / "table_4_3.awn")
+    (skies / "table_4_3.awn").write_text("7\n1\n7, 2, 2, 2, 0, 0, 0, 1\n")       # another program's edit
+    ed.field("Radius").fill("3")
+    ed.button("Save").click()
+    ed.page.wait_for_function("fishgenEditor.message.includes('changed on disk since')")
+    ed.field("Radius").fill("4")
+    assert "changed on disk since" in ed.state("message")
+    ed.field("Radius").fill("0")
+    assert ed.state("message").startswith("Radius: expected a number greater than 0")
+    ed.field("Radius").fill("5")
+    assert ed.state("message") == ""
