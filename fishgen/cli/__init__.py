@@ -90,6 +90,16 @@ def _interrupt(signum: int, _frame: object) -> None:
     interrupts.deliver(Interrupted(128 + signum))  # after the renames under way, if any
 
 
+def _typed_among(option: str | None, args: list[str]) -> bool:
+    """Whether ``option`` is among ``args`` as typed: alone, with ``=value``, or a short one in a
+    bundle of them (``-qx``)."""
+    if not option:
+        return False
+    return any(a == option or a.startswith(option + "=")
+               or (len(option) == 2 and a.startswith("-") and not a.startswith("--") and option[1] in a[1:])
+               for a in args)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry: bad input becomes a one-line error, never a traceback.
 
@@ -122,8 +132,8 @@ def main(argv: list[str] | None = None) -> None:
             # command is found in the arguments, so the line names it as every other usage error does;
             # not an option typed before the command's name (`fishgen --foo build`): the group's
             at = next((i for i, a in enumerate(args) if a in MODULES), None)
-            before = getattr(err, "option_name", None) in args[:at] if at is not None else True
-            command = f"fishgen {args[at]}" if at is not None and not before else command
+            if at is not None and not _typed_among(getattr(err, "option_name", None), args[:at]):
+                command = f"fishgen {args[at]}"
         _fail(f"{command}: {err.format_message()}", err.exit_code, kind="usage")
     except click.ClickException as err:
         if not json_errors():

@@ -158,8 +158,16 @@ class TerminalEvents:
         bar = click.progressbar(length=total, label=label, file=sys.stderr, width=width)
         self.bars.append(bar)
         try:
-            with bar:
+            bar.__enter__()
+            try:
                 yield _Bar(bar)
+            except BaseException:
+                # the error's one line takes the bar's place: a refusal found once the bar was up
+                # (a total past --max-particles over several files) left "[---] 0%" above it
+                sys.stderr.write("\r\x1b[K\x1b[?25h")
+                sys.stderr.flush()
+                raise
+            bar.render_finish()
         finally:
             self.bars.pop()
 

@@ -128,22 +128,28 @@ def cube_clouds(models: Sequence[CubeFile], *, seed: int = 0, method: str = "pap
     """
     from fishgen.clouds.fill import fill_cloud, merge_clouds
     from fishgen.clouds.light import light_cloud
-    from fishgen.errors import UsageError, plural
 
     models = tuple(models)
     places = tuple(offsets) or ((0.0, 0.0, 0.0),) * len(models)
     filled = tuple(scaled(m, most) if most is not None and m.total > most else m for m in models)
-    total = sum(m.total for m in filled)
-    if total > max_particles:
-        files = plural(len(models), "file")
-        raise UsageError(f"expected at most {max_particles:,} particles in the scene (raise the limit with "
-                         f"--max-particles), found {total:,} in {files}")
+    check_total(filled, max_particles)
     fills = (fill_cloud(m, seed=seed + i, method=method, offset=place, advance=advance)
              for i, (m, place) in enumerate(zip(filled, places, strict=True)))
     if not light:
         return CubeClouds(models, filled, tuple(fills), None)
     # the files' clouds are dropped once merged: a scene near the limit is not held twice while lit
     return CubeClouds(models, filled, (), light_cloud(merge_clouds(list(fills)), lighting, advance=advance))
+
+
+def check_total(models: Sequence[CubeFile], max_particles: int = DEFAULT_MAX_PARTICLES) -> None:
+    """Refuse more than ``max_particles`` in all the files (each was read under it)."""
+    from fishgen.errors import UsageError, plural
+
+    total = sum(m.total for m in models)
+    if total > max_particles:
+        files = plural(len(models), "file")
+        raise UsageError(f"expected at most {max_particles:,} particles in the scene (raise the limit with "
+                         f"--max-particles), found {total:,} in {files}")
 
 
 def cloud_steps(models: Sequence[CubeFile], *, light: bool = True) -> int:

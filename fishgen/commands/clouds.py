@@ -125,7 +125,7 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
     """Fill every cube file, light them together (so clouds shadow each other) and write them as one
     scene; input i is filled with seed + i. A texture cloud (.awa) becomes textured billboards."""
     inputs = COMMAND.given(inputs, options)
-    from fishgen.clouds.pipeline import cloud_steps, cloud_textures, cube_clouds, read_cube_files
+    from fishgen.clouds.pipeline import check_total, cloud_steps, cloud_textures, cube_clouds, read_cube_files
     from fishgen.commands.paths import check_inputs, check_targets, output_at_fault
     from fishgen.errors import UsageError, plural
     from fishgen.exchange.clouds import VOLUME_FORMATS, check_output, export_cloud
@@ -166,6 +166,7 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
         except FishgenError as err:     # too fine a --voxel-size: the option's fault, not the output's
             raise UsageError(err.message) from None
     seed = options.seed or 0
+    check_total(files, options.max_particles)     # before the bar: a refusal is the command's one line
     with events.progress("filling and lighting" if options.light else "filling",
                          cloud_steps(files, light=options.light)) as bar:
         made = cube_clouds(files, seed=seed, method=options.method, offsets=options.offset,
@@ -178,7 +179,12 @@ def clouds(inputs: Sequence[Path], output: str | os.PathLike, options: CloudsOpt
         from fishgen.clouds.fill import merge_clouds
 
         cloud, sun = merge_clouds(made.clouds), "unlit"
-    written = export_cloud(cloud, output, billboards=billboards, voxel_size=voxel_size)
+    if volume:      # splatting 10^6 particles into voxels took 20 s, after the fill's bar was full
+        with events.progress("voxelizing", len(cloud)) as bar:
+            written = export_cloud(cloud, output, billboards=billboards, voxel_size=voxel_size,
+                                   advance=bar.update)
+    else:
+        written = export_cloud(cloud, output, billboards=billboards, voxel_size=voxel_size)
     line = (f"{output}: {plural(len(cloud), made.noun)} in {plural(len(cloud.cube_bounds), 'cube')} "
             f"from {plural(len(files), 'file')} ({options.method} fill, seed {seed}, {sun}"
             f"{f', voxels of {voxel_size:g}' * volume})")

@@ -108,8 +108,8 @@ def targets(inputs: Sequence[Path], given: str | os.PathLike | None, *, fmt: str
             raise UsageError(f"expected a folder for {len(inputs)} {noun}s (an existing folder, or a "
                              f"name ending in /), found {os.fspath(output)!r}")
         if not output.suffix:
-            raise UsageError(f"expected an output file with an extension, or a folder (an existing one, "
-                             f"or a name ending in /), found {os.fspath(output)!r}")
+            raise UsageError("expected an output file with an extension, or a folder (an existing one, "
+                             "or a name ending in /), found no extension", output)
         with output_at_fault():
             output_format(output, need)
         return [output]

@@ -20,11 +20,13 @@ const tidy = ( v ) => Number( v.toPrecision( 12 ) );
 const doc = { mode: 'particles', cubes: [] };   // what a file holds: cubes {particles, size, centre, radius, texture}
 let name = '';                                 // the file the document was opened from or saved as
 let selected = - 1;
-// The field holding text that is no valid value, kept as typed (and marked) while its cube stays
-// selected, also once it loses the focus: a click on Save had put the old value back and saved it
-// without a word (QA pass 22); now Save refuses while it is there.
-let typedWrong = null;
-let fieldMessage = null;   // the message line as a field's error left it
+// Fields holding text that is no valid value, each kept as typed (and marked) while the cube it was
+// typed for is the one selected, also once it loses the focus: a click on Save had put the old
+// value back and saved it without a word (QA pass 22); now Save refuses while one is shown. Keyed
+// by the cube object, so a cube added, duplicated, deleted or undone is not shown another's typing.
+const typedWrong = new Map();    // input -> the cube it was typed for
+let fieldMessage = null;         // the message line as a field's error (or a save it stopped) left it
+let conflicted = null;           // the name a save was refused under (409): the next Save there asks
 let saved = '';                                // the document as last opened or saved (JSON)
 let stamp = null;                              // the file's bytes as last read or written (its hash), or null
 let textures = [];                             // names a .awa file may use
@@ -89,7 +91,7 @@ function step( from, to ) {
 	to.push( snapshot() );
 	restore( from.pop() );
 	lastKey = null;
-	typedWrong = null;
+	typedWrong.clear();
 	changed();
 }
 
@@ -386,7 +388,7 @@ function toScreen( p ) {
 function select( index ) {
 	selected = index >= 0 && index < doc.cubes.length ? index : - 1;
 	lastKey = null;
-	typedWrong = null;   // choosing a cube (the same one too) shows its values again
+	typedWrong.clear();   // choosing a cube (the same one too) shows its values again
 	syncCubes();
 	showCube();
 }
@@ -422,8 +424,8 @@ for ( const id of Object.keys( FIELDS ) ) {
 		if ( ! c ) return;
 		const { value, error } = parseField( id, input.value );
 		input.setAttribute( 'aria-invalid', error ? 'true' : 'false' );
-		if ( error ) { typedWrong = input; say( error, true ); fieldMessage = state.message; return; }
-		if ( typedWrong === input ) typedWrong = null;
+		if ( error ) { typedWrong.set( input, c ); say( error, true ); fieldMessage = state.message; return; }
+		typedWrong.delete( input );
 		if ( state.message === fieldMessage ) say( '' );   // a field's own error goes; a save's stays
 		if ( FIELDS[ id ].get( c ) === value ) return;
 		change( () => FIELDS[ id ].set( current(), value ), `${ id }:${ selected }` );
@@ -436,7 +438,8 @@ function showCube() {
 	for ( const [ id, f ] of Object.entries( FIELDS ) ) {
 		const input = $( id );
 		input.disabled = ! c;
-		if ( input === typedWrong && c ) continue;
+		if ( c && typedWrong.get( input ) === c ) continue;
+		typedWrong.delete( input );
 		if ( document.activeElement !== input || ! c || Number( input.value ) !== f.get( c ) ) input.value = c ? String( f.get( c ) ) : '';
 		input.setAttribute( 'aria-invalid', 'false' );
 	}
@@ -827,7 +830,8 @@ function load( answer, fresh ) {
 	files = answer.files;
 	textures = answer.textures;
 	selected = doc.cubes.length ? 0 : - 1;
-	typedWrong = null;
+	typedWrong.clear();
+	conflicted = null;
 	saved = answer.exists ? json() : JSON.stringify( { mode: doc.mode, cubes: [] } );
 	undo.length = redo.length = 0;
 	lastKey = null;
@@ -857,29 +861,34 @@ async function openFile() {
 async function saveFile() {
 	// a field still marked wrong holds a value the document does not: saving would say "saved" and
 	// write the last good one (QA pass 22)
-	if ( typedWrong && ! typedWrong.disabled ) {
-		say( `not saved: ${ typedWrong.labels[ 0 ].textContent } holds no valid value (${ JSON.stringify( typedWrong.value ) }); `
+	const wrong = [ ...typedWrong ].find( ( [ input, cube ] ) => cube === current() && ! input.disabled );
+	if ( wrong ) {
+		say( `not saved: ${ wrong[ 0 ].labels[ 0 ].textContent } holds no valid value (${ JSON.stringify( wrong[ 0 ].value ) }); `
 			+ 'correct it, or choose the cube again to drop the typing', true );
-		typedWrong.focus();
+		fieldMessage = state.message;   // correcting the field clears it, as the field's own error
+		wrong[ 0 ].focus();
 		return;
 	}
 	let target = $( 'file-name' ).value.trim() || name;
 	if ( ! /\.(awn|awa)$/i.test( target ) ) target += SUFFIX[ doc.mode ];
 	// another file of the folder is replaced only when asked (picking it in the list and pressing
 	// Enter wrote over it without a word: QA pass 22); a name not there is written only if still free
-	const other = target !== name;
-	if ( other && files.includes( target ) && ! confirm( `Replace ${ target } with the cubes of ${ name || 'this page' }? Its cubes are lost.` ) ) {
+	// A save refused under this name (another program made, changed or removed the file since)
+	// asks before it writes there: else each Save was refused again, for good.
+	const other = target !== name, asked = target === conflicted || other && files.includes( target );
+	const why = target === conflicted ? 'It changed on disk since this page last saw it.' : 'Its cubes are lost.';
+	if ( asked && ! confirm( `Replace ${ target } with the cubes of ${ name || 'this page' }? ${ why }` ) ) {
 		say( `not saved: ${ target } kept` );
 		return;
 	}
 	const sent = json();
 	try {
 		const body = { name: target, mode: doc.mode, cubes: doc.cubes };
-		if ( ! other ) body.stamp = stamp;   // refused if another program changed the file since
-		else if ( ! files.includes( target ) ) body.stamp = null;   // refused if one was made since
+		if ( ! asked ) body.stamp = other ? null : stamp;   // refused (409) if made or changed since
 		const answer = await api( '/api/save', body );
 		saved = sent;
 		stamp = answer.stamp;
+		conflicted = null;
 		name = answer.saved;
 		files = answer.files;
 		$( 'file-name' ).value = name;
@@ -888,12 +897,9 @@ async function saveFile() {
 		say( `saved ${ name }: ${ answer.particles.toLocaleString( 'en' ) } ${ doc.mode === 'texture' ? 'billboards' : 'particles' } in ${ answer.cubes } cubes` );
 	} catch ( err ) {
 		say( err.message, true, err.line );
-		if ( err.status === 409 ) {   // the folder as it is now: the next Save asks, or writes anew
-			api( '/api/lists' ).then( ( answer ) => {
-				files = answer.files;
-				showLists();
-				if ( target === name && ! files.includes( name ) ) stamp = null;
-			}, () => {} );
+		if ( err.status === 409 ) {   // the next Save under this name asks first
+			conflicted = target;
+			api( '/api/lists' ).then( ( answer ) => { files = answer.files; showLists(); }, () => {} );
 		}
 	}
 }

@@ -214,7 +214,8 @@ def _conflict(name: str, expected: str | None, found: str | None) -> str:
         return (f"expected {name} as this page read it, found it removed since (by another program or "
                 "another page of this editor); Save again to write it anew")
     return (f"expected {name} as this page read it, found it changed on disk since (by another program or "
-            "another page of this editor); open it again, or save under another name")
+            "another page of this editor); open it again, save under another name, or Save again to "
+            "replace it")
 
 
 def _stamp(path: Path) -> str | None:

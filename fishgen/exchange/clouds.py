@@ -4,6 +4,7 @@ The writers' side of a cloud, above the cloud package: fishgen.clouds re-exports
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 from fishgen.clouds.model import DEFAULT_VOXEL_SIZE, Cloud
@@ -47,9 +48,11 @@ def check_output(path: str | os.PathLike, billboards: bool = False, particles: i
 
 
 def export_cloud(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = False,
-                 voxel_size: float = DEFAULT_VOXEL_SIZE) -> list[Path]:
+                 voxel_size: float = DEFAULT_VOXEL_SIZE,
+                 advance: Callable[[int], None] | None = None) -> list[Path]:
     """Write ``cloud`` to ``path`` (.ply, .glb, .gltf, .csv, .npy, or as volume grids of
-    ``voxel_size`` to .nvdb or .vdb), atomically."""
+    ``voxel_size`` to .nvdb or .vdb), atomically; a volume calls ``advance(k)`` as each k particles
+    are splatted."""
     from fishgen.clouds.scene import cloud_scene
     from fishgen.exchange import export
 
@@ -58,5 +61,5 @@ def export_cloud(cloud: Cloud, path: str | os.PathLike, *, billboards: bool = Fa
         raise FishgenError("expected at least 1 particle to export, found 0", path)
     scene = cloud_scene(cloud, billboards=billboards)
     if suffix in VOLUME_FORMATS:
-        return export(scene, path, voxel_size=voxel_size)
+        return export(scene, path, voxel_size=voxel_size, advance=advance)
     return export(scene, path)

@@ -11,6 +11,7 @@ volume's first leaf; the map's translation puts it back in the world.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -58,8 +59,9 @@ assert (GRID.itemsize, TREE.itemsize, ROOT.itemsize, TILE.itemsize, UPPER_NODE.i
         LOWER_NODE.itemsize, LEAF_NODE.itemsize, META.itemsize) == (672, 64, 64, 32, 270400, 33856, 2144, 176)
 
 
-def write_nvdb(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZE) -> list[Path]:
-    write_files({path: nanovdb_bytes(scene_volume(scene, path, voxel_size))})
+def write_nvdb(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZE,
+               advance: Callable[[int], None] | None = None) -> list[Path]:
+    write_files({path: nanovdb_bytes(scene_volume(scene, path, voxel_size, advance))})
     return [path]
 
 

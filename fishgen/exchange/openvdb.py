@@ -16,6 +16,7 @@ from __future__ import annotations
 import hashlib
 import struct
 import uuid
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -33,10 +34,11 @@ ALL_VALUES = 6  # NO_MASK_AND_ALL_VALS: the node's every value follows, uncompre
 MAP = "UniformScaleTranslateMap"
 
 
-def write_vdb(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZE) -> list[Path]:
+def write_vdb(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZE,
+              advance: Callable[[int], None] | None = None) -> list[Path]:
     from fishgen.exchange.volumes import scene_volume
 
-    write_files({path: openvdb_bytes(scene_volume(scene, path, voxel_size))})
+    write_files({path: openvdb_bytes(scene_volume(scene, path, voxel_size, advance))})
     return [path]
 
 

@@ -76,8 +76,9 @@ FORMATS: dict[str, Format] = {}
 READER_OPTIONS = ("textures_dir", "seed", "lighting")
 """What a caller may offer readers: a species file's (or texture cloud's) texture folder, a cube
 file's fill seed, and the sunlight a cloud is lit with (:class:`fishgen.clouds.lighting.Lighting`)."""
-WRITER_OPTIONS = ("voxel_size",)
-"""What a caller may offer writers: a volume's voxel side (.vdb, .nvdb)."""
+WRITER_OPTIONS = ("voxel_size", "advance")
+"""What a caller may offer writers: a volume's voxel side (.vdb, .nvdb), and ``advance(k)`` for a
+progress bar of its particles splatted."""
 
 
 def register_format(fmt: Format) -> Format:
@@ -296,10 +297,10 @@ register_format(Format("npy", (".npy",), "NumPy structured array of particles", 
                        "fishgen.exchange.table:write_npy"))
 register_format(Format("nvdb", (".nvdb",), "NanoVDB volume: a cloud's density and light grids",
                        frozenset({POINTS}), "fishgen.exchange.nanovdb:write_nvdb",
-                       writes_with=("voxel_size",)))
+                       writes_with=("voxel_size", "advance")))
 register_format(Format("vdb", (".vdb",), "OpenVDB volume: a cloud's density and light grids",
                        frozenset({POINTS}), "fishgen.exchange.openvdb:write_vdb",
-                       writes_with=("voxel_size",)))
+                       writes_with=("voxel_size", "advance")))
 register_format(Format("species", (".txt",), "a VRFish species file",
                        frozenset({MESHES, TEXTURES, NODE_ANIMATION}),
                        reader="fishgen.assembly.fish:species_scene", command="build",

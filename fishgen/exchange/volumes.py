@@ -3,6 +3,7 @@ leaves grouped into the tree both formats store (root -> 32^3 internal -> 16^3 i
 leaves, each internal node covering 4096 and 128 voxels a side)."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -15,9 +16,11 @@ UPPER, LOWER = 4096, 128
 """Voxels along the side of an upper (32^3 children) and a lower (16^3 children) internal node."""
 
 
-def scene_volume(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZE) -> Volume:
+def scene_volume(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZE,
+                 advance: Callable[[int], None] | None = None) -> Volume:
     """The one particle set of ``scene`` (a cloud's points) splatted into density and light grids,
-    with the extinction its lighting was baked with (the scene's extras; else the default)."""
+    with the extinction its lighting was baked with (the scene's extras; else the default);
+    ``advance(k)`` as each k particles are splatted."""
     from fishgen.clouds.lighting import Lighting, from_extras
     from fishgen.clouds.volume import particle_volume
     from fishgen.errors import FishgenError
@@ -30,7 +33,7 @@ def scene_volume(scene: Scene, path: Path, voxel_size: float = DEFAULT_VOXEL_SIZ
     a = prim.attributes
     lighting = from_extras(scene.extras) or Lighting()
     return particle_volume(a["POSITION"], a["_RADIUS"], a["_DENSITY"], a.get("_LIGHT"),
-                           lighting.extinction, voxel_size, path)
+                           lighting.extinction, voxel_size, path, advance=advance)
 
 
 def shifted(volume: Volume) -> tuple[Volume, np.ndarray]:

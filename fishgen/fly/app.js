@@ -663,7 +663,7 @@ function finish( end ) {
 		: Promise.resolve();
 	post.then( () => {
 		state.done = true;
-		$( 'hud' ).textContent = `${ line }   (time out: ${ config.report ? 'the report is written, and fishgen fly has stopped' : 'done' })`;
+		$( 'hud' ).textContent = `${ line }   (time out: ${ config.report ? 'the figures are sent, and fishgen fly has stopped' : 'done' })`;
 	} ).catch( fail );
 }
 

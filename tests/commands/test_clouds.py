@@ -36,3 +36,25 @@ def test_an_unlit_cloud_counts_its_fill_alone(tmp_path):
     clouds([_cube_file(tmp_path / "c.awn", 70_000)], tmp_path / "c.ply", CloudsOptions(light=False),
            Events(progress=progress))
     assert bars == [("filling", 70_000, [65_536, 70_000 - 65_536])]
+
+
+def test_a_volume_counts_its_particles_splatted_on_a_bar_of_its_own(tmp_path):
+    """10^6 particles took 20 s to voxelize after the fill's bar was full (a review)."""
+    bars, progress = recorded_bars()
+    table = PARAMS / "clouds" / "table_4_4.awn"
+    clouds([table], tmp_path / "c.nvdb", CloudsOptions(), Events(progress=progress))
+    assert [(label, total) for label, total, _ in bars] == [("filling and lighting", 3 * 615),
+                                                            ("voxelizing", 615)]
+    assert sum(bars[1][2]) == 615 and len(bars[1][2]) >= 1
+
+
+def test_a_scene_past_the_limit_is_refused_before_any_bar(tmp_path):
+    """Two files each under --max-particles, over it together: the refusal came with the bar drawn."""
+    from fishgen.errors import UsageError
+
+    bars, progress = recorded_bars()
+    table = PARAMS / "clouds" / "table_4_4.awn"
+    with pytest.raises(UsageError, match="expected at most 1,000 particles in the scene"):
+        clouds([table, table], tmp_path / "c.ply", CloudsOptions(max_particles=1000),
+               Events(progress=progress))
+    assert bars == []

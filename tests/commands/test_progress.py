@@ -182,3 +182,17 @@ def test_the_line_fits_with_an_eta_of_days_too(monkeypatch, columns):
         bar.pos, bar.eta_known = 1, True
         monkeypatch.setattr(type(bar), "format_eta", lambda self: "10d 00:00:00")
         assert len(bar.format_progress_line()) < columns
+
+
+def test_a_command_that_fails_under_its_bar_leaves_no_bar_above_its_error(monkeypatch):
+    """A refusal found once the bar was up left "[----] 0%" on the line above the error (a review)."""
+    from fishgen.cli.adapter import TerminalEvents
+    from fishgen.errors import UsageError
+
+    terminal = _a_person_watches(monkeypatch)
+    with pytest.raises(UsageError):
+        with TerminalEvents("clouds").progress("filling and lighting", 10) as bar:
+            bar.update(3)
+            raise UsageError("expected at most 1,000 particles")
+    text = terminal.text.getvalue()
+    assert text.endswith("\r\x1b[K\x1b[?25h") and "\n" not in text       # erased, cursor shown again

@@ -488,3 +488,40 @@ def test_typing_a_valid_value_clears_a_field_s_error_but_not_a_save_s(skies, ope
     assert ed.state("message").startswith("Radius: expected a number greater than 0")
     ed.field("Radius").fill("5")
     assert ed.state("message") == ""
+
+
+def test_a_wrong_field_stays_wrong_while_another_is_edited_and_leaves_with_its_cube(skies, open_editor):
+    """Only the last wrong field was kept: a second field edited let Save through with Radius still
+    showing 0 in red. And the typing stayed on a cube added, duplicated or deleted (a review)."""
+    ed = open_editor(skies / "table_4_3.awn")
+    path = skies / "table_4_3.awn"
+    before = path.read_bytes()
+    ed.field("Radius").fill("0")
+    ed.field("Particles").fill("15")
+    ed.button("Save").click()
+    assert ed.state("message").startswith('not saved: Radius holds no valid value ("0")')
+    assert path.read_bytes() == before
+    ed.field("Radius").fill("1.5")
+    assert ed.state("message") == ""                 # the refusal was the field's: corrected, it goes
+    ed.field("Radius").fill("0")
+    ed.button("Add Cube").click()                    # another cube: its own values, nothing marked
+    radius = ed.field("Radius")
+    assert radius.get_attribute("aria-invalid") == "false" and radius.input_value() != "0"
+    ed.button("Save").click()
+    ed.page.wait_for_function("fishgenEditor.message.startsWith('saved')")
+
+
+def test_a_new_file_made_by_another_program_can_still_be_saved_once_asked(tmp_path, open_editor):
+    """`fishgen edit new.awn`, then another program makes new.awn: each Save was refused again."""
+    ed = open_editor(tmp_path / "new.awn")
+    ed.button("Add Cube").click()
+    (tmp_path / "new.awn").write_text("7\n1\n7, 2, 2, 2, 0, 0, 0, 1\n")
+    ed.button("Save").click()
+    ed.page.wait_for_function("fishgenEditor.message.includes('expected no file new.awn')")
+    asked = []
+    ed.page.on("dialog", lambda d: (asked.append(d.message), d.accept()))
+    ed.button("Save").click()
+    ed.page.wait_for_function("fishgenEditor.message.startsWith('saved new.awn')")
+    assert asked == ["Replace new.awn with the cubes of new.awn? "
+                     "It changed on disk since this page last saw it."]
+    assert load_cubes(tmp_path / "new.awn").total == 10

@@ -245,9 +245,9 @@ def test_with_a_timeout_the_page_reports_writes_the_file_and_stops_serving(tmp_p
     tab.goto(made.lines[0])
     served.join(timeout=120)
     if not tab.is_closed():
-        # the page says the flight ended with its report written (it said "(time out)" alone: QA 22)
+        # the page says the flight ended, its figures with the command (it said "(time out)" alone: QA 22)
         tab.wait_for_function("window.fishgenFly.done", timeout=30_000)
-        assert "(time out: the report is written, and fishgen fly has stopped)" in tab.inner_text("#hud")
+        assert "(time out: the figures are sent, and fishgen fly has stopped)" in tab.inner_text("#hud")
         tab.close()
     made.server.server_close()
     assert not served.is_alive()                             # Pakawan closed its window at the time-out
