@@ -8,6 +8,9 @@ shared one; the next test that asks for it starts it again.
 """
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 from fishgen.fly.headless import find_chromium
@@ -85,3 +88,17 @@ def frames(page, count: int = 2) -> None:
         const step = () => (--n <= 0 ? done() : requestAnimationFrame(step));
         requestAnimationFrame(step);
     })""", count)
+
+
+@contextmanager
+def still_fly(cube_file: Path, size: tuple[int, int] = (640, 480)) -> Iterator[Any]:
+    """`fishgen fly`'s page of ``cube_file`` served, held still (no path): its session, closed after."""
+    from fishgen.fly.assets import prepare_assets
+    from fishgen.fly.session import FlyConfig, FlySession
+
+    session = FlySession(prepare_assets([cube_file])[0], FlyConfig(size=size, warmup=0.1, path="still"))
+    session.serve_in_background()
+    try:
+        yield session
+    finally:
+        session.close()

@@ -8,11 +8,9 @@ import shutil
 import pytest
 
 from fishgen.clouds.parser import load_cubes
-from fishgen.fly.assets import prepare_assets
-from fishgen.fly.session import FlyConfig, FlySession
 from fishgen.viewer.page import write_page
 from tests.browser import browser as shared_browser
-from tests.browser import unavailable
+from tests.browser import still_fly, unavailable
 from tests.conftest import PARAMS, run_cli
 
 pytestmark = pytest.mark.skipif(unavailable() is not None, reason=str(unavailable()))
@@ -42,17 +40,14 @@ def test_the_viewer_says_it_has_no_webgl(tmp_path):
 
 
 def test_fly_says_it_has_no_webgl_and_its_driver_hears_it():
-    session = FlySession(prepare_assets([PARAMS / "clouds" / "table_4_4.awn"])[0],
-                         FlyConfig(size=(640, 480), warmup=0.1, path="still"))
-    session.serve_in_background()
-    page = _page()
-    try:
-        page.goto(session.url())
-        page.wait_for_function("window.fishgenFly && fishgenFly.error", timeout=30_000)
-        assert SAID in page.locator("#hud").inner_text() and SAID in page.evaluate("fishgenFly.error")
-    finally:
-        page.close()
-        session.close()
+    with still_fly(PARAMS / "clouds" / "table_4_4.awn") as session:
+        page = _page()
+        try:
+            page.goto(session.url())
+            page.wait_for_function("window.fishgenFly && fishgenFly.error", timeout=30_000)
+            assert SAID in page.locator("#hud").inner_text() and SAID in page.evaluate("fishgenFly.error")
+        finally:
+            page.close()
 
 
 def test_the_editor_without_webgl_says_so_and_still_edits_and_saves_by_numbers(tmp_path):

@@ -6,11 +6,9 @@ import time
 
 import pytest
 
-from fishgen.fly.assets import prepare_assets
-from fishgen.fly.session import FlyConfig, FlySession
 from fishgen.viewer.page import write_page
 from tests.browser import browser as shared_browser
-from tests.browser import unavailable
+from tests.browser import still_fly, unavailable
 from tests.conftest import PARAMS, run_cli
 
 pytestmark = pytest.mark.skipif(unavailable() is not None, reason=str(unavailable()))
@@ -61,17 +59,14 @@ def test_the_viewer_page_of_a_textured_fish_runs_under_its_policy_from_disk(tmp_
 
 
 def test_the_fly_page_runs_under_its_policy_when_served():
-    session = FlySession(prepare_assets([PARAMS / "clouds" / "table_4_4.awn"])[0],
-                         FlyConfig(size=(640, 480), warmup=0.1, path="still"))
-    session.serve_in_background()
-    page = new_page()
-    try:
-        page.goto(session.url())
-        check(page, "window.fishgenFly.loaded || window.fishgenFly.error")
-        assert page.evaluate("window.fishgenFly.error") is None
-    finally:
-        page.close()
-        session.close()
+    with still_fly(PARAMS / "clouds" / "table_4_4.awn") as session:
+        page = new_page()
+        try:
+            page.goto(session.url())
+            check(page, "window.fishgenFly.loaded || window.fishgenFly.error")
+            assert page.evaluate("window.fishgenFly.error") is None
+        finally:
+            page.close()
 
 
 def test_the_editor_page_runs_under_its_policy_when_served():
