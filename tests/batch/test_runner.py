@@ -294,7 +294,7 @@ def test_a_dask_cluster_builds_the_same_bytes_as_the_local_pool(shipped):
     manifest = shipped / "params" / "assets.toml"
     assert batch(manifest, "--out", shipped / "local", "-j", "2").returncode == 0
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, protocol="tcp",
-                                  host="127.0.0.1", dashboard_address=None) as cluster:
+                                  host="127.0.0.1", dashboard_address="127.0.0.1:0") as cluster:
         run = batch(manifest, "--out", shipped / "dask", "--scheduler", cluster.scheduler_address,
                     "--report", shipped / "dask.json")
         assert run.returncode == 0, run.stderr
@@ -373,5 +373,5 @@ def test_a_scheduler_passes_the_probe():
     from fishgen.batch.runner import _probe
 
     with distributed.LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
-                                  dashboard_address=None) as cluster:
+                                  dashboard_address="127.0.0.1:0") as cluster:
         _probe(cluster.scheduler_address, seconds=5)
