@@ -408,6 +408,8 @@ const FIELDS = {   // input id -> how it reads and writes the selected cube
 
 function parseField( id, text ) {
 	const f = FIELDS[ id ], label = $( id ).labels[ 0 ].textContent;
+	if ( $( id ).dataset.comma && text.trim() !== '' ) return { error: `${ label }: expected a point before the decimals (2.5), found a comma` };
+	delete $( id ).dataset.comma;
 	const v = text.trim() === '' ? NaN : Number( text );
 	// the browser gives no text for what it cannot read as a number (1e309, "1..2")
 	if ( $( id ).validity.badInput ) return { error: `${ label }: expected a number, found something the browser cannot read as one (too large, or not a number)` };
@@ -431,6 +433,14 @@ for ( const id of Object.keys( FIELDS ) ) {
 		change( () => FIELDS[ id ].set( current(), value ), `${ id }:${ selected }` );
 	} );
 	input.addEventListener( 'change', () => { lastKey = null; showCube(); } );
+	// Chromium drops a comma from a number field without a word: 2,5 became a radius of 25 (QA 22).
+	// A comma typed marks the field wrong until it is emptied or its cube's value shown again.
+	input.addEventListener( 'keydown', ( e ) => {
+		if ( e.key !== ',' ) return;
+		e.preventDefault();
+		input.dataset.comma = 'typed';
+		input.dispatchEvent( new Event( 'input' ) );
+	} );
 }
 
 function showCube() {
@@ -440,6 +450,7 @@ function showCube() {
 		input.disabled = ! c;
 		if ( c && typedWrong.get( input ) === c ) continue;
 		typedWrong.delete( input );
+		delete input.dataset.comma;
 		if ( document.activeElement !== input || ! c || Number( input.value ) !== f.get( c ) ) input.value = c ? String( f.get( c ) ) : '';
 		input.setAttribute( 'aria-invalid', 'false' );
 	}

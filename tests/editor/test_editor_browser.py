@@ -525,3 +525,17 @@ def test_a_new_file_made_by_another_program_can_still_be_saved_once_asked(tmp_pa
     assert asked == ["Replace new.awn with the cubes of new.awn? "
                      "It changed on disk since this page last saw it."]
     assert load_cubes(tmp_path / "new.awn").total == 10
+
+
+def test_a_comma_typed_into_a_number_is_refused_and_said(skies, open_editor):
+    """Chromium dropped it without a word: 2,5 became a radius of 25 (QA pass 22)."""
+    ed = open_editor(skies / "table_4_3.awn")
+    radius = ed.state("cubes[0].radius")
+    ed.field("Radius").fill("")
+    ed.field("Radius").press_sequentially("2,5")
+    assert ed.state("message").startswith("Radius: expected a point before the decimals (2.5), found a comma")
+    assert ed.state("cubes[0].radius") == 2 and ed.field("Radius").get_attribute("aria-invalid") == "true"
+    ed.field("Radius").fill("")
+    ed.field("Radius").press_sequentially("2.5")
+    assert ed.state("cubes[0].radius") == 2.5 and ed.state("message") == ""
+    assert radius != 2.5
