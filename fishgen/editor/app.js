@@ -27,6 +27,7 @@ let selected = - 1;
 const typedWrong = new Map();    // input -> the cube it was typed for
 let fieldMessage = null;         // the message line as a field's error (or a save it stopped) left it
 let conflicted = null;           // the name a save was refused under (409): the next Save there asks
+let emptyNote = null;            // the message a new file's empty workspace left, until a cube is added
 let saved = '';                                // the document as last opened or saved (JSON)
 let stamp = null;                              // the file's bytes as last read or written (its hash), or null
 let textures = [];                             // names a .awa file may use
@@ -752,7 +753,7 @@ function showFill() {
 	const f = state.fill;
 	if ( f.ms === null ) { $( 'fill-time' ).textContent = 'not filled yet'; return; }
 	const noun = previewMode === 'texture' ? 'billboards' : 'particles';
-	$( 'fill-time' ).textContent = `${ f.particles.toLocaleString( 'en' ) } ${ noun } filled and lit in ${ f.ms } ms`
+	$( 'fill-time' ).textContent = `${ f.particles.toLocaleString( 'en' ) } ${ noun } filled and lit in ${ Math.round( f.ms ).toLocaleString( 'en' ) } ms`
 		+ ( f.latency !== null ? `, shown ${ f.latency } ms after the edit` : '' ) + ( f.note ? ` (${ f.note })` : '' );
 }
 
@@ -782,6 +783,7 @@ function changed() {
 	changedAt.set( version, performance.now() );
 	if ( changedAt.size > 1000 ) changedAt.delete( changedAt.keys().next().value );
 	if ( selected >= doc.cubes.length ) selected = doc.cubes.length - 1;
+	if ( doc.cubes.length && state.message === emptyNote ) say( '' );   // no longer an empty workspace
 	showMode();
 	syncCubes();
 	showCube();
@@ -854,6 +856,7 @@ function load( answer, fresh ) {
 	const notes = [ ...( answer.warnings || [] ) ];
 	if ( ! answer.exists ) notes.push( `${ name } does not exist yet: an empty workspace; Save writes it` );
 	say( notes.join( '; ' ) );
+	emptyNote = answer.exists ? null : state.message;
 }
 
 async function openFile() {

@@ -5,6 +5,7 @@ Playwright drives the system browser, never a downloaded one. WebGL runs on Swif
 """
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -217,6 +218,7 @@ def test_an_edit_refreshes_the_preview_and_the_totals_and_fill_time_are_shown(sk
     ed.settle()
     assert ed.state("previewParticles().count") == 554
     assert "554 particles filled and lit in" in ed.page.locator("#fill-time").inner_text()
+    assert re.search(r"lit in [\d,]+ ms", ed.page.locator("#fill-time").inner_text())   # whole ms (QA 22)
     ed.page.get_by_label("Cube", exact=True).select_option("0")
     ed.field("Particles").fill("100")
     ed.settle()
@@ -539,3 +541,11 @@ def test_a_comma_typed_into_a_number_is_refused_and_said(skies, open_editor):
     ed.field("Radius").press_sequentially("2.5")
     assert ed.state("cubes[0].radius") == 2.5 and ed.state("message") == ""
     assert radius != 2.5
+
+
+def test_a_new_file_s_note_goes_once_it_has_a_cube(tmp_path, open_editor):
+    """"new.awn does not exist yet: an empty workspace" stayed on screen with cubes in it (QA 22)."""
+    ed = open_editor(tmp_path / "new.awn")
+    assert ed.state("message").startswith("new.awn does not exist yet")
+    ed.button("Add Cube").click()
+    assert ed.state("message") == ""
