@@ -591,7 +591,8 @@ def _blur_shares(grid: _Grid, first_share, second_share, slabs: int, per_slab: i
         found.append((klass, slab * rows + row, col, sums[lo:hi]))
     planes = []
     for c in range(CLASSES):
-        picked = [(key[klass == c], col[klass == c], value[klass == c]) for klass, key, col, value in found]
+        picked = [(key[mine], col[mine], value[mine])
+                  for klass, key, col, value in found for mine in (klass == c,)]
         keys = np.unique(np.concatenate([key for key, _, _ in picked]))
         values = np.zeros((len(keys), cols))
         for n, (key, col, value) in enumerate(picked):

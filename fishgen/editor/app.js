@@ -885,10 +885,10 @@ async function saveFile() {
 	}
 	let target = $( 'file-name' ).value.trim() || name;
 	if ( ! /\.(awn|awa)$/i.test( target ) ) target += SUFFIX[ doc.mode ];
-	// another file of the folder is replaced only when asked (picking it in the list and pressing
-	// Enter wrote over it without a word: QA pass 22); a name not there is written only if still free
-	// A save refused under this name (another program made, changed or removed the file since)
-	// asks before it writes there: else each Save was refused again, for good.
+	// Another file of the folder is replaced only when asked (picking it in the list and pressing
+	// Enter wrote over it without a word: QA pass 22), and so is a name a save was refused under
+	// (made, changed or removed since: else each Save was refused again, for good). Any other name
+	// goes with its stamp, so the server refuses it if the file changed under it.
 	const other = target !== name, asked = target === conflicted || other && files.includes( target );
 	const why = target === conflicted ? 'It changed on disk since this page last saw it.' : 'Its cubes are lost.';
 	if ( asked && ! confirm( `Replace ${ target } with the cubes of ${ name || 'this page' }? ${ why }` ) ) {
