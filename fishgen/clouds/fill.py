@@ -270,12 +270,13 @@ def _paper_offsets(rng: np.random.Generator, m: int, work: _Scratch) -> np.ndarr
         np.maximum(worst, np.abs(s[1], out=other), out=worst)
         np.maximum(worst, np.abs(s[2], out=other), out=worst)
         inside = np.less_equal(worst, 1, out=work.mask[:d])
-        kept = int(np.count_nonzero(inside))
-        take = min(kept, need)
+        # the first ``need`` kept draws, straight into ``out``: one nonzero for the three axes, and
+        # take with mode="clip" (the indices are in range), which does not buffer ``out`` as
+        # compress (take's "raise") does
+        kept = np.flatnonzero(inside)[:need]
+        take = len(kept)
         for axis in range(3):
-            row = rows[1 + axis, :kept]
-            np.compress(inside, s[axis], out=row)
-            out[axis, filled:filled + take] = row[:take]
+            np.take(s[axis], kept, out=out[axis, filled:filled + take], mode="clip")
         filled += take
     if filled < m:  # cannot happen with CLUMP as set: acceptance is ~77 %
         raise RuntimeError("rejection sampling did not converge")

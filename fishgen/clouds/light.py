@@ -858,10 +858,13 @@ def _slab_numbers(depth: np.ndarray, slabs: int, pool: ThreadPoolExecutor | None
     nearer = np.empty(n, np.uint16)
 
     def number(span: tuple[int, int]) -> None:
-        np.take(table, key[span[0]:span[1]], out=slab[span[0]:span[1]])
+        # mode="clip" (every level is in range): with the default "raise", take copies ``out``
+        # into a buffer and back, reading fresh pages before writing them (a copy-on-write fault and
+        # a TLB shootdown of the other threads for each page of the three arrays)
+        np.take(table, key[span[0]:span[1]], out=slab[span[0]:span[1]], mode="clip")
         if lead is not None:
-            np.take(table, read[span[0]:span[1]], out=face[span[0]:span[1]])
-        np.take(shares, read[span[0]:span[1]], out=nearer[span[0]:span[1]])
+            np.take(table, read[span[0]:span[1]], out=face[span[0]:span[1]], mode="clip")
+        np.take(shares, read[span[0]:span[1]], out=nearer[span[0]:span[1]], mode="clip")
 
     _each(pool, number, spans)
     return slab, face, nearer
