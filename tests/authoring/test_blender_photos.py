@@ -6,6 +6,7 @@ photographed again by Blender itself."""
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -51,7 +52,7 @@ def fitted(tmp_path_factory):
 def test_fixtures_are_whole():
     """Each committed photo has its true silhouette and the shot it was taken with."""
     records = bp.fixture_records()
-    assert {"sampled_303", "long", "deep-tail"} <= set(records)
+    assert {"sampled_303", "long", "deep-tail", "sampled_2007"} <= set(records)
     for name, rec in records.items():
         truth = bp.read_mask(rec["mask"])
         assert truth.shape == (rec["camera"]["height"], rec["camera"]["width"]), name
@@ -203,3 +204,20 @@ def test_a_fit_that_leans_on_the_faint_edges_and_faded_pixels_together_is_said_s
     assert not any(n.startswith("needs --mask") for n in unpatched.row.notes), unpatched.row.notes
     for name in ("bonybream.txt", "bonybream.png", "bonybream_mask.png"):
         assert (tmp_path / name).read_bytes() == unpatched.out.with_name(name).read_bytes(), name
+
+
+@pytest.mark.slow
+def test_a_fit_that_misses_a_pale_fin_says_so(gl_available, fitted):
+    """Seed 2007 over water (a fresh set's photo, 50 mm): its translucent pelvic fin is nearly the
+    water's colour, the silhouette leaves it out, and the rebuilt fish, without it, matches that
+    silhouette well (0.907-0.935 by the command's own figure on the four bases) but not the photo
+    (0.795-0.818 in Blender). The pale patch the fin leaves (silhouette.pale_patches) is taken with
+    the other doubts, and one line says so with each figure."""
+    row = fitted("sampled_2007", "threadfingoldie").row
+    assert row.kept and row.own is not None and row.own >= 0.9, row
+    assert row.raster < TARGET, row     # the miss, as CI measures it without Blender
+    said = [n for n in row.notes if n.startswith("silhouette IoU")]
+    assert len(said) == 1 and "\n" not in said[0], row.notes
+    assert "pale patches joined to its outline" in said[0] and "with all three" in said[0], said
+    figures = [float(f) for f in re.findall(r"\b0\.\d{3}\b", said[0])]
+    assert figures[0] == round(row.own, 3) and figures[-1] < TARGET, said

@@ -372,13 +372,21 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
                     *_half_covered_ious(photo, chosen, out, distance))
     # Fitted to the silhouette with its faint edges, the rebuilt fish is measured against them too;
     # against the bare silhouette it may score less (the faint pixels may not be fish), and counted
-    # at half coverage less again. Each doubt alone is said when it alone falls under the line; both
-    # at once take their losses together (605 in Blender, a grey-blue fish over grey-blue water: 0.894
-    # by its own figure, 0.857 bare, 0.874 at half coverage, 0.840 in Blender).
-    doubt = None    # (IoU with both doubts taken, the bare silhouette's, at half coverage)
+    # at half coverage less again, and against it with the pale patches joined to it
+    # (silhouette.pale_patches: a translucent fin nearly the water's colour) less again. Each doubt
+    # alone is said when it alone falls under the line; all at once take their losses together (605
+    # in Blender, a grey-blue fish over grey-blue water: 0.894 by its own figure, 0.857 bare, 0.874 at
+    # half coverage, 0.840 in Blender; 2007 on BonyBream, a pale pelvic fin lost: 0.925, 0.877 bare,
+    # 0.921 at half, 0.876 with the patches, 0.824 all together, 0.805 in Blender).
+    doubt = None    # (IoU with every doubt taken, the bare silhouette's, at half coverage, with patches)
     if shown is not None and faded is not None and fitted and target_faint is not None:
+        from fishgen.authoring.photo.silhouette import pale_patches
+
         bare = _iou_with(chosen, sil.mask, shown[0])
-        doubt = (faded + bare - shown[1], bare, faded)
+        pale = pale_patches(photo, sil.mask | target_faint)
+        paled = _iou_with(chosen, sil.mask | target_faint | pale, shown[0]) if pale.any() else shown[1]
+        paled = paled if paled < shown[1] - RENDERERS_DIFFER else shown[1]   # a few stray pixels: no doubt
+        doubt = (faded + bare + paled - 2 * shown[1], bare, faded, paled)
     apart = None    # (share, IoU): the rebuilt fish seen from another distance, the worse of two
     if shown is not None and distance is not None and faded is not None \
             and faded >= ADVICE_IOU + RENDERERS_DIFFER and (doubt is None or doubt[0] >= ADVICE_IOU):
@@ -396,10 +404,14 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
              f"rebuilt fish covers at least half (thin or translucent fin parts fade out there){margin}: it "
              "may look unlike the photographed fish in another renderer; see --compare")
     elif shown is not None and doubt is not None and doubt[0] < ADVICE_IOU:
+        patches = (f", {doubt[2]:.3f} counting only the pixels the rebuilt fish covers at least half and "
+                   f"{doubt[3]:.3f} if the pale patches joined to its outline are fish (a translucent fin "
+                   f"nearly the water's colour), {doubt[0]:.3f} with all three" if doubt[3] < shown[1] else
+                   f" and {doubt[2]:.3f} counting only the pixels the rebuilt fish covers at least half, "
+                   f"{doubt[0]:.3f} with both")
         note(f"silhouette IoU {shown[1]:.3f}, but {doubt[1]:.3f} without the faint pixels round the photo's "
-             f"outline and {doubt[2]:.3f} counting only the pixels the rebuilt fish covers at least half, "
-             f"{doubt[0]:.3f} with both (a fish near the backdrop's colour): the rebuilt fish may be unlike "
-             "the photographed one; give --mask to be sure")
+             f"outline{patches} (a fish near the backdrop's colour): the rebuilt fish may be unlike the "
+             "photographed one; give --mask to be sure")
     elif shown is not None and apart is not None and apart[1] < ADVICE_IOU:
         note(f"silhouette IoU {shown[1]:.3f}, but {apart[1]:.3f} seen from {abs(apart[0]):.0%} "
              f"{'nearer' if apart[0] < 0 else 'farther'} (the camera's distance is estimated from the "
