@@ -158,7 +158,7 @@ def test_told_the_lens_a_fit_over_water_keeps_the_faint_fin_tips_in_its_mask(gl_
         assert run.result.fitted
         assert not any(n.startswith("needs --mask") for n in notes), notes   # its own silhouette
         # its bare figure is its own: nothing to say of doubts taken together (the next test)
-        assert not [n for n in notes if "with both" in n], notes
+        assert not [n for n in notes if "give --mask to be sure" in n], notes
         mask = np.asarray(ImageOps.flip(Image.open(run.out.with_name("bonybream_mask.png")))) >= 128
         assert mask.shape == sil.mask.shape and mask[sil.mask].all()
         # a fitted fish's mask also widens the outline's 1-px threads (test_photo_roundtrip)
@@ -218,6 +218,7 @@ def test_a_fit_that_misses_a_pale_fin_says_so(gl_available, fitted):
     assert row.raster < TARGET, row     # the miss, as CI measures it without Blender
     said = [n for n in row.notes if n.startswith("silhouette IoU")]
     assert len(said) == 1 and "\n" not in said[0], row.notes
-    assert "pale patches joined to its outline" in said[0] and "with all three" in said[0], said
+    assert "if the pale patches joined to the photo's outline are fish" in said[0], said
+    assert "translucent fin" in said[0] and "give --mask" in said[0], said
     figures = [float(f) for f in re.findall(r"\b0\.\d{3}\b", said[0])]
     assert figures[0] == round(row.own, 3) and figures[-1] < TARGET, said

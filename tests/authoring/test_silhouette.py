@@ -75,12 +75,15 @@ def test_translucent_fins_over_mottled_water_are_fish():
     from tests.authoring.blender_photo import fixture_records, read_mask
 
     for name, rec in fixture_records().items():
-        if rec["shot"]["backdrop"] != "water" or name == PALE_FIN:
+        if rec["shot"]["backdrop"] != "water":
             continue
         sil = silhouette(load_photo(rec["photo"]))
         truth = read_mask(rec["mask"])
         assert sil.source == "background model"
         iou = (sil.mask & truth).sum() / (sil.mask | truth).sum()
+        if name == PALE_FIN:   # the known shortfall: a fin nearly the water's colour left out
+            assert 0.85 <= iou < 0.92, f"{name}: silhouette IoU {iou:.3f} (a fix? move it to the rest)"
+            continue
         assert iou >= 0.92, f"{name}: silhouette IoU {iou:.3f} with the true coverage"
 
 
@@ -94,7 +97,7 @@ def test_faint_edges_give_back_the_fin_tips_that_set_the_box():
     from tests.authoring.blender_photo import fixture_records, read_mask
 
     for name, rec in fixture_records().items():
-        if rec["shot"]["backdrop"] != "water" or name == PALE_FIN:
+        if rec["shot"]["backdrop"] != "water":
             continue
         photo, truth = load_photo(rec["photo"]), read_mask(rec["mask"])
         fish = silhouette(photo).mask
@@ -103,7 +106,9 @@ def test_faint_edges_give_back_the_fin_tips_that_set_the_box():
         # the rest is mostly the rim: pixels less than half covered, which the truth leaves out
         assert (faint & truth).sum() >= 2 / 3 * faint.sum(), f"{name}: faint edges off the fish"
         before, after = silhouette_iou(truth, fish), silhouette_iou(truth, fish | faint)
-        assert after >= before + 0.03, f"{name}: cropped IoU {before:.3f} -> {after:.3f}"
+        # 2007's faint edges stop 8 rows short of its dorsal fin's one-pixel tip (0.857 -> 0.871)
+        gain = 0.01 if name == PALE_FIN else 0.03
+        assert after >= before + gain, f"{name}: cropped IoU {before:.3f} -> {after:.3f}"
 
 
 def test_faint_edges_of_an_alpha_photo_are_its_faint_alpha():
@@ -150,14 +155,14 @@ def test_a_translucent_fin_over_a_swirl_of_darker_water_is_fish():
     assert (truth & ~mask).sum() <= 200 and (mask & ~truth).sum() <= 50
 
 
-def _pale_scene(kind: str) -> tuple[Photo, np.ndarray, np.ndarray]:
+def _pale_scene(kind: str, noise: float = 0.6) -> tuple[Photo, np.ndarray, np.ndarray]:
     """A dark fish over plain water, and under it a patch as large as a pelvic fin: ``fin``, the
     water's colour but 4 levels with paler rays every 8 px; ``swirl``, smooth water 8 levels paler.
     (photo, the fish, where the patch is)."""
     rng = np.random.default_rng(3)
     h, w = 200, 320
     y, x = np.mgrid[0:h, 0:w]
-    rgb = np.array([110.0, 153.0, 166.0]) + rng.normal(0, 0.6, (h, w, 3))
+    rgb = np.array([110.0, 153.0, 166.0]) + rng.normal(0, noise, (h, w, 3))
     fish = ((x - 160) / 80.0) ** 2 + ((y - 90) / 30.0) ** 2 <= 1
     rgb[fish] = [150, 110, 160]
     under = (x >= 140) & (x < 180) & (y >= 112) & (y < 150) & ~fish
@@ -166,7 +171,7 @@ def _pale_scene(kind: str) -> tuple[Photo, np.ndarray, np.ndarray]:
         rgb[under & ((x - 140) % 8 < 2)] += 6
     else:
         rgb += 8 * np.exp(-(((x - 160) / 16.0) ** 2 + ((y - 128) / 16.0) ** 2))[..., None] * ~fish[..., None]
-    return Photo(np.clip(rgb, 0, 255).astype(np.float32), None, Path("p.png")), fish, under
+    return Photo(np.clip(np.rint(rgb), 0, 255).astype(np.uint8), None, Path("p.png")), fish, under
 
 
 def test_a_fin_nearly_the_water_s_colour_is_a_pale_patch_and_a_smooth_swirl_is_not(monkeypatch):
@@ -183,6 +188,7 @@ def test_a_fin_nearly_the_water_s_colour_is_a_pale_patch_and_a_smooth_swirl_is_n
     assert not module.pale_patches(photo, fish).any()
     monkeypatch.setattr(module, "PALE_GRAIN", 0.0)
     assert (module.pale_patches(photo, fish) & under).sum() >= 0.5 * under.sum()
+    monkeypatch.undo()
     alpha = Photo(photo.rgb, np.full(fish.shape, 255, np.uint8), Path("p.png"))
     assert not module.pale_patches(alpha, fish).any()    # an alpha channel says what is fish
 
@@ -190,7 +196,7 @@ def test_a_fin_nearly_the_water_s_colour_is_a_pale_patch_and_a_smooth_swirl_is_n
 def test_blender_s_pale_pelvic_fin_is_a_pale_patch():
     """Blender's committed photo of seed 2007 over water: its translucent pelvic fin, nearly the
     water's colour, is left out of the silhouette and its faint edges (IoU 0.922 with the true
-    coverage) but found as a pale patch, nearly all of it fish (0.950 with it). On the other water
+    coverage) but found as a pale patch, nearly all of it fish (0.949 with it). On the other water
     photos the pale patches are a few dozen pixels."""
     from fishgen.authoring.photo.image import load_photo
     from fishgen.authoring.photo.silhouette import faint_edges, pale_patches
@@ -210,3 +216,15 @@ def test_blender_s_pale_pelvic_fin_is_a_pale_patch():
         assert pale.sum() >= 0.03 * outline.sum() and (pale & truth).sum() >= 0.9 * pale.sum()
         iou = [(m & truth).sum() / (m | truth).sum() for m in (outline, outline | pale)]
         assert iou[0] < 0.93 and iou[1] >= iou[0] + 0.02, iou
+
+
+def test_over_a_noise_free_backdrop_a_smooth_patch_is_not_pale(monkeypatch):
+    """A backdrop with no noise at all (a flat studio colour, a synthetic render) has no fine detail
+    to compare with: it counts as PALE_DETAIL's, so a smooth shadow beside the fish is not taken
+    for a fin, as it would be were any detail at all 1.5 times none."""
+    from fishgen.authoring.photo import silhouette as module
+
+    photo, fish, under = _pale_scene("swirl", noise=0.0)
+    assert not module.pale_patches(photo, fish).any()
+    monkeypatch.setattr(module, "PALE_DETAIL", 0.0)
+    assert (module.pale_patches(photo, fish) & under).sum() >= 0.3 * under.sum()

@@ -373,11 +373,12 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     # Fitted to the silhouette with its faint edges, the rebuilt fish is measured against them too;
     # against the bare silhouette it may score less (the faint pixels may not be fish), and counted
     # at half coverage less again, and against it with the pale patches joined to it
-    # (silhouette.pale_patches: a translucent fin nearly the water's colour) less again. Each doubt
-    # alone is said when it alone falls under the line; all at once take their losses together (605
+    # (silhouette.pale_patches: a translucent fin nearly the water's colour) less again. The faint
+    # edges and half coverage are each said when they alone fall under the line; all the doubts at
+    # once take their losses together, and the line names those that lose something (605
     # in Blender, a grey-blue fish over grey-blue water: 0.894 by its own figure, 0.857 bare, 0.874 at
     # half coverage, 0.840 in Blender; 2007 on BonyBream, a pale pelvic fin lost: 0.925, 0.877 bare,
-    # 0.921 at half, 0.876 with the patches, 0.824 all together, 0.805 in Blender).
+    # 0.921 at half, 0.877 with the patches, 0.825 all together, 0.805 in Blender).
     doubt = None    # (IoU with every doubt taken, the bare silhouette's, at half coverage, with patches)
     if shown is not None and faded is not None and fitted and target_faint is not None:
         from fishgen.authoring.photo.silhouette import pale_patches
@@ -404,14 +405,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
              f"rebuilt fish covers at least half (thin or translucent fin parts fade out there){margin}: it "
              "may look unlike the photographed fish in another renderer; see --compare")
     elif shown is not None and doubt is not None and doubt[0] < ADVICE_IOU:
-        patches = (f", {doubt[2]:.3f} counting only the pixels the rebuilt fish covers at least half and "
-                   f"{doubt[3]:.3f} if the pale patches joined to its outline are fish (a translucent fin "
-                   f"nearly the water's colour), {doubt[0]:.3f} with all three" if doubt[3] < shown[1] else
-                   f" and {doubt[2]:.3f} counting only the pixels the rebuilt fish covers at least half, "
-                   f"{doubt[0]:.3f} with both")
-        note(f"silhouette IoU {shown[1]:.3f}, but {doubt[1]:.3f} without the faint pixels round the photo's "
-             f"outline{patches} (a fish near the backdrop's colour): the rebuilt fish may be unlike the "
-             "photographed one; give --mask to be sure")
+        note(f"silhouette IoU {shown[1]:.3f}, but {_doubts_said(shown[1], *doubt)}: the rebuilt fish may be "
+             "unlike the photographed one; give --mask to be sure")
     elif shown is not None and apart is not None and apart[1] < ADVICE_IOU:
         note(f"silhouette IoU {shown[1]:.3f}, but {apart[1]:.3f} seen from {abs(apart[0]):.0%} "
              f"{'nearer' if apart[0] < 0 else 'farther'} (the camera's distance is estimated from the "
@@ -541,6 +536,20 @@ def _half_covered_ious(photo: Photo, candidate: _Candidate, out: Path,
     with _rebuilt(candidate, out) as rebuilt:
         return [silhouette_iou(candidate.measured.frame_mask, covered)
                 for covered in half_covered_grids(rebuilt, *_render_size(photo), distance, SAMPLE_GRIDS)]
+
+
+def _doubts_said(iou: float, together: float, bare: float, faded: float, paled: float) -> str:
+    """The doubts that lose something against ``iou``, each with its figure, and with two or more,
+    their losses ``together``: what follows "but" in the command's line."""
+    said = [f"{v:.3f} {what}" for v, what in (
+        (bare, "without the faint pixels round the photo's outline"),
+        (faded, "counting only the pixels the rebuilt fish covers at least half"),
+        (paled, "if the pale patches joined to the photo's outline are fish")) if v < iou]
+    listed = said[0] if len(said) == 1 else ", ".join(said[:-1]) + " and " + said[-1]
+    if len(said) > 1:
+        listed += f", {together:.3f} with {'both' if len(said) == 2 else 'all three'}"
+    return listed + (" (a fish or a translucent fin near the backdrop's colour)" if paled < iou else
+                     " (a fish near the backdrop's colour)")
 
 
 def _iou_with(candidate: _Candidate, mask: np.ndarray, render: np.ndarray) -> float:

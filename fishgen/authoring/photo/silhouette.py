@@ -38,6 +38,7 @@ SWIRL_SIGMAS = 3.0         # distance from the swirls' smooth backdrop, in its o
 PALE_SIGMAS = 2.5          # a patch's distance from the water around it that may be a fin nearly its colour
 PALE_LEVELS = 3.0          # ... and never less than this (0-255 units)
 PALE_GRAIN = 1.5           # ... with this many times the fine detail of the water near the fish
+PALE_DETAIL = 0.5          # ... the water's detail taken as at least this (a noise-free backdrop has none)
 SWIRL_CLEAR = 12           # px round the fish left out of that smooth backdrop (a fin not yet found)
 
 
@@ -153,7 +154,7 @@ def pale_patches(photo: Photo, fish: np.ndarray) -> np.ndarray:
     band = known & ndimage.binary_dilation(grown, structure=np.ones((3, 3), bool), iterations=NEAR_BAND)
     near = band if band.sum() >= 50 else known
     spread = float(np.median(contrast[near])) * 1.4826 + 0.5
-    raw = (contrast > max(PALE_SIGMAS * spread, PALE_LEVELS)) & (weight > 0.002) & ~fish
+    raw = (contrast > max(PALE_SIGMAS * spread, PALE_LEVELS)) & (weight > 0.02) & ~fish
     raw = ndimage.binary_opening(raw, structure=np.ones((LOCAL_WIDTH, LOCAL_WIDTH), bool))
     labels, count = ndimage.label(raw, structure=np.ones((3, 3), bool))
     if count == 0:
@@ -163,7 +164,7 @@ def pale_patches(photo: Photo, fish: np.ndarray) -> np.ndarray:
                                                               iterations=2) & raw])
     big = np.bincount(labels.ravel(), minlength=count + 1)[1:] >= LOCAL_PATCH * fish.sum()
     detail = np.sqrt(np.einsum("ijk,ijk->ij", photo.rgb - img, photo.rgb - img))   # what the box smooths
-    water = float(np.median(detail[near]))
+    water = max(float(np.median(detail[near])), PALE_DETAIL)
     grainy = np.asarray(ndimage.median(detail, labels, index)) >= PALE_GRAIN * water
     return np.isin(labels, index[touching & big & grainy])
 
