@@ -197,7 +197,8 @@ def test_blender_s_pale_pelvic_fin_is_a_pale_patch():
     """Blender's committed photo of seed 2007 over water: its translucent pelvic fin, nearly the
     water's colour, is left out of the silhouette and its faint edges (IoU 0.922 with the true
     coverage) but found as a pale patch, nearly all of it fish (0.949 with it). On the other water
-    photos the pale patches are a few dozen pixels."""
+    photos there is none: the few dozen pixels their outlines' halos leave are judged only
+    PALE_RING px off the outline and more, where they are water."""
     from fishgen.authoring.photo.image import load_photo
     from fishgen.authoring.photo.silhouette import faint_edges, pale_patches
     from tests.authoring.blender_photo import fixture_records, read_mask
@@ -210,8 +211,8 @@ def test_blender_s_pale_pelvic_fin_is_a_pale_patch():
         outline = sil | faint_edges(photo, sil)
         pale = pale_patches(photo, outline)
         assert not (pale & outline).any()
-        if name != PALE_FIN:
-            assert pale.sum() <= 0.002 * outline.sum(), name
+        if name != PALE_FIN:   # beside the outline (ringing, a rim's halo) nothing is judged
+            assert not pale.any(), name
             continue
         assert pale.sum() >= 0.03 * outline.sum() and (pale & truth).sum() >= 0.9 * pale.sum()
         iou = [(m & truth).sum() / (m | truth).sum() for m in (outline, outline | pale)]

@@ -39,6 +39,7 @@ PALE_SIGMAS = 2.5          # a patch's distance from the water around it that ma
 PALE_LEVELS = 3.0          # ... and never less than this (0-255 units)
 PALE_GRAIN = 1.5           # ... with this many times the fine detail of the water near the fish
 PALE_DETAIL = 0.5          # ... the water's detail taken as at least this (a noise-free backdrop has none)
+PALE_RING = 6              # px: a patch's detail is judged this far from the outline and more
 SWIRL_CLEAR = 12           # px round the fish left out of that smooth backdrop (a fin not yet found)
 
 
@@ -140,7 +141,8 @@ def pale_patches(photo: Photo, fish: np.ndarray) -> np.ndarray:
     from it (three.js's: 6-12 levels) but are as smooth as the water (1.0-1.5 times its detail);
     Blender's pelvic fin of seed 2007 stood 3-6 levels off, 4 spreads, its rays 10 times the water's
     detail. Their backdrop is taken from SWIRL_CLEAR px off the fish and more, so such a fin is not
-    its own backdrop. Too unsure to measure the fish by, they tell how far its measure can be
+    its own backdrop, and their detail PALE_RING px off it and more, past the outline's halo and
+    JPEG's colour bleeding. Too unsure to measure the fish by, they tell how far its measure can be
     trusted."""
     if photo.alpha is not None:
         return np.zeros_like(fish)
@@ -165,7 +167,10 @@ def pale_patches(photo: Photo, fish: np.ndarray) -> np.ndarray:
     big = np.bincount(labels.ravel(), minlength=count + 1)[1:] >= LOCAL_PATCH * fish.sum()
     detail = np.sqrt(np.einsum("ijk,ijk->ij", photo.rgb - img, photo.rgb - img))   # what the box smooths
     water = max(float(np.median(detail[near])), PALE_DETAIL)
-    grainy = np.asarray(ndimage.median(detail, labels, index)) >= PALE_GRAIN * water
+    # judged off the outline: JPEG rings beside every strong edge, as detail the water lacks
+    off = ~ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=PALE_RING)
+    judged = np.where(off, labels, 0)
+    grainy = np.asarray(ndimage.median(detail, judged, index)) >= PALE_GRAIN * water
     return np.isin(labels, index[touching & big & grainy])
 
 
