@@ -17,7 +17,7 @@ from fishgen.authoring.photo.anatomy import BodyOutline, body_outline, body_regi
 from fishgen.authoring.photo.frame import Frame, fish_frame
 from fishgen.authoring.photo.image import MEASURE_SIDE, Photo, load_photo, working_copy
 from fishgen.authoring.photo.sideview import SideView, side_view, with_counts
-from fishgen.authoring.photo.silhouette import silhouette
+from fishgen.authoring.photo.silhouette import pale_patches, silhouette
 from fishgen.errors import FishgenError, UsageError, cannot
 from fishgen.species.model import Species, TexturePoints
 
@@ -381,8 +381,6 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     # 0.921 at half, 0.877 with the patches, 0.825 all together, 0.805 in Blender).
     doubt = None    # (IoU with every doubt taken, the bare silhouette's, at half coverage, with patches)
     if shown is not None and faded is not None and fitted and target_faint is not None:
-        from fishgen.authoring.photo.silhouette import pale_patches
-
         bare = _iou_with(chosen, sil.mask, shown[0])
         pale = pale_patches(photo, sil.mask | target_faint)
         paled = _iou_with(chosen, sil.mask | target_faint | pale, shown[0]) if pale.any() else shown[1]

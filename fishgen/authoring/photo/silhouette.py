@@ -107,7 +107,7 @@ def translucent_mask(rgb: np.ndarray, fish: np.ndarray) -> np.ndarray:
     local = _local_contrast(img, fish)
     if local is None:
         return np.zeros_like(fish)
-    contrast, weight, spread = local
+    contrast, weight, spread, _ = local
     # weight: far from any known backdrop (a frame filled by fish) there is nothing to compare with
     raw = (contrast > max(LOCAL_SIGMAS * spread, LOCAL_CONTRAST)) & (weight > 0.02) & ~fish
     raw = ndimage.binary_opening(raw, structure=np.ones((3, 3), bool))   # the fish's own halo is 1 px
@@ -147,15 +147,10 @@ def pale_patches(photo: Photo, fish: np.ndarray) -> np.ndarray:
     if photo.alpha is not None:
         return np.zeros_like(fish)
     img = ndimage.uniform_filter(photo.rgb.astype(np.float32), size=(LOCAL_BOX, LOCAL_BOX, 1))
-    _, distance = _off_backdrop(img)
-    grown = ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=SWIRL_CLEAR)
-    known = ~grown & ((distance < 3.0) | _swirls(img, fish, ~grown))
-    if not known.any():
+    local = _local_contrast(img, fish, SWIRL_CLEAR, SWIRL_CLEAR + NEAR_BAND)
+    if local is None:
         return np.zeros_like(fish)
-    contrast, weight = _off_smoothed(img, known, LOCAL_SIGMA)
-    band = known & ndimage.binary_dilation(grown, structure=np.ones((3, 3), bool), iterations=NEAR_BAND)
-    near = band if band.sum() >= 50 else known
-    spread = float(np.median(contrast[near])) * 1.4826 + 0.5
+    contrast, weight, spread, near = local
     raw = (contrast > max(PALE_SIGMAS * spread, PALE_LEVELS)) & (weight > 0.02) & ~fish
     raw = ndimage.binary_opening(raw, structure=np.ones((LOCAL_WIDTH, LOCAL_WIDTH), bool))
     labels, count = ndimage.label(raw, structure=np.ones((3, 3), bool))
@@ -186,7 +181,7 @@ def faint_edges(photo: Photo, fish: np.ndarray) -> np.ndarray:
         local = _local_contrast(photo.rgb.astype(np.float32), fish)
         if local is None:
             return np.zeros_like(fish)
-        contrast, weight, spread = local
+        contrast, weight, spread, _ = local
         maybe = (contrast > max(FAINT_SIGMAS * spread, LOCAL_CONTRAST)) & (weight > 0.02)
     grown = ndimage.binary_propagation(fish, mask=maybe | fish, structure=np.ones((3, 3), bool)) & ~fish
     if photo.alpha is not None:
@@ -200,22 +195,24 @@ def faint_edges(photo: Photo, fish: np.ndarray) -> np.ndarray:
     return np.isin(labels, index[widest <= FAINT_HALF_WIDTH])
 
 
-def _local_contrast(img: np.ndarray, fish: np.ndarray) -> tuple[np.ndarray, np.ndarray, float] | None:
+def _local_contrast(img: np.ndarray, fish: np.ndarray, clear: int = 3, reach: int = NEAR_BAND
+                    ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray] | None:
     """How far each pixel of ``img`` is from the backdrop around it: (contrast in 0-255 units, the
-    weight of known backdrop near it, the spread of that contrast over the backdrop near the fish);
-    None when no pixel is surely backdrop. The backdrop is the photo's confidently-backdrop pixels
-    (away from the fish, under 3 border deviations or in a swirl: :func:`_swirls`) spread over the
-    gaps by a normalised Gaussian."""
+    weight of known backdrop near it, the spread of that contrast over the backdrop near the fish,
+    where that backdrop is); None when no pixel is surely backdrop. The backdrop is the photo's
+    confidently-backdrop pixels (``clear`` px off the fish and more, under 3 border deviations or in
+    a swirl: :func:`_swirls`) spread over the gaps by a normalised Gaussian; near the fish is within
+    ``reach`` px of it."""
     _, distance = _off_backdrop(img)
-    away = ~ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=3)
+    away = ~ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=clear)
     known = away & ((distance < 3.0) | _swirls(img, fish, away))
     if not known.any():
         return None
     contrast, weight = _off_smoothed(img, known, LOCAL_SIGMA)
     # the spread is the backdrop's near the fish: JPEG rings round an outline, a flat frame does not
-    band = known & ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=NEAR_BAND)
+    band = known & ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=reach)
     near = band if band.sum() >= 50 else known
-    return contrast, weight, float(np.median(contrast[near])) * 1.4826 + 0.5
+    return contrast, weight, float(np.median(contrast[near])) * 1.4826 + 0.5, near
 
 
 def _swirls(img: np.ndarray, fish: np.ndarray, away: np.ndarray) -> np.ndarray:
