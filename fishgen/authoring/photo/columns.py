@@ -53,8 +53,9 @@ def neck_depth(thickness: np.ndarray) -> np.ndarray:
     return depth
 
 
-def tail_side(mask: np.ndarray) -> str:
-    """"right" or "left": the end with the deeper neck (a caudal fin beyond a narrow peduncle)."""
+def tail_necks(mask: np.ndarray) -> tuple[float, float]:
+    """(right, left): the deepest neck in each end's 45 % of the silhouette's columns. A caudal fin
+    beyond a narrow peduncle makes the tail's end the deeper."""
     _, _, has = extent(mask)
     cols = np.flatnonzero(has)
     lo, hi = cols[0], cols[-1] + 1
@@ -62,6 +63,10 @@ def tail_side(mask: np.ndarray) -> str:
     e = bottom - top
     n = e.size
     reach = max(2, int(0.45 * n))
-    right = neck_depth(e)[n - reach:].max()
-    left = neck_depth(e[::-1])[n - reach:].max()
+    return float(neck_depth(e)[n - reach:].max()), float(neck_depth(e[::-1])[n - reach:].max())
+
+
+def tail_side(mask: np.ndarray) -> str:
+    """"right" or "left": the end with the deeper neck."""
+    right, left = tail_necks(mask)
     return "right" if right >= left else "left"
