@@ -415,16 +415,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         lens = ("" if options.focal_length is not None else
                 "; if it was taken close up, give --focal-length (fishgen preview draws at about 50 mm, "
                 "or none with --ortho)")
-        if sil.source != "alpha" and options.mask is None and _greyscale(photo):
-            # the base is seldom to blame: a grey head beside grey water is lost to the backdrop
-            note(f"silhouette IoU {shown[1]:.3f}: a greyscale photo, whose fish is told from the "
-                 f"backdrop by brightness alone, so its silhouette may be wrong; give --mask{lens}")
-        elif options.fit_shape:
-            note(f"silhouette IoU {shown[1]:.3f}: the rebuilt fish is still unlike the photo's; if the "
-                 f"silhouette is wrong (a busy background), give --mask{lens}")
-        else:
-            note(f"silhouette IoU {shown[1]:.3f}: the base's geometry does not match the photographed "
-                 f"fish; try --fit-shape{lens}")
+        note(_misfit_said(shown[1], traced=sil.source == "alpha" or options.mask is not None,
+                          fit_shape=options.fit_shape, greyscale=_greyscale(photo), lens=lens))
     files = dict(chosen.files)
     if options.fxl_out is not None:
         tp = chosen.species.texture_points
@@ -534,6 +526,26 @@ def _half_covered_ious(photo: Photo, candidate: _Candidate, out: Path,
     with _rebuilt(candidate, out) as rebuilt:
         return [silhouette_iou(candidate.measured.frame_mask, covered)
                 for covered in half_covered_grids(rebuilt, *_render_size(photo), distance, SAMPLE_GRIDS)]
+
+
+def _misfit_said(iou: float, *, traced: bool, fit_shape: bool, greyscale: bool, lens: str) -> str:
+    """The line for a rebuilt fish whose silhouette IoU is under the target, with what to try: the
+    silhouette (unless the photo's alpha or a --mask ``traced`` it), else the base."""
+    if not traced and greyscale:
+        # the base is seldom to blame: a grey head beside grey water is lost to the backdrop
+        return (f"silhouette IoU {iou:.3f}: a greyscale photo, whose fish is told from the backdrop by "
+                f"brightness alone, so its silhouette may be wrong; give --mask{lens}")
+    if not fit_shape:
+        return (f"silhouette IoU {iou:.3f}: the base's geometry does not match the photographed fish; "
+                f"try --fit-shape{lens}")
+    if traced:
+        # misses over alpha differ by base (Blender 2604, 2605, 2610: one base of four each)
+        return (f"silhouette IoU {iou:.3f}: the rebuilt fish is still unlike the photo's; another base "
+                f"(--species) may take its shape{lens}")
+    # most misses over a backdrop are fish near its colour (Blender 2601, blue on blue: the
+    # silhouette 0.81 with the truth); few are busy backgrounds
+    return (f"silhouette IoU {iou:.3f}: the rebuilt fish is still unlike the photo's; if the silhouette "
+            f"is wrong (a fish near the backdrop's colour, or a busy background), give --mask{lens}")
 
 
 def _doubts_said(iou: float, together: float, bare: float, faded: float, paled: float) -> str:
