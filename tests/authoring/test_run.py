@@ -14,7 +14,7 @@ def test_a_misfit_over_a_backdrop_names_a_fish_near_its_colour_and_the_mask():
 
 def test_a_misfit_on_a_traced_silhouette_points_at_the_base_not_the_mask():
     """From the photo's alpha or a --mask the silhouette is the user's own: --mask cannot help, and
-    over alpha the misses differ by base (Blender 2604, 2605, 2610: one base of four each)."""
+    over alpha Blender's misses were one base of four (2610 on Centroberyx, 902 on ThreadfinGoldie)."""
     for lens in ("", "; if it was taken close up, give --focal-length"):
         line = _misfit_said(0.813, traced=True, fit_shape=True, greyscale=True, lens=lens)
         assert "--mask" not in line and "another base (--species)" in line and line.endswith(lens)

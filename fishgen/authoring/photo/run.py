@@ -539,7 +539,7 @@ def _misfit_said(iou: float, *, traced: bool, fit_shape: bool, greyscale: bool, 
         return (f"silhouette IoU {iou:.3f}: the base's geometry does not match the photographed fish; "
                 f"try --fit-shape{lens}")
     if traced:
-        # misses over alpha differ by base (Blender 2604, 2605, 2610: one base of four each)
+        # over alpha the Blender misses were one base of four (2610 on Centroberyx, 902 on ThreadfinGoldie)
         return (f"silhouette IoU {iou:.3f}: the rebuilt fish is still unlike the photo's; another base "
                 f"(--species) may take its shape{lens}")
     # most misses over a backdrop are fish near its colour (Blender 2601, blue on blue: the
