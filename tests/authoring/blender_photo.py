@@ -195,6 +195,23 @@ def photograph(species: dict, shots: dict, folder: Path) -> dict[str, dict]:
     return out
 
 
+def mirrored(records: dict[str, dict], folder: Path) -> dict[str, dict]:
+    """:func:`photograph`'s records with each photo and its true silhouette mirrored into ``folder``:
+    the fish facing right, as a camera on its other side shows it. The command's frame turns it
+    head-left, and its levelling of the mirrored truth is what a fit is measured against."""
+    from PIL import Image, ImageOps
+
+    folder.mkdir(parents=True, exist_ok=True)
+    out = {}
+    for name, rec in records.items():
+        paths = {key: folder / Path(rec[key]).name for key in ("photo", "mask")}
+        for key, path in paths.items():
+            with Image.open(rec[key]) as img:
+                ImageOps.mirror(img).save(path)
+        out[name] = {**rec, **paths}
+    return out
+
+
 def fitted_masks(fits: dict[str, tuple], folder: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Each fitted species (name -> (species, Shot)) photographed side-on in Blender with its photo's
     lens and framing: name -> its coverage masks, of what the file shows (the materials' alpha kept:
