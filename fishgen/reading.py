@@ -22,3 +22,11 @@ def read_capped(handle: BinaryIO, limit: int) -> bytes:
         data += more
         size = len(data) - 1
     return data
+
+
+def unheeded(message: Warning | str, category: type[Warning]) -> bool:
+    """Whether a warning is about a part of an input fishgen does not need, so it is not said: a
+    picture's damaged EXIF block, which Pillow reads what it can of as it opens the file (fishgen
+    reads only a photo's orientation and lens there). Said, it was Pillow's own two lines naming
+    its source file, before the command's one line; in a batch, a note naming no file."""
+    return issubclass(category, UserWarning) and "corrupt exif" in str(message).lower()

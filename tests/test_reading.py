@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from fishgen.reading import read_capped
+from fishgen.reading import read_capped, unheeded
 
 
 def test_a_file_under_the_cap_is_read_whole_and_one_over_says_so(tmp_path):
@@ -36,3 +36,12 @@ def test_reading_a_small_file_reserves_no_more_than_it_holds(tmp_path):
         "print(len(data))\n")
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
     assert done.returncode == 0 and done.stdout.strip() == "1024", done.stderr
+
+
+def test_only_a_damaged_exif_block_goes_unsaid():
+    """Pillow's warning of a damaged EXIF block is not said (by the command line or as a batch job's
+    note); any other warning is."""
+    assert unheeded(UserWarning("Corrupt EXIF data.  Expecting to read 2 bytes but only got 0."), UserWarning)
+    assert unheeded("Possibly corrupt EXIF data.  Expecting to read 8 bytes", UserWarning)
+    assert not unheeded("fish.awn:3: warning: cube 2 overlaps cube 1", UserWarning)
+    assert not unheeded("Corrupt EXIF data", DeprecationWarning)

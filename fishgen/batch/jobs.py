@@ -22,6 +22,7 @@ from fishgen import interrupts
 from fishgen.batch.manifest import Job
 from fishgen.batch.record import file_sha256
 from fishgen.errors import FishgenError, SystemFailure, cannot
+from fishgen.reading import unheeded
 
 Work = Callable[[Job, Callable[[str], None]], tuple[Iterable[Path], Iterable[Path]]]
 """Runs one job, telling each warning about its inputs to the callable it is given; returns the
@@ -70,7 +71,8 @@ def run_job(job: Job, work: Work) -> Result:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             read, written = work(job, notes.append)
-        notes += [str(w.message) for w in caught if issubclass(w.category, UserWarning)]
+        notes += [str(w.message) for w in caught
+                  if issubclass(w.category, UserWarning) and not unheeded(w.message, w.category)]
         result.notes = notes
         result.inputs = {os.fspath(p): file_sha256(p) for p in dict.fromkeys(read)}
         result.outputs = {os.fspath(p): file_sha256(p) for p in written}

@@ -95,11 +95,14 @@ def _warnings_as_notes(events: TerminalEvents) -> Iterator[None]:
     import warnings
 
     from fishgen.clouds.parser import CubeFileWarning
+    from fishgen.reading import unheeded
 
     with warnings.catch_warnings():
         shown = warnings.showwarning
 
         def show(message, category, filename, lineno, file=None, line=None):
+            if unheeded(message, category):
+                return
             # under --json every line on stderr is an object: any warning, said as a batch job says it
             if issubclass(category, CubeFileWarning) or json_errors():
                 events.note(str(message))

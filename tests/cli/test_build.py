@@ -299,3 +299,22 @@ def test_one_input_never_overwrites_a_texture_another_input_names(tmp_path):
     assert result.returncode == 2 and "a_skin" in result.stderr, result.stderr
     assert (tmp_path / "a_skin.png").read_bytes() == before
     assert (tmp_path / "b.gltf").is_file() and not (tmp_path / "a.gltf").exists()
+
+
+def test_a_texture_whose_exif_block_is_damaged_builds_and_says_nothing(tmp_path):
+    """A JPEG texture with a damaged EXIF block: Pillow warns each time it opens the file, two lines
+    naming its own source (five times for one preview); fishgen reads nothing there, so nothing is
+    said (a subprocess: Python itself prints the warning)."""
+    from PIL import Image
+
+    from tests.conftest import run_cli_process
+
+    species = _species_copy(tmp_path)
+    with Image.open(ROOT / "textures" / "bonybream.png") as img:
+        img.convert("RGB").save(tmp_path / "skin.jpg", exif=b"Exif\x00\x00II*\x00\xff\xff\xff\x7f")
+    species.write_text(species.read_text().replace("bonybream.png bonybream_mask.png",
+                                                   "skin.jpg bonybream_mask.png"))
+    for args in (("build", species, "-o", tmp_path / "f.glb"),
+                 ("preview", species, "-o", tmp_path / "f.png")):
+        done = run_cli_process(*args)
+        assert done.returncode == 0 and done.stderr == "", done.stderr

@@ -59,11 +59,15 @@ def test_mirrored_jpeg_and_level_of_detail_options(tmp_path, cli, bream_photo):
     rgba = photo.rgba[:, ::-1]
     a = rgba[:, :, 3:4] / 255.0
     rgb = (rgba[:, :, :3] * a + np.array([180, 200, 215]) * (1 - a)).astype(np.uint8)
-    Image.fromarray(rgb).save(tmp_path / "p.jpg", quality=80)
+    exif = Image.Exif()
+    exif.get_ifd(0x8769)[0xA405] = 85     # FocalLengthIn35mmFilm, as a camera writes it
+    Image.fromarray(rgb).save(tmp_path / "p.jpg", quality=80, exif=exif)
     r = cli("texture", tmp_path / "p.jpg", "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "n.txt",
             "--body-sections", "24", "--circle-sections", "16", "--spacing", "even")
     assert r.returncode == 0, r.stderr
     assert "background model" in r.stdout and "head on the right" in r.stdout
+    # the camera's lens is told, not taken: a cropped photo keeps its camera's figure
+    assert "EXIF gives a 85 mm lens" in r.stderr and "give --focal-length 85" in r.stderr
     lines = (tmp_path / "n.txt").read_text().splitlines()
     assert str(24 * 16) in lines
 

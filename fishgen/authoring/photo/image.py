@@ -1,6 +1,7 @@
 """Decode a photo safely: the size is checked from the header before any pixel is decoded."""
 from __future__ import annotations
 
+import math
 import os
 import re
 import warnings
@@ -28,6 +29,7 @@ class Photo:
     rgb: np.ndarray              # (H, W, 3) uint8, upright as the file shows it
     alpha: np.ndarray | None     # (H, W) uint8 when the file has an alpha channel worth using
     path: Path
+    lens_35mm: float | None = None   # EXIF's FocalLengthIn35mmFilm, where the camera wrote one
 
     @property
     def size(self) -> tuple[int, int]:
@@ -48,7 +50,7 @@ def working_copy(photo: Photo, longest: int) -> Photo:
     alpha = None
     if photo.alpha is not None:
         alpha = np.asarray(Image.fromarray(photo.alpha, "L").resize(size, Image.Resampling.BOX))
-    return Photo(np.ascontiguousarray(rgb), alpha, photo.path)
+    return Photo(np.ascontiguousarray(rgb), alpha, photo.path, photo.lens_35mm)
 
 
 def load_photo(path: str | os.PathLike) -> Photo:
@@ -61,6 +63,8 @@ def load_photo(path: str | os.PathLike) -> Photo:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)
+            # a damaged EXIF block, read as the file opens: the lens is lost, the photo is not
+            warnings.filterwarnings("ignore", ".*corrupt EXIF", UserWarning)
             with Image.open(path) as img:
                 w, h = img.size            # from the header; nothing is decoded yet
                 if w * h > MAX_PHOTO_PIXELS:
@@ -76,6 +80,7 @@ def load_photo(path: str | os.PathLike) -> Photo:
                 if getattr(img, "n_frames", 1) > 1:   # a GIF's or WebP's first frame is no choice
                     raise FishgenError(f"expected a still photo, found an animation of {img.n_frames} "
                                        "frames", path)
+                lens = _lens_35mm(img)
                 img = ImageOps.exif_transpose(img)  # phones store portrait shots sideways
                 has_alpha = img.mode in ("RGBA", "LA", "PA") or "transparency" in img.info
                 rgba = np.asarray(_eight_bit(img).convert("RGBA"))
@@ -94,7 +99,20 @@ def load_photo(path: str | os.PathLike) -> Photo:
     alpha = rgba[:, :, 3]
     # An alpha channel that is opaque everywhere says nothing about the background.
     usable = has_alpha and bool((alpha < 128).any())
-    return Photo(np.ascontiguousarray(rgba[:, :, :3]), alpha.copy() if usable else None, path)
+    return Photo(np.ascontiguousarray(rgba[:, :, :3]), alpha.copy() if usable else None, path, lens)
+
+
+#: EXIF's Exif IFD, and its FocalLengthIn35mmFilm tag.
+_EXIF_IFD, _FOCAL_35MM = 0x8769, 0xA405
+
+
+def _lens_35mm(img) -> float | None:
+    """The focal length the camera wrote as on 35 mm film (0 is EXIF's "unknown")."""
+    try:
+        value = float(img.getexif().get_ifd(_EXIF_IFD).get(_FOCAL_35MM, 0))
+    except Exception:   # noqa: BLE001 - a damaged EXIF block costs a hint, never the photo
+        return None
+    return value if math.isfinite(value) and value > 0 else None
 
 
 def _eight_bit(img):
