@@ -1,4 +1,5 @@
-"""Reading an input with a size cap, without reserving the cap."""
+"""Reading inputs: with a size cap, without reserving the cap; a picture's colours in sRGB; and the
+warnings about the parts of an input fishgen does not read."""
 from __future__ import annotations
 
 import os
@@ -30,3 +31,22 @@ def unheeded(message: Warning | str, category: type[Warning]) -> bool:
     reads only a photo's orientation and lens there). Said, it was Pillow's own two lines naming
     its source file, before the command's one line; in a batch, a note naming no file."""
     return issubclass(category, UserWarning) and "corrupt exif" in str(message).lower()
+
+
+def in_srgb(img, icc: bytes | None):
+    """A Pillow image ``img`` with the colours its ICC profile ``icc`` (as the file embedded it) gives
+    taken to sRGB, the space fishgen's textures are written in and glTF reads (a phone's Display
+    P3 photo read as sRGB came out duller); as it is without a profile, for a grey picture, or
+    with a profile that cannot be read or does not fit it."""
+    if not icc or img.mode not in ("RGB", "RGBA", "CMYK"):
+        return img
+    import io
+
+    from PIL import ImageCms
+
+    try:
+        source = ImageCms.ImageCmsProfile(io.BytesIO(icc))
+        mode = "RGBA" if img.mode == "RGBA" else "RGB"
+        return ImageCms.profileToProfile(img, source, ImageCms.createProfile("sRGB"), outputMode=mode)
+    except (ImageCms.PyCMSError, OSError, ValueError, TypeError):
+        return img

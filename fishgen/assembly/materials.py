@@ -51,9 +51,12 @@ def _decode(species: Species, path, mode: str):
     """Decode a whole texture; a damaged file is the species file's error, at its texture line."""
     from PIL import Image
 
+    from fishgen.reading import in_srgb
+
     try:
         with Image.open(path) as img:
-            return img.convert(mode)
+            # a colour texture's profile gives its colours; a mask's levels are no colours
+            return (img if mode == "L" else in_srgb(img, img.info.get("icc_profile"))).convert(mode)
     except (OSError, ValueError, Image.DecompressionBombError) as err:
         raise FishgenError(f"expected a readable texture image, found {path.name!r} damaged ({err})",
                            species.source, species.line_of("texture")) from None

@@ -28,3 +28,31 @@ def test_a_damaged_exif_block_costs_the_lens_not_the_photo_and_says_nothing(tmp_
         warnings.simplefilter("error")
         photo = load_photo(path)
     assert photo.size == (96, 64) and photo.lens_35mm is None
+
+
+@pytest.mark.parametrize("suffix", [".png", ".jpg"])
+def test_a_photo_tagged_display_p3_is_read_in_srgb(tmp_path, suffix):
+    """A phone writes Display P3 and tags it: read as sRGB its colours came out duller (P3's
+    (200, 100, 100) is sRGB's (216, 93, 97)); the texture is written, and glTF reads it, in sRGB."""
+    from tests.authoring.icc import D65, P3_PRIMARIES, p3_to_srgb, profile
+
+    colour = (200, 100, 100)
+    path = tmp_path / f"p3{suffix}"
+    icc = profile("Display P3, gamma 2.2", P3_PRIMARIES, D65, 2.2)
+    extra = {"quality": 100} if suffix == ".jpg" else {}
+    Image.new("RGB", (96, 64), colour).save(path, icc_profile=icc, **extra)
+    read = load_photo(path).rgb[32, 48].astype(int)
+    assert abs(read - p3_to_srgb(colour)).max() <= (1 if suffix == ".png" else 3), read
+    assert abs(read - colour).max() >= 10
+
+
+def test_a_tagged_photo_keeps_its_alpha_and_a_damaged_profile_keeps_its_pixels(tmp_path):
+    from tests.authoring.icc import D65, P3_PRIMARIES, profile
+
+    img = Image.new("RGBA", (96, 64), (200, 100, 100, 255))
+    img.paste((0, 0, 0, 0), (0, 0, 48, 64))
+    img.save(tmp_path / "a.png", icc_profile=profile("P3", P3_PRIMARIES, D65, 2.2))
+    photo = load_photo(tmp_path / "a.png")
+    assert photo.alpha is not None and photo.alpha[:, :48].max() == 0 and photo.alpha[:, 48:].min() == 255
+    Image.new("RGB", (96, 64), (200, 100, 100)).save(tmp_path / "d.png", icc_profile=b"not a profile" * 20)
+    assert load_photo(tmp_path / "d.png").rgb[0, 0].tolist() == [200, 100, 100]

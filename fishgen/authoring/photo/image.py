@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from fishgen.errors import FishgenError, not_a_file
+from fishgen.reading import in_srgb
 
 #: Largest photo accepted, in pixels (about a 64-megapixel camera frame).
 MAX_PHOTO_PIXELS = 64_000_000
@@ -81,9 +82,10 @@ def load_photo(path: str | os.PathLike) -> Photo:
                     raise FishgenError(f"expected a still photo, found an animation of {img.n_frames} "
                                        "frames", path)
                 lens = _lens_35mm(img)
+                icc = img.info.get("icc_profile")
                 img = ImageOps.exif_transpose(img)  # phones store portrait shots sideways
                 has_alpha = img.mode in ("RGBA", "LA", "PA") or "transparency" in img.info
-                rgba = np.asarray(_eight_bit(img).convert("RGBA"))
+                rgba = np.asarray(in_srgb(_eight_bit(img), icc).convert("RGBA"))
     except FishgenError:
         raise
     except (Image.DecompressionBombError, Image.DecompressionBombWarning) as err:
