@@ -38,6 +38,8 @@ def in_srgb(img, icc: bytes | None):
     taken to sRGB, the space fishgen's textures are written in and glTF reads (a phone's Display
     P3 photo read as sRGB came out duller); as it is without a profile, for a grey picture, or
     with a profile that cannot be read or does not fit it."""
+    if icc and img.mode in ("P", "PA"):    # a palette's colours are in the profile's space too
+        img = img.convert("RGBA" if img.mode == "PA" or "transparency" in img.info else "RGB")
     if not icc or img.mode not in ("RGB", "RGBA", "CMYK"):
         return img
     import io

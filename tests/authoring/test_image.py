@@ -46,7 +46,7 @@ def test_a_photo_tagged_display_p3_is_read_in_srgb(tmp_path, suffix):
     assert abs(read - colour).max() >= 10
 
 
-def test_a_tagged_photo_keeps_its_alpha_and_a_damaged_profile_keeps_its_pixels(tmp_path):
+def test_a_tagged_photo_keeps_its_alpha_a_palette_is_converted_and_a_bad_profile_is_not(tmp_path):
     from tests.authoring.icc import D65, P3_PRIMARIES, profile
 
     img = Image.new("RGBA", (96, 64), (200, 100, 100, 255))
@@ -54,5 +54,10 @@ def test_a_tagged_photo_keeps_its_alpha_and_a_damaged_profile_keeps_its_pixels(t
     img.save(tmp_path / "a.png", icc_profile=profile("P3", P3_PRIMARIES, D65, 2.2))
     photo = load_photo(tmp_path / "a.png")
     assert photo.alpha is not None and photo.alpha[:, :48].max() == 0 and photo.alpha[:, 48:].min() == 255
+    palette = Image.new("P", (96, 64))
+    palette.putpalette([200, 100, 100] * 256)
+    palette.save(tmp_path / "p.png", icc_profile=profile("P3", P3_PRIMARIES, D65, 2.2))
+    converted = load_photo(tmp_path / "a.png").rgb[0, 60].tolist()
+    assert load_photo(tmp_path / "p.png").rgb[0, 0].tolist() == converted != [200, 100, 100]
     Image.new("RGB", (96, 64), (200, 100, 100)).save(tmp_path / "d.png", icc_profile=b"not a profile" * 20)
     assert load_photo(tmp_path / "d.png").rgb[0, 0].tolist() == [200, 100, 100]
