@@ -3,6 +3,7 @@ warnings about the parts of an input fishgen does not read."""
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from typing import BinaryIO
 
 
@@ -25,12 +26,19 @@ def read_capped(handle: BinaryIO, limit: int) -> bytes:
     return data
 
 
-def unheeded(message: Warning | str, category: type[Warning]) -> bool:
-    """Whether a warning is about a part of an input fishgen does not need, so it is not said: a
-    picture's damaged EXIF block, which Pillow reads what it can of as it opens the file (fishgen
-    reads only a photo's orientation and lens there). Said, it was Pillow's own two lines naming
-    its source file, before the command's one line; in a batch, a note naming no file."""
-    return issubclass(category, UserWarning) and "corrupt exif" in str(message).lower()
+#: The module of Pillow's EXIF and TIFF tag reader, whose warnings :func:`unheeded` drops.
+PILLOW_TAG_READER = r"PIL\.TiffImagePlugin"
+
+
+def unheeded(message: Warning | str, category: type[Warning], filename: str) -> bool:
+    """Whether a warning is about a part of an input fishgen does not need, so it is not said: one
+    from Pillow's EXIF and TIFF tag reader (``filename``: where it was raised), which reads what it
+    can of a damaged block as a picture opens (fishgen reads only a photo's orientation and lens
+    there). Said, it was Pillow's own two lines naming its source file, before the command's one
+    line; in a batch, a note naming no file."""
+    where = Path(filename)
+    return (issubclass(category, UserWarning) and where.name == "TiffImagePlugin.py"
+            and where.parent.name == "PIL")
 
 
 def in_srgb(img, icc: bytes | None):
@@ -38,6 +46,8 @@ def in_srgb(img, icc: bytes | None):
     taken to sRGB, the space fishgen's textures are written in and glTF reads (a phone's Display
     P3 photo read as sRGB came out duller); as it is without a profile, for a grey picture, or
     with a profile that cannot be read or does not fit it."""
+    if icc:
+        img.load()   # a damaged picture's own error, not taken for the profile's below
     if icc and img.mode in ("P", "PA"):    # a palette's colours are in the profile's space too
         img = img.convert("RGBA" if img.mode == "PA" or "transparency" in img.info else "RGB")
     if not icc or img.mode not in ("RGB", "RGBA", "CMYK"):

@@ -72,7 +72,8 @@ def run_job(job: Job, work: Work) -> Result:
             warnings.simplefilter("always")
             read, written = work(job, notes.append)
         notes += [str(w.message) for w in caught
-                  if issubclass(w.category, UserWarning) and not unheeded(w.message, w.category)]
+                  if issubclass(w.category, UserWarning)
+                  and not unheeded(w.message, w.category, w.filename)]
         result.notes = notes
         result.inputs = {os.fspath(p): file_sha256(p) for p in dict.fromkeys(read)}
         result.outputs = {os.fspath(p): file_sha256(p) for p in written}

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from fishgen.authoring.photo import FOCAL_LENGTHS
 from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
 from fishgen.options import FILE, FiniteRange, option
 
@@ -38,7 +39,7 @@ class TextureCommandOptions:
     fxl_out: Path | None = option(FILE, "Also write the points as a Fixel .FXL file.", shown_default="none",
                                   metavar="POINTS.FXL")
     focal_length: float | None = option(
-        FiniteRange(4.0, 2000.0), "The photo's focal length in mm on a 36 mm wide sensor (EXIF's "
+        FiniteRange(*FOCAL_LENGTHS), "The photo's focal length in mm on a 36 mm wide sensor (EXIF's "
         "FocalLengthIn35mmFilm): the rebuilt fish is measured in that perspective and, with --fit-shape, "
         "its fins are refined in it.", shown_default="none: seen from afar, no perspective", metavar="MM")
 

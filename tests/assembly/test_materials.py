@@ -32,3 +32,20 @@ def test_a_texture_tagged_display_p3_is_built_in_srgb_and_its_mask_as_it_is(tmp_
     with Image.open(ROOT / "textures" / "bonybream_mask.png") as img:
         mask = np.asarray(img.convert("L").resize(raw.size, Image.Resampling.NEAREST))
     assert np.array_equal(built[:, :, 3] >= 128, mask >= 128)
+
+
+def test_a_damaged_texture_with_a_profile_is_refused_at_its_line(tmp_path):
+    """The profile's conversion decoded the picture first and took its error for the profile's: a
+    damaged texture was built from the part decoded (a review)."""
+    import pytest
+
+    from fishgen.errors import FishgenError
+    from tests.authoring.test_image import _damaged_png
+
+    shutil.copy(PARAMS / "bonybream.txt", tmp_path)
+    shutil.copy(ROOT / "textures" / "bonybream_mask.png", tmp_path)
+    rgb = np.random.default_rng(0).integers(0, 256, (200, 300, 3), dtype=np.uint8)
+    icc = profile("P3", P3_PRIMARIES, D65, 2.2)
+    (tmp_path / "bonybream.png").write_bytes(_damaged_png(rgb, icc))
+    with pytest.raises(FishgenError, match="damaged"):
+        load_textures(load_species(tmp_path / "bonybream.txt"), "mask")

@@ -1,16 +1,21 @@
 """Reading a photo: the lens a camera wrote in its EXIF."""
 from __future__ import annotations
 
+import io
+import struct
 import warnings
+import zlib
 
+import numpy as np
 import pytest
 from PIL import Image
 
 from fishgen.authoring.photo.image import load_photo
+from fishgen.errors import FishgenError
 
 
-@pytest.mark.parametrize("focal, read", [(50, 50.0), (0, None), (None, None)])
-def test_the_35mm_focal_length_a_camera_wrote_is_read_and_zero_is_unknown(tmp_path, focal, read):
+@pytest.mark.parametrize("focal, read", [(50, 50.0), (0, None), (None, None), (65535, None)])
+def test_the_35mm_focal_length_a_camera_wrote_is_read_if_the_option_would_take_it(tmp_path, focal, read):
     exif = Image.Exif()
     if focal is not None:
         exif.get_ifd(0x8769)[0xA405] = focal     # FocalLengthIn35mmFilm; EXIF's 0 is "unknown"
@@ -61,3 +66,47 @@ def test_a_tagged_photo_keeps_its_alpha_a_palette_is_converted_and_a_bad_profile
     assert load_photo(tmp_path / "p.png").rgb[0, 0].tolist() == converted != [200, 100, 100]
     Image.new("RGB", (96, 64), (200, 100, 100)).save(tmp_path / "d.png", icc_profile=b"not a profile" * 20)
     assert load_photo(tmp_path / "d.png").rgb[0, 0].tolist() == [200, 100, 100]
+
+
+def _damaged_png(rgb: np.ndarray, icc: bytes | None = None) -> bytes:
+    """A PNG of ``rgb`` with 64 bytes of its pixel data zeroed and the chunk's checksum made right:
+    only decoding it finds the damage."""
+    buf = io.BytesIO()
+    Image.fromarray(rgb).save(buf, "PNG", icc_profile=icc)
+    data = bytearray(buf.getvalue())
+    at = data.index(b"IDAT") - 4
+    size = struct.unpack(">I", data[at:at + 4])[0]
+    data[at + 8 + size // 3:at + 8 + size // 3 + 64] = bytes(64)
+    data[at + 8 + size:at + 12 + size] = struct.pack(">I", zlib.crc32(bytes(data[at + 4:at + 8 + size])))
+    return bytes(data)
+
+
+def test_a_damaged_photo_is_refused_not_read_in_part(tmp_path):
+    """Reading a PNG's EXIF decodes it, and the lens's guard had swallowed the decoding error: the
+    photo was fitted from the part decoded (a review: 68 % of the rows black)."""
+    from tests.authoring.icc import D65, P3_PRIMARIES, profile
+
+    rgb = np.random.default_rng(0).integers(0, 256, (200, 300, 3), dtype=np.uint8)
+    for icc in (None, profile("P3", P3_PRIMARIES, D65, 2.2)):
+        (tmp_path / "d.png").write_bytes(_damaged_png(rgb, icc))
+        with pytest.raises(FishgenError, match="found a damaged file"):
+            load_photo(tmp_path / "d.png")
+
+
+def test_a_mask_is_read_as_its_levels_whatever_its_profile(tmp_path):
+    from tests.authoring.icc import D65, P3_PRIMARIES, profile
+
+    Image.new("RGB", (96, 64), (200, 100, 100)).save(tmp_path / "m.png",
+                                                      icc_profile=profile("P3", P3_PRIMARIES, D65, 2.2))
+    assert load_photo(tmp_path / "m.png", colours=False).rgb[0, 0].tolist() == [200, 100, 100]
+
+
+def test_an_exif_tag_larger_than_the_file_says_nothing(tmp_path):
+    """Pillow's tag reader warns of more than a "corrupt" block: "Tag data larger than file" too."""
+    exif = bytearray(b"Exif\x00\x00II*\x00\x08\x00\x00\x00\x01\x00")
+    exif += struct.pack("<HHII", 271, 2, 100, 1000) + bytes(4)    # Make: 100 bytes at offset 1000
+    path = tmp_path / "p.jpg"
+    Image.new("RGB", (96, 64), (40, 90, 120)).save(path, exif=bytes(exif))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert load_photo(path).size == (96, 64)

@@ -6,3 +6,6 @@ The stages, one module each: :mod:`.image` (safe decoding), :mod:`.silhouette`
 body outline under the fins), :mod:`.points` (Fixel's points), :mod:`.fit`
 (--fit-shape), :mod:`.fxl` (Fixel's .FXL files) and :mod:`.run` (the command).
 """
+
+#: The focal lengths `--focal-length` takes, mm on a 36 mm wide sensor.
+FOCAL_LENGTHS = (4.0, 2000.0)

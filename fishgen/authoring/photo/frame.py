@@ -29,6 +29,9 @@ STANDING_NECK = 1.5
 #: Within it the fit's own turns (:data:`.run.TURNS`, up to 4 degrees) take the rest.
 RELEVEL_DEGREES = 4.0
 RELEVELS = 6
+#: The photo as it stands overrules the principal axis's turn on which end is the tail only where
+#: one of its necks is at least this many times the other (:func:`_tail_left`).
+TAIL_DECISIVE = 2.0
 
 
 @dataclass(frozen=True)
@@ -132,14 +135,24 @@ def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
 
 def _tail_left(turned: np.ndarray, level: np.ndarray | None) -> bool:
     """Whether the tail is on the left: the end with the deeper neck, read on the fish turned by its
-    principal axis and, if that is a turn, on the photo as it stands (side photos show fish about
-    level); where the two disagree, the reading whose deeper neck is the more times the other's.
-    Tall fins pull the axis round: a sail-finned fish 2 degrees off level, turned 22 degrees by its
-    axis, has its two ends' necks 1.3 times apart there and the tail's 10 times the head's as it
-    stands (Blender photo 2407: read on the turn alone, it was fitted backwards)."""
-    readings = [columns.tail_necks(turned)] + ([columns.tail_necks(level)] if level is not None else [])
-    right, left = max(readings, key=lambda r: max(r) / max(min(r), 1e-9))
+    principal axis; or, if that was a turn, on the photo as it stands (side photos show fish about
+    level) where that reading is clearly decisive (one neck at least TAIL_DECISIVE times the other)
+    and more so than the turned one. Tall fins pull the axis round: a sail-finned fish 2 degrees off
+    level, turned 22 degrees by its axis, has its two ends' necks 1.3 times apart there and the
+    tail's 10 times the head's as it stands (Blender photo 2407: read on the turn alone, it was fitted
+    backwards). A weak reading as it stands does not overrule the turn: on small-tailed fish tilted a
+    few degrees both are near 1, and the turned one is the better (a review's 1,800 drawn fish)."""
+    right, left = columns.tail_necks(turned)
+    if level is not None:
+        stands = columns.tail_necks(level)
+        if _decisive(stands) >= max(TAIL_DECISIVE, _decisive((right, left))):
+            right, left = stands
     return left > right
+
+
+def _decisive(necks: tuple[float, float]) -> float:
+    """How many times the deeper neck is the other."""
+    return max(necks) / max(min(necks), 1e-9)
 
 
 def turned(mask: np.ndarray, frame: Frame, degrees: float) -> Frame:

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from fishgen.errors import FishgenError, not_a_file
-from fishgen.reading import in_srgb
+from fishgen.reading import PILLOW_TAG_READER, in_srgb
 
 #: Largest photo accepted, in pixels (about a 64-megapixel camera frame).
 MAX_PHOTO_PIXELS = 64_000_000
@@ -54,8 +54,9 @@ def working_copy(photo: Photo, longest: int) -> Photo:
     return Photo(np.ascontiguousarray(rgb), alpha, photo.path, photo.lens_35mm)
 
 
-def load_photo(path: str | os.PathLike) -> Photo:
-    """Read ``path`` as RGB (+ alpha). Absurd sizes are refused from the header alone."""
+def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
+    """Read ``path`` as RGB (+ alpha), in sRGB unless ``colours`` is off (a mask's levels are no
+    colours). Absurd sizes are refused from the header alone."""
     from PIL import Image, ImageOps, UnidentifiedImageError
 
     path = Path(path)
@@ -64,8 +65,9 @@ def load_photo(path: str | os.PathLike) -> Photo:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)
-            # a damaged EXIF block, read as the file opens: the lens is lost, the photo is not
-            warnings.filterwarnings("ignore", ".*corrupt EXIF", UserWarning)
+            # a damaged EXIF block, read as the file opens (Pillow's tag reader warns): the lens is
+            # lost, the photo is not
+            warnings.filterwarnings("ignore", category=UserWarning, module=PILLOW_TAG_READER)
             with Image.open(path) as img:
                 w, h = img.size            # from the header; nothing is decoded yet
                 if w * h > MAX_PHOTO_PIXELS:
@@ -81,8 +83,9 @@ def load_photo(path: str | os.PathLike) -> Photo:
                 if getattr(img, "n_frames", 1) > 1:   # a GIF's or WebP's first frame is no choice
                     raise FishgenError(f"expected a still photo, found an animation of {img.n_frames} "
                                        "frames", path)
+                img.load()   # a damaged picture is refused here, before its EXIF is read apart
                 lens = _lens_35mm(img)
-                icc = img.info.get("icc_profile")
+                icc = img.info.get("icc_profile") if colours else None
                 img = ImageOps.exif_transpose(img)  # phones store portrait shots sideways
                 has_alpha = img.mode in ("RGBA", "LA", "PA") or "transparency" in img.info
                 rgba = np.asarray(in_srgb(_eight_bit(img), icc).convert("RGBA"))
@@ -109,12 +112,16 @@ _EXIF_IFD, _FOCAL_35MM = 0x8769, 0xA405
 
 
 def _lens_35mm(img) -> float | None:
-    """The focal length the camera wrote as on 35 mm film (0 is EXIF's "unknown")."""
-    try:
+    """The focal length the camera wrote as on 35 mm film (0 is EXIF's "unknown"), if --focal-length
+    would take it."""
+    from fishgen.authoring.photo import FOCAL_LENGTHS
+
+    try:   # the picture is decoded already: what fails here is the EXIF block alone
         value = float(img.getexif().get_ifd(_EXIF_IFD).get(_FOCAL_35MM, 0))
     except Exception:   # noqa: BLE001 - a damaged EXIF block costs a hint, never the photo
         return None
-    return value if math.isfinite(value) and value > 0 else None
+    # one --focal-length takes (a camera's 65535 is no lens)
+    return value if math.isfinite(value) and FOCAL_LENGTHS[0] <= value <= FOCAL_LENGTHS[1] else None
 
 
 def _eight_bit(img):

@@ -273,7 +273,7 @@ def _mask_file(path: str | os.PathLike, size: tuple[int, int], work: tuple[int, 
 
     from fishgen.authoring.photo.image import load_photo
 
-    m = load_photo(path)
+    m = load_photo(path, colours=False)
     if m.size != size:
         raise FishgenError(f"expected a mask the size of the photo ({size[0]} x {size[1]}), "
                            f"found {m.size[0]} x {m.size[1]}", path)
