@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -15,6 +16,13 @@ import pytest
 from tests.cli_runner import run_cli, run_cli_process  # noqa: F401 - the tests take them from here
 
 ROOT = Path(__file__).resolve().parents[1]
+
+# The Ctrl-C tests send SIGINT to the commands they start, and fishgen, as a well-behaved program,
+# leaves SIGINT ignored where its parent ignored it. A suite started in the background by a script
+# (`bash .ci/run &`) ignores it from the shell on, every command it starts did too, and those tests
+# failed and left a `fishgen edit` serving (seen in a dry run started so). Ctrl-C is restored here.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 VALIDATOR_SCRIPT = ROOT / "tools" / "validate_gltf.mjs"
 PARAMS = ROOT / "params"
 #: Where the client matrix's table is written when its tests have run (tests/clients/conftest.py).

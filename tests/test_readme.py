@@ -66,9 +66,13 @@ def test_the_examples_run_as_written_in_order(tmp_path):
             proc = subprocess.Popen(["bash", "-c", f"exec {command}"], cwd=tmp_path, env=env, text=True,
                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE)
             assert proc.stdout is not None
-            said = [proc.stdout.readline() for _ in range(2)]
-            proc.send_signal(signal.SIGINT)
-            proc.communicate(timeout=60)
+            try:
+                said = [proc.stdout.readline() for _ in range(2)]
+                proc.send_signal(signal.SIGINT)
+                proc.communicate(timeout=60)
+            finally:   # a server that outlived its Ctrl-C is the test's failure, not the machine's
+                proc.kill()
+                proc.wait()
             assert any("http://127.0.0.1:" in s and "token=" in s for s in said), (line, said)
             continue
         run = subprocess.run(["bash", "-c", command], cwd=tmp_path, env=env, capture_output=True, text=True,
