@@ -114,6 +114,7 @@ def _photos(tmp_path, bream_photo):
     _png_header_only(tmp_path / "huge.png", 30000, 30000)   # PIL itself refuses this header
     _png_header_only(tmp_path / "big.png", 9000, 9000)      # PIL would decode it; fishgen does not
     (tmp_path / "notes.png").write_text("not a picture\n")
+    (tmp_path / "phone.heic").write_bytes(b"\x00\x00\x00\x18ftypheic\x00\x00\x00\x00mif1heic" + bytes(64))
     Image.fromarray(photo.rgba[:40, :40]).save(tmp_path / "tiny.png")
     frames = [Image.fromarray(np.ascontiguousarray(rgba)).convert("RGB")
               for rgba in (photo.rgba, photo.rgba[:, ::-1])]
@@ -125,6 +126,7 @@ def _photos(tmp_path, bream_photo):
             "huge.png": "at most 64 megapixels, found 900 megapixels",
             "big.png": "at most 64 megapixels, found 9000 x 9000",
             "notes.png": "expected a photo",
+            "phone.heic": "found a HEIF/HEIC picture, which fishgen cannot read (a phone's default)",
             "tiny.png": "at least 64 pixels a side",
             "missing.png": "found no such file"}
 

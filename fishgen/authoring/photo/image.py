@@ -97,8 +97,8 @@ def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
         size = f"{int(found[1]) / 1e6:.0f} megapixels" if found else "a larger one"
         raise FishgenError(f"expected a photo of at most {MAX_PHOTO_PIXELS // 1_000_000} megapixels, "
                            f"found {size}", path) from None
-    except UnidentifiedImageError as err:
-        raise FishgenError(f"expected a photo (PNG, JPEG, WebP, ...), found {_why(err)}", path) from None
+    except UnidentifiedImageError:
+        raise FishgenError(f"expected a photo (PNG, JPEG, WebP, ...), found {_why(path)}", path) from None
     except (OSError, ValueError, SyntaxError) as err:
         raise FishgenError(f"expected a readable photo, found a damaged file ({err})", path) from None
     alpha = rgba[:, :, 3]
@@ -138,5 +138,17 @@ def _eight_bit(img):
     return Image.fromarray(np.clip(np.round(grey / top * 255), 0, 255).astype(np.uint8), "L")
 
 
-def _why(err: Exception) -> str:
+#: The brands of an ISO media file (``ftyp``) that hold HEIF pictures: a phone camera's default.
+_HEIF_BRANDS = {b"heic", b"heix", b"hevc", b"hevx", b"heim", b"heis", b"mif1", b"msf1"}
+
+
+def _why(path: Path) -> str:
+    """What a file Pillow cannot read is, said so the user knows what to do with it."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(12)
+    except OSError:
+        head = b""
+    if head[4:8] == b"ftyp" and head[8:12] in _HEIF_BRANDS:
+        return "a HEIF/HEIC picture, which fishgen cannot read (a phone's default): save it as JPEG or PNG"
     return "a file that is not an image PIL can read"
