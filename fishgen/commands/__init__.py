@@ -149,6 +149,14 @@ class Progress:
         pass
 
 
+def stage(bar: Any, label: str) -> None:
+    """``bar.stage(label)`` where the caller's bar has stages: a library caller may hand any counter
+    with ``update`` (tqdm's, say), and a school ended in an AttributeError at its bake."""
+    named = getattr(bar, "stage", None)
+    if callable(named):
+        named(label)
+
+
 def _no_bar(label: str, total: int) -> ContextManager[Progress]:
     return nullcontext(Progress())
 

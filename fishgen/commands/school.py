@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output
+from fishgen.commands import QUIET, Command, Events, Inputs, Made, Output, stage
 from fishgen.exchange.registry import MESHES, NODE_ANIMATION
 from fishgen.options import (
     FILE,
@@ -220,7 +220,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
             bar.update(n)
             simulated += n
             if simulated == steps:
-                bar.stage("baking")
+                stage(bar, "baking")
 
         run = run_school(scene, fins=options.fins, swim=options.swim, tolerance=options.tolerance,
                          textures_dir=options.textures, progress=step, lods=options.lods,
@@ -231,7 +231,7 @@ def school(inputs: Sequence[Path], output: str | os.PathLike,
 
             compact_clips(run.scene)
         bar.update(scene.frames)
-        bar.stage("writing")
+        stage(bar, "writing")
         warmup = run.warmup_frames
         per_frame: dict = {}
         numbers: dict = {}
