@@ -104,6 +104,7 @@ _FIRST = ("tests/authoring/test_fit.py",          # the goldie fits' group, 77 s
 
 
 @pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups
+@pytest.hookimpl(tryfirst=True)   # before pytest-xdist's, which names each item's group from its marker
 def pytest_collection_modifyitems(config, items):
     """Tests that share a fixture wider than a function (a built asset, a browser page, a server,
     the fuzz run) stay on one pytest-xdist worker, so it is made once, not once per worker: one

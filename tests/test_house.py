@@ -107,3 +107,19 @@ def test_a_damaged_timeline_is_one_line_naming_its_file_and_line(tmp_path):
         assert said.returncode == 2 and said.stdout == "", damage
         assert said.stderr.startswith(f"{tmp_path / 'gw0.jsonl'}:2: expected one JSON event a line, found ")
         assert said.stderr.count("\n") == 1
+
+
+@pytest.fixture(scope="module")
+def _shared_by_this_module():
+    return object()
+
+
+def test_tests_sharing_a_fixture_run_as_one_group_on_one_worker(request, _shared_by_this_module):
+    """Under `--dist loadgroup` (tools/test.sh) a test that shares a fixture wider than a function
+    carries its group in its id, which is how pytest-xdist keeps the group on one worker. pytest
+    9.2 builds ids pytest-xdist 3.8 cannot add the group to: every group was split, its fixtures
+    (a built asset, a browser, the fuzz run) made on both workers, and the suite took 487 s against
+    384 (pyproject.toml keeps pytest under 9.2)."""
+    if getattr(request.config, "workerinput", None) is None or not request.config.getvalue("loadgroup"):
+        pytest.skip("only pytest-xdist's --dist loadgroup names groups")
+    assert request.node.nodeid.endswith("@_shared_by_this_module@tests/test_house.py"), request.node.nodeid
