@@ -2,6 +2,7 @@
 warnings about the parts of an input fishgen does not read."""
 from __future__ import annotations
 
+import io
 import os
 from pathlib import Path
 from typing import BinaryIO
@@ -46,14 +47,13 @@ def in_srgb(img, icc: bytes | None):
     taken to sRGB, the space fishgen's textures are written in and glTF reads (a phone's Display
     P3 photo read as sRGB came out duller); as it is without a profile, for a grey picture, or
     with a profile that cannot be read or does not fit it."""
-    if icc:
-        img.load()   # a damaged picture's own error, not taken for the profile's below
-    if icc and img.mode in ("P", "PA"):    # a palette's colours are in the profile's space too
-        img = img.convert("RGBA" if img.mode == "PA" or "transparency" in img.info else "RGB")
-    if not icc or img.mode not in ("RGB", "RGBA", "CMYK"):
+    if not icc:
         return img
-    import io
-
+    img.load()   # a damaged picture's own error, not taken for the profile's below
+    if img.mode in ("P", "PA"):    # a palette's colours are in the profile's space too
+        img = img.convert("RGBA" if img.mode == "PA" or "transparency" in img.info else "RGB")
+    if img.mode not in ("RGB", "RGBA", "CMYK"):
+        return img
     from PIL import ImageCms
 
     try:

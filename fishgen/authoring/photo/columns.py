@@ -65,8 +65,3 @@ def tail_necks(mask: np.ndarray) -> tuple[float, float]:
     reach = max(2, int(0.45 * n))
     return float(neck_depth(e)[n - reach:].max()), float(neck_depth(e[::-1])[n - reach:].max())
 
-
-def tail_side(mask: np.ndarray) -> str:
-    """"right" or "left": the end with the deeper neck."""
-    right, left = tail_necks(mask)
-    return "right" if right >= left else "left"

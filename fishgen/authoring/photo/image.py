@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fishgen.authoring.photo import FOCAL_LENGTHS
 from fishgen.errors import FishgenError, not_a_file
 from fishgen.reading import PILLOW_TAG_READER, in_srgb
 
@@ -114,8 +115,6 @@ _EXIF_IFD, _FOCAL_35MM = 0x8769, 0xA405
 def _lens_35mm(img) -> float | None:
     """The focal length the camera wrote as on 35 mm film (0 is EXIF's "unknown"), if --focal-length
     would take it."""
-    from fishgen.authoring.photo import FOCAL_LENGTHS
-
     try:   # the picture is decoded already: what fails here is the EXIF block alone
         value = float(img.getexif().get_ifd(_EXIF_IFD).get(_FOCAL_35MM, 0))
     except Exception:   # noqa: BLE001 - a damaged EXIF block costs a hint, never the photo

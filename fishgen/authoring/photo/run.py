@@ -273,8 +273,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     if options.focal_length is None and original.lens_35mm is not None:
         # not taken on trust: a cropped photo keeps its camera's figure, and the fit would be
         # measured in another perspective than the crop's
-        lens = f"{original.lens_35mm:g}"
-        note(f"the photo's EXIF gives a {lens} mm lens (as on 35 mm film): give --focal-length {lens} to "
+        exif = f"{original.lens_35mm:g}"
+        note(f"the photo's EXIF gives a {exif} mm lens (as on 35 mm film): give --focal-length {exif} to "
              "measure the fish in that perspective, unless the photo was cropped")
     if options.focal_length is not None:
         from fishgen.authoring.photo.compare import camera_distance
