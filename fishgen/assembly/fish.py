@@ -129,16 +129,17 @@ def build_fish(species: Species, *, fins: str | None = None, length: float | Non
                fps: float = 30.0, swim: str = "body", speed: float = DEFAULT_SPEED,
                wave: BodyWave | None = None, lods: str | Sequence[tuple[int, int]] | None = None,
                merge: bool = False, clips: str | Sequence[str] = DEFAULT_CLIPS,
-               compact: bool = False) -> Scene:
+               compact: bool = False, still: bool = False) -> Scene:
     """The scene of :func:`make_fish` (the library's one-line way to a fish)."""
     return make_fish(species, fins=fins, length=length, fps=fps, swim=swim, speed=speed, wave=wave,
-                     lods=lods, merge=merge, clips=clips, compact=compact).scene
+                     lods=lods, merge=merge, clips=clips, compact=compact, still=still).scene
 
 
 def make_fish(species: Species, *, fins: str | None = None, length: float | None = None,
               fps: float = 30.0, swim: str = "body", speed: float = DEFAULT_SPEED,
               wave: BodyWave | None = None, lods: str | Sequence[tuple[int, int]] | None = None,
-              merge: bool = False, clips: str | Sequence[str] = DEFAULT_CLIPS, compact: bool = False) -> Fish:
+              merge: bool = False, clips: str | Sequence[str] = DEFAULT_CLIPS, compact: bool = False,
+              still: bool = False) -> Fish:
     """Build the fish of ``species``, and say what was built.
 
     ``fins``: ``blend``, ``mask`` or ``opaque`` (default: ``mask`` when the file
@@ -150,19 +151,20 @@ def make_fish(species: Species, *, fins: str | None = None, length: float | None
     (BodySections, CircleSections) from finest to coarsest (default: the file's own level only).
     ``merge``: one skinned mesh of two primitives instead of a node per part. ``clips``: names of
     CLIP_NAMES. ``compact``: rotation and weight keys as normalized 16-bit integers. Each is
-    checked as `fishgen build` checks its option (:class:`FishOptions`).
+    checked as `fishgen build` checks its option (:class:`FishOptions`). ``still``: the fish at rest
+    alone, without its clips and morph targets, for a picture of it at rest (the same vertices).
     """
     # a string is the command line's "swim,idle" or "32x24,16x12" (FishOptions converts it as the
     # option does), not its letters
     options = FishOptions(fins=fins, length=length, fps=fps, swim=swim, speed=speed, merge=merge,
                           lods=cast(Any, lods if isinstance(lods, str) else tuple(lods)) if lods else None,
                           clips=cast(Any, clips if isinstance(clips, str) else tuple(clips)), compact=compact)
-    return fish_of(species, options, wave)
+    return fish_of(species, options, wave, still)
 
 
-def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None) -> Fish:
+def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None, still: bool = False) -> Fish:
     """The fish of ``species`` built as ``options`` (checked when they were made) say: what
-    `fishgen build` runs for each species file."""
+    `fishgen build` runs for each species file (``still``: as :func:`make_fish`)."""
     length, fps, swim = options.length, options.fps, options.swim
     speed = options.speed if options.speed is not None else DEFAULT_SPEED
     merge, clips, compact = options.merge, options.clips, options.compact
@@ -201,13 +203,14 @@ def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None
     materials = tuple(scene.add_material(m) for m in make_materials(species, mode, texture))
 
     waving = swim == "body"
-    targets = targets_for(clips, waving)
+    # a fit draws a still fish hundreds of times: its morph targets were half of each build
+    targets = () if still else targets_for(clips, waving)
     first = parts[0]
     nose = max(float(p.positions[:, 2].max()) for p in first)
     body_length = nose - min(float(p.positions[:, 2].min()) for p in first)
     if not (np.isfinite(body_length) and body_length > 0):
         targets = ()
-    plans = _plans(clips, targets, list(swings.values()), wave, speed, fps, fin_loop, waving)
+    plans = [] if still else _plans(clips, targets, list(swings.values()), wave, speed, fps, fin_loop, waving)
     coverage = _coverages(species, levels)
     look = _Look(targets, nose, body_length, wave, materials, texture)
     lay = (_merged if merge else _separate)(scene, species.name, parts, look, coverage)

@@ -174,3 +174,19 @@ def test_with_the_body_wave_the_tail_fin_rides_the_wave_and_the_loop_closes(bony
     for channel in clip.channels:
         assert np.allclose(channel.sampler.values[0], channel.sampler.values[-1], atol=1e-6)
         assert channel.sampler.times[-1] == pytest.approx(clip.duration)
+
+
+@pytest.mark.parametrize("name", ["bonybream", "centroberyx", "threadfingoldie"])
+def test_a_still_fish_is_the_fish_at_rest_without_clips_or_morph_targets(name):
+    """What a picture of the fish at rest needs (a photo fit draws hundreds): the same nodes and
+    triangles at the same rest positions, and nothing that moves them."""
+    from fishgen.exchange.rest import rest_meshes
+
+    sp = load_species(PARAMS / f"{name}.txt")
+    full, still = build_fish(sp, clips="swim,idle,turn_left"), build_fish(sp, still=True)
+    assert full.clips and full.meshes[0].primitives[0].targets
+    assert not still.clips and not any(p.targets for m in still.meshes for p in m.primitives)
+    assert [n.name for n in still.nodes] == [n.name for n in full.nodes]
+    for a, b in zip(rest_meshes(full), rest_meshes(still), strict=True):
+        assert a.name == b.name and np.array_equal(a.faces, b.faces)
+        assert np.array_equal(a.positions, b.positions) and np.array_equal(a.normals, b.normals)

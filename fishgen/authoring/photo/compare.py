@@ -30,7 +30,7 @@ def render_side(species: Species, width: int, height: int, distance: float | Non
     from fishgen.assembly.fish import build_fish
     from fishgen.preview.render import Renderer
 
-    scene = build_fish(species)
+    scene = build_fish(species, still=True)
     camera = side_camera(scene, width, height, distance)
     own = renderer is None
     renderer = Renderer(width, height) if own else renderer
@@ -65,7 +65,7 @@ def half_covered_grids(species: Species, width: int, height: int, distance: floa
     from fishgen.assembly.fish import build_fish
     from fishgen.preview.render import Renderer
 
-    scene = build_fish(species)
+    scene = build_fish(species, still=True)
     camera = side_camera(scene, width, height, distance)
     finest = max(grids)
     renderer = Renderer(width * finest, height * finest, samples=1)
@@ -103,7 +103,7 @@ def seen_fins(species: Species, width: int, height: int, distance: float,
     from fishgen.preview.render import Renderer
 
     bare = replace(species, texture_points=None, colour_texture=None, mask_texture=None)
-    scene = build_fish(bare)
+    scene = build_fish(bare, still=True)
     camera = side_camera(scene, width, height, distance)
     renderer = Renderer(width, height)
     try:
@@ -165,7 +165,7 @@ def render_scale(species: Species, width: int, height: int) -> float:
     from fishgen.assembly.fish import METRES_PER_WORLD_UNIT, THESIS_TO_GLTF, build_fish
     from fishgen.preview.pipeline import frame_scene
 
-    camera = frame_scene(build_fish(species), "side", width / height, ortho=True)
+    camera = frame_scene(build_fish(species, still=True), "side", width / height, ortho=True)
     vp = camera.projection() @ camera.view()
     # one thesis unit along the body, from the origin, in clip space (orthographic: w stays 1)
     ends = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]) @ THESIS_TO_GLTF.T
