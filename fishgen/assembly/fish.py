@@ -162,7 +162,8 @@ def make_fish(species: Species, *, fins: str | None = None, length: float | None
     return fish_of(species, options, wave, still)
 
 
-def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None, still: bool = False) -> Fish:
+def fish_of(species: Species, options: FishOptions, wave: BodyWave | None = None,
+            still: bool = False) -> Fish:
     """The fish of ``species`` built as ``options`` (checked when they were made) say: what
     `fishgen build` runs for each species file (``still``: as :func:`make_fish`)."""
     length, fps, swim = options.length, options.fps, options.swim

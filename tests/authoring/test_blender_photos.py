@@ -143,12 +143,13 @@ def test_told_the_lens_a_fit_over_water_keeps_the_faint_fin_tips_in_its_mask(gl_
     from PIL import Image, ImageOps
     from scipy import ndimage
 
-    from fishgen.authoring.photo.image import MEASURE_SIDE, load_photo, working_copy
+    from fishgen.authoring.photo.image import load_photo, measuring_side, working_copy
     from fishgen.authoring.photo.silhouette import faint_edges, silhouette
 
     rec = bp.fixture_records()["long"]
     assert rec["shot"]["lens"] == 50.0
-    photo = working_copy(load_photo(rec["photo"]), MEASURE_SIDE)
+    original = load_photo(rec["photo"])
+    photo = working_copy(original, measuring_side(original.size))
     sil = silhouette(photo)
     faint = faint_edges(photo, sil.mask)
     assert sil.source == "background model" and faint.sum() > 20
@@ -176,12 +177,13 @@ def test_a_fit_that_leans_on_the_faint_edges_and_faded_pixels_together_is_said_s
     (the same fit unpatched, in the test above). What is said changes nothing written: the files are
     the unpatched fit's byte for byte, as the same inputs always write the same bytes."""
     from fishgen.authoring.photo import run as run_module
-    from fishgen.authoring.photo.image import MEASURE_SIDE, load_photo, working_copy
+    from fishgen.authoring.photo.image import load_photo, measuring_side, working_copy
     from fishgen.authoring.photo.run import TextureOptions, make_texture
     from fishgen.authoring.photo.silhouette import silhouette
 
     rec = bp.fixture_records()["long"]
-    bare = silhouette(working_copy(load_photo(rec["photo"]), MEASURE_SIDE)).mask
+    original = load_photo(rec["photo"])
+    bare = silhouette(working_copy(original, measuring_side(original.size))).mask
     base = _bases(["bonybream"])["bonybream"]
     options = TextureOptions(fit_shape=True, focal_length=rec["shot"]["lens"])
     real = run_module._iou_with

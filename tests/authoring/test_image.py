@@ -1,16 +1,17 @@
-"""Reading a photo: the lens a camera wrote in its EXIF."""
+"""Reading a photo: the lens a camera wrote in its EXIF, its colours, and the copy it is measured on."""
 from __future__ import annotations
 
 import io
 import struct
 import warnings
 import zlib
+from pathlib import Path
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from fishgen.authoring.photo.image import load_photo
+from fishgen.authoring.photo.image import MIN_PHOTO_SIDE, Photo, load_photo, measuring_side, working_copy
 from fishgen.errors import FishgenError
 
 
@@ -110,3 +111,16 @@ def test_an_exif_tag_larger_than_the_file_says_nothing(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert load_photo(path).size == (96, 64)
+
+
+@pytest.mark.parametrize("size, side", [((640, 360), 1024), ((1920, 1080), 1024), ((6000, 3375), 1024),
+                                        ((3000, 3000), 1024), ((2000, 100), 1280), ((8000, 250), 2048)])
+def test_a_photo_is_measured_on_a_copy_1024_px_long_unless_that_would_be_under_64_px_across(size, side):
+    """A camera's photo is measured at 1024 px (a full-HD fit took twice as long at 2048 for no
+    better fish); a long thin one keeps at least MIN_PHOTO_SIDE rows, as the refusal of longer ones
+    promises."""
+    assert measuring_side(size) == side
+    w, h = size
+    photo = Photo(np.zeros((h, w, 3), np.uint8), None, Path("photo.png"))
+    copy = working_copy(photo, measuring_side(size))
+    assert max(copy.size) == min(max(size), side) and min(copy.size) >= MIN_PHOTO_SIDE

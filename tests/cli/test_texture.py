@@ -253,6 +253,20 @@ def test_more_body_sections_than_the_photo_has_pixels_are_refused_at_once(tmp_pa
     assert not (tmp_path / "new.txt").exists()
 
 
+def test_a_big_photo_s_section_limit_names_the_copy_it_is_measured_on(tmp_path):
+    """A 2400 px photo is measured on a 1024 px copy: the limit is that copy's, and says so."""
+    photo = tmp_path / "big.png"
+    image = Image.new("RGBA", (2400, 1200), (0, 0, 0, 0))
+    ImageDraw.Draw(image).ellipse((1000, 500, 1600, 700), fill=(200, 150, 50, 255))
+    image.save(photo)
+    r = run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "new.txt",
+                "--body-sections", "200")
+    said = re.search(r"at most (\d+) for a fish (\d+) px long in the 1024 x 512 copy it is measured on",
+                     r.stderr)
+    assert r.returncode == 2 and said, r.stderr
+    assert 254 <= int(said[2]) <= 258 and int(said[1]) == int(said[2]) // 2
+
+
 def test_focal_length_measures_the_rebuilt_fish_in_that_perspective(tmp_path, cli, bream_photo):
     """--focal-length: the rebuilt fish is rendered as that lens saw it. The photo here is an
     orthographic render, so a wide angle's view of the rebuilt fish is less like it than a side-on

@@ -18,12 +18,14 @@ from fishgen.reading import PILLOW_TAG_READER, in_srgb
 MAX_PHOTO_PIXELS = 64_000_000
 #: Smallest side accepted: below this a fish has too few pixels to measure.
 MIN_PHOTO_SIDE = 64
-MEASURE_SIDE = 2048
-"""Photos are measured on a copy at most this many pixels a side (a 0.05 % step is finer than any
-tolerance, and a 64-megapixel photo would otherwise need gigabytes)."""
-MAX_ASPECT = MEASURE_SIDE // MIN_PHOTO_SIDE
-"""Longest side over the shortest: beyond it the measuring copy is under MIN_PHOTO_SIDE across (an
-8000 x 64 photo measured 16 pixels tall, and its analysis ran out of fish rows: NaN)."""
+MEASURE_SIDE = 1024
+"""Photos are measured on a copy at most this many pixels a side (:func:`measuring_side`): a 0.1 %
+step is finer than any tolerance, the fits were tuned on fish 400-900 px long, and at 2048 a full-HD
+photo's fit took twice as long for no better fish (docs/decisions.md)."""
+MAX_ASPECT = 32
+"""Longest side over the shortest: beyond it the measuring copy, however long, would be under
+MIN_PHOTO_SIDE across (an 8000 x 64 photo measured 16 pixels tall, and its analysis ran out of fish
+rows: NaN)."""
 
 
 @dataclass(frozen=True)
@@ -36,6 +38,13 @@ class Photo:
     @property
     def size(self) -> tuple[int, int]:
         return self.rgb.shape[1], self.rgb.shape[0]
+
+
+def measuring_side(size: tuple[int, int]) -> int:
+    """The longest side of the copy a photo of ``size`` is measured on: MEASURE_SIDE, or longer for
+    a photo so long and thin that its copy would be under MIN_PHOTO_SIDE across."""
+    w, h = size
+    return max(MEASURE_SIDE, MIN_PHOTO_SIDE * math.ceil(max(w, h) / min(w, h)))
 
 
 def working_copy(photo: Photo, longest: int) -> Photo:
@@ -79,8 +88,8 @@ def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
                                        f"found {w} x {h}", path)
                 if max(w, h) > MAX_ASPECT * min(w, h):
                     raise FishgenError(f"expected a photo at most {MAX_ASPECT} times as long as it is tall "
-                                       f"(measured on a copy {MEASURE_SIDE} pixels long), found {w} x {h}",
-                                       path)
+                                       f"(measured on a copy at least {MIN_PHOTO_SIDE} pixels across), "
+                                       f"found {w} x {h}", path)
                 if getattr(img, "n_frames", 1) > 1:   # a GIF's or WebP's first frame is no choice
                     raise FishgenError(f"expected a still photo, found an animation of {img.n_frames} "
                                        "frames", path)

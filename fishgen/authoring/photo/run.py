@@ -15,7 +15,7 @@ import numpy as np
 from fishgen.authoring.photo import points as fixel
 from fishgen.authoring.photo.anatomy import BodyOutline, body_outline, body_region, calibrate
 from fishgen.authoring.photo.frame import Frame, fish_frame
-from fishgen.authoring.photo.image import MEASURE_SIDE, Photo, load_photo, working_copy
+from fishgen.authoring.photo.image import Photo, load_photo, measuring_side, working_copy
 from fishgen.authoring.photo.sideview import SideView, side_view, with_counts
 from fishgen.authoring.photo.silhouette import pale_patches, silhouette
 from fishgen.errors import FishgenError, UsageError, cannot
@@ -255,15 +255,17 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         raise UsageError(f"expected --spacing {'|'.join(fixel.SPACINGS)}, found {options.spacing!r}")
     note = on_note or (lambda _text: None)
     original = load_photo(photo_path)
-    # Measured on at most MEASURE_SIDE pixels a side: a 0.05 % step is finer than any tolerance,
-    # and a 64-megapixel photo would otherwise need gigabytes.
-    photo = working_copy(original, MEASURE_SIDE)
+    # Measured on a copy of at most MEASURE_SIDE pixels a side: a 64-megapixel photo would
+    # otherwise need gigabytes, and a full-HD one's fit took twice as long for no better fish.
+    photo = working_copy(original, measuring_side(original.size))
     sil = silhouette(photo, options.mask, original.size)
     span = int(sil.mask.any(axis=0).sum())  # the fish's length in the working copy's pixels
     if options.body_sections is not None and options.body_sections > max(3, span // 2):
         # more sections than the photo has pixels measures nothing, and --fit-shape took 31 s at 256
+        w, h = photo.size
+        where = "the photo" if photo is original else f"the {w} x {h} copy it is measured on"
         raise FishgenError(f"expected --body-sections of at most {max(3, span // 2)} for a fish {span} px "
-                           f"long in the photo (two pixels a section), found {options.body_sections}",
+                           f"long in {where} (two pixels a section), found {options.body_sections}",
                            photo_path)
     given = base
     base = with_counts(base, options.body_sections, options.circle_sections)
