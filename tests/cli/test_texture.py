@@ -254,14 +254,15 @@ def test_more_body_sections_than_the_photo_has_pixels_are_refused_at_once(tmp_pa
 
 
 def test_a_big_photo_s_section_limit_names_the_copy_it_is_measured_on(tmp_path):
-    """A 2400 px photo is measured on a 1024 px copy: the limit is that copy's, and says so."""
+    """A 4800 px photo of a small fish is measured on a 2048 px copy: the limit is that copy's, and
+    says so."""
     photo = tmp_path / "big.png"
-    image = Image.new("RGBA", (2400, 1200), (0, 0, 0, 0))
-    ImageDraw.Draw(image).ellipse((1000, 500, 1600, 700), fill=(200, 150, 50, 255))
+    image = Image.new("RGBA", (4800, 2400), (0, 0, 0, 0))
+    ImageDraw.Draw(image).ellipse((2100, 1100, 2700, 1300), fill=(200, 150, 50, 255))
     image.save(photo)
     r = run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "new.txt",
                 "--body-sections", "200")
-    said = re.search(r"at most (\d+) for a fish (\d+) px long in the 1024 x 512 copy it is measured on",
+    said = re.search(r"at most (\d+) for a fish (\d+) px long in the 2048 x 1024 copy it is measured on",
                      r.stderr)
     assert r.returncode == 2 and said, r.stderr
     assert 254 <= int(said[2]) <= 258 and int(said[1]) == int(said[2]) // 2

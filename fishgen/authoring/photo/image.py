@@ -22,6 +22,11 @@ MEASURE_SIDE = 1024
 """Photos are measured on a copy at most this many pixels a side (:func:`measuring_side`): a 0.1 %
 step is finer than any tolerance, the fits were tuned on fish 400-900 px long, and at 2048 a full-HD
 photo's fit took twice as long for no better fish (docs/decisions.md)."""
+FINE_SIDE = 2048
+"""...and a fish under SMALL_FISH pixels long in that copy on one at most this long (as every photo was
+until the twentieth session): a small fish's few pixels are worth the time. The fits were shown to
+hold on fish 181-434 px long (Blender's 640 x 360 photos) and 320-662 px (its full-HD ones at 1024)."""
+SMALL_FISH = 256
 MAX_ASPECT = 32
 """Longest side over the shortest: beyond it the measuring copy, however long, would be under
 MIN_PHOTO_SIDE across (an 8000 x 64 photo measured 16 pixels tall, and its analysis ran out of fish
@@ -40,11 +45,11 @@ class Photo:
         return self.rgb.shape[1], self.rgb.shape[0]
 
 
-def measuring_side(size: tuple[int, int]) -> int:
-    """The longest side of the copy a photo of ``size`` is measured on: MEASURE_SIDE, or longer for
+def measuring_side(size: tuple[int, int], longest: int = MEASURE_SIDE) -> int:
+    """The longest side of the copy a photo of ``size`` is measured on: ``longest``, or longer for
     a photo so long and thin that its copy would be under MIN_PHOTO_SIDE across."""
     w, h = size
-    return max(MEASURE_SIDE, MIN_PHOTO_SIDE * math.ceil(max(w, h) / min(w, h)))
+    return max(longest, MIN_PHOTO_SIDE * math.ceil(max(w, h) / min(w, h)))
 
 
 def working_copy(photo: Photo, longest: int) -> Photo:

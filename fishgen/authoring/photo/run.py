@@ -15,7 +15,14 @@ import numpy as np
 from fishgen.authoring.photo import points as fixel
 from fishgen.authoring.photo.anatomy import BodyOutline, body_outline, body_region, calibrate
 from fishgen.authoring.photo.frame import Frame, fish_frame
-from fishgen.authoring.photo.image import Photo, load_photo, measuring_side, working_copy
+from fishgen.authoring.photo.image import (
+    FINE_SIDE,
+    SMALL_FISH,
+    Photo,
+    load_photo,
+    measuring_side,
+    working_copy,
+)
 from fishgen.authoring.photo.sideview import SideView, side_view, with_counts
 from fishgen.authoring.photo.silhouette import pale_patches, silhouette
 from fishgen.errors import FishgenError, UsageError, cannot
@@ -258,7 +265,16 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     # Measured on a copy of at most MEASURE_SIDE pixels a side: a 64-megapixel photo would
     # otherwise need gigabytes, and a full-HD one's fit took twice as long for no better fish.
     photo = working_copy(original, measuring_side(original.size))
-    sil = silhouette(photo, options.mask, original.size)
+    try:
+        sil = silhouette(photo, options.mask, original.size)
+        small = int(sil.mask.any(axis=0).sum()) < SMALL_FISH
+    except FishgenError:
+        if photo is original:
+            raise
+        small = True   # said again below, from the larger copy, if it is the photo's fault
+    if small and photo is not original:
+        photo = working_copy(original, measuring_side(original.size, FINE_SIDE))
+        sil = silhouette(photo, options.mask, original.size)
     span = int(sil.mask.any(axis=0).sum())  # the fish's length in the working copy's pixels
     if options.body_sections is not None and options.body_sections > max(3, span // 2):
         # more sections than the photo has pixels measures nothing, and --fit-shape took 31 s at 256
