@@ -268,6 +268,18 @@ def test_a_big_photo_s_section_limit_names_the_copy_it_is_measured_on(tmp_path):
     assert 254 <= int(said[2]) <= 258 and int(said[1]) == int(said[2]) // 2
 
 
+def test_body_sections_a_big_photo_holds_are_taken_from_the_larger_copy(tmp_path):
+    """A 1200 px fish in a 4000 px photo is 300 px long in the 1024 px copy: --body-sections 200 asks
+    for more pixels than that, and the 2048 px copy (600 px of fish) has them, as before."""
+    photo = tmp_path / "big.png"
+    image = Image.new("RGBA", (4000, 2000), (0, 0, 0, 0))
+    ImageDraw.Draw(image).ellipse((1400, 850, 2600, 1150), fill=(200, 150, 50, 255))
+    image.save(photo)
+    r = run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "new.txt",
+                "--body-sections", "200")
+    assert r.returncode == 0, r.stderr
+
+
 def test_focal_length_measures_the_rebuilt_fish_in_that_perspective(tmp_path, cli, bream_photo):
     """--focal-length: the rebuilt fish is rendered as that lens saw it. The photo here is an
     orthographic render, so a wide angle's view of the rebuilt fish is less like it than a side-on

@@ -267,7 +267,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     photo = working_copy(original, measuring_side(original.size))
     try:
         sil = silhouette(photo, options.mask, original.size)
-        small = int(sil.mask.any(axis=0).sum()) < SMALL_FISH
+        # --body-sections asks for two pixels a section: as many as the larger copy gives
+        small = int(sil.mask.any(axis=0).sum()) < max(SMALL_FISH, 2 * (options.body_sections or 0))
     except FishgenError:
         if photo is original:
             raise
