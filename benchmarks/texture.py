@@ -7,12 +7,14 @@
         # perspective; each on its own geometry, then --fit-shape on every shipped base, the
         # rebuilt fish photographed by three.js
     python benchmarks/texture.py --blender [--seeds 301,302,303,304] [--bases a,b] [--no-lens] [--mirror]
+                                           [--size 1920x1080]
         # issue 32: fish from `fishgen species --random` on seeds held out from all tuning,
         # photographed by Blender (Cycles, a 50-135 mm lens, small yaw and roll, a sun, translucent
         # fins over alpha or a mottled backdrop); --fit-shape on every shipped base, the rebuilt
         # fish photographed again by Blender side-on with the photo's lens: IoU per fit, min, median;
         # the command is told each photo's --focal-length unless --no-lens; --mirror fits the
-        # photos mirrored (the fish facing right); and how many misses the command said in one line
+        # photos mirrored (the fish facing right); --size photographs them (and the rebuilt fish) at
+        # that size (default 640x360); and how many misses the command said in one line
 
 Each photo is an orthographic side render (tests/authoring/photos.py), varied as
 the robustness tests vary it. Columns: the rebuilt fish's silhouette IoU against
@@ -231,12 +233,13 @@ def blender() -> None:
     work = Path(tempfile.mkdtemp(prefix="fishgen-blender-"))
     subjects = write_subjects(work / "subjects", seeds, {})
     shots = shots_for(list(subjects))
-    records = photograph(subjects, shots, work / "shots")
+    w, h = (int(v) for v in (_option("--size") or ["640x360"])[0].split("x"))
+    records = photograph(subjects, shots, work / "shots", (w, h))
     if "--mirror" in sys.argv:
         records = mirrored(records, work / "mirrored")
     shot_s = time.perf_counter() - start
     bases = {n: load_species(ROOT / "params" / f"{n}.txt") for n in (_option("--bases") or SHIPPED)}
-    rows = fit_photos(records, bases, work / "fits", lens="--no-lens" not in sys.argv)
+    rows = fit_photos(records, bases, work / "fits", lens="--no-lens" not in sys.argv, size=(w, h))
     # Blender: the fitted glb as Blender shows it (its materials' alpha kept: a fitted fin's texture
     # mask trims it in every glTF client); triangles: every triangle, the masks ignored (as Pillow).
     print(f"{'photo':12s} {'lens':>5s} {'yaw':>5s} {'roll':>5s} {'backdrop':8s} {'base':16s} {'Blender':>8s} "
@@ -250,7 +253,8 @@ def blender() -> None:
               f"{r.seconds:5.1f} {note}")
     for label, ious in (("as Blender shows the file", [r.blender or 0.0 for r in rows]),
                         ("every triangle, fin masks ignored", [r.triangles or 0.0 for r in rows])):
-        print(f"{len(rows)} fits of {len(records)} Blender photos (seeds {','.join(map(str, seeds))}), "
+        print(f"{len(rows)} fits of {len(records)} Blender photos {w}x{h} "
+              f"(seeds {','.join(map(str, seeds))}), "
               f"{label}: IoU min {min(ious):.3f}, median {statistics.median(ious):.3f}, "
               f"{sum(i >= 0.85 for i in ious)}/{len(ious)} >= 0.85")
     said = [r for r in rows if (r.blender or 0.0) < 0.85 and any(

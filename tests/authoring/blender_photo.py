@@ -172,10 +172,10 @@ def read_mask(path: Path) -> np.ndarray:
     return np.asarray(img.convert("L")) >= 128
 
 
-def photograph(species: dict, shots: dict, folder: Path) -> dict[str, dict]:
-    """Photograph each ``species[name]`` as ``shots[name]`` into ``folder``: ``NAME.png`` (the photo),
-    ``NAME_mask.png`` (its true silhouette) and ``NAME.json`` (the shot and the camera); name ->
-    that record with the paths."""
+def photograph(species: dict, shots: dict, folder: Path, size: tuple[int, int] = SIZE) -> dict[str, dict]:
+    """Photograph each ``species[name]`` as ``shots[name]`` into ``folder`` at ``size``: ``NAME.png``
+    (the photo), ``NAME_mask.png`` (its true silhouette) and ``NAME.json`` (the shot and the camera);
+    name -> that record with the paths."""
     from fishgen.assembly.fish import build_fish
 
     folder.mkdir(parents=True, exist_ok=True)
@@ -183,7 +183,7 @@ def photograph(species: dict, shots: dict, folder: Path) -> dict[str, dict]:
     for name, sp in species.items():
         shot = shots[name]
         scene = build_fish(sp, fins="blend")     # translucent fins, as a real fin shows the backdrop
-        camera = camera_for(rest_triangles(scene).reshape(-1, 3), shot)
+        camera = camera_for(rest_triangles(scene).reshape(-1, 3), shot, size)
         glb = fish_glb(scene, folder / f"{name}.glb")
         jobs.append(Job(glb, camera, folder / f"{name}_mask.png", folder / f"{name}.png", shot.seed))
         record = {"shot": asdict(shot), "camera": camera}
@@ -212,17 +212,18 @@ def mirrored(records: dict[str, dict], folder: Path) -> dict[str, dict]:
     return out
 
 
-def fitted_masks(fits: dict[str, tuple], folder: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def fitted_masks(fits: dict[str, tuple], folder: Path,
+                 size: tuple[int, int] = SIZE) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Each fitted species (name -> (species, Shot)) photographed side-on in Blender with its photo's
-    lens and framing: name -> its coverage masks, of what the file shows (the materials' alpha kept:
-    a fitted fin's texture mask trims it) and of every triangle."""
+    lens and framing, at ``size``: name -> its coverage masks, of what the file shows (the
+    materials' alpha kept: a fitted fin's texture mask trims it) and of every triangle."""
     from fishgen.assembly.fish import build_fish
 
     folder.mkdir(parents=True, exist_ok=True)
     jobs = []
     for name, (sp, shot) in fits.items():
         scene = build_fish(sp)
-        camera = camera_for(rest_triangles(scene).reshape(-1, 3), shot.side_on())
+        camera = camera_for(rest_triangles(scene).reshape(-1, 3), shot.side_on(), size)
         glb = fish_glb(scene, folder / f"{name}.glb")
         jobs += [Job(glb, camera, folder / f"{name}_shown.png", alpha=True),
                  Job(glb, camera, folder / f"{name}_mask.png")]
@@ -301,26 +302,27 @@ def fit_one(name: str, rec: dict, base_name: str, base: Any, folder: Path, lens:
     return FitRun(f"{name}--{base_name}", row, result, out, rebuilt, shot, level)
 
 
-def photographed(runs: list[FitRun], folder: Path) -> list[Fitted]:
+def photographed(runs: list[FitRun], folder: Path, size: tuple[int, int] = SIZE) -> list[Fitted]:
     """Each run's row with the rebuilt fish photographed side-on by Blender (:func:`fitted_masks`)
     against the photo's true silhouette: as the file shows it and every triangle of it."""
     from fishgen.authoring.photo.compare import silhouette_iou
 
-    masks = fitted_masks({run.key: (run.rebuilt, run.shot) for run in runs}, folder)
+    masks = fitted_masks({run.key: (run.rebuilt, run.shot) for run in runs}, folder, size)
     return [replace(run.row, blender=silhouette_iou(run.level, masks[run.key][0]),
                     triangles=silhouette_iou(run.level, masks[run.key][1])) for run in runs]
 
 
 def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: bool = True,
-               skip: dict[str, str] | None = None, lens: bool = True) -> list[Fitted]:
+               skip: dict[str, str] | None = None, lens: bool = True,
+               size: tuple[int, int] = SIZE) -> list[Fitted]:
     """``fishgen texture --fit-shape`` of every photo (name -> :func:`photograph`'s record) on every
     base (name -> species) but the one it was shaped from (``skip``: photo -> base), told the
     photo's ``--focal-length`` when ``lens`` (as a camera's EXIF tells it): :func:`fit_one` each,
-    then, with ``blender``, :func:`photographed`."""
+    then, with ``blender``, :func:`photographed` at ``size`` (the photos')."""
     runs = [fit_one(name, rec, base_name, base, folder, lens)
             for name, rec in records.items() for base_name, base in bases.items()
             if (skip or {}).get(name) != base_name]
-    return photographed(runs, folder / "blender") if blender else [run.row for run in runs]
+    return photographed(runs, folder / "blender", size) if blender else [run.row for run in runs]
 
 
 #: The lenses photos are taken with (mm on a 36 mm sensor: a normal lens to a short telephoto). A
