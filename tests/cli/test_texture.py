@@ -253,15 +253,20 @@ def test_more_body_sections_than_the_photo_has_pixels_are_refused_at_once(tmp_pa
     assert not (tmp_path / "new.txt").exists()
 
 
+def _sections_asked_of_an_oval(tmp_path, size: tuple[int, int], oval: tuple[int, int, int, int]):
+    """`fishgen texture --body-sections 200` of a photo of ``size`` showing one golden ``oval``."""
+    photo = tmp_path / "big.png"
+    image = Image.new("RGBA", size, (0, 0, 0, 0))
+    ImageDraw.Draw(image).ellipse(oval, fill=(200, 150, 50, 255))
+    image.save(photo)
+    return run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "new.txt",
+                   "--body-sections", "200")
+
+
 def test_a_big_photo_s_section_limit_names_the_copy_it_is_measured_on(tmp_path):
     """A 4800 px photo of a small fish is measured on a 2048 px copy: the limit is that copy's, and
     says so."""
-    photo = tmp_path / "big.png"
-    image = Image.new("RGBA", (4800, 2400), (0, 0, 0, 0))
-    ImageDraw.Draw(image).ellipse((2100, 1100, 2700, 1300), fill=(200, 150, 50, 255))
-    image.save(photo)
-    r = run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "new.txt",
-                "--body-sections", "200")
+    r = _sections_asked_of_an_oval(tmp_path, (4800, 2400), (2100, 1100, 2700, 1300))
     said = re.search(r"at most (\d+) for a fish (\d+) px long in the 2048 x 1024 copy it is measured on",
                      r.stderr)
     assert r.returncode == 2 and said, r.stderr
@@ -271,12 +276,7 @@ def test_a_big_photo_s_section_limit_names_the_copy_it_is_measured_on(tmp_path):
 def test_body_sections_a_big_photo_holds_are_taken_from_the_larger_copy(tmp_path):
     """A 1200 px fish in a 4000 px photo is 300 px long in the 1024 px copy: --body-sections 200 asks
     for more pixels than that, and the 2048 px copy (600 px of fish) has them, as before."""
-    photo = tmp_path / "big.png"
-    image = Image.new("RGBA", (4000, 2000), (0, 0, 0, 0))
-    ImageDraw.Draw(image).ellipse((1400, 850, 2600, 1150), fill=(200, 150, 50, 255))
-    image.save(photo)
-    r = run_cli("texture", photo, "-s", PARAMS / "bonybream.txt", "-o", tmp_path / "new.txt",
-                "--body-sections", "200")
+    r = _sections_asked_of_an_oval(tmp_path, (4000, 2000), (1400, 850, 2600, 1150))
     assert r.returncode == 0, r.stderr
 
 
