@@ -19,14 +19,15 @@ MAX_PHOTO_PIXELS = 64_000_000
 #: Smallest side accepted: below this a fish has too few pixels to measure.
 MIN_PHOTO_SIDE = 64
 MEASURE_SIDE = 1024
-"""Photos are measured on a copy at most this many pixels a side (:func:`measuring_side`): a 0.1 %
-step is finer than any tolerance, the fits were tuned on fish 400-900 px long, and at 2048 a full-HD
-photo's fit took twice as long for no better fish (docs/decisions.md)."""
-FINE_SIDE = 2048
-"""...and a fish under SMALL_FISH pixels long in that copy on one at most this long (as every photo was
-until the twentieth session): a small fish's few pixels are worth the time. The fits were shown to
-hold on fish 181-434 px long (Blender's 640 x 360 photos) and 320-662 px (its full-HD ones at 1024)."""
+"""Photos are measured on a copy at most this many pixels a side (:func:`measuring_side`): a
+64-megapixel photo would otherwise need gigabytes, and at 2048 a full-HD photo's fit took twice as
+long for fish no better in Blender (docs/decisions.md)."""
 SMALL_FISH = 256
+"""A fish shorter than this in that copy is measured again on one at most FINE_SIDE long, as every
+photo was until the twentieth session: the fits were shown to hold on fish 181-434 px long
+(Blender's 640 x 360 photos) and 320-662 px (its full-HD ones, at 1024), not below."""
+FINE_SIDE = 2048
+"""The longest side of that larger copy."""
 MAX_ASPECT = 32
 """Longest side over the shortest: beyond it the measuring copy, however long, would be under
 MIN_PHOTO_SIDE across (an 8000 x 64 photo measured 16 pixels tall, and its analysis ran out of fish
