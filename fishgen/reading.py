@@ -31,7 +31,7 @@ def read_capped(handle: BinaryIO, limit: int) -> bytes:
 PILLOW_TAG_READER = r"PIL\.TiffImagePlugin"
 
 
-def unheeded(message: Warning | str, category: type[Warning], filename: str) -> bool:
+def unheeded(category: type[Warning], filename: str) -> bool:
     """Whether a warning is about a part of an input fishgen does not need, so it is not said: one
     from Pillow's EXIF and TIFF tag reader (``filename``: where it was raised), which reads what it
     can of a damaged block as a picture opens (fishgen reads only a photo's orientation and lens

@@ -73,7 +73,7 @@ def run_job(job: Job, work: Work) -> Result:
             read, written = work(job, notes.append)
         notes += [str(w.message) for w in caught
                   if issubclass(w.category, UserWarning)
-                  and not unheeded(w.message, w.category, w.filename)]
+                  and not unheeded(w.category, w.filename)]
         result.notes = notes
         result.inputs = {os.fspath(p): file_sha256(p) for p in dict.fromkeys(read)}
         result.outputs = {os.fspath(p): file_sha256(p) for p in written}

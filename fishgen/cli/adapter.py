@@ -101,7 +101,7 @@ def _warnings_as_notes(events: TerminalEvents) -> Iterator[None]:
         shown = warnings.showwarning
 
         def show(message, category, filename, lineno, file=None, line=None):
-            if unheeded(message, category, filename):
+            if unheeded(category, filename):
                 return
             # under --json every line on stderr is an object: any warning, said as a batch job says it
             if issubclass(category, CubeFileWarning) or json_errors():
