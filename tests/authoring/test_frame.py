@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 from PIL import Image, ImageDraw
 
-from fishgen.authoring.photo.frame import fish_frame, turned
+from fishgen.authoring.photo.frame import faces_right, fish_frame, turned
 
 
 def _fish(mirrored: bool) -> np.ndarray:
@@ -99,3 +99,20 @@ def test_a_weak_neck_as_the_photo_stands_does_not_overrule_the_turn():
     mask = np.asarray(Image.open(ROOT / "tests" / "fixtures" / "silhouettes" / "drawn_small_tail.png")
                       .convert("L")) > 127
     assert not fish_frame(mask).mirrored
+
+
+def test_a_frame_of_the_mirror_image_levels_and_maps_the_photo_itself():
+    """A fish facing right is measured on its photo's mirror image: the frame the command gives
+    back levels a mask of the photo as the mirror's frame levels the mirrored mask, maps frame
+    points to the photo's own pixels, and says the photo's turn and facing."""
+    photo = np.asarray(Image.fromarray(_fish(True)).rotate(6.0, resample=Image.Resampling.NEAREST)) > 0
+    mirror = photo[:, ::-1].copy()
+    assert faces_right(photo) and not faces_right(mirror)
+    of_mirror = fish_frame(mirror)
+    frame = of_mirror.of_mirror(photo.shape[1])
+    assert np.array_equal(frame.level(photo), of_mirror.level(mirror))
+    point = np.array([[100.0, 70.0]])
+    assert np.allclose(frame.to_photo(point), [[photo.shape[1] - of_mirror.to_photo(point)[0, 0],
+                                               of_mirror.to_photo(point)[0, 1]]])
+    assert frame.mirrored and frame.angle == -of_mirror.angle
+    assert abs(frame.angle - fish_frame(photo).angle) < 0.5

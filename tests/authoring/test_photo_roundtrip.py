@@ -31,7 +31,8 @@ def run_round_trip(tmp_path, species, photo: ph.Photo, fmt: str = "PNG", on_note
     photo.save(path, fmt, **({"quality": 95} if fmt == "JPEG" else {}))
     result = make_texture(path, species, tmp_path / "new.txt", on_note=on_note)
     rebuilt = load_species(tmp_path / "new.txt")
-    body, fins = ph.errors(rebuilt, photo)
+    # a fish facing right is measured on the photo's mirror image, which is then its texture
+    body, fins = ph.errors(rebuilt, ph.mirrored(photo) if result.mirrored else photo)
     return result, rebuilt, body, fins
 
 

@@ -2,6 +2,7 @@
 copy of a big photo it measures."""
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from fishgen.authoring.photo.run import _misfit_said
@@ -50,3 +51,65 @@ def test_a_big_photo_is_measured_at_1024_px_unless_its_fish_is_small_there(tmp_p
     assert result.level_mask is not None
     span = int(result.level_mask.any(axis=0).sum())
     assert abs(span - (fish + fish // 6) * side / 2400) <= 8, span   # the fish and its tail, in the copy
+
+
+
+def _files(folder) -> dict[str, bytes]:
+    return {f.name: f.read_bytes() for f in sorted(folder.iterdir())}
+
+
+@pytest.mark.parametrize("with_mask", [False, True])
+def test_a_fish_facing_right_gives_the_files_its_mirror_image_gives(tmp_path, gl_available, with_mask):
+    """Resampled mirrored and turned, a right-facing fish's outline fell on other pixels and a
+    Blender photo's fits moved by up to 0.07 between facing left and right. It is measured on the
+    photo's mirror image, so the species file, texture and mask are the same bytes
+    as the mirror image's (its --mask mirrored with it), and the result still says the photo's
+    turn and that the head is on the right."""
+    from PIL import Image
+
+    from fishgen.authoring.photo.run import TextureOptions, make_texture
+    from fishgen.species.parser import load_species
+    from tests.authoring import photos as ph
+    from tests.conftest import PARAMS
+
+    species = load_species(PARAMS / "bonybream.txt")
+    shot = ph.rotated(ph.render_photo(species), 4.0)
+    covered = shot.rgba[:, :, 3] >= 128
+    results = {}
+    for side, photo, mask in (("left", shot, covered), ("right", ph.mirrored(shot), covered[:, ::-1])):
+        folder = tmp_path / side
+        folder.mkdir()
+        ph.on_background(photo, (60, 120, 150), (30, 80, 120)).save(folder / "photo.png")
+        Image.fromarray(mask.astype("uint8") * 255).save(folder / "mask.png")
+        options = TextureOptions(mask=folder / "mask.png") if with_mask else TextureOptions()
+        results[side] = make_texture(folder / "photo.png", species, folder / "out" / "new.txt", options)
+    assert _files(tmp_path / "left" / "out") == _files(tmp_path / "right" / "out")
+    assert not results["left"].mirrored and results["right"].mirrored
+    assert results["right"].angle == -results["left"].angle and abs(results["left"].angle) > 2.0
+
+
+def test_points_in_and_out_of_a_fish_facing_right_are_on_the_photo(tmp_path, gl_available):
+    """--fxl-out writes the points on the photo as the user has it (a right-facing fish's mirrored
+    back from the image it was measured on), and --fxl-in reads them so: a photo's points and its
+    mirror image's are mirror images, and each read back gives its photo's files."""
+    from fishgen.authoring.photo.fxl import read_fxl
+    from fishgen.authoring.photo.run import TextureOptions, make_texture
+    from fishgen.species.parser import load_species
+    from tests.authoring import photos as ph
+    from tests.conftest import PARAMS
+
+    species = load_species(PARAMS / "pineapplefish.txt")
+    shot = ph.on_background(ph.rotated(ph.render_photo(species), -3.0), (60, 120, 150), (30, 80, 120))
+    points = {}
+    for side, photo in (("left", shot), ("right", ph.mirrored(shot))):
+        photo.save(tmp_path / f"{side}.png")
+        make_texture(tmp_path / f"{side}.png", species, tmp_path / side / "new.txt",
+                     TextureOptions(fxl_out=tmp_path / f"{side}.fxl"))
+        points[side] = read_fxl(tmp_path / f"{side}.fxl")
+        make_texture(tmp_path / f"{side}.png", species, tmp_path / f"{side}-read" / "new.txt",
+                     TextureOptions(fxl_in=tmp_path / f"{side}.fxl"))
+        assert _files(tmp_path / side) == _files(tmp_path / f"{side}-read")
+    for part, left in points["left"].items():
+        right = np.asarray(points["right"][part])
+        assert np.allclose(1.0 - right[:, 0], np.asarray(left)[:, 0], atol=1e-8)
+        assert np.allclose(right[:, 1], np.asarray(left)[:, 1])

@@ -5,7 +5,7 @@ import math
 import os
 import re
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -68,6 +68,12 @@ def working_copy(photo: Photo, longest: int) -> Photo:
     if photo.alpha is not None:
         alpha = np.asarray(Image.fromarray(photo.alpha, "L").resize(size, Image.Resampling.BOX))
     return Photo(np.ascontiguousarray(rgb), alpha, photo.path, photo.lens_35mm)
+
+
+def mirror_image(photo: Photo) -> Photo:
+    """``photo`` mirrored left to right, pixel for pixel."""
+    alpha = None if photo.alpha is None else np.ascontiguousarray(photo.alpha[:, ::-1])
+    return replace(photo, rgb=np.ascontiguousarray(photo.rgb[:, ::-1]), alpha=alpha)
 
 
 def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:

@@ -6,7 +6,7 @@ import io
 import os
 import tempfile
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -14,13 +14,14 @@ import numpy as np
 
 from fishgen.authoring.photo import points as fixel
 from fishgen.authoring.photo.anatomy import BodyOutline, body_outline, body_region, calibrate
-from fishgen.authoring.photo.frame import Frame, fish_frame
+from fishgen.authoring.photo.frame import Frame, faces_right, fish_frame
 from fishgen.authoring.photo.image import (
     FINE_SIDE,
     SMALL_FISH,
     Photo,
     load_photo,
     measuring_side,
+    mirror_image,
     working_copy,
 )
 from fishgen.authoring.photo.sideview import SideView, side_view, with_counts
@@ -264,7 +265,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     original = load_photo(photo_path)
     # Measured on a copy of at most MEASURE_SIDE pixels a side: a 64-megapixel photo would
     # otherwise need gigabytes, and a full-HD one's fit took twice as long for no better fish.
-    photo = working_copy(original, measuring_side(original.size))
+    side = measuring_side(original.size)
+    photo = working_copy(original, side)
     try:
         sil = silhouette(photo, options.mask, original.size)
         # --body-sections asks for two pixels a section: as many as the larger copy gives
@@ -274,8 +276,16 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
             raise
         small = True   # said again below, from the larger copy, if it is the photo's fault
     if small and photo is not original:
-        photo = working_copy(original, measuring_side(original.size, FINE_SIDE))
+        side = measuring_side(original.size, FINE_SIDE)
+        photo = working_copy(original, side)
         sil = silhouette(photo, options.mask, original.size)
+    # A fish facing right is measured on the photo's mirror image, so it gives the files that
+    # image gives, texture and all (the texture then faces left, as every species' does).
+    flipped = faces_right(sil.mask)
+    if flipped:
+        original = mirror_image(original)
+        photo = working_copy(original, side)
+        sil = silhouette(photo, options.mask, original.size, mirror=True)
     span = int(sil.mask.any(axis=0).sum())  # the fish's length in the working copy's pixels
     if options.body_sections is not None and options.body_sections > max(3, span // 2):
         # more sections than the photo has pixels measures nothing, and --fit-shape took 31 s at 256
@@ -287,6 +297,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     given = base
     base = with_counts(base, options.body_sections, options.circle_sections)
     imported = fxl.read_fxl(options.fxl_in) if options.fxl_in is not None else {}
+    if flipped:   # points on the photo, as the texture is the photo's mirror image
+        imported = {part: list(_mirrored_uv(values)) for part, values in imported.items()}
     textures = texture_bytes(original, photo, sil.mask)
     distance = None   # from the camera, in fish lengths: the perspective the rebuilt fish is seen in
     if options.focal_length is None and original.lens_35mm is not None:
@@ -446,15 +458,26 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     if options.fxl_out is not None:
         tp = chosen.species.texture_points
         assert tp is not None
+        if flipped:   # on the photo, as --fxl-in reads them
+            tp = TexturePoints(**{f.name: _mirrored_uv(getattr(tp, f.name)) for f in fields(tp)})
         files[Path(options.fxl_out)] = fxl.format_fxl(tp, chosen.species.circle_sections).encode()
     if options.compare is not None:
         if shown is None:
             shown = _rendered(photo, chosen, out, distance)
         files[Path(options.compare)], _ = _compare_png(photo, *shown)
     write_files(files)
-    return TextureResult(chosen.species, list(files), chosen.measured.angle, chosen.measured.mirrored,
+    frame = chosen.measured.frame
+    if flipped and frame is not None:
+        frame = frame.of_mirror(photo.size[0])
+    return TextureResult(chosen.species, list(files), chosen.measured.angle if frame is None else frame.angle,
+                         chosen.measured.mirrored if frame is None else frame.mirrored,
                          sil.source, list(chosen.unseen), None if shown is None else shown[1],
-                         chosen.measured.frame_mask, chosen.measured.frame, fitted, problems, fit)
+                         chosen.measured.frame_mask, frame, fitted, problems, fit)
+
+
+def _mirrored_uv(points) -> tuple[tuple[float, float], ...]:
+    """Texture points on a photo as on its mirror image, and back."""
+    return tuple((round(1.0 - u, UV_DECIMALS), v) for u, v in points)
 
 
 def _greyscale(photo: Photo) -> bool:

@@ -50,11 +50,12 @@ class Silhouette:
 
 
 def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None,
-               mask_size: tuple[int, int] | None = None) -> Silhouette:
+               mask_size: tuple[int, int] | None = None, mirror: bool = False) -> Silhouette:
     """The fish's silhouette, checked: one object, wholly inside the frame. A mask file must be
-    ``mask_size`` (the original photo's, when ``photo`` is a scaled-down working copy)."""
+    ``mask_size`` (the original photo's, when ``photo`` is a scaled-down working copy); with
+    ``mirror``, it is mirrored as ``photo`` was (:func:`.image.mirror_image`)."""
     if mask_path is not None:
-        raw, source = _mask_file(mask_path, mask_size or photo.size, photo.size), "mask file"
+        raw, source = _mask_file(mask_path, mask_size or photo.size, photo.size, mirror), "mask file"
     elif photo.alpha is not None:
         raw, source = photo.alpha >= ALPHA_CUTOFF, "alpha"
     else:
@@ -268,7 +269,8 @@ def _off_backdrop(img: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return contrast, distance
 
 
-def _mask_file(path: str | os.PathLike, size: tuple[int, int], work: tuple[int, int]) -> np.ndarray:
+def _mask_file(path: str | os.PathLike, size: tuple[int, int], work: tuple[int, int],
+               mirror: bool = False) -> np.ndarray:
     from PIL import Image
 
     from fishgen.authoring.photo.image import load_photo
@@ -279,6 +281,8 @@ def _mask_file(path: str | os.PathLike, size: tuple[int, int], work: tuple[int, 
                            f"found {m.size[0]} x {m.size[1]}", path)
     grey = m.rgb.mean(axis=2)
     white = (grey >= 128) if m.alpha is None else (m.alpha >= 128) & (grey >= 128)
+    if mirror:   # before any scaling, as the photo was mirrored before its working copy was made
+        white = white[:, ::-1]
     if work != size:
         img = Image.fromarray(white.astype(np.uint8) * 255).resize(work, Image.Resampling.BILINEAR)
         white = np.asarray(img) >= 128
