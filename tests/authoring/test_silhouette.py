@@ -124,44 +124,62 @@ def test_faint_edges_of_an_alpha_photo_are_its_faint_alpha():
     assert faint_edges(photo, fish).sum() == 20 and faint_edges(photo, fish)[19:21, 40:50].all()
 
 
-def _curled(hole_alpha: int) -> Photo:
-    """An alpha photo of a fish whose fin curls back to its body: a ring 60 x 40 px round a
-    hole 20 x 10 px of alpha ``hole_alpha`` (0: the backdrop seen through it)."""
-    alpha = np.zeros((80, 120), np.uint8)
-    alpha[20:60, 30:90] = 255
-    alpha[35:45, 50:70] = hole_alpha
-    return Photo(np.zeros((80, 120, 3), np.uint8), alpha, Path("p.png"))
+def _curled(hole_alpha: int, hole: tuple[int, int] = (10, 20)) -> Photo:
+    """An alpha photo of a fish 100 x 60 px round a hole of ``hole`` (rows, columns) px of alpha
+    ``hole_alpha`` (0: the backdrop seen through it), as a fin curled back to the body leaves."""
+    alpha = np.zeros((100, 160), np.uint8)
+    alpha[20:80, 30:130] = 255
+    rows, cols = hole
+    alpha[45:45 + rows, 60:60 + cols] = hole_alpha
+    return Photo(np.zeros((100, 160, 3), np.uint8), alpha, Path("p.png"))
 
 
 def test_a_hole_an_alpha_photo_shows_the_backdrop_through_stays_open():
     """The hand-shaped tall fish's caudal lobe closes a hole over its body: filled, the fit's
     target stood 0.92 from the true silhouette, and the fish fitted to it 0.847 in Blender."""
-    fish = silhouette(_curled(0)).mask
-    assert not fish[35:45, 50:70].any()
-    assert fish.sum() == 40 * 60 - 10 * 20
+    fish = silhouette(_curled(0, (10, 20))).mask
+    assert not fish[45:55, 60:80].any()
+    assert fish.sum() == 60 * 100 - 10 * 20
 
 
 def test_a_hole_of_faint_alpha_is_a_translucent_fin_and_filled():
-    assert silhouette(_curled(40)).mask[35:45, 50:70].all()
+    assert silhouette(_curled(40, (10, 20))).mask[45:55, 60:80].all()
 
 
-def test_a_mask_file_s_hole_stays_open_and_a_pinhole_is_filled(tmp_path):
-    drawn = np.zeros((80, 120), np.uint8)
-    drawn[20:60, 30:90] = 255
-    drawn[35:45, 50:70] = 0
-    drawn[25, 40] = 0                  # a speck the brush missed
+def test_a_transparent_spot_under_a_fiftieth_of_the_fish_is_filled():
+    """A background remover's transparent eye or spot is no gap between fin and body."""
+    assert silhouette(_curled(0, (8, 8))).mask[45:53, 60:68].all()     # 64 px: about 1 %
+
+
+def test_opening_a_hole_never_cuts_a_fin_off():
+    """A dorsal arch 2 px off the body, which the gap-closing joined across the hole under it:
+    opened, the arch would float apart, so that hole stays filled."""
+    alpha = np.zeros((100, 160), np.uint8)
+    alpha[50:80, 30:130] = 255          # the body
+    alpha[20:26, 50:110] = 255          # the arch's top
+    alpha[26:48, 50:56] = 255           # its legs, ending 2 px above the body
+    alpha[26:48, 104:110] = 255
+    fish = silhouette(Photo(np.zeros((100, 160, 3), np.uint8), alpha, Path("p.png"))).mask
+    assert fish[30:45, 60:100].all()
+
+
+def test_a_mask_file_s_holes_are_filled_as_unpainted_spots(tmp_path):
+    """A drawn mask's unpainted spots, or a mask drawn as an outline, are no backdrop: 25 spots of
+    6 px took a review's fit from 0.933 to 0.742 while they were left open."""
+    drawn = np.zeros((100, 160), np.uint8)
+    drawn[20:80, 30:130] = 255
+    drawn[45:55, 60:80] = 0
     Image.fromarray(drawn).save(tmp_path / "mask.png")
-    photo = Photo(np.full((80, 120, 3), 90, np.uint8), None, Path("p.png"))
-    fish = silhouette(photo, tmp_path / "mask.png").mask
-    assert not fish[35:45, 50:70].any() and fish[25, 40]
+    photo = Photo(np.full((100, 160, 3), 90, np.uint8), None, Path("p.png"))
+    assert silhouette(photo, tmp_path / "mask.png").mask[45:55, 60:80].all()
 
 
 def test_over_water_a_hole_is_filled_as_fish_of_the_water_s_colour():
-    """Over Blender's water photos, nearly every hole past 10 px was fish the water's colour."""
-    rgb = np.full((80, 120, 3), (40, 90, 120), np.uint8)
-    rgb[20:60, 30:90] = (200, 120, 60)
-    rgb[35:45, 50:70] = (40, 90, 120)
-    assert silhouette(Photo(rgb, None, Path("p.png"))).mask[35:45, 50:70].all()
+    """Over Blender's water photos, 143 of 144 holes were fish the water's colour."""
+    rgb = np.full((100, 160, 3), (40, 90, 120), np.uint8)
+    rgb[20:80, 30:130] = (200, 120, 60)
+    rgb[45:55, 60:80] = (40, 90, 120)
+    assert silhouette(Photo(rgb, None, Path("p.png"))).mask[45:55, 60:80].all()
 
 
 def _swirled_photo() -> tuple[Photo, np.ndarray]:
