@@ -192,8 +192,9 @@ def silhouette_iou(a: np.ndarray, b: np.ndarray) -> float:
     return float((ca & cb2).sum() / union) if union else 0.0
 
 
-def compare_image(photo_rgba: np.ndarray, render_rgba: np.ndarray, caption: str):
-    """The photo and the rebuilt fish side by side on a light grey ground, with a caption."""
+def compare_image(photo_rgba: np.ndarray, render_rgba: np.ndarray, caption: str, label: str = "photo"):
+    """The photo (``label`` under it) and the rebuilt fish side by side on a light grey ground,
+    with a caption."""
     from PIL import Image, ImageDraw
 
     h = max(photo_rgba.shape[0], render_rgba.shape[0])
@@ -202,6 +203,6 @@ def compare_image(photo_rgba: np.ndarray, render_rgba: np.ndarray, caption: str)
     sheet.alpha_composite(Image.fromarray(photo_rgba, "RGBA"), (0, 0))
     sheet.alpha_composite(Image.fromarray(render_rgba, "RGBA"), (photo_rgba.shape[1], 0))
     draw = ImageDraw.Draw(sheet)
-    draw.text((8, h + 8), "photo", fill=(40, 40, 40, 255))
+    draw.text((8, h + 8), label, fill=(40, 40, 40, 255))
     draw.text((photo_rgba.shape[1] + 8, h + 8), caption, fill=(40, 40, 40, 255))
     return sheet.convert("RGB")

@@ -189,7 +189,7 @@ def turned(mask: np.ndarray, frame: Frame, degrees: float) -> Frame:
     out, shift = _resample(mask, linear)
     # R(-d) F = F R(d) for the mirror F: a mirrored fish's turn on the photo is the other way
     angle = frame.angle - degrees if frame.mirrored else frame.angle + degrees
-    return Frame(linear, shift, out, angle, frame.mirrored)
+    return replace(frame, linear=linear, shift=shift, mask=out, angle=angle)
 
 
 def _neck(mask: np.ndarray) -> float:

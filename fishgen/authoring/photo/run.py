@@ -25,7 +25,7 @@ from fishgen.authoring.photo.image import (
     working_copy,
 )
 from fishgen.authoring.photo.sideview import SideView, side_view, with_counts
-from fishgen.authoring.photo.silhouette import pale_patches, silhouette
+from fishgen.authoring.photo.silhouette import Silhouette, pale_patches, silhouette
 from fishgen.errors import FishgenError, UsageError, cannot
 from fishgen.species.model import Species, TexturePoints
 
@@ -243,6 +243,27 @@ def make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pat
         raise
 
 
+def _measured_copy(original: Photo, options: TextureOptions,
+                   mirror: bool = False) -> tuple[Photo, Silhouette]:
+    """The copy of ``original`` the fish is measured on, and its silhouette (``mirror``: the photo
+    is a mirror image, and so is the --mask file made to be)."""
+    # At most MEASURE_SIDE pixels a side: a 64-megapixel photo would otherwise need gigabytes, and
+    # a full-HD one's fit took twice as long for no better fish.
+    photo = working_copy(original, measuring_side(original.size))
+    try:
+        sil = silhouette(photo, options.mask, original.size, mirror)
+        # --body-sections asks for two pixels a section: as many as the larger copy gives
+        small = int(sil.mask.any(axis=0).sum()) < max(SMALL_FISH, 2 * (options.body_sections or 0))
+    except FishgenError:
+        if photo is original:
+            raise
+        small = True   # said again below, from the larger copy, if it is the photo's fault
+    if small and photo is not original:
+        photo = working_copy(original, measuring_side(original.size, FINE_SIDE))
+        sil = silhouette(photo, options.mask, original.size, mirror)
+    return photo, sil
+
+
 def check_out(out: str | os.PathLike) -> Path:
     """``out`` as the new species file's path, when it names one (.txt)."""
     out = Path(out)
@@ -263,29 +284,13 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         raise UsageError(f"expected --spacing {'|'.join(fixel.SPACINGS)}, found {options.spacing!r}")
     note = on_note or (lambda _text: None)
     original = load_photo(photo_path)
-    # Measured on a copy of at most MEASURE_SIDE pixels a side: a 64-megapixel photo would
-    # otherwise need gigabytes, and a full-HD one's fit took twice as long for no better fish.
-    side = measuring_side(original.size)
-    photo = working_copy(original, side)
-    try:
-        sil = silhouette(photo, options.mask, original.size)
-        # --body-sections asks for two pixels a section: as many as the larger copy gives
-        small = int(sil.mask.any(axis=0).sum()) < max(SMALL_FISH, 2 * (options.body_sections or 0))
-    except FishgenError:
-        if photo is original:
-            raise
-        small = True   # said again below, from the larger copy, if it is the photo's fault
-    if small and photo is not original:
-        side = measuring_side(original.size, FINE_SIDE)
-        photo = working_copy(original, side)
-        sil = silhouette(photo, options.mask, original.size)
-    # A fish facing right is measured on the photo's mirror image, so it gives the files that
-    # image gives, texture and all (the texture then faces left, as every species' does).
+    photo, sil = _measured_copy(original, options)
+    # A fish facing right is measured on the photo's mirror image from here on, so it gives the
+    # files that image gives, texture and all (the texture then faces left, as every species' does).
     flipped = faces_right(sil.mask)
     if flipped:
         original = mirror_image(original)
-        photo = working_copy(original, side)
-        sil = silhouette(photo, options.mask, original.size, mirror=True)
+        photo, sil = _measured_copy(original, options, mirror=True)
     span = int(sil.mask.any(axis=0).sum())  # the fish's length in the working copy's pixels
     if options.body_sections is not None and options.body_sections > max(3, span // 2):
         # more sections than the photo has pixels measures nothing, and --fit-shape took 31 s at 256
@@ -464,14 +469,14 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     if options.compare is not None:
         if shown is None:
             shown = _rendered(photo, chosen, out, distance)
-        files[Path(options.compare)], _ = _compare_png(photo, *shown)
+        files[Path(options.compare)], _ = _compare_png(photo, *shown, mirrored=flipped)
     write_files(files)
     frame = chosen.measured.frame
-    if flipped and frame is not None:
+    assert frame is not None   # measure() always has one
+    if flipped:
         frame = frame.of_mirror(photo.size[0])
-    return TextureResult(chosen.species, list(files), chosen.measured.angle if frame is None else frame.angle,
-                         chosen.measured.mirrored if frame is None else frame.mirrored,
-                         sil.source, list(chosen.unseen), None if shown is None else shown[1],
+    return TextureResult(chosen.species, list(files), frame.angle, frame.mirrored, sil.source,
+                         list(chosen.unseen), None if shown is None else shown[1],
                          chosen.measured.frame_mask, frame, fitted, problems, fit)
 
 
@@ -627,7 +632,7 @@ def _render_size(photo: Photo) -> tuple[int, int]:
     return max(64, round(w * k)), max(64, round(h * k))
 
 
-def _compare_png(photo: Photo, render: np.ndarray, iou: float) -> tuple[bytes, float]:
+def _compare_png(photo: Photo, render: np.ndarray, iou: float, mirrored: bool = False) -> tuple[bytes, float]:
     from PIL import Image
 
     from fishgen.authoring.photo.compare import compare_image
@@ -636,7 +641,8 @@ def _compare_png(photo: Photo, render: np.ndarray, iou: float) -> tuple[bytes, f
     opaque = np.full(photo.rgb.shape[:2], 255, np.uint8)
     rgba = np.dstack([photo.rgb, opaque if photo.alpha is None else photo.alpha])
     small = np.asarray(Image.fromarray(rgba, "RGBA").resize((rw, rh), Image.Resampling.LANCZOS))
-    sheet = compare_image(small, render, f"fishgen texture: rebuilt (silhouette IoU {iou:.3f})")
+    sheet = compare_image(small, render, f"fishgen texture: rebuilt (silhouette IoU {iou:.3f})",
+                          "photo, mirrored" if mirrored else "photo")
     buf = io.BytesIO()
     sheet.save(buf, "PNG")
     return buf.getvalue(), iou
