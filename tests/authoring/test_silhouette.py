@@ -7,7 +7,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from fishgen.authoring.photo.image import Photo
-from fishgen.authoring.photo.silhouette import silhouette
+from fishgen.authoring.photo.silhouette import grain, silhouette
 
 SIZE = (400, 240)
 FISH = np.array([220.0, 200.0, 150.0])
@@ -287,3 +287,13 @@ def test_over_a_noise_free_backdrop_a_smooth_patch_is_not_pale(monkeypatch):
     assert not module.pale_patches(photo, fish).any()
     monkeypatch.setattr(module, "PALE_DETAIL", 0.0)
     assert (module.pale_patches(photo, fish) & under).sum() >= 0.3 * under.sum()
+
+
+def test_grain_is_the_border_s_spread_round_its_own_mean():
+    """A render's backdrop is smooth; a camera's sensor adds grain, measured in levels."""
+    smooth = _photo()
+    rng = np.random.default_rng(7)
+    grainy = Photo(np.clip(smooth.rgb + rng.normal(0.0, 4.0, smooth.rgb.shape), 0, 255).astype(np.uint8),
+                   None, Path("grainy.png"))
+    assert grain(smooth) < 0.5
+    assert 3.0 < grain(grainy) < 4.5        # 4 levels, less the 3 x 3 mean's own share of it

@@ -25,7 +25,7 @@ from fishgen.authoring.photo.image import (
     working_copy,
 )
 from fishgen.authoring.photo.sideview import SideView, side_view, with_counts
-from fishgen.authoring.photo.silhouette import Silhouette, pale_patches, silhouette
+from fishgen.authoring.photo.silhouette import Silhouette, grain, pale_patches, silhouette
 from fishgen.errors import FishgenError, UsageError, cannot
 from fishgen.species.model import Species, TexturePoints
 
@@ -37,6 +37,13 @@ ADVICE_IOU = 0.85
 #: command's half-coverage figure and Blender's over 27 fits (issue 32; docs/blender-photos.md). A
 #: fish that clears ADVICE_IOU at half coverage by less is said to be near the line.
 RENDERERS_DIFFER = 0.006
+#: A photo over a backdrop this grainy (:func:`.silhouette.grain`, levels) may have lost a fin's thin
+#: tips to the grain, from its silhouette and so from the command's own figure: the tallest fin's tip
+#: 9-11 px short on Blender's photos given grain (1.5 levels) and JPEG 85, the box the overlap crops to
+#: 4 % smaller, and their fits up to 0.10 under the command's figure in Blender. A render's grain is 0-0.5.
+#: Under ADVICE_IOU + GRAIN_MARGIN such a fit is said to be unsure.
+GRAINY = 1.0
+GRAIN_MARGIN = 0.10
 #: --focal-length: how far the camera's distance, estimated from the fish's length in the photo
 #: (:func:`.compare.camera_distance`), may be off: a turned fish's length is not its side-on one, and
 #: another camera framing the rebuilt fish by its own extents stands elsewhere (issue 32: 2-6 % on
@@ -459,6 +466,11 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
                 "or none with --ortho)")
         note(_misfit_said(shown[1], traced=sil.source == "alpha" or options.mask is not None,
                           fit_shape=options.fit_shape, greyscale=_greyscale(photo), lens=lens))
+    elif shown is not None and sil.source == "background model" and shown[1] < ADVICE_IOU + GRAIN_MARGIN \
+            and (grainy := grain(photo)) >= GRAINY:
+        note(f"silhouette IoU {shown[1]:.3f}, but the photo is grainy ({grainy:.1f} levels on its border): a "
+             "fin's thin tips may be lost in the grain, from its outline and from this figure alike, and "
+             "the rebuilt fish may look unlike the photographed one; give --mask to be sure")
     files = dict(chosen.files)
     if options.fxl_out is not None:
         tp = chosen.species.texture_points

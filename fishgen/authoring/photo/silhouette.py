@@ -32,6 +32,7 @@ LOCAL_PATCH = 0.001        # of the fish's area: the smallest patch of fin judge
 NEAR_BAND = 12             # px round the fish whose backdrop sets that spread
 FAINT_ALPHA = 16           # alpha that may be a translucent fin's edge, not surely fish
 OPEN_HOLE = 0.02           # of the fish's area: the smallest hole an alpha channel leaves open
+GRAIN_BORDER = 0.05        # of the frame's shorter side: the border strips a photo's grain is read in
 FAINT_SIGMAS = 4.0         # unfiltered colour distance from the local backdrop that may be fin
 FAINT_HALF_WIDTH = 2.5     # px: the widest run of such pixels that is a fin's thread, not a swirl
 SWIRL_SIGMA = 24.0         # px: the scale of murky water's swirls, which the border's plane cannot follow
@@ -169,6 +170,21 @@ def pale_patches(photo: Photo, fish: np.ndarray) -> np.ndarray:
     judged = np.where(off, labels, 0)
     grainy = np.asarray(ndimage.median(detail, judged, index)) >= PALE_GRAIN * water
     return np.isin(labels, index[touching & big & grainy])
+
+
+def grain(photo: Photo) -> float:
+    """How grainy ``photo`` is: the spread (a robust standard deviation, in levels of 0-255) of its
+    border's pixels round their 3 x 3 mean, in the strips GRAIN_BORDER of the frame deep where
+    the backdrop is. Renders are smooth (Blender's 0.5, three.js's 0.2, JPEG's 0); a camera's
+    sensor is not (Blender's photos given grain of 4 levels and saved as JPEG 85: 1.5)."""
+    h, w = photo.rgb.shape[:2]
+    k = max(2, round(GRAIN_BORDER * min(h, w)))
+    rgb = photo.rgb.astype(np.float32)
+    residual = rgb - ndimage.uniform_filter(rgb, size=(3, 3, 1))
+    strips = [residual[1:k, 1:-1], residual[h - k:-1, 1:-1],          # the filter's own edge left out
+              residual[k:h - k, 1:k], residual[k:h - k, w - k:-1]]
+    values = np.concatenate([s.reshape(-1) for s in strips])
+    return float(1.4826 * np.median(np.abs(values))) if values.size else 0.0
 
 
 def faint_edges(photo: Photo, fish: np.ndarray) -> np.ndarray:
