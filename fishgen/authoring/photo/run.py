@@ -5,7 +5,7 @@ import contextlib
 import io
 import os
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
@@ -492,7 +492,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
                          chosen.measured.frame_mask, frame, fitted, problems, fit)
 
 
-def _mirrored_uv(points) -> tuple[tuple[float, float], ...]:
+def _mirrored_uv(points: Iterable[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
     """Texture points on a photo as on its mirror image, and back."""
     return tuple((round(1.0 - u, UV_DECIMALS), v) for u, v in points)
 
