@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageDraw
+from scipy import ndimage  # type: ignore[import-untyped]
 
 from fishgen.authoring.photo.image import Photo
 from fishgen.authoring.photo.silhouette import grain, silhouette
@@ -362,3 +363,26 @@ def test_water_in_shade_between_two_fins_stays_water():
         assert not (leaked_inside(rgb, fish) & notch).any(), shade
     rgb, fish, notch = _notch(WATER + np.array([20.0, -8.0, -8.0]))
     assert (leaked_inside(rgb, fish) & notch).sum() >= 0.9 * notch.sum()
+
+
+def test_the_water_between_a_spiny_fish_s_spines_is_no_leaked_body():
+    """A spiny fish's dorsal seals many narrow gaps, each a chance to stand out in hue from the
+    water beside it (over water blotched in hue, a review's spiny fish took 2-21 of its 46 gaps at
+    5 levels: its IoU 0.97 -> 0.80-0.96). A gap the disk merely bridged is no wider than the disk:
+    only a region wider than that, a body behind a break, is judged."""
+    from fishgen.authoring.photo.silhouette import LEAK_CLOSE, leaked_inside
+
+    w, h = SIZE
+    img = Image.new("L", SIZE, 0)
+    pen = ImageDraw.Draw(img)
+    pen.ellipse((80, 110, 320, 170), fill=255)
+    for x in range(120, 280, 13):            # spines 3 px wide, 10 px apart
+        pen.polygon([(x, 125), (x + 3, 125), (x + 2, 50), (x + 1, 50)], fill=255)
+    fish = np.asarray(img) > 0
+    gaps = ndimage.binary_fill_holes(ndimage.binary_closing(fish, structure=np.ones((2 * LEAK_CLOSE + 1,) * 2,
+                                                                                   bool))) & ~fish
+    assert gaps.sum() > 1000
+    rgb = np.ones((h, w, 1)) * WATER
+    rgb = np.where(gaps[:, :, None], WATER + np.array([20.0, -8.0, -8.0]), rgb)   # another hue there
+    rgb = np.where(fish[:, :, None], FISH, rgb)
+    assert not (leaked_inside(np.clip(rgb, 0, 255).astype(np.uint8), fish) & gaps).any()
