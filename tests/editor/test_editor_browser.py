@@ -51,10 +51,18 @@ def _values(path: Path) -> list[tuple]:
 
 def _drag_handle(ed: EditorPage, axis: str, dx: float, dy: float) -> None:
     """Drag the selected cube's handle along ``axis`` by (dx, dy) pixels, as a mouse does, once two
-    frames have been drawn: on a loaded machine the handles of a cube just selected may not be
-    placed yet, and the press then misses them (seen once in CI)."""
-    ed.page.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
-    point = ed.page.evaluate(f"fishgenEditor.handlePoint('{axis}')")
+    frames have been drawn and the handle stands still from one frame to the next: on a loaded
+    machine the handles of a cube just selected may not be placed yet, and the press then misses
+    them (seen twice in CI, the second time after a wait of two frames alone)."""
+    ed.settle()
+    point = None
+    for _ in range(50):
+        ed.page.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
+        now = ed.page.evaluate(f"fishgenEditor.handlePoint('{axis}')")
+        if now == point:
+            break
+        point = now
+    assert point is not None
     mouse = ed.page.mouse
     mouse.move(point["x"], point["y"])
     mouse.down()
