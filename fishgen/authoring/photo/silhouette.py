@@ -49,8 +49,6 @@ LEAK_CORE = 20             # px of a sealed region LEAK_CLEAR px off the fish an
 LEAK_CLEAR = 3             # px: past the outline's own halo
 LEAK_WATER = 15            # px: how far round a sealed region the water it is compared with lies
 LEAK_DARK = 30.0           # water darker than this (its colour's length, 0-255 units) is judged by nothing
-WATER_HOLE_LEVELS = 5.0    # a hole's mean colour nearer the water round the fish than this is water
-WATER_HOLE_REACH = 40      # px: how far round a hole the water it is compared with lies
 
 
 @dataclass(frozen=True)
@@ -75,7 +73,6 @@ def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None,
         fish |= _slivers(thread_mask(photo.rgb, fish) & ~fish, fish)
         fish |= translucent_mask(photo.rgb, fish)
         fish |= leaked_inside(photo.rgb, fish)
-        fish &= ~water_holes(photo.rgb, fish, ndimage.binary_opening(raw, structure=np.ones((3, 3), bool)))
     return Silhouette(fish, source)
 
 
@@ -202,43 +199,6 @@ def leaked_inside(rgb: np.ndarray, fish: np.ndarray) -> np.ndarray:
         if float(np.linalg.norm(step - (step @ unit) * unit)) >= LEAK_LEVELS:
             leaked[rows, cols] |= region
     return leaked
-
-
-def water_holes(rgb: np.ndarray, fish: np.ndarray, found: np.ndarray) -> np.ndarray:
-    """Holes in ``fish`` (pixels the background model had not ``found``, enclosed by fish) whose
-    mean colour, LEAK_CLEAR px off the fish round them, is within WATER_HOLE_LEVELS of the water's
-    near the hole: water a fin's thread closed in, not fish.
-
-    Over water a hole is nearly always fish nearly the water's colour, and is filled; but 2609's
-    dorsal thread, bled onto its caudal fin in JPEG 90, closed in 373 px of water, and the fit took
-    it for fin (0.845 in Blender, unsaid). Over the water photos of 8 of Blender's sets as PNG and
-    JPEG 90 (tuned on) 153 fish holes stood 6.9-50 levels from the water, that one 3.3; held out
-    (JPEG 75 and 85, grain, full HD) 190 fish holes 7.0 and more. Only the hole as the closing left
-    it is opened: what the closing added round it may be all that joins a thread to its fin."""
-    # the holes as the fish's own gap-closing made them (:func:`_one_fish`)
-    closed = ndimage.binary_closing(found, structure=np.ones((5, 5), bool)) | found
-    enclosed = ndimage.binary_fill_holes(closed) & ~closed & fish
-    labels, count = ndimage.label(enclosed, structure=np.ones((3, 3), bool))
-    holes = np.zeros_like(fish)
-    water = ~ndimage.binary_dilation(fish, structure=np.ones((3, 3), bool), iterations=2)
-    if count == 0 or not water.any():
-        return holes
-    core = enclosed & (ndimage.distance_transform_edt(fish & ~found) > LEAK_CLEAR)
-    cores = np.bincount(labels[core], minlength=count + 1)
-    h, w = fish.shape
-    for index, box in enumerate(ndimage.find_objects(labels), start=1):
-        if box is None or cores[index] < LEAK_CORE:
-            continue
-        rows = slice(max(box[0].start - WATER_HOLE_REACH, 0), min(box[0].stop + WATER_HOLE_REACH, h))
-        cols = slice(max(box[1].start - WATER_HOLE_REACH, 0), min(box[1].stop + WATER_HOLE_REACH, w))
-        near = rgb[rows, cols][water[rows, cols]]
-        near = near if len(near) >= LEAK_CORE else rgb[water]
-        region = labels[rows, cols] == index
-        step = rgb[rows, cols][region & core[rows, cols]].mean(axis=0, dtype=np.float64) \
-            - near.mean(axis=0, dtype=np.float64)
-        if float(np.linalg.norm(step)) < WATER_HOLE_LEVELS:
-            holes[rows, cols] |= region
-    return holes
 
 
 def pale_patches(photo: Photo, fish: np.ndarray) -> np.ndarray:
@@ -450,8 +410,8 @@ def _open_holes(holes: np.ndarray, clean: np.ndarray, fish: np.ndarray, alpha: n
     """``fish`` with the holes an alpha channel shows the backdrop through left open, out to the
     fish's own pixels round them: the gap between a body and a fin that curls back towards it.
 
-    A photo over a backdrop fills every hole but the water's own colour (:func:`water_holes`), for
-    there a hole is nearly always fish nearly the water's colour, and a mask file fills all, whose
+    A photo over a backdrop fills every hole, for there a hole is nearly always fish of the water's
+    colour (143 of 144 over Blender's water photos, PNG and JPEG), and so does a mask file, whose
     unpainted spots or outline-only drawing are no backdrop (a review's masks: 25 spots of 6 px
     took a fit from 0.933 to 0.742). An alpha channel tells the backdrop from fish: a hole there
     is left open if its alpha averages under FAINT_ALPHA (a fin so translucent that it fell under
