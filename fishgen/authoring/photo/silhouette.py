@@ -87,8 +87,6 @@ def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None,
 
 def _joined_faint(fish: np.ndarray, faint: np.ndarray) -> np.ndarray:
     """``fish`` with the pieces of ``faint`` (:func:`_faint_body`) that touch it, and what they enclose."""
-    if not faint.any():
-        return fish
     labels, count = ndimage.label(faint & ~fish, structure=np.ones((3, 3), bool))
     if count == 0:
         return fish
@@ -99,14 +97,9 @@ def _joined_faint(fish: np.ndarray, faint: np.ndarray) -> np.ndarray:
     return ndimage.binary_fill_holes(fish | np.isin(labels, touching))
 
 
-def background_model_mask(rgb: np.ndarray) -> np.ndarray:
-    """Pixels whose colour the border's planar colour model does not explain."""
-    return background_model_masks(rgb)[0]
-
-
 def background_model_masks(rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(fish, faint body): the pixels that stand out from the border's planar colour model by
-    MIN_CONTRAST, and the :func:`_faint_body` joined to them."""
+    """(fish, faint body): the pixels whose colour the border's planar colour model does not explain
+    (they stand out by MIN_CONTRAST), and the :func:`_faint_body` joined to them."""
     img = ndimage.uniform_filter(rgb.astype(np.float32), size=(3, 3, 1))   # float32 halves the memory
     contrast, distance = _off_backdrop(img)
     sure = (distance > NOISE_SIGMAS) & (contrast > MIN_CONTRAST)
@@ -147,6 +140,7 @@ def _faint_body(contrast: np.ndarray, distance: np.ndarray, sure: np.ndarray) ->
     for index, box in enumerate(ndimage.find_objects(labels), start=1):
         if box is None:
             continue
+        # room for the ring outside it, 4 px
         rows = slice(max(box[0].start - 6, 0), min(box[0].stop + 6, h))
         cols = slice(max(box[1].start - 6, 0), min(box[1].stop + 6, w))
         region = labels[rows, cols] == index
@@ -166,7 +160,7 @@ def _faint_body(contrast: np.ndarray, distance: np.ndarray, sure: np.ndarray) ->
 def thread_mask(rgb: np.ndarray, fish: np.ndarray) -> np.ndarray:
     """Pixels of the unfiltered photo that stand out from the backdrop as surely as the fish's do
     and carry at least half the contrast of the fish near them (``fish``: within THREAD_REACH px):
-    a fin's last 1-px thread, which the box filter before :func:`background_model_mask` averages
+    a fin's last 1-px thread, which the box filter before :func:`background_model_masks` averages
     into the backdrop, and not the faint halo round an anti-aliased edge."""
     contrast, distance = _off_backdrop(rgb.astype(np.float32))
     near = ndimage.maximum_filter(np.where(fish, contrast, 0.0), size=2 * THREAD_REACH + 1)
@@ -183,7 +177,7 @@ def translucent_mask(rgb: np.ndarray, fish: np.ndarray) -> np.ndarray:
     deviations, away from the fish) spread over the gaps by a normalised Gaussian, and a pixel is fin
     when it differs from it by LOCAL_SIGMAS of its own spread and LOCAL_CONTRAST, in a patch at least
     LOCAL_WIDTH px wide that touches the fish and differs by PATCH_SIGMAS at its median. Its rim is
-    kept as :func:`background_model_mask` keeps the fish's: where it carries half the contrast of
+    kept as :func:`background_model_masks` keeps the fish's: where it carries half the contrast of
     the fin just inside it."""
     img = ndimage.uniform_filter(rgb.astype(np.float32), size=(LOCAL_BOX, LOCAL_BOX, 1))
     local = _local_contrast(img, fish)
