@@ -164,29 +164,42 @@ def camera(tab) -> dict:
     return tab.evaluate("({...window.fishgenFly.camera, speed: window.fishgenFly.speed})")
 
 
-def hold(tab, key: str, count: int = 6) -> None:
-    """Hold a key down while the page draws ``count`` frames."""
+def hold(tab, key: str, until: str, count: int = 3) -> None:
+    """Hold a key down for at least ``count`` frames and until ``until`` (a JavaScript test of the
+    camera ``c``) holds, sending keydown again every second as a keyboard's auto-repeat does.
+
+    The page moves on a key it holds down, not on each keydown; the repeats only guard against
+    a keydown a loaded headless Chromium lost (CI saw one arrow move nothing in four frames).
+    """
+    import playwright.sync_api as pw
+
     drawn = tab.evaluate("window.fishgenFly.frames")
-    tab.keyboard.down(key)
-    tab.wait_for_function(f"window.fishgenFly.frames > {drawn + count}", timeout=60_000)
+    test = f"window.fishgenFly.frames > {drawn + count} && (c => {until})(window.fishgenFly.camera)"
+    for _ in range(30):
+        tab.keyboard.down(key)
+        try:
+            tab.wait_for_function(test, timeout=1_000)
+            break
+        except pw.TimeoutError:
+            continue
     tab.keyboard.up(key)
 
 
 def test_pakawans_keys_move_and_turn_the_camera(page):
     start = camera(page)
     assert start["yaw"] == 0 and start["pitch"] == 0          # looking along -z, into the sky
-    hold(page, "w")
+    hold(page, "w", f"c.position[2] < {start['position'][2]}", 6)
     ahead = camera(page)
     dx, dy, dz = (a - b for a, b in zip(ahead["position"], start["position"], strict=True))
     assert dz < 0 and abs(dx) < 1e-6 * abs(dz) + 1e-9 and abs(dy) < 1e-6 * abs(dz) + 1e-9   # forward
-    hold(page, "s", 3)
+    hold(page, "s", f"c.position[2] > {ahead['position'][2]}")
     assert camera(page)["position"][2] > ahead["position"][2]                                  # back
     before = camera(page)
-    hold(page, "d", 3)
+    hold(page, "d", f"c.position[0] > {before['position'][0]}")
     assert camera(page)["position"][0] > before["position"][0]                                 # right
-    hold(page, "ArrowLeft", 3)
+    hold(page, "ArrowLeft", "c.yaw > 0")
     assert camera(page)["yaw"] > 0                                                             # turned left
-    hold(page, "ArrowUp", 3)
+    hold(page, "ArrowUp", "c.pitch > 0")
     assert camera(page)["pitch"] > 0                                                           # looks up
     page.keyboard.press("3")
     assert camera(page)["speed"] == 3
