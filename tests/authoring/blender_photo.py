@@ -253,7 +253,8 @@ class Fitted:
 class FitRun:
     """One ``fishgen texture --fit-shape`` of a photo on a base (:func:`fit_one`): its row, the
     command's result, the species file written (beside its textures), the rebuilt species, the shot
-    it is photographed side-on with, and the photo's true silhouette levelled by the command."""
+    it is photographed side-on with, the photo's true silhouette levelled by the command, and the
+    photo's size in pixels (the rebuilt fish is photographed at it)."""
     key: str
     row: Fitted
     result: Any = field(repr=False)
@@ -261,13 +262,20 @@ class FitRun:
     rebuilt: Any = field(repr=False)
     shot: Shot
     level: np.ndarray = field(repr=False)
+    size: tuple[int, int] = SIZE
+
+
+def photo_size(rec: dict) -> tuple[int, int]:
+    """The size a :func:`photograph` record's photo was taken at (its camera's), in pixels."""
+    camera = rec.get("camera") or {}
+    return (int(camera["width"]), int(camera["height"])) if "width" in camera else SIZE
 
 
 def fit_one(name: str, rec: dict, base_name: str, base: Any, folder: Path, lens: bool = True) -> FitRun:
     """``fishgen texture --fit-shape`` of the photo ``name`` (:func:`photograph`'s record) on
     ``base``, into ``folder/name/base_name.txt``, told the photo's ``--focal-length`` when ``lens``
     (as a camera's EXIF tells it); the rebuilt fish filled from the photo's camera, side-on, by
-    :func:`raster_mask` against the photo's true silhouette."""
+    :func:`raster_mask` at the photo's own size against the photo's true silhouette."""
     import time
 
     from PIL import Image
@@ -296,29 +304,35 @@ def fit_one(name: str, rec: dict, base_name: str, base: Any, folder: Path, lens:
     rebuilt = load_species(out)
     level = result.frame.level(truth)
     scene = build_fish(rebuilt)
-    camera = camera_for(rest_triangles(scene).reshape(-1, 3), shot.side_on())
+    size = photo_size(rec)
+    camera = camera_for(rest_triangles(scene).reshape(-1, 3), shot.side_on(), size)
     raster = silhouette_iou(level, raster_mask(scene, camera))
     row = Fitted(name, base_name, result.fitted, result.iou, raster, None, tuple(notes), seconds)
-    return FitRun(f"{name}--{base_name}", row, result, out, rebuilt, shot, level)
+    return FitRun(f"{name}--{base_name}", row, result, out, rebuilt, shot, level, size)
 
 
-def photographed(runs: list[FitRun], folder: Path, size: tuple[int, int] = SIZE) -> list[Fitted]:
+def photographed(runs: list[FitRun], folder: Path, size: tuple[int, int] | None = None) -> list[Fitted]:
     """Each run's row with the rebuilt fish photographed side-on by Blender (:func:`fitted_masks`)
-    against the photo's true silhouette: as the file shows it and every triangle of it."""
+    against the photo's true silhouette: as the file shows it and every triangle of it, at ``size``
+    or else at its photo's own size (a full-HD photo's thin fin tips vanish at 640 x 360, and the
+    overlap, cropped to each fish's box, then stretches the rebuilt fish onto the photo's)."""
     from fishgen.authoring.photo.compare import silhouette_iou
 
-    masks = fitted_masks({run.key: (run.rebuilt, run.shot) for run in runs}, folder, size)
+    masks: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for each in sorted({size or run.size for run in runs}):
+        fits = {run.key: (run.rebuilt, run.shot) for run in runs if (size or run.size) == each}
+        masks |= fitted_masks(fits, folder, each)
     return [replace(run.row, blender=silhouette_iou(run.level, masks[run.key][0]),
                     triangles=silhouette_iou(run.level, masks[run.key][1])) for run in runs]
 
 
 def fit_photos(records: dict[str, dict], bases: dict, folder: Path, blender: bool = True,
                skip: dict[str, str] | None = None, lens: bool = True,
-               size: tuple[int, int] = SIZE) -> list[Fitted]:
+               size: tuple[int, int] | None = None) -> list[Fitted]:
     """``fishgen texture --fit-shape`` of every photo (name -> :func:`photograph`'s record) on every
     base (name -> species) but the one it was shaped from (``skip``: photo -> base), told the
     photo's ``--focal-length`` when ``lens`` (as a camera's EXIF tells it): :func:`fit_one` each,
-    then, with ``blender``, :func:`photographed` at ``size`` (the photos')."""
+    then, with ``blender``, :func:`photographed` at ``size`` (by default each photo's own)."""
     runs = [fit_one(name, rec, base_name, base, folder, lens)
             for name, rec in records.items() for base_name, base in bases.items()
             if (skip or {}).get(name) != base_name]

@@ -113,6 +113,27 @@ def test_fit_photographed_again_by_blender(tmp_path, gl_available, fitted):
     assert abs(row.blender - row.raster) <= 0.03
 
 
+def test_each_rebuilt_fish_is_photographed_at_its_photo_s_size(monkeypatch, tmp_path):
+    """A full-HD photo's rebuilt fish is photographed at full HD, a small photo's at its size: at
+    640 x 360 a full-HD fish's thin fin tips vanish and the box-cropped overlap stretches it."""
+    asked = []
+
+    def masks(fits, folder, size):
+        asked.append((sorted(fits), size))
+        return {key: (np.ones((4, 8), bool), np.ones((4, 8), bool)) for key in fits}
+
+    monkeypatch.setattr(bp, "fitted_masks", masks)
+    records = {"hd": {"camera": {"width": 1920, "height": 1080}},
+               "small": {"camera": {"width": 640, "height": 360}}}
+    runs = [bp.FitRun(f"{name}--bonybream", bp.Fitted(name, "bonybream", True, 0.9, 0.9, None, (), 0.0), None,
+                      tmp_path, None, bp.Shot(), np.ones((4, 8), bool), bp.photo_size(rec))
+            for name, rec in records.items()]
+    rows = bp.photographed(runs, tmp_path)
+    assert asked == [(["small--bonybream"], (640, 360)), (["hd--bonybream"], (1920, 1080))]
+    assert [row.blender for row in rows] == [1.0, 1.0]
+    assert bp.photo_size({"shot": {}}) == bp.SIZE     # a record without its camera: the default
+
+
 def test_fixtures_folder_is_small():
     """Committed photos stay a few hundred KB."""
     assert sum(p.stat().st_size for p in bp.FIXTURES.iterdir()) < 800_000
