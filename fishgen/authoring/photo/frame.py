@@ -29,6 +29,8 @@ STANDING_NECK = 1.5
 #: Within it the fit's own turns (:data:`.run.TURNS`, up to 4 degrees) take the rest.
 RELEVEL_DEGREES = 4.0
 RELEVELS = 6
+#: Two levels at least this many degrees apart are two readings of the fish, not one (fish_frame).
+TWO_LEVELS = 8.0
 #: The photo as it stands overrules the principal axis's turn on which end is the tail only where
 #: one of its necks is at least this many times the other (:func:`_tail_left`).
 TAIL_DECISIVE = 2.0
@@ -155,6 +157,16 @@ def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
     if settled[1] != phi or abs(settled[1]) > STEEPEST_AXIS:
         tries = [settled, levelled(0.0)]
         settled = min(tries, key=lambda t: (abs(t[1]) > STEEPEST_AXIS, abs(t[0])))
+    elif abs(phi) > TWO_LEVELS:
+        # Tall fins may give a fish two levels its midline agrees with: the axis's turn, and one
+        # near level (3207, turned 26 degrees, as it stands 2.3 off). Side photos show fish about
+        # level: the one nearer level is kept when it too is a level (its midline within
+        # RELEVEL_DEGREES) and the two are TWO_LEVELS apart (a fish a few degrees off is one).
+        stands = levelled(0.0)
+        if abs(stands[0]) <= RELEVEL_DEGREES and abs(stands[1]) <= abs(phi) - TWO_LEVELS:
+            near = stands[1] - stands[0] if mirrored else stands[1] + stands[0]
+            again = levelled(near if abs(near) >= LEVEL_DEGREES else 0.0)
+            settled = again if abs(again[0]) <= abs(stands[0]) else stands
     _, phi, linear, out, shift = settled
     return Frame(linear, shift, out, phi, mirrored)
 
