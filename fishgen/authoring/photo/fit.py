@@ -80,12 +80,14 @@ def fit_shape(base: Species, mask: np.ndarray) -> Species:
     return fit_species(base, mask).species
 
 
-def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False, turn: float = 0.0) -> ShapeFit:
-    """Fit ``base``'s geometry to the silhouette ``mask`` (any orientation; it is levelled here,
-    then turned ``turn`` degrees further: see :data:`.run.TURNS`)."""
+def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False, turn: float = 0.0,
+                level: Any = None) -> ShapeFit:
+    """Fit ``base``'s geometry to the silhouette ``mask`` (any orientation; it is levelled here, or
+    as the frame ``level`` of it says (:func:`.frame.other_level`), then turned ``turn`` degrees
+    further: see :data:`.run.TURNS`)."""
     from fishgen.authoring.photo.frame import fish_frame, turned
 
-    frame = turned(mask, fish_frame(mask), turn)
+    frame = turned(mask, level if level is not None else fish_frame(mask), turn)
     work, to_frame, offset = working_mask(frame.mask)
     body = measure_body(work)
     base = replace(base, texture_points=None, colour_texture=None, mask_texture=None)

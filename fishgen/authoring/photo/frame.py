@@ -29,7 +29,7 @@ STANDING_NECK = 1.5
 #: Within it the fit's own turns (:data:`.run.TURNS`, up to 4 degrees) take the rest.
 RELEVEL_DEGREES = 4.0
 RELEVELS = 6
-#: Two levels at least this many degrees apart are two readings of the fish, not one (fish_frame).
+#: Two levels at least this many degrees apart are two readings of the fish, not one (other_level).
 TWO_LEVELS = 8.0
 #: The photo as it stands overrules the principal axis's turn on which end is the tail only where
 #: one of its necks is at least this many times the other (:func:`_tail_left`).
@@ -114,21 +114,19 @@ def _axis_and_facing(mask: np.ndarray) -> tuple[float, bool]:
     return theta, _tail_left(first, mask if theta else None)
 
 
-def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
-    """Level the fish by its principal axis, turn its head left, then level its midline
-    (nose to tail base) exactly, as Fixel's user would draw it."""
-    theta, mirrored = _axis_and_facing(mask)
-    flip = np.diag([-1.0, 1.0]) if mirrored else np.eye(2)
-    level, _ = _resample(mask, flip @ _rotation(-theta))
+def _leveller(mask: np.ndarray, mirrored: bool, tail_drop: float):
+    """(levelled, midline) for ``mask``: ``midline(level)`` is the degrees its nose-to-tail line is
+    off level; ``levelled(phi)`` the fish turned by phi and then levelled again on its own turn while
+    it is RELEVEL_DEGREES off, up to RELEVELS times: (midline, phi, linear, mask, shift)."""
     from fishgen.authoring.photo.anatomy import nose_and_tail_base
+
+    flip = np.diag([-1.0, 1.0]) if mirrored else np.eye(2)
 
     def midline(level: np.ndarray) -> float:
         (nx, ny), (px, py) = nose_and_tail_base(level, drop=tail_drop)
         return float(np.degrees(np.arctan2(py - ny, px - nx)))
 
     def levelled(phi: float) -> tuple[float, float, np.ndarray, np.ndarray, np.ndarray]:
-        """(midline's degrees off level, phi, linear, mask, shift) with the fish turned by phi,
-        then levelled again on its own turn while it is RELEVEL_DEGREES off, up to RELEVELS times."""
         linear = flip @ _rotation(-phi)
         out, shift = _resample(mask, linear)
         best = (midline(out), phi, linear, out, shift)
@@ -143,6 +141,16 @@ def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
             best = (midline(out), phi, linear, out, shift)
         return best
 
+    return levelled, midline
+
+
+def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
+    """Level the fish by its principal axis, turn its head left, then level its midline
+    (nose to tail base) exactly, as Fixel's user would draw it."""
+    theta, mirrored = _axis_and_facing(mask)
+    levelled, midline = _leveller(mask, mirrored, tail_drop)
+    flip = np.diag([-1.0, 1.0]) if mirrored else np.eye(2)
+    level, _ = _resample(mask, flip @ _rotation(-theta))
     delta = midline(level)
     phi = theta - delta if mirrored else theta + delta
     if abs(phi) < LEVEL_DEGREES:
@@ -157,18 +165,28 @@ def fish_frame(mask: np.ndarray, tail_drop: float = 0.0) -> Frame:
     if settled[1] != phi or abs(settled[1]) > STEEPEST_AXIS:
         tries = [settled, levelled(0.0)]
         settled = min(tries, key=lambda t: (abs(t[1]) > STEEPEST_AXIS, abs(t[0])))
-    elif abs(phi) > TWO_LEVELS:
-        # Tall fins may give a fish two levels its midline agrees with: the axis's turn, and one
-        # near level (3207, turned 26 degrees, as it stands 2.3 off). Side photos show fish about
-        # level: the one nearer level is kept when it too is a level (its midline within
-        # RELEVEL_DEGREES) and the two are TWO_LEVELS apart (a fish a few degrees off is one).
-        stands = levelled(0.0)
-        if abs(stands[0]) <= RELEVEL_DEGREES and abs(stands[1]) <= abs(phi) - TWO_LEVELS:
-            near = stands[1] - stands[0] if mirrored else stands[1] + stands[0]
-            again = levelled(near if abs(near) >= LEVEL_DEGREES else 0.0)
-            settled = again if abs(again[0]) <= abs(stands[0]) else stands
     _, phi, linear, out, shift = settled
     return Frame(linear, shift, out, phi, mirrored)
+
+
+def other_level(mask: np.ndarray, frame: Frame, tail_drop: float = 0.0) -> Frame | None:
+    """A second reading of the level of the fish ``frame`` (:func:`fish_frame` of ``mask``) levels:
+    the fish as it stands, corrected by its own midline, when ``frame`` turns it more than
+    TWO_LEVELS degrees and as it stands its midline is also within RELEVEL_DEGREES of level, at
+    least TWO_LEVELS nearer level; else None. Tall fins may give a fish two levels its nose and tail
+    base agree with (3207: turned 30 degrees by its fins' axis, level as it stands, and the fit made
+    at 30 scored 0.51-0.67 in Blender). The silhouette alone does not tell which is right (150
+    random fish turned 3-14 degrees: each reading right 4 times where they differ): a fit tries both."""
+    if abs(frame.angle) <= TWO_LEVELS:
+        return None
+    levelled, _ = _leveller(mask, frame.mirrored, tail_drop)
+    stands = levelled(0.0)
+    if abs(stands[0]) > RELEVEL_DEGREES or abs(stands[1]) > abs(frame.angle) - TWO_LEVELS:
+        return None
+    near = stands[1] - stands[0] if frame.mirrored else stands[1] + stands[0]
+    again = levelled(near if abs(near) >= LEVEL_DEGREES else 0.0)
+    _, phi, linear, out, shift = again if abs(again[0]) <= abs(stands[0]) else stands
+    return Frame(linear, shift, out, phi, frame.mirrored)
 
 
 def _tail_left(turned: np.ndarray, level: np.ndarray | None) -> bool:

@@ -55,8 +55,9 @@ DISTANCE_UNSURE = 0.05
 #: it is tried again with the photo turned these degrees further, in order, until one matches that
 #: well; a level is kept only when its rebuilt fish matches at least TURN_GAIN better.
 TURNS = (4.0, -4.0, 2.0, -2.0)
-LEVELS = 1 + len(TURNS)
-"""Levels --fit-shape may try: side-on, then each of TURNS."""
+LEVELS = 2 + len(TURNS)
+"""Levels --fit-shape may try: side-on at the measured level, at the second reading of it where
+there is one (:func:`.frame.other_level`), then each of TURNS from the better."""
 FITS = LEVELS + 1
 """A --fit-shape's steps for a progress bar: each level, then the rebuilt fish measured."""
 TURN_GOOD = 0.87
@@ -339,8 +340,10 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         from fishgen.authoring.photo.checks import fit_problems
         from fishgen.authoring.photo.compare import render_scale
         from fishgen.authoring.photo.fit import fit_species, settled_in_perspective, settled_tips
+        from fishgen.authoring.photo.frame import fish_frame, other_level
 
         tried: tuple[np.ndarray, float] | None = None
+        as_it_stands = False   # the kept fit levels the fish as it stands (frame.other_level)
         chosen_fit: tuple[_Candidate, Any] | None = None
         # Over a backdrop the silhouette loses a translucent fin's last tips, and the fish fitted
         # without them was 0.85 in Blender where the command's own measure said 0.93: the fit
@@ -356,18 +359,28 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         # A fitted fin reaches out along the photo's 1-px threads: its mask keeps them (threads=True).
         seen = target if distance is not None and target is not sil.mask else sil.mask
         seen_textures = texture_bytes(original, photo, seen, threads=True)
-        for k, turn in enumerate((0.0, *TURNS)):
-            if tried is not None and tried[1] >= TURN_GOOD:
+        # A second reading of the fish's level (tall fins' axis against its line as it stands:
+        # frame.other_level) is always fitted too, as the silhouette cannot tell which is right;
+        # the TURNS then turn the better of the two.
+        first = fish_frame(target)
+        second = other_level(target, first)
+        best_level = None     # the level the kept fit was made at (None: the first reading)
+        for k, turn in enumerate((0.0, 0.0, *TURNS)):
+            if k > 1 and tried is not None and tried[1] >= TURN_GOOD:
                 step(LEVELS - k + 1)  # the level just fitted, and those left unneeded
                 break
             if k:
                 step(1)           # the level before
-            attempt = fit_species(base, target, sections_fixed=options.body_sections is not None, turn=turn)
+            if k == 1 and second is None:
+                continue          # no second reading of the fish's level
+            level = second if k == 1 else best_level
+            attempt = fit_species(base, target, sections_fixed=options.body_sections is not None, turn=turn,
+                                  level=level)
             attempt = settled_tips(attempt, render_scale(attempt.species, *_render_size(photo)))
             if distance is not None:
                 attempt = settled_in_perspective(attempt, distance, _render_size(photo))
             found = fit_problems(attempt.species, attempt.work, attempt.placement)
-            if turn == 0.0:
+            if k == 0:
                 fit, problems = attempt, found
             if found:
                 continue
@@ -377,6 +390,8 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
             # another level is kept only for a clear gain: the renders differ by a little anyway
             if tried is None or rendered[1] >= tried[1] + TURN_GAIN:
                 tried, chosen_fit, fit, problems = rendered, (candidate, attempt), attempt, []
+                best_level = level if turn == 0.0 else best_level
+                as_it_stands = level is not None
         else:
             step(1)
         if chosen_fit is None:
@@ -393,6 +408,10 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
                 if kept.turn:
                     note(f"note: the photographed fish is taken as turned {kept.turn:+.0f} degrees from "
                          "its nose-to-tail line (it is not side-on): that level matched best")
+                if as_it_stands:
+                    note("note: the fish is levelled by its nose-to-tail line as the photo stands "
+                         f"({kept.frame.angle:+.0f} degrees), not by its fins' long axis "
+                         f"({first.angle:+.0f}): that level matched best")
                 for line in kept.notes:
                     note(f"note: {line}")
                 chosen, shown, fitted = candidate, tried, True
