@@ -83,8 +83,9 @@ def fit_shape(base: Species, mask: np.ndarray) -> Species:
 def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False, turn: float = 0.0,
                 level: Any = None) -> ShapeFit:
     """Fit ``base``'s geometry to the silhouette ``mask`` (any orientation; it is levelled here, or
-    as the frame ``level`` of it says (:func:`.frame.other_level`), then turned ``turn`` degrees
-    further: see :data:`.run.TURNS`)."""
+    as the frame ``level`` of it says (:func:`.frame.fish_frame`, once for every level a caller
+    tries, or :func:`.frame.other_level`), then turned ``turn`` degrees further: see
+    :data:`.run.TURNS`)."""
     from fishgen.authoring.photo.frame import fish_frame, turned
 
     frame = turned(mask, level if level is not None else fish_frame(mask), turn)

@@ -364,7 +364,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         # the TURNS then turn the better of the two.
         first = fish_frame(target)
         second = other_level(target, first)
-        best_level = None     # the level the kept fit was made at (None: the first reading)
+        best_level = first    # the level the kept fit was made at
         for k, turn in enumerate((0.0, 0.0, *TURNS)):
             if k > 1 and tried is not None and tried[1] >= TURN_GOOD:
                 step(LEVELS - k + 1)  # the level just fitted, and those left unneeded
@@ -373,7 +373,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
                 step(1)           # the level before
             if k == 1 and second is None:
                 continue          # no second reading of the fish's level
-            level = second if k == 1 else best_level
+            level = second if k == 1 and second is not None else best_level
             attempt = fit_species(base, target, sections_fixed=options.body_sections is not None, turn=turn,
                                   level=level)
             attempt = settled_tips(attempt, render_scale(attempt.species, *_render_size(photo)))
@@ -391,7 +391,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
             if tried is None or rendered[1] >= tried[1] + TURN_GAIN:
                 tried, chosen_fit, fit, problems = rendered, (candidate, attempt), attempt, []
                 best_level = level if turn == 0.0 else best_level
-                as_it_stands = level is not None
+                as_it_stands = level is second
         else:
             step(1)
         if chosen_fit is None:
