@@ -124,3 +124,16 @@ def test_a_photo_is_measured_on_a_copy_1024_px_long_unless_that_would_be_under_6
     photo = Photo(np.zeros((h, w, 3), np.uint8), None, Path("photo.png"))
     copy = working_copy(photo, measuring_side(size))
     assert max(copy.size) == min(max(size), side) and min(copy.size) >= MIN_PHOTO_SIDE
+
+
+@pytest.mark.parametrize(("suffix", "lossy"), [(".jpg", True), (".png", False), (".webp", False)])
+def test_a_jpeg_is_known_as_lossy_and_its_copies_and_mirror_stay_so(tmp_path, suffix, lossy):
+    from fishgen.authoring.photo.image import mirror_image
+
+    path = tmp_path / f"photo{suffix}"
+    options = {"lossless": True} if suffix == ".webp" else {}
+    Image.new("RGB", (2048, 1024), (40, 90, 120)).save(path, **options)
+    photo = load_photo(path)
+    assert photo.lossy is lossy
+    assert working_copy(photo, 1024).lossy is lossy and working_copy(photo, 1024).size == (1024, 512)
+    assert mirror_image(photo).lossy is lossy

@@ -32,6 +32,9 @@ MAX_ASPECT = 32
 """Longest side over the shortest: beyond it the measuring copy, however long, would be under
 MIN_PHOTO_SIDE across (an 8000 x 64 photo measured 16 pixels tall, and its analysis ran out of fish
 rows: NaN)."""
+LOSSY_FORMATS = ("JPEG", "MPO")
+"""Pillow's names of the formats whose codec rings round a sharp outline (JPEG's 8 x 8 blocks; MPO
+is a camera's JPEG with a second frame). A lossy WebP rings too, but its header does not say so."""
 
 
 @dataclass(frozen=True)
@@ -40,6 +43,7 @@ class Photo:
     alpha: np.ndarray | None     # (H, W) uint8 when the file has an alpha channel worth using
     path: Path
     lens_35mm: float | None = None   # EXIF's FocalLengthIn35mmFilm, where the camera wrote one
+    lossy: bool = False          # saved as JPEG, whose blocks ring round every sharp outline
 
     @property
     def size(self) -> tuple[int, int]:
@@ -67,7 +71,7 @@ def working_copy(photo: Photo, longest: int) -> Photo:
     alpha = None
     if photo.alpha is not None:
         alpha = np.asarray(Image.fromarray(photo.alpha, "L").resize(size, Image.Resampling.BOX))
-    return Photo(np.ascontiguousarray(rgb), alpha, photo.path, photo.lens_35mm)
+    return Photo(np.ascontiguousarray(rgb), alpha, photo.path, photo.lens_35mm, photo.lossy)
 
 
 def mirror_image(photo: Photo) -> Photo:
@@ -107,6 +111,7 @@ def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
                                        "frames", path)
                 img.load()   # a damaged picture is refused here, before its EXIF is read apart
                 lens = _lens_35mm(img)
+                lossy = img.format in LOSSY_FORMATS
                 icc = img.info.get("icc_profile") if colours else None
                 img = ImageOps.exif_transpose(img)  # phones store portrait shots sideways
                 has_alpha = img.mode in ("RGBA", "LA", "PA") or "transparency" in img.info
@@ -126,7 +131,7 @@ def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
     alpha = rgba[:, :, 3]
     # An alpha channel that is opaque everywhere says nothing about the background.
     usable = has_alpha and bool((alpha < 128).any())
-    return Photo(np.ascontiguousarray(rgba[:, :, :3]), alpha.copy() if usable else None, path, lens)
+    return Photo(np.ascontiguousarray(rgba[:, :, :3]), alpha.copy() if usable else None, path, lens, lossy)
 
 
 #: EXIF's Exif IFD, and its FocalLengthIn35mmFilm tag.

@@ -44,6 +44,11 @@ RENDERERS_DIFFER = 0.006
 #: Under ADVICE_IOU + GRAIN_MARGIN such a fit is said to be unsure.
 GRAINY = 1.0
 GRAIN_MARGIN = 0.10
+#: A JPEG rings round every sharp outline, and the thin fin tips and edges the overlap turns on blur
+#: with it: on Blender's water photos saved as JPEG 90 (120 fits, issue 32) the command's own figure
+#: read a median 0.021 above Blender's, 0.078 at the 90th percentile, where the same photos as PNG
+#: read 0.007 and 0.022. A JPEG's fit under ADVICE_IOU + LOSSY_MARGIN is said to be unsure.
+LOSSY_MARGIN = 0.07
 #: --focal-length: how far the camera's distance, estimated from the fish's length in the photo
 #: (:func:`.compare.camera_distance`), may be off: a turned fish's length is not its side-on one, and
 #: another camera framing the rebuilt fish by its own extents stands elsewhere (issue 32: 2-6 % on
@@ -490,6 +495,12 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         note(f"silhouette IoU {shown[1]:.3f}, but the photo is grainy ({grainy:.1f} levels on its border): a "
              "fin's thin tips may be lost in the grain, from its outline and from this figure alike, and "
              "the rebuilt fish may look unlike the photographed one; give --mask to be sure")
+    elif shown is not None and sil.source == "background model" and photo.lossy \
+            and shown[1] < ADVICE_IOU + LOSSY_MARGIN:
+        note(f"silhouette IoU {shown[1]:.3f}, but the photo is a JPEG, whose ringing blurs the thin fin tips "
+             f"and edges this figure turns on (on JPEG photos it read up to {LOSSY_MARGIN:.2f} above another "
+             "renderer's): the rebuilt fish may look unlike the photographed one; give a PNG or --mask to "
+             "be sure")
     files = dict(chosen.files)
     if options.fxl_out is not None:
         tp = chosen.species.texture_points
