@@ -498,9 +498,9 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
     elif shown is not None and sil.source == "background model" and photo.lossy \
             and shown[1] < ADVICE_IOU + LOSSY_MARGIN:
         note(f"silhouette IoU {shown[1]:.3f}, but the photo is a JPEG, whose ringing blurs the thin fin tips "
-             f"and edges this figure turns on (on JPEG photos it read up to {LOSSY_MARGIN:.2f} above another "
-             "renderer's): the rebuilt fish may look unlike the photographed one; give a PNG or --mask to "
-             "be sure")
+             f"and edges this figure turns on (on JPEG photos it read over {LOSSY_MARGIN:.2f} above another "
+             "renderer's for one fit in ten): the rebuilt fish may look unlike the photographed one; give a "
+             "PNG or --mask to be sure")
     files = dict(chosen.files)
     if options.fxl_out is not None:
         tp = chosen.species.texture_points
