@@ -134,6 +134,7 @@ def test_a_jpeg_is_known_as_lossy_and_its_copies_and_mirror_stay_so(tmp_path, su
     options = {"lossless": True} if suffix == ".webp" else {}
     Image.new("RGB", (2048, 1024), (40, 90, 120)).save(path, **options)
     photo = load_photo(path)
+    copy = working_copy(photo, 1024)
     assert photo.lossy is lossy
-    assert working_copy(photo, 1024).lossy is lossy and working_copy(photo, 1024).size == (1024, 512)
+    assert copy.lossy is lossy and copy.size == (1024, 512)
     assert mirror_image(photo).lossy is lossy

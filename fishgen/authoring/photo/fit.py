@@ -35,7 +35,7 @@ stay the base's. Everything here is pure numpy/scipy on masks and plain numbers.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -54,6 +54,9 @@ from fishgen.authoring.photo.optimise import PARAMETERS, better, drop_hidden, re
 from fishgen.authoring.photo.sideview import with_counts
 from fishgen.species.model import Species
 
+if TYPE_CHECKING:
+    from fishgen.authoring.photo.frame import Frame
+
 #: BodySections tried, in order, when the base's cannot hold the photographed body and fins.
 LODS = (8, 12, 16, 20, 24, 32)
 #: settled_tips: relative steps of a fin length, halved from the first down to the last
@@ -70,7 +73,7 @@ class ShapeFit:
     notes: tuple[str, ...]     # what was left out or changed, one line each
     #: the levelled silhouette the fit was made on (working scale)
     work: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((1, 1), bool))
-    frame: Any = field(default=None, repr=False)              # the levelled frame (:class:`.frame.Frame`)
+    frame: Frame | None = field(default=None, repr=False)     # the levelled frame
     frame_map: tuple[float, float, float, float] | None = None   # thesis -> frame: x0, y0, x scale, y scale
     turn: float = 0.0          # degrees the measured level was turned before fitting
 
@@ -81,7 +84,7 @@ def fit_shape(base: Species, mask: np.ndarray) -> Species:
 
 
 def fit_species(base: Species, mask: np.ndarray, sections_fixed: bool = False, turn: float = 0.0,
-                level: Any = None) -> ShapeFit:
+                level: Frame | None = None) -> ShapeFit:
     """Fit ``base``'s geometry to the silhouette ``mask`` (any orientation; it is levelled here, or
     as the frame ``level`` of it says (:func:`.frame.fish_frame`, once for every level a caller
     tries, or :func:`.frame.other_level`), then turned ``turn`` degrees further: see
@@ -228,6 +231,7 @@ def _settled(fit: ShapeFit, sp: Species) -> ShapeFit:
         if problem not in before and tall is not None:
             sp = with_fin(sp, tall, getattr(first, tall))
     settled = replace(fit, species=sp, iou=shape_score(fit.work)(draw(sp, fit.placement, fit.work.shape)))
+    assert fit.frame is not None   # fit_species sets it
     _, to_frame, offset = working_mask(fit.frame.mask)
     return replace(settled, frame_map=_frame_map(settled, to_frame, offset))
 
