@@ -35,6 +35,10 @@ rows: NaN)."""
 LOSSY_FORMATS = ("JPEG", "MPO")
 """Pillow's names of the formats whose codec rings round a sharp outline (JPEG's 8 x 8 blocks; MPO
 is a camera's JPEG with a second frame). A lossy WebP rings too, but its header does not say so."""
+REDRAW_SIDE = 2 * MEASURE_SIDE
+"""The longest side up to which a 4:2:0 JPEG's colour is drawn again at full size
+(:mod:`.chroma`): a larger photo is measured on a copy half its size or less, where a 2 x 2 block
+of colour is a pixel at most, and on a 12-megapixel photo the redrawing would cost a second."""
 
 
 @dataclass(frozen=True)
@@ -112,6 +116,8 @@ def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
                 img.load()   # a damaged picture is refused here, before its EXIF is read apart
                 lens = _lens_35mm(img)
                 lossy = img.format in LOSSY_FORMATS
+                if colours:
+                    img = _colour_at_full_size(img, path)
                 icc = img.info.get("icc_profile") if colours else None
                 img = ImageOps.exif_transpose(img)  # phones store portrait shots sideways
                 has_alpha = img.mode in ("RGBA", "LA", "PA") or "transparency" in img.info
@@ -132,6 +138,31 @@ def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
     # An alpha channel that is opaque everywhere says nothing about the background.
     usable = has_alpha and bool((alpha < 128).any())
     return Photo(np.ascontiguousarray(rgba[:, :, :3]), alpha.copy() if usable else None, path, lens, lossy)
+
+
+def _colour_at_full_size(img, path: Path):
+    """``img`` with a 4:2:0 JPEG's colour drawn again at full size along its brightness
+    (:func:`.chroma.redraw`, from the file's own half-size colour planes); any other picture as it
+    is. Decoded smoothly, such a JPEG's colour spreads a pixel or two past a fish's outline and
+    thins a fin's: Blender's water photos saved so fitted 62 of 72 times at 0.85, 70 saved with
+    full-size colour (4:4:4), and 65 so redrawn (docs/decisions.md)."""
+    from PIL import Image, JpegImagePlugin
+
+    w, h = img.size
+    if img.format != "JPEG" or img.mode != "RGB" or max(w, h) > REDRAW_SIDE \
+            or img.info.get("adobe_transform") == 0 or JpegImagePlugin.get_sampling(img) != 2:
+        return img   # an Adobe transform of 0 stores RGB, not brightness and colour
+    half_size = ((w + 1) // 2, (h + 1) // 2)
+    with Image.open(path) as again:
+        again.draft("YCbCr", half_size)   # decoded at half size: the colour as stored
+        planes = np.asarray(again.convert("YCbCr") if again.mode != "YCbCr" else again)
+    if planes.shape != (half_size[1], half_size[0], 3):
+        return img
+    from fishgen.authoring.photo.chroma import redraw
+
+    drawn = Image.fromarray(redraw(np.asarray(img), planes), "RGB")
+    drawn.info.update(img.info)   # the EXIF orientation and the colour profile go with the pixels
+    return drawn
 
 
 #: EXIF's Exif IFD, and its FocalLengthIn35mmFilm tag.
