@@ -126,15 +126,20 @@ def test_a_photo_is_measured_on_a_copy_1024_px_long_unless_that_would_be_under_6
     assert max(copy.size) == min(max(size), side) and min(copy.size) >= MIN_PHOTO_SIDE
 
 
-@pytest.mark.parametrize(("suffix", "lossy"), [(".jpg", True), (".png", False), (".webp", False)])
-def test_a_jpeg_is_known_as_lossy_and_its_copies_and_mirror_stay_so(tmp_path, suffix, lossy):
+@pytest.mark.parametrize(("suffix", "options", "lossy", "halved"), [
+    (".jpg", {}, True, True), (".jpg", {"subsampling": 1}, True, True),
+    (".jpg", {"subsampling": 0}, True, False),
+    (".png", {}, False, False), (".webp", {"lossless": True}, False, False)])
+def test_a_jpeg_is_known_as_lossy_and_by_its_colours_size_and_its_copies_and_mirror_stay_so(
+        tmp_path, suffix, options, lossy, halved):
+    """Pillow's JPEGs keep colour for 2 x 2 blocks (4:2:0) unless told 4:2:2 or full size (4:4:4)."""
     from fishgen.authoring.photo.image import mirror_image
 
     path = tmp_path / f"photo{suffix}"
-    options = {"lossless": True} if suffix == ".webp" else {}
     Image.new("RGB", (2048, 1024), (40, 90, 120)).save(path, **options)
     photo = load_photo(path)
     copy = working_copy(photo, 1024)
-    assert photo.lossy is lossy
-    assert copy.lossy is lossy and copy.size == (1024, 512)
-    assert mirror_image(photo).lossy is lossy
+    assert (photo.lossy, photo.colour_halved) == (lossy, halved)
+    assert (copy.lossy, copy.colour_halved) == (lossy, halved) and copy.size == (1024, 512)
+    mirrored = mirror_image(photo)
+    assert (mirrored.lossy, mirrored.colour_halved) == (lossy, halved)

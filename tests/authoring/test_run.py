@@ -144,7 +144,8 @@ def test_a_fit_on_a_jpeg_near_the_line_is_said_to_be_unsure(tmp_path, gl_availab
     """A JPEG's ringing blurs the thin tips and edges the overlap turns on: on Blender's water photos
     in JPEG 90 the command's figure read a median 0.021 over Blender's (PNG: 0.007), five misses
     unsaid. With the margin widened past this rebuilt fish's figure, the photo saved as JPEG gets
-    the line and the same photo as PNG does not; nor does the JPEG given --mask (the user's outline)."""
+    the line and the same photo as PNG does not; nor does the JPEG given --mask (the user's outline).
+    A JPEG that keeps its colour at half size is also told of one that keeps it whole."""
     from PIL import Image
 
     from fishgen.authoring.photo import run
@@ -159,15 +160,18 @@ def test_a_fit_on_a_jpeg_near_the_line_is_said_to_be_unsure(tmp_path, gl_availab
     species = load_species(PARAMS / "bonybream.txt")
     photo = ph.on_background(ph.render_photo(species))
     photo.save(tmp_path / "photo.png")
-    photo.save(tmp_path / "photo.jpg", "JPEG", quality=95)
+    photo.save(tmp_path / "photo.jpg", "JPEG", quality=95)                  # colour in 2 x 2 blocks
+    photo.save(tmp_path / "full.jpg", "JPEG", quality=95, subsampling=0)   # colour at full size
     mask = tmp_path / "mask.png"
     Image.fromarray(silhouette(load_photo(tmp_path / "photo.png")).mask.astype(np.uint8) * 255).save(mask)
     said = {}
     runs = (("png", "photo.png", TextureOptions()), ("jpg", "photo.jpg", TextureOptions()),
-            ("masked", "photo.jpg", TextureOptions(mask=mask)))
+            ("masked", "photo.jpg", TextureOptions(mask=mask)), ("full", "full.jpg", TextureOptions()))
     for name, path, options in runs:
         notes: list[str] = []
         make_texture(tmp_path / path, species, tmp_path / name / "new.txt", options, notes.append)
         said[name] = [n for n in notes if "is a JPEG" in n]
     assert not said["png"] and not said["masked"]
-    assert len(said["jpg"]) == 1 and said["jpg"][0].endswith("give a PNG or --mask to be sure")
+    assert len(said["jpg"]) == 1 and said["jpg"][0].endswith(
+        "give a PNG, a JPEG saved with its colour at full size (4:4:4) or --mask to be sure")
+    assert len(said["full"]) == 1 and said["full"][0].endswith("give a PNG or --mask to be sure")

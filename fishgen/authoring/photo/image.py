@@ -48,6 +48,7 @@ class Photo:
     path: Path
     lens_35mm: float | None = None   # EXIF's FocalLengthIn35mmFilm, where the camera wrote one
     lossy: bool = False          # saved as JPEG, whose blocks ring round every sharp outline
+    colour_halved: bool = False  # a JPEG keeping colour for 2 x 2 or 2 x 1 blocks (4:2:0, 4:2:2)
 
     @property
     def size(self) -> tuple[int, int]:
@@ -75,7 +76,7 @@ def working_copy(photo: Photo, longest: int) -> Photo:
     alpha = None
     if photo.alpha is not None:
         alpha = np.asarray(Image.fromarray(photo.alpha, "L").resize(size, Image.Resampling.BOX))
-    return Photo(np.ascontiguousarray(rgb), alpha, photo.path, photo.lens_35mm, photo.lossy)
+    return replace(photo, rgb=np.ascontiguousarray(rgb), alpha=alpha)
 
 
 def mirror_image(photo: Photo) -> Photo:
@@ -87,7 +88,7 @@ def mirror_image(photo: Photo) -> Photo:
 def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
     """Read ``path`` as RGB (+ alpha), in sRGB unless ``colours`` is off (a mask's levels are no
     colours). Absurd sizes are refused from the header alone."""
-    from PIL import Image, ImageOps, UnidentifiedImageError
+    from PIL import Image, ImageOps, JpegImagePlugin, UnidentifiedImageError
 
     path = Path(path)
     if not path.is_file():
@@ -116,6 +117,7 @@ def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
                 img.load()   # a damaged picture is refused here, before its EXIF is read apart
                 lens = _lens_35mm(img)
                 lossy = img.format in LOSSY_FORMATS
+                halved = lossy and JpegImagePlugin.get_sampling(img) in (1, 2)
                 if colours:
                     img = _colour_at_full_size(img, path)
                 icc = img.info.get("icc_profile") if colours else None
@@ -137,7 +139,8 @@ def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
     alpha = rgba[:, :, 3]
     # An alpha channel that is opaque everywhere says nothing about the background.
     usable = has_alpha and bool((alpha < 128).any())
-    return Photo(np.ascontiguousarray(rgba[:, :, :3]), alpha.copy() if usable else None, path, lens, lossy)
+    return Photo(np.ascontiguousarray(rgba[:, :, :3]), alpha.copy() if usable else None, path, lens, lossy,
+                 halved)
 
 
 def _colour_at_full_size(img, path: Path):

@@ -49,6 +49,10 @@ GRAIN_MARGIN = 0.10
 #: read a median 0.021 above Blender's, 0.078 at the 90th percentile, where the same photos as PNG
 #: read 0.007 and 0.022. A JPEG's fit under ADVICE_IOU + LOSSY_MARGIN is said to be unsure.
 LOSSY_MARGIN = 0.07
+#: Said to a JPEG keeping its colour at half size: Blender's water photos saved at full size (4:4:4)
+#: fitted 149 of 168 times at 0.85 in JPEG 90, at half size (4:2:0, Pillow's and most cameras'
+#: default) 127 (docs/decisions.md).
+HALVED_ADVICE = ", a JPEG saved with its colour at full size (4:4:4)"
 #: --focal-length: how far the camera's distance, estimated from the fish's length in the photo
 #: (:func:`.compare.camera_distance`), may be off: a turned fish's length is not its side-on one, and
 #: another camera framing the rebuilt fish by its own extents stands elsewhere (issue 32: 2-6 % on
@@ -500,7 +504,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         note(f"silhouette IoU {shown[1]:.3f}, but the photo is a JPEG, whose ringing blurs the thin fin tips "
              f"and edges this figure turns on (on JPEG photos it read over {LOSSY_MARGIN:.2f} above another "
              "renderer's for one fit in ten): the rebuilt fish may look unlike the photographed one; give a "
-             "PNG or --mask to be sure")
+             f"PNG{HALVED_ADVICE if photo.colour_halved else ''} or --mask to be sure")
     files = dict(chosen.files)
     if options.fxl_out is not None:
         tp = chosen.species.texture_points
