@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from fishgen.lazy import lazy_exports
 
-__version__ = "0.2.15"
+__version__ = "0.2.16"
 
 _API = {
     "load_species": "fishgen.species.parser",

@@ -49,9 +49,9 @@ GRAIN_MARGIN = 0.10
 #: read a median 0.021 above Blender's, 0.078 at the 90th percentile, where the same photos as PNG
 #: read 0.007 and 0.022. A JPEG's fit under ADVICE_IOU + LOSSY_MARGIN is said to be unsure.
 LOSSY_MARGIN = 0.07
-#: Said to a JPEG keeping its colour at half size: Blender's water photos saved at full size (4:4:4)
-#: fitted 149 of 168 times at 0.85 in JPEG 90, at half size (4:2:0, Pillow's and most cameras'
-#: default) 127 (docs/decisions.md).
+#: Said to a JPEG keeping its colour at half size: Blender's water photos in JPEG 90 on seven sets
+#: fitted 149 of 168 times at 0.85 saved with full-size colour (4:4:4), 131 with colour at half size
+#: (4:2:0, Pillow's and most cameras' default) even redrawn (image.py; 127 before), docs/decisions.md.
 HALVED_ADVICE = ", a JPEG saved with its colour at full size (4:4:4)"
 #: --focal-length: how far the camera's distance, estimated from the fish's length in the photo
 #: (:func:`.compare.camera_distance`), may be off: a turned fish's length is not its side-on one, and
