@@ -23,11 +23,12 @@ def _fish_in_water(width: int = 320, height: int = 180) -> np.ndarray:
     return img.astype(np.uint8)
 
 
-def test_a_420_jpeg_keeps_a_thin_fins_colour_and_the_water_beside_it_its_own(tmp_path):
+@pytest.mark.parametrize("size", [(320, 180), (321, 181)])
+def test_a_420_jpeg_keeps_a_thin_fins_colour_and_the_water_beside_it_its_own(tmp_path, size):
     """Within two pixels of every outline, the colour read is nearer the picture that was saved than
     the decoder's own smooth upsampling (which spreads each 2 x 2 block's colour over its
-    neighbours)."""
-    original = _fish_in_water()
+    neighbours); odd sides too, whose last block holds one row or column."""
+    original = _fish_in_water(*size)
     path = tmp_path / "fish.jpg"
     Image.fromarray(original).save(path, quality=90)          # Pillow's default: 4:2:0
     decoded = np.asarray(Image.open(path).convert("RGB")).astype(float)
@@ -62,7 +63,7 @@ def test_a_turned_420_jpeg_is_redrawn_then_turned(tmp_path):
     assert np.array_equal(load_photo(turned).rgb, np.asarray(upright))
 
 
-@pytest.mark.parametrize("size", [(7, 9), (8, 10), (1030, 5), (5, 1)])
+@pytest.mark.parametrize("size", [(7, 9), (8, 10), (1030, 5), (5, 1), (1, 7), (513, 3)])
 def test_each_pixel_takes_the_colour_of_the_four_nearest_blocks_weighed_by_brightness(size):
     """The vectorised strips against the definition, pixel by pixel: odd sizes, one column, and a
     photo taller than one strip."""
@@ -89,3 +90,22 @@ def test_each_pixel_takes_the_colour_of_the_four_nearest_blocks_weighed_by_brigh
                                               luma + 1.772 * cb]), 0, 255)
     got = redraw(rgb, half)
     assert np.abs(got.astype(int) - expected).max() <= 1   # float32 against float64 rounding
+
+
+def test_a_jpeg_whose_components_are_named_rgb_is_read_as_decoded(tmp_path):
+    """Components named R, G, B (no JFIF marker) are RGB to libjpeg, which then gives no brightness
+    and colour planes: the photo is read as decoded, not refused as damaged."""
+    import io
+    import struct
+
+    buffer = io.BytesIO()
+    Image.fromarray(_fish_in_water()).save(buffer, "JPEG", quality=90)
+    data = bytearray(buffer.getvalue())
+    assert data[2:4] == b"\xff\xe0"                          # drop the JFIF marker (APP0)
+    data = data[:2] + data[4 + struct.unpack(">H", data[4:6])[0]:]
+    frame, scan = data.find(b"\xff\xc0"), data.find(b"\xff\xda")
+    for k in range(3):
+        data[frame + 10 + 3 * k] = data[scan + 5 + 2 * k] = b"RGB"[k]
+    path = tmp_path / "rgb.jpg"
+    path.write_bytes(bytes(data))
+    assert np.array_equal(load_photo(path).rgb, np.asarray(Image.open(path).convert("RGB")))

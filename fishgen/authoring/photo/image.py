@@ -157,9 +157,14 @@ def _colour_at_full_size(img, path: Path):
             or img.info.get("adobe_transform") == 0 or JpegImagePlugin.get_sampling(img) != 2:
         return img   # an Adobe transform of 0 stores RGB, not brightness and colour
     half_size = ((w + 1) // 2, (h + 1) // 2)
-    with Image.open(path) as again:
-        again.draft("YCbCr", half_size)   # decoded at half size: the colour as stored
-        planes = np.asarray(again.convert("YCbCr") if again.mode != "YCbCr" else again)
+    try:
+        with Image.open(path) as again:
+            # decoded at half size: the colour as stored. Asked for the size rounded down, as
+            # Pillow picks the scale by whole divisions and libjpeg rounds an odd side up.
+            again.draft("YCbCr", (max(1, w // 2), max(1, h // 2)))
+            planes = np.asarray(again.convert("YCbCr") if again.mode != "YCbCr" else again)
+    except (OSError, ValueError, SyntaxError):
+        return img   # e.g. components named R, G, B: libjpeg gives no YCbCr, the decode stands
     if planes.shape != (half_size[1], half_size[0], 3):
         return img
     from fishgen.authoring.photo.chroma import redraw
