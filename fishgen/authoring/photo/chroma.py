@@ -30,12 +30,12 @@ def redraw(rgb: np.ndarray, half: np.ndarray) -> np.ndarray:
     columns = (cols // 2 + 1, cols // 2 + 2 * (cols % 2))
     out = np.empty_like(rgb)
     for top in range(0, h, ROWS):   # ROWS is even, so a strip starts on a block's first row
+        stop = min(top + ROWS, h)
         base = top // 2             # the padded block row above the strip's first
-        strip = planes[base:min(top + ROWS, h) // 2 + 3]
+        strip = planes[base:stop // 2 + 3]
         across = [strip[:, c] for c in columns]
         for parity in (0, 1):   # a row's own block row and the next one towards it are slices
             first = top + parity
-            stop = min(top + ROWS, h)
             if first >= stop:
                 continue
             f = rgb[first:stop:2].astype(np.float32)

@@ -117,8 +117,8 @@ def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
                 img.load()   # a damaged picture is refused here, before its EXIF is read apart
                 lens = _lens_35mm(img)
                 lossy = img.format in LOSSY_FORMATS
-                halved = lossy and JpegImagePlugin.get_sampling(img) in (1, 2)
-                if colours:
+                sampling = JpegImagePlugin.get_sampling(img) if lossy else -1   # 2: 4:2:0, 1: 4:2:2
+                if colours and sampling == 2:
                     img = _colour_at_full_size(img, path)
                 icc = img.info.get("icc_profile") if colours else None
                 img = ImageOps.exif_transpose(img)  # phones store portrait shots sideways
@@ -140,21 +140,20 @@ def load_photo(path: str | os.PathLike, colours: bool = True) -> Photo:
     # An alpha channel that is opaque everywhere says nothing about the background.
     usable = has_alpha and bool((alpha < 128).any())
     return Photo(np.ascontiguousarray(rgba[:, :, :3]), alpha.copy() if usable else None, path, lens, lossy,
-                 halved)
+                 sampling in (1, 2))
 
 
 def _colour_at_full_size(img, path: Path):
-    """``img`` with a 4:2:0 JPEG's colour drawn again at full size along its brightness
+    """``img``, a 4:2:0 JPEG or MPO, with its colour drawn again at full size along its brightness
     (:func:`.chroma.redraw`, from the file's own half-size colour planes); any other picture as it
     is. Decoded smoothly, such a JPEG's colour spreads a pixel or two past a fish's outline and
     thins a fin's. Blender's water photos in JPEG 90 on nine sets fitted 170 of 216 times at 0.85
     as decoded and 174 so redrawn (123 fits up, 68 down); saved with full-size colour (4:4:4), 149
     of the 168 on seven of them against 127 (docs/decisions.md)."""
-    from PIL import Image, JpegImagePlugin
+    from PIL import Image
 
     w, h = img.size
-    if img.format != "JPEG" or img.mode != "RGB" or max(w, h) > REDRAW_SIDE \
-            or img.info.get("adobe_transform") == 0 or JpegImagePlugin.get_sampling(img) != 2:
+    if img.mode != "RGB" or max(w, h) > REDRAW_SIDE or img.info.get("adobe_transform") == 0:
         return img   # an Adobe transform of 0 stores RGB, not brightness and colour
     half_size = ((w + 1) // 2, (h + 1) // 2)
     try:
@@ -162,10 +161,10 @@ def _colour_at_full_size(img, path: Path):
             # decoded at half size: the colour as stored. Asked for the size rounded down, as
             # Pillow picks the scale by whole divisions and libjpeg rounds an odd side up.
             again.draft("YCbCr", (max(1, w // 2), max(1, h // 2)))
-            planes = np.asarray(again.convert("YCbCr") if again.mode != "YCbCr" else again)
+            planes = np.asarray(again) if again.mode == "YCbCr" else None
     except (OSError, ValueError, SyntaxError):
         return img   # e.g. components named R, G, B: libjpeg gives no YCbCr, the decode stands
-    if planes.shape != (half_size[1], half_size[0], 3):
+    if planes is None or planes.shape != (half_size[1], half_size[0], 3):
         return img
     from fishgen.authoring.photo.chroma import redraw
 
