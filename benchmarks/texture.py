@@ -7,14 +7,17 @@
         # perspective; each on its own geometry, then --fit-shape on every shipped base, the
         # rebuilt fish photographed by three.js
     python benchmarks/texture.py --blender [--seeds 301,302,303,304] [--bases a,b] [--no-lens] [--mirror]
-                                           [--size 1920x1080]
+                                           [--size 1920x1080] [--jpeg 90 [--subsampling 4:4:4]] [--camera]
         # issue 32: fish from `fishgen species --random` on seeds held out from all tuning,
         # photographed by Blender (Cycles, a 50-135 mm lens, small yaw and roll, a sun, translucent
         # fins over alpha or a mottled backdrop); --fit-shape on every shipped base, the rebuilt
         # fish photographed again by Blender side-on with the photo's lens: IoU per fit, min, median;
         # the command is told each photo's --focal-length unless --no-lens; --mirror fits the
         # photos mirrored (the fish facing right); --size photographs them (and the rebuilt fish) at
-        # that size (default 640x360); and how many misses the command said in one line
+        # that size (default 640x360); --jpeg Q fits the water photos saved as JPEG at quality Q with
+        # their colour at half size (--subsampling 4:2:0, the default) or full size (4:4:4); --camera
+        # fits them blurred 0.6 px, given a camera's grain and saved as JPEG 85; and how many misses
+        # the command said in one line
 
 Each photo is an orthographic side render (tests/authoring/photos.py), varied as
 the robustness tests vary it. Columns: the rebuilt fish's silhouette IoU against
@@ -222,7 +225,15 @@ def blender() -> None:
     """Issue 32, item 1: Blender's photos of held-out sampled fish, fitted on every shipped base."""
     import statistics
 
-    from tests.authoring.blender_photo import bpy_python, fit_photos, mirrored, photograph, shots_for
+    from tests.authoring.blender_photo import (
+        CAMERA_QUALITY,
+        bpy_python,
+        fit_photos,
+        mirrored,
+        photograph,
+        resaved,
+        shots_for,
+    )
     from tests.authoring.subjects import write_subjects
 
     if bpy_python() is None:
@@ -237,6 +248,14 @@ def blender() -> None:
     records = photograph(subjects, shots, work / "shots", (w, h))
     if "--mirror" in sys.argv:
         records = mirrored(records, work / "mirrored")
+    saved = "PNG"
+    if "--camera" in sys.argv:
+        records = resaved(records, work / "camera", CAMERA_QUALITY, camera=True)
+        saved = f"blurred, grainy, JPEG {CAMERA_QUALITY}"
+    elif _option("--jpeg"):
+        quality, subsampling = int(_option("--jpeg")[0]), (_option("--subsampling") or ["4:2:0"])[0]
+        records = resaved(records, work / "jpeg", quality, subsampling)
+        saved = f"JPEG {quality} {subsampling}"
     shot_s = time.perf_counter() - start
     bases = {n: load_species(ROOT / "params" / f"{n}.txt") for n in (_option("--bases") or SHIPPED)}
     rows = fit_photos(records, bases, work / "fits", lens="--no-lens" not in sys.argv, size=(w, h))
@@ -253,7 +272,7 @@ def blender() -> None:
               f"{r.seconds:5.1f} {note}")
     for label, ious in (("as Blender shows the file", [r.blender or 0.0 for r in rows]),
                         ("every triangle, fin masks ignored", [r.triangles or 0.0 for r in rows])):
-        print(f"{len(rows)} fits of {len(records)} Blender photos {w}x{h} "
+        print(f"{len(rows)} fits of {len(records)} Blender photos {w}x{h}, {saved} "
               f"(seeds {','.join(map(str, seeds))}), "
               f"{label}: IoU min {min(ious):.3f}, median {statistics.median(ious):.3f}, "
               f"{sum(i >= 0.85 for i in ious)}/{len(ious)} >= 0.85")

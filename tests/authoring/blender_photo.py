@@ -212,6 +212,41 @@ def mirrored(records: dict[str, dict], folder: Path) -> dict[str, dict]:
     return out
 
 
+#: A camera's photo as issue 32's JPEG rounds made it (docs/blender-photos.md): a lens's softness
+#: (Gaussian blur, px), sensor grain (normal, levels a channel; this share of its variance shared by
+#: the three channels, as luma grain is) and the camera's JPEG quality.
+CAMERA_BLUR, CAMERA_GRAIN, CAMERA_SHARED, CAMERA_QUALITY = 0.6, 4.0, 0.6, 85
+
+
+def resaved(records: dict[str, dict], folder: Path, quality: int, subsampling: str = "4:2:0",
+            camera: bool = False) -> dict[str, dict]:
+    """:func:`photograph`'s water photos (a JPEG has no alpha) saved again into ``folder`` as JPEG at
+    ``quality`` with its colour kept at ``subsampling`` ("4:2:0", as Pillow and most cameras do, or
+    "4:4:4"); with ``camera`` first blurred and given grain (``CAMERA_*``, seeded by the shot), as a
+    camera's photo is. The true silhouettes are the same files."""
+    import numpy as np
+    from PIL import Image, ImageFilter
+
+    folder.mkdir(parents=True, exist_ok=True)
+    out = {}
+    for name, rec in records.items():
+        if rec["shot"]["backdrop"] != "water":
+            continue
+        with Image.open(rec["photo"]) as img:
+            rgb = img.convert("RGB")
+        if camera:
+            rgb = rgb.filter(ImageFilter.GaussianBlur(CAMERA_BLUR))
+            rng = np.random.default_rng(int(rec["shot"]["seed"]))
+            h, w = rgb.height, rgb.width
+            noise = CAMERA_GRAIN * (np.sqrt(CAMERA_SHARED) * rng.standard_normal((h, w, 1))
+                                    + np.sqrt(1 - CAMERA_SHARED) * rng.standard_normal((h, w, 3)))
+            rgb = Image.fromarray(np.clip(np.asarray(rgb) + noise, 0, 255).round().astype(np.uint8))
+        path = folder / f"{name}.jpg"
+        rgb.save(path, "JPEG", quality=quality, subsampling=subsampling)
+        out[name] = {**rec, "photo": path}
+    return out
+
+
 def fitted_masks(fits: dict[str, tuple], folder: Path,
                  size: tuple[int, int] = SIZE) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Each fitted species (name -> (species, Shot)) photographed side-on in Blender with its photo's

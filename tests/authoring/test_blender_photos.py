@@ -245,3 +245,35 @@ def test_a_fit_that_misses_a_pale_fin_says_so(gl_available, fitted):
     assert "translucent fin" in said[0] and "give --mask" in said[0], said
     figures = [float(f) for f in re.findall(r"\b0\.\d{3}\b", said[0])]
     assert figures[0] == round(row.own, 3) and figures[-1] < TARGET, said
+
+
+@pytest.mark.parametrize("subsampling, sampling", [("4:2:0", 2), ("4:4:4", 0)])
+def test_photos_resaved_as_jpeg_keep_their_water_and_their_colour_s_sampling(tmp_path, subsampling, sampling):
+    """The benchmark's JPEG rounds (`benchmarks/texture.py --blender --jpeg 90`): only water photos
+    (a JPEG has no alpha), saved at the quality and sampling asked, the true silhouette unchanged."""
+    from PIL import Image, JpegImagePlugin
+
+    records = bp.fixture_records()
+    out = bp.resaved(records, tmp_path, 90, subsampling)
+    assert set(out) == {n for n, r in records.items() if r["shot"]["backdrop"] == "water"}
+    for name, rec in out.items():
+        assert rec["mask"] == records[name]["mask"]
+        with Image.open(rec["photo"]) as img:
+            assert img.format == "JPEG" and img.size == (rec["camera"]["width"], rec["camera"]["height"])
+            assert JpegImagePlugin.get_sampling(img) == sampling
+            with Image.open(records[name]["photo"]) as png:
+                error = np.abs(np.asarray(img, float) - np.asarray(png.convert("RGB"), float)).mean()
+        assert 0 < error < 2, f"{name}: {error:.2f} levels from the PNG"
+
+
+def test_a_camera_s_photo_is_blurred_and_grainy_and_the_same_every_time(tmp_path):
+    """`--camera`: blur, grain seeded by the shot and JPEG 85, so a rerun fits the same photo."""
+    from fishgen.authoring.photo.image import load_photo
+    from fishgen.authoring.photo.silhouette import grain
+
+    records = {"long": bp.fixture_records()["long"]}
+    first = bp.resaved(records, tmp_path / "a", bp.CAMERA_QUALITY, camera=True)["long"]["photo"]
+    again = bp.resaved(records, tmp_path / "b", bp.CAMERA_QUALITY, camera=True)["long"]["photo"]
+    assert first.read_bytes() == again.read_bytes()
+    clean = bp.resaved(records, tmp_path / "c", bp.CAMERA_QUALITY)["long"]["photo"]
+    assert grain(load_photo(first)) > grain(load_photo(clean)) + 0.5
