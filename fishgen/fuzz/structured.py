@@ -631,10 +631,15 @@ def photo_bytes(seed_png: bytes, rng: random.Random) -> bytes:
     except ValueError:
         pass
     buf = io.BytesIO()
-    fmt = "PNG" if rng.random() < 0.93 else rng.choice(["JPEG", "GIF", "BMP", "TIFF"])
+    fmt = rng.choices(["PNG", "JPEG", "GIF", "BMP", "TIFF"], weights=[80, 14, 2, 2, 2])[0]
     try:
-        im.save(buf, fmt)
+        if fmt == "JPEG":
+            im, options = _as_jpeg(im, rng)
+            im.save(buf, fmt, **options)
+        else:
+            im.save(buf, fmt)
     except (OSError, ValueError, KeyError):
+        buf = io.BytesIO()
         im.convert("RGB").save(buf, "PNG")
     data = buf.getvalue()
     if rng.random() < 0.12:  # truncated data
@@ -642,6 +647,24 @@ def photo_bytes(seed_png: bytes, rng: random.Random) -> bytes:
     elif rng.random() < 0.05:
         data = mutate.mutate_bytes(data, rng)
     return data
+
+
+def _as_jpeg(im, rng: random.Random) -> tuple[Any, dict]:
+    """``im`` as a camera or an editor might save it as JPEG, and the save's options: in a mode JPEG
+    holds (its alpha dropped), at any quality, its colour at full, half-width or half size (the
+    reader draws a 4:2:0 photo's colour again: `chroma.redraw`), sometimes progressive or turned by
+    an EXIF orientation."""
+    from PIL import Image
+
+    if im.mode not in ("RGB", "L", "CMYK"):
+        im = im.convert(rng.choices(["RGB", "L", "CMYK"], weights=[8, 1, 1])[0])
+    options: dict = {"quality": rng.choice([1, 5, 30, 75, 90, 95, 100]),
+                     "subsampling": rng.choice([0, 1, 2, 2]), "progressive": rng.random() < 0.2}
+    if rng.random() < 0.2:
+        exif = Image.Exif()
+        exif[0x0112] = rng.choice([0, 1, 2, 3, 5, 6, 8, 9, 255])
+        options["exif"] = exif.tobytes()
+    return im, options
 
 
 # -- .awa texture clouds ---------------------------------------------------------------------------

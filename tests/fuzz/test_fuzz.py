@@ -224,3 +224,28 @@ def test_a_replayed_case_shows_what_the_input_got(capsys):
     assert replay("species:1:5", DEFAULT_CORPUS) == 0
     shown = capsys.readouterr().out
     assert shown.startswith("species case 5 of seed 1: refused in one line: <fuzz>:") and "expected" in shown
+
+
+def test_the_photo_target_makes_jpegs_as_cameras_save_them():
+    """A photo's JPEG decoding, its 4:2:0 colour drawn again at full size, its EXIF turning: one
+    photo in ten or more is a JPEG, most in colour at half size, some at full size, some turned."""
+    import io
+    from collections import Counter
+
+    from PIL import Image, JpegImagePlugin
+
+    from fishgen.fuzz.structured import photo_bytes
+
+    seed = next(p for p in sorted((DEFAULT_CORPUS / "photo").rglob("*.png"))).read_bytes()
+    rng = random.Random(3)
+    kinds: Counter[str] = Counter()
+    for _ in range(1000):
+        try:
+            with Image.open(io.BytesIO(photo_bytes(seed, rng))) as im:
+                if im.format == "JPEG":
+                    kinds[f"{im.mode} {JpegImagePlugin.get_sampling(im)}"] += 1
+                    kinds["turned"] += 0x0112 in im.getexif()
+        except Exception:   # truncated or changed bytes: the reader's to refuse
+            pass
+    assert sum(n for k, n in kinds.items() if k != "turned") >= 100
+    assert kinds["RGB 2"] >= 25 and kinds["RGB 0"] >= 5 and kinds["turned"] >= 4, kinds
