@@ -265,7 +265,8 @@ def blender() -> None:
           f"{'triangles':>9s} {'Pillow':>7s} {'own':>6s} {'s':>5s} note")
     for r in rows:
         shot = shots[r.photo]
-        note = next((n for n in r.notes if n.startswith("silhouette IoU") or "not kept" in n), "")
+        note = next((n for n in r.notes
+                     if n.startswith(("silhouette IoU", "needs --mask")) or "not kept" in n), "")
         print(f"{r.photo:12s} {shot.lens:5.0f} {shot.yaw:5.0f} {shot.roll:5.0f} {shot.backdrop:8s} "
               f"{r.base:16s} "
               f"{r.blender or 0:8.3f} {r.triangles or 0:9.3f} {r.raster:7.3f} {r.own or 0:6.3f} "
@@ -279,6 +280,9 @@ def blender() -> None:
     said = [r for r in rows if (r.blender or 0.0) < 0.85 and any(
         n.startswith("silhouette IoU") or "not kept" in n for n in r.notes)]
     misses = sum((r.blender or 0.0) < 0.85 for r in rows)
+    masked = sum(any(n.startswith("needs --mask") for n in r.notes) for r in rows)
+    if masked:
+        print(f"fits whose photo's own silhouette failed, given the true one as --mask: {masked}")
     print(f"misses (as Blender shows the file) the command said in one line: {len(said)} of {misses}"
           f"{' (the photos mirrored: the fish facing right)' if '--mirror' in sys.argv else ''}")
     print(f"photos {shot_s:.0f} s, fits {sum(r.seconds for r in rows):.0f} s, "
