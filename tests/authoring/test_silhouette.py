@@ -434,3 +434,25 @@ def test_a_smooth_swirl_of_water_as_faint_beside_the_fish_stays_water(monkeypatc
     assert mask[apart].sum() == 0
     monkeypatch.setattr(module, "FAINT_STEP", -np.inf)
     assert silhouette(photo).mask[apart].sum() > 1000
+
+
+def test_a_fish_whose_fins_alone_stand_out_is_told_it_may_be_one_fish():
+    """Two bright fins on a body of the water's own colour are two objects to the border model; the
+    refusal says that they may be one fish, not only "crop the photo to one fish" (3607 in Blender)."""
+    import pytest
+
+    from fishgen.errors import FishgenError
+
+    w, h = SIZE
+    fins = Image.new("L", SIZE, 0)      # on a body (100, 80)-(300, 160) drawn in the water's colour
+    pen = ImageDraw.Draw(fins)
+    pen.polygon([(150, 85), (200, 85), (190, 30)], fill=255)
+    pen.polygon([(170, 155), (220, 155), (230, 215)], fill=255)
+    fin = np.asarray(fins) > 0
+    rgb = np.ones((h, w, 1)) * WATER
+    rgb = np.where(fin[:, :, None], np.array([40.0, 70.0, 230.0]), rgb)
+    rgb += np.random.default_rng(7).normal(0.0, 1.0, rgb.shape)
+    photo = Photo(np.clip(rgb + 0.5, 0, 255).astype(np.uint8), None, Path("photo.png"))
+    with pytest.raises(FishgenError, match="found 2 objects of similar size .several fish, or one whose "
+                                           "body is nearly the backdrop's colour"):
+        silhouette(photo)

@@ -452,8 +452,12 @@ def _one_fish(raw: np.ndarray, photo: Photo, source: str) -> np.ndarray:
                            f"{MIN_FISH_FRACTION:.1%} of the frame ({_hint(source)})", photo.path)
     if count > 1 and sizes[order[1]] >= SECOND_OBJECT * sizes[order[0]]:
         many = int((sizes >= SECOND_OBJECT * sizes[order[0]]).sum())
-        raise FishgenError(f"expected one fish, found {many} objects of similar size; crop the photo to "
-                           "one fish or give --mask", photo.path)
+        # over a backdrop, most often one fish: fins that stand out, a body of the water's colour
+        # between them (3607 in Blender, refused as 3 objects in PNG and JPEG alike)
+        what = (" (several fish, or one whose body is nearly the backdrop's colour and only its fins "
+                "stand out)") if source == "background model" else ""
+        raise FishgenError(f"expected one fish, found {many} objects of similar size{what}; crop the "
+                           "photo to one fish or give --mask", photo.path)
     # The closing decides what belongs together and which holes are holes (a pale eye ring on
     # the outline leaves a gap a few pixels wide); the outline itself is the unclosed one.
     closed = labels == order[0] + 1
