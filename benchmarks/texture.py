@@ -252,8 +252,8 @@ def blender() -> None:
     if "--camera" in sys.argv:
         records = resaved(records, work / "camera", CAMERA_QUALITY, camera=True)
         saved = f"blurred, grainy, JPEG {CAMERA_QUALITY}"
-    elif _option("--jpeg"):
-        quality, subsampling = int(_option("--jpeg")[0]), (_option("--subsampling") or ["4:2:0"])[0]
+    elif jpeg := _option("--jpeg"):
+        quality, subsampling = int(jpeg[0]), (_option("--subsampling") or ["4:2:0"])[0]
         records = resaved(records, work / "jpeg", quality, subsampling)
         saved = f"JPEG {quality} {subsampling}"
     shot_s = time.perf_counter() - start

@@ -224,7 +224,6 @@ def resaved(records: dict[str, dict], folder: Path, quality: int, subsampling: s
     ``quality`` with its colour kept at ``subsampling`` ("4:2:0", as Pillow and most cameras do, or
     "4:4:4"); with ``camera`` first blurred and given grain (``CAMERA_*``, seeded by the shot), as a
     camera's photo is. The true silhouettes are the same files."""
-    import numpy as np
     from PIL import Image, ImageFilter
 
     folder.mkdir(parents=True, exist_ok=True)

@@ -4,11 +4,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 from PIL import Image, ImageDraw
 from scipy import ndimage  # type: ignore[import-untyped]
 
 from fishgen.authoring.photo.image import Photo
 from fishgen.authoring.photo.silhouette import grain, silhouette
+from fishgen.errors import FishgenError
 
 SIZE = (400, 240)
 FISH = np.array([220.0, 200.0, 150.0])
@@ -439,10 +441,6 @@ def test_a_smooth_swirl_of_water_as_faint_beside_the_fish_stays_water(monkeypatc
 def test_a_fish_whose_fins_alone_stand_out_is_told_it_may_be_one_fish():
     """Two bright fins on a body of the water's own colour are two objects to the border model; the
     refusal says that they may be one fish, not only "crop the photo to one fish" (3607 in Blender)."""
-    import pytest
-
-    from fishgen.errors import FishgenError
-
     w, h = SIZE
     fins = Image.new("L", SIZE, 0)      # on a body (100, 80)-(300, 160) drawn in the water's colour
     pen = ImageDraw.Draw(fins)
