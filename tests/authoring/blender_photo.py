@@ -281,6 +281,7 @@ class Fitted:
     notes: tuple[str, ...]
     seconds: float
     triangles: float | None = None
+    half: float | None = None     # the command's figure at half coverage (TextureResult.half_covered)
 
 
 @dataclass(frozen=True)
@@ -341,7 +342,8 @@ def fit_one(name: str, rec: dict, base_name: str, base: Any, folder: Path, lens:
     size = photo_size(rec)
     camera = camera_for(rest_triangles(scene).reshape(-1, 3), shot.side_on(), size)
     raster = silhouette_iou(level, raster_mask(scene, camera))
-    row = Fitted(name, base_name, result.fitted, result.iou, raster, None, tuple(notes), seconds)
+    row = Fitted(name, base_name, result.fitted, result.iou, raster, None, tuple(notes), seconds,
+                 half=result.half_covered)
     return FitRun(f"{name}--{base_name}", row, result, out, rebuilt, shot, level, size)
 
 

@@ -100,6 +100,9 @@ class TextureResult:
     fitted: bool = False        # --fit-shape's geometry was kept
     fit_problems: list[str] = field(default_factory=list)   # why a fit was refused
     shape_fit: Any = field(default=None, repr=False)   # the fit tried (:class:`.fit.ShapeFit`)
+    #: ``iou`` counting only the pixels the rebuilt fish covers at least half, the worst of the
+    #: renders tried (None: not measured, as when ``iou`` is already under the line)
+    half_covered: float | None = None
 
 
 @dataclass(frozen=True)
@@ -523,7 +526,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         frame = frame.of_mirror(photo.size[0])
     return TextureResult(chosen.species, list(files), frame.angle, frame.mirrored, sil.source,
                          list(chosen.unseen), None if shown is None else shown[1],
-                         chosen.measured.frame_mask, frame, fitted, problems, fit)
+                         chosen.measured.frame_mask, frame, fitted, problems, fit, faded)
 
 
 def _mirrored_uv(points: Iterable[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
