@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from fishgen.lazy import lazy_exports
 
-__version__ = "0.2.16"
+__version__ = "0.2.17"
 
 _API = {
     "load_species": "fishgen.species.parser",
