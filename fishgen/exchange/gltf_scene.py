@@ -4,7 +4,7 @@ Materials, meshes (triangle strips and fans as triangle lists; lines, which have
 preview, dropped), nodes, skins and animation clips map one to one onto
 :mod:`fishgen.scene.model`. The few rules only decoded values can break are checked on the way:
 vertex indices below the vertex count, skin weights that sum to 1, joints within their skin,
-keyframe times that never decrease.
+keyframe times that never decrease; and, last, that the scene poses within reach (:data:`REACH`).
 """
 from __future__ import annotations
 
@@ -64,8 +64,62 @@ def build_scene(document: Document, label: str, source: str) -> Scene:
     if isinstance(extras, dict):  # kept as read; whoever uses a member checks it
         scene.extras = extras
     scene.clips = [_clip(data, k, a) for k, a in enumerate(lists["animations"])]
+    _check_reach(scene)
     return scene
 
+
+#: How far from the origin a posed vertex may lie: what a float32 camera can frame (the preview
+#: refuses a scene past it). Every consumer poses the scene, the preview at rest, the viewer and
+#: the fly-through through its clips, so a file whose finite numbers multiply past it (morph
+#: weights of 1e300, nested scales of 1e20) is refused here, once, not in each of them. Only rest
+#: and each clip's middle are posed (the school's 2,000 nodes take about 60 ms a pose): keyframes
+#: that reach past it at other moments are left to the preview's own check of each frame it draws.
+REACH = 1e30
+
+
+def _check_reach(scene: Scene) -> None:
+    """Refuse a scene whose drawn vertices, posed at rest or halfway through each clip, are not
+    finite numbers within :data:`REACH` of the origin. Each moment is first bounded
+    from the node matrices and each primitive's largest coordinates (cheap: a school's 200 fish
+    are not deformed vertex by vertex), and posed exactly only when that bound is past reach."""
+    from fishgen.scene.pose import bounds, pose
+
+    drawn = [(node, prim) for node, prim in scene.drawn() if prim.vertex_count]
+    if not drawn:
+        return
+    with np.errstate(all="ignore"):   # an overflow is what is being looked for
+        sizes = [(float(np.abs(prim.attributes["POSITION"]).max()),
+                  [float(np.abs(t["POSITION"]).max()) if "POSITION" in t else 0.0 for t in prim.targets])
+                 for _, prim in drawn]
+    moments: list[tuple[float | None, Clip | None]] = [(None, None)]
+    moments += [(clip.duration / 2, clip) for clip in scene.clips]
+    for t, clip in moments:
+        with np.errstate(all="ignore"):
+            posed = pose(scene, t, clip)
+            reach = 0.0
+            for (node, prim), (size, targets) in zip(drawn, sizes, strict=True):
+                w = posed.weights.get(node)
+                if prim.targets and w is not None:
+                    size += sum(abs(float(a)) * b for a, b in zip(w, targets, strict=False))
+                skin = scene.nodes[node].skin
+                mats = ([posed.world[j] @ m for j, m in zip(scene.skins[skin].joints,
+                                                             scene.skins[skin].inverse_bind_matrices,
+                                                             strict=False)]
+                        if skin is not None and "JOINTS_0" in prim.attributes else [posed.world[node]])
+                for m in mats:   # |M x + c| <= (largest row sum of |M|) |x| + |c|, each axis
+                    reach = max(reach, float(np.abs(m[:3, :3]).sum(axis=1).max()) * size
+                                + float(np.abs(m[:3, 3]).max()))
+            if reach < REACH:   # NaN fails too
+                continue
+            box = bounds(scene, t, clip)   # the bound is loose: pose every vertex to be sure
+        if (np.abs(box) < REACH).all():
+            continue
+        when = "at rest" if clip is None else f"in animation {clip.name!r} at {t:g} s"
+        found = ("a vertex that is not a number" if np.isnan(box).any()
+                 else f"one {float(np.abs(box).max()):.3g} away")
+        far = f"{REACH:.0e}".replace("e+", "e")
+        raise expected(f"drawn vertices within {far} of the origin posed {when} (morph weights, "
+                       "scales and translations that multiply within reach)", found)
 
 def _mime(img: dict) -> str:
     mime = img.get("mimeType")

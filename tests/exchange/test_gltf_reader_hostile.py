@@ -271,6 +271,16 @@ SEMANTICS = {
                                  r"JOINTS_0 values below 2 .* found 2"),
     "weights summing to 0": (lambda d: (_skin(d), d.prim["attributes"].update(
         WEIGHTS_0=d.add(np.zeros((3, 4), np.float32), "VEC4"))), r"WEIGHTS_0 .* summing to 1"),
+    # finite numbers that multiply past what a float32 camera can frame (the fuzz harness's
+    # finding at 0.2.17: a cloud's default morph weight of 1e300, its points posed to NaN)
+    "morph weight past reach": (lambda d: (_morph(d, (1,), weights_len=1),
+                                           d.d["meshes"][0].update(weights=[1e300])),
+                                r"within 1e30 of the origin posed at rest .* found one 1e\+299 away"),
+    "nested scales past reach": (lambda d: d.d.update(nodes=[{"children": [1], "scale": [1e20] * 3},
+                                                             {"mesh": 0, "scale": [1e20] * 3}]),
+                                 r"within 1e30 of the origin posed at rest .* found one 1e\+40 away"),
+    "animated past reach": (lambda d: _channel(d, "translation", [[0, 0, 0], [1e35, 0, 0]], "VEC3"),
+                            r"posed in animation .* at 0.5 s .* found one 5e\+34 away"),
 }
 
 
@@ -280,6 +290,16 @@ def test_data_faults_are_one_line(tmp_path, case):
     mutate, pattern = SEMANTICS[case]
     mutate(doc)
     refused(doc.write(tmp_path), pattern)
+
+
+def test_large_scenes_within_reach_load(tmp_path):
+    """Scales, weights and translations large but within a float32 camera's reach still load."""
+    doc = Doc()
+    _morph(doc, (1,), weights_len=1)
+    doc.d["meshes"][0]["weights"] = [1e20]
+    doc.d["nodes"] = [{"children": [1], "scale": [1e4] * 3}, {"mesh": 0, "translation": [1e9, 0, 0]}]
+    scene = read_gltf(doc.write(tmp_path))
+    assert np.isfinite(bounds(scene)).all() and np.abs(bounds(scene)).max() > 1e23
 
 
 def test_valid_skins_morphs_and_cubic_splines_load(tmp_path):
