@@ -327,8 +327,9 @@ def faint_edges(photo: Photo, fish: np.ndarray) -> np.ndarray:
     """Pixels joined to ``fish`` that may be fish too, though the silhouette left them out: an
     alpha photo's pixels of alpha FAINT_ALPHA and more; over a backdrop, thin runs (at most
     2 x FAINT_HALF_WIDTH px wide) of the unfiltered photo that differ from the backdrop around them
-    by FAINT_SIGMAS of its spread: a translucent fin's last tips and the outline's own rim. Too
-    unsure to measure the fish by, they tell how far its measure can be trusted."""
+    by FAINT_SIGMAS of its spread: a translucent fin's last tips and the outline's own rim; and
+    lines fainter still (TIP_SIGMAS) that run on out from them: a tall fin's tip over water nearly
+    its colour. Too unsure to measure the fish by, they tell how far its measure can be trusted."""
     if photo.alpha is not None:
         maybe = photo.alpha >= FAINT_ALPHA
     else:
