@@ -8,6 +8,10 @@ import os
 import struct
 from pathlib import Path
 
+MAX_EMBED_BYTES = 256 << 20
+"""`fishgen view` embeds at most this much in its page: beyond it a browser struggles with a base64
+page, and such assets need a desktop tool."""
+
 GODOT3_TRACKS = 1024
 """Godot 3 updates at most this many animated nodes, and as many animated properties (a mesh's
 blend-shape weights, one a morph target), each frame (``NODE_CACHE_UPDATE_MAX``); the rest stand
@@ -40,7 +44,6 @@ def notes(written: tuple[os.PathLike | str, ...]) -> list[str]:
 def _too_big(path: Path, size: int) -> list[str]:
     """`sky --billboards --particles 1200000` wrote 528 MiB that `preview` and `fly` then refused."""
     from fishgen.exchange.gltf_container import MAX_FILE_BYTES
-    from fishgen.viewer import MAX_EMBED_BYTES
 
     mib, read, embed = f"{size / 2**20:,.0f} MiB", MAX_FILE_BYTES >> 20, MAX_EMBED_BYTES >> 20
     if size > MAX_FILE_BYTES:

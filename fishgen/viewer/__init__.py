@@ -1,4 +1,5 @@
 """`fishgen view`: a single-file three.js viewer page for an asset, served on loopback."""
 
-MAX_EMBED_BYTES = 256 << 20
-"""Beyond this a browser struggles with a base64 page; such assets need a desktop tool."""
+from fishgen.exchange.client_limits import MAX_EMBED_BYTES
+
+__all__ = ["MAX_EMBED_BYTES"]
