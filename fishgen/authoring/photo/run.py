@@ -25,7 +25,7 @@ from fishgen.authoring.photo.image import (
     working_copy,
 )
 from fishgen.authoring.photo.sideview import SideView, side_view, with_counts
-from fishgen.authoring.photo.silhouette import Silhouette, grain, pale_patches, silhouette
+from fishgen.authoring.photo.silhouette import GRAINY, Silhouette, grain, pale_patches, silhouette
 from fishgen.errors import FishgenError, UsageError, cannot
 from fishgen.species.model import Species, TexturePoints
 
@@ -42,12 +42,11 @@ RENDERERS_DIFFER = 0.020
 #: A loss this small from joining the pale patches is a few stray pixels, no doubt: the two
 #: renderers' median gap either way (the figure RENDERERS_DIFFER held until 0.2.17).
 STRAY_PIXELS = 0.006
-#: A photo over a backdrop this grainy (:func:`.silhouette.grain`, levels) may have lost a fin's thin
-#: tips to the grain, from its silhouette and so from the command's own figure: the tallest fin's tip
-#: 9-11 px short on Blender's photos given grain (1.5 levels) and JPEG 85, the box the overlap crops to
-#: 4 % smaller, and their fits up to 0.10 under the command's figure in Blender. A render's grain is 0-0.5.
+#: A photo over a backdrop as grainy as a camera's (:data:`.silhouette.GRAINY`) may have lost a fin's
+#: thin tips to the grain, from its silhouette and so from the command's own figure: the tallest fin's
+#: tip 9-11 px short on Blender's photos given grain (1.5 levels) and JPEG 85, the box the overlap
+#: crops to 4 % smaller, and their fits up to 0.10 under the command's figure in Blender.
 #: Under ADVICE_IOU + GRAIN_MARGIN such a fit is said to be unsure.
-GRAINY = 1.0
 GRAIN_MARGIN = 0.10
 #: A JPEG rings round every sharp outline, and the thin fin tips and edges the overlap turns on blur
 #: with it: on Blender's water photos saved as JPEG 90 (120 fits, issue 32) the command's own figure
