@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from fishgen.lazy import lazy_exports
 
-__version__ = "0.2.18"
+__version__ = "0.2.19"
 
 _API = {
     "load_species": "fishgen.species.parser",
