@@ -25,7 +25,7 @@ from fishgen.authoring.photo.image import (
     working_copy,
 )
 from fishgen.authoring.photo.sideview import SideView, side_view, with_counts
-from fishgen.authoring.photo.silhouette import GRAINY, Silhouette, grain, pale_patches, silhouette
+from fishgen.authoring.photo.silhouette import GRAINY, Silhouette, pale_patches, silhouette
 from fishgen.errors import FishgenError, UsageError, cannot
 from fishgen.species.model import Species, TexturePoints
 
@@ -503,7 +503,7 @@ def _make_texture(photo_path: str | os.PathLike, base: Species, out: str | os.Pa
         note(_misfit_said(shown[1], traced=sil.source == "alpha" or options.mask is not None,
                           fit_shape=options.fit_shape, greyscale=_greyscale(photo), lens=lens))
     elif shown is not None and sil.source == "background model" and shown[1] < ADVICE_IOU + GRAIN_MARGIN \
-            and (grainy := grain(photo)) >= GRAINY:
+            and sil.grain is not None and (grainy := sil.grain) >= GRAINY:
         note(f"silhouette IoU {shown[1]:.3f}, but the photo is grainy ({grainy:.1f} levels on its border): a "
              "fin's thin tips may be lost in the grain, from its outline and from this figure alike, and "
              "the rebuilt fish may look unlike the photographed one; give --mask to be sure")

@@ -68,6 +68,7 @@ GRAIN_FLOOR_PER_LEVEL = 5.0  # ... and this many times the grain (heavier grain,
 class Silhouette:
     mask: np.ndarray       # (H, W) bool, the fish alone
     source: str            # "alpha", "background model" or "mask file"
+    grain: float | None = None   # the photo's grain (:func:`grain`), measured for the background model
 
 
 def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None,
@@ -75,12 +76,14 @@ def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None,
     """The fish's silhouette, checked: one object, wholly inside the frame. A mask file must be
     ``mask_size`` (the original photo's, when ``photo`` is a scaled-down working copy); with
     ``mirror``, it is mirrored as ``photo`` was (:func:`.image.mirror_image`)."""
+    levels = None
     if mask_path is not None:
         raw, source = _mask_file(mask_path, mask_size or photo.size, photo.size, mirror), "mask file"
     elif photo.alpha is not None:
         raw, source = photo.alpha >= ALPHA_CUTOFF, "alpha"
     else:
-        raw, faint = background_model_masks(photo.rgb, grain(photo))
+        levels = grain(photo)
+        raw, faint = background_model_masks(photo.rgb, levels)
         source = "background model"
     fish = _one_fish(raw, photo, source)
     if source == "background model":
@@ -92,7 +95,7 @@ def silhouette(photo: Photo, mask_path: str | os.PathLike | None = None,
         # water's colour refused as several objects, to 0.35 of it by the truth), and its outline
         # stands where it was (redrawn round a faint body it already held, 2801's fits moved 0.05)
         fish = _joined_faint(fish, faint)
-    return Silhouette(fish, source)
+    return Silhouette(fish, source, levels)
 
 
 def _joined_faint(fish: np.ndarray, faint: np.ndarray) -> np.ndarray:
@@ -122,9 +125,9 @@ def background_model_masks(rgb: np.ndarray, grain_levels: float = 0.0) -> tuple[
 
 def _faint_in_grain(rgb: np.ndarray, found: np.ndarray, grain_levels: float) -> np.ndarray:
     """The :func:`_faint_body` joined to ``found`` (the fish and the faint body judged pixel by pixel)
-    in a grainy photo, judged on the photo smoothed over
-    GRAIN_SMOOTH px: down to GRAIN_SIGMAS of its border's deviations and GRAIN_FLOOR levels, or
-    GRAIN_FLOOR_PER_LEVEL times the grain where that is more.
+    in a grainy photo, judged on the photo smoothed over GRAIN_SMOOTH px: down to GRAIN_SIGMAS of its
+    border's deviations and GRAIN_FLOOR levels, or GRAIN_FLOOR_PER_LEVEL times the grain where that
+    is more.
 
     A camera's grain of 3-4 levels a channel hides a head or a back 9-14 levels off the water from the
     pixel-by-pixel judgement (4303 and 4109 in Blender, given the benchmark's camera: heads lost,
